@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Set up a fresh machine: Debian tools the tests use as oracles, then a virtual
+# environment with cospherical and its test dependencies in .venv/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+packages=()
+command -v qdelaunay >/dev/null 2>&1 || packages+=(qhull-bin)   # Qhull's merged Delaunay regions: the oracle
+if [ ${#packages[@]} -gt 0 ]; then
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${packages[@]}" >/dev/null
+fi
+
+python3 -m venv .venv
+.venv/bin/python -m pip install -q --upgrade pip
+.venv/bin/python -m pip install -q -e '.[test]'

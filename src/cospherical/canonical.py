@@ -1,0 +1,141 @@
+"""Canonical code of a polyhedron's labelled face graph.
+
+The vertex-edge graph of a convex polyhedron is planar and 3-connected, so its
+embedding (the cyclic order of neighbours around each vertex) is unique up to
+mirror image.  From a starting dart (directed edge) and an orientation, a
+breadth-first walk numbers the vertices in order of discovery and lists, for
+every vertex, its neighbours' numbers in rotation order together with the kind
+of the face on the dart's left.  That list determines the labelled map
+completely, so the smallest list over all darts and both orientations is a
+canonical form: two polyhedra share it exactly when their labelled face graphs
+are isomorphic (mirror images included).  The minimising walk's discovery order
+is the type's reference vertex order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+__all__ = ["CanonicalForm", "canonical_form", "KIND_LETTERS"]
+
+# Order matters only for which walk is smallest; letters make the code readable.
+KIND_LETTERS = {
+    "triangle": "t",
+    "rectangle": "r",
+    "quadrilateral": "q",
+    "pentagon": "p",
+    "hexagon": "h",
+    "heptagon": "s",
+    "octagon": "o",
+}
+_KIND_RANK = {kind: rank for rank, kind in enumerate(KIND_LETTERS)}
+_END = -1  # closes one vertex's neighbour list
+
+
+@dataclass(frozen=True)
+class CanonicalForm:
+    """``code``: the canonical string; ``order``: vertices in reference order."""
+
+    code: str
+    order: tuple[int, ...]
+
+
+def _kind_rank(kind: str) -> int:
+    if kind in _KIND_RANK:
+        return _KIND_RANK[kind]
+    return 100 + int(kind.split("-")[0])  # "9-gon"
+
+
+def _kind_letter(rank: int) -> str:
+    if rank < 100:
+        return list(KIND_LETTERS.values())[rank]
+    return f"g{rank - 100}"
+
+
+def canonical_form(faces: Sequence[Sequence[int]], kinds: Sequence[str]) -> CanonicalForm:
+    """Canonical code of the map given by face cycles (counter-clockwise from outside).
+
+    Examples
+    --------
+    >>> tetra = [(0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2)]
+    >>> canonical_form(tetra, ["triangle"] * 4).code
+    'v4:1t2t3t/0t3t2t/0t1t3t/0t2t1t'
+    """
+    # For a face (..., u, v, w, ...) the next neighbour of v after w, turning
+    # counter-clockwise seen from outside, is u; that face lies left of v->w.
+    turn: dict[tuple[int, int], int] = {}
+    left: dict[tuple[int, int], int] = {}
+    for face, kind in zip(faces, kinds):
+        rank = _kind_rank(kind)
+        n = len(face)
+        for i in range(n):
+            u, v, w = face[i - 1], face[i], face[(i + 1) % n]
+            turn[v, w] = u
+            left[v, w] = rank
+    mirror_turn = {(v, u): w for (v, w), u in turn.items()}
+    mirror_left = {(v, w): left[w, v] for (v, w) in left}
+
+    best: list[int] | None = None
+    best_order: list[int] = []
+    for rotation, label in ((turn, left), (mirror_turn, mirror_left)):
+        for start in sorted(turn):
+            walk = _walk(start, rotation, label, best)
+            if walk is not None:
+                best, best_order = walk
+    assert best is not None
+    return CanonicalForm(_encode(best, len(best_order)), tuple(best_order))
+
+
+def _walk(start, rotation, label, best):
+    """The walk's list from ``start``, or ``None`` as soon as it exceeds ``best``."""
+    v0, w0 = start
+    number = {v0: 0}
+    order = [v0]
+    entry = {v0: w0}
+    code: list[int] = []
+    smaller = best is None  # once smaller than best, no more comparisons
+
+    def emit(x: int) -> bool:
+        nonlocal smaller
+        position = len(code)
+        code.append(x)
+        if not smaller:
+            if x < best[position]:
+                smaller = True
+            elif x > best[position]:
+                return False
+        return True
+
+    i = 0
+    while i < len(order):
+        v = order[i]
+        first = w = entry[v]
+        while True:
+            if w not in number:
+                number[w] = len(order)
+                order.append(w)
+                entry[w] = v
+            if not (emit(number[w]) and emit(label[v, w])):
+                return None
+            w = rotation[v, w]
+            if w == first:
+                break
+        if not emit(_END):
+            return None
+        i += 1
+    if not smaller:  # equal to best: keep the first
+        return None
+    return code, order
+
+
+def _encode(code: list[int], vertices: int) -> str:
+    lists, current = [], []
+    items = iter(code)
+    for x in items:
+        if x == _END:
+            lists.append("".join(current))
+            current = []
+        else:
+            current.append(f"{x}{_kind_letter(next(items))}")
+    return f"v{vertices}:" + "/".join(lists)

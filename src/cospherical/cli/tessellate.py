@@ -1,0 +1,49 @@
+"""``cospherical tessellate``: one configuration, its elements as JSON or YAML."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..configuration import POINT_POLICIES, Configuration
+from ..exact import InputError
+from ..tessellation import tessellate
+from .output import FORMATS, emit
+
+
+def _steiner(text: str) -> tuple[str, str]:
+    edge, sep, t = text.partition(":")
+    if not sep:
+        raise argparse.ArgumentTypeError(f"Steiner point {text!r}: write EDGE:T, for example 0:1/2")
+    return edge, t
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser(
+        "tessellate",
+        help="tessellate one 1-irregular cuboid",
+        description="Tessellate one 1-irregular cuboid: Delaunay cells = largest co-spherical elements.",
+    )
+    parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), required=True,
+                        help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2)")
+    points = parser.add_mutually_exclusive_group()
+    points.add_argument("--steiner", nargs="+", type=_steiner, default=[], metavar="K:T",
+                        help="Steiner point on edge K (0..11) at parameter T in (0,1), e.g. 0:1/2")
+    points.add_argument("--code", help="12 hexadecimal digits, digit k = 16*t on edge k (0 = no point)")
+    parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree",
+                        help="octree (default): add face and body points of refined neighbours; none: edges only")
+    parser.add_argument("--format", choices=FORMATS, default="json")
+    parser.set_defaults(run=run)
+
+
+def run(args) -> int:
+    if args.code is not None:
+        configuration = Configuration.from_code(args.code, args.box, args.face_points)
+    else:
+        steiner = {}
+        for edge, t in args.steiner:
+            if edge.strip() in steiner:
+                raise InputError(f"edge {edge}: given twice")
+            steiner[edge.strip()] = t
+        configuration = Configuration.from_steiner(args.box, steiner, args.face_points)
+    emit(tessellate(configuration).to_dict(), args.format)
+    return 0

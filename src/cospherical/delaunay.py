@@ -1,0 +1,146 @@
+"""Delaunay cells: every cell is the convex hull of all points on one empty sphere.
+
+The subdivision is built exactly by walking from cell to cell across interior
+faces.  Across a face with points p, q, r, the neighbour's sphere belongs to the
+pencil of spheres through the circle pqr; on the far side of the face those
+spheres' caps are nested, so one scan for the point whose sphere contains no
+other far-side point finds it.  The neighbour is then every point on that
+sphere.  A face with no point beyond it lies on the convex hull.  All tests are
+integer determinants (:mod:`cospherical.geometry`), so co-spherical points
+always end up in one cell, whatever the box or Steiner positions.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import cmp_to_key
+from itertools import combinations
+
+from .geometry import Frame, Sphere, cross, dot, sub
+
+__all__ = ["Cell", "delaunay_cells", "hull_faces"]
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One Delaunay cell.
+
+    ``nodes`` are node ids in increasing order; ``faces`` are node-id cycles,
+    counter-clockwise seen from outside; ``center`` is the exact circumcenter in
+    unit coordinates.
+    """
+
+    nodes: tuple[int, ...]
+    faces: tuple[tuple[int, ...], ...]
+    center: tuple[Fraction, Fraction, Fraction]
+
+
+def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], tuple[int, int, int]]]:
+    """Faces of the convex hull of points in convex position (indices into the frame).
+
+    Returns ``(cycle, outward normal)`` pairs, each cycle counter-clockwise seen
+    from outside and starting at its smallest index.
+    """
+    coords = frame.coords
+    found: list[frozenset[int]] = []
+    faces = []
+    for i, j, k in combinations(members, 3):
+        if any(i in f and j in f and k in f for f in found):
+            continue
+        normal = cross(sub(coords[j], coords[i]), sub(coords[k], coords[i]))
+        if normal == (0, 0, 0):
+            continue
+        above = below = False
+        on_plane = []
+        for m in members:
+            side = dot(normal, sub(coords[m], coords[i]))
+            if side > 0:
+                above = True
+            elif side < 0:
+                below = True
+            else:
+                on_plane.append(m)
+            if above and below:
+                break
+        if above and below:
+            continue
+        if not (above or below):
+            raise ValueError("points are coplanar: no 3D hull")
+        if above:
+            normal = (-normal[0], -normal[1], -normal[2])
+        found.append(frozenset(on_plane))
+        faces.append((_counter_clockwise(coords, on_plane, normal), normal))
+    return faces
+
+
+def _counter_clockwise(coords, points: list[int], normal) -> tuple[int, ...]:
+    first = min(points)
+    origin = coords[first]
+
+    def turn(x: int, y: int) -> int:
+        # x before y when y lies counter-clockwise of x, seen from the normal's tip.
+        return -dot(normal, cross(sub(coords[x], origin), sub(coords[y], origin)))
+
+    rest = sorted((p for p in points if p != first), key=cmp_to_key(turn))
+    return (first, *rest)
+
+
+def _first_cell(frame: Frame) -> tuple[list[int], Sphere]:
+    # The lexicographically smallest point is a hull vertex, so some cell has it;
+    # try spheres through it and its nearest points first.
+    coords, lifted = frame.coords, frame.lifted
+    anchor = min(range(len(coords)), key=lambda i: coords[i])
+    others = sorted(
+        (i for i in range(len(coords)) if i != anchor),
+        key=lambda i: (frame.real_dot(sub(coords[i], coords[anchor]), sub(coords[i], coords[anchor])), i),
+    )
+    for j, k, m in combinations(others, 3):
+        sphere = frame.sphere(anchor, j, k, m)
+        if sphere is None:
+            continue
+        sides = [sphere.side(p) for p in lifted]
+        if min(sides) == 0:
+            return [i for i, side in enumerate(sides) if side == 0], sphere
+    raise ValueError("no empty sphere: the points do not span 3D")
+
+
+def delaunay_cells(frame: Frame) -> list[Cell]:
+    """The Delaunay subdivision of the frame's points, cells sorted by node ids."""
+    coords, lifted = frame.coords, frame.lifted
+    members, sphere = _first_cell(frame)
+    seen = {frozenset(members)}
+    queue = deque([(members, sphere)])
+    crossed: set[frozenset[int]] = set()
+    cells = []
+    while queue:
+        members, sphere = queue.popleft()
+        faces = hull_faces(frame, members)
+        cells.append(
+            Cell(
+                nodes=tuple(frame.ids[i] for i in members),
+                faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle, _ in faces),
+                center=frame.center(sphere),
+            )
+        )
+        for cycle, normal in faces:
+            key = frozenset(cycle)
+            if key in crossed:
+                continue
+            crossed.add(key)
+            origin = coords[cycle[0]]
+            beyond = [m for m in range(len(coords)) if dot(normal, sub(coords[m], origin)) > 0]
+            if not beyond:
+                continue
+            i, j, k = cycle[:3]
+            best = frame.sphere(i, j, k, beyond[0])
+            for y in beyond[1:]:
+                if best.side(lifted[y]) < 0:
+                    best = frame.sphere(i, j, k, y)
+            neighbour = [m for m in range(len(coords)) if best.side(lifted[m]) == 0]
+            if frozenset(neighbour) not in seen:
+                seen.add(frozenset(neighbour))
+                queue.append((neighbour, best))
+    cells.sort(key=lambda cell: cell.nodes)
+    return cells

@@ -1,0 +1,159 @@
+"""Element types: canonical code, short stable id, standard name, reference node order."""
+
+from __future__ import annotations
+
+import hashlib
+from collections import Counter
+from dataclasses import dataclass
+
+from .canonical import canonical_form
+from .polyhedron import Polyhedron
+
+__all__ = ["ElementType", "classify", "element_type"]
+
+_POLYGON_ADJECTIVE = {3: "triangular", 4: "quadrilateral", 5: "pentagonal", 6: "hexagonal", 7: "heptagonal", 8: "octagonal"}
+_KIND_PLURAL = {
+    "triangle": "triangles",
+    "rectangle": "rectangles",
+    "quadrilateral": "quadrilaterals",
+    "pentagon": "pentagons",
+    "hexagon": "hexagons",
+    "heptagon": "heptagons",
+    "octagon": "octagons",
+}
+
+
+@dataclass(frozen=True)
+class ElementType:
+    """One element type: polyhedra whose labelled face graphs are isomorphic.
+
+    ``face_kinds`` counts faces per kind, e.g. ``(("rectangle", 1), ("triangle", 4))``.
+    ``vtk`` names the VTK cell type when the type has one (its nodes then follow
+    VTK order), else ``None``.
+    """
+
+    code: str
+    id: str
+    name: str
+    vertices: int
+    edges: int
+    faces: int
+    face_kinds: tuple[tuple[str, int], ...]
+    vtk: str | None
+
+    @property
+    def face_summary(self) -> str:
+        """``4 triangles + 1 rectangle``."""
+        parts = []
+        for kind, count in sorted(self.face_kinds, key=lambda kc: (-kc[1], kc[0])):
+            parts.append(f"{count} {kind if count == 1 else _KIND_PLURAL.get(kind, kind + 's')}")
+        return " + ".join(parts)
+
+
+def type_id(code: str, vertices: int, faces: int) -> str:
+    """Short stable id: size plus the first hex digits of the code's SHA-256."""
+    return f"v{vertices}f{faces}-{hashlib.sha256(code.encode()).hexdigest()[:6]}"
+
+
+def _adjacency(faces) -> dict[int, set[int]]:
+    adjacent: dict[int, set[int]] = {}
+    for face in faces:
+        for i, v in enumerate(face):
+            w = face[(i + 1) % len(face)]
+            adjacent.setdefault(v, set()).add(w)
+            adjacent.setdefault(w, set()).add(v)
+    return adjacent
+
+
+def _is_bipyramid(faces, kinds) -> bool:
+    if any(kind != "triangle" for kind in kinds):
+        return False
+    adjacent = _adjacency(faces)
+    ring = len(adjacent) - 2
+    apexes = [v for v, ws in adjacent.items() if len(ws) == ring]
+    return ring >= 3 and any(
+        u not in adjacent[v] and len(adjacent[u] | adjacent[v]) == ring
+        for i, u in enumerate(apexes)
+        for v in apexes[i + 1 :]
+    )
+
+
+def _standard(faces, kinds) -> tuple[str | None, str | None]:
+    """(name, VTK cell type) where the face structure has a standard one."""
+    counts = Counter(kinds)
+    vertices = len({v for f in faces for v in f})
+    polygons = [kind for kind in kinds if kind != "triangle"]
+    if vertices == 4:
+        return "tetrahedron", "tetra"
+    if len(polygons) == 1 and len(faces) == vertices:
+        base = next(face for face, kind in zip(faces, kinds) if kind != "triangle")
+        if len(base) == 4:
+            return f"{'rectangular' if polygons[0] == 'rectangle' else 'quadrilateral'} pyramid", "pyramid"
+        return f"{_POLYGON_ADJECTIVE.get(len(base), f'{len(base)}-gonal')} pyramid", None
+    if vertices == 6 and counts["triangle"] == 2 and len(faces) == 5:
+        return ("triangular prism" if counts["rectangle"] == 3 else None), "wedge"
+    if vertices == 8 and len(faces) == 6 and all(len(face) == 4 for face in faces):
+        return ("cuboid" if counts["rectangle"] == 6 else None), "hexahedron"
+    if _is_bipyramid(faces, kinds):
+        return f"{_POLYGON_ADJECTIVE.get(vertices - 2, f'{vertices - 2}-gonal')} bipyramid", None
+    return None, None
+
+
+_TYPES: dict[str, ElementType] = {}
+
+
+def element_type(code: str, faces, kinds) -> ElementType:
+    """The element type of a canonical code (faces and kinds of any member); one object per code."""
+    if code not in _TYPES:
+        _TYPES[code] = _new_type(code, faces, kinds)
+    return _TYPES[code]
+
+
+def _new_type(code: str, faces, kinds) -> ElementType:
+    counts = Counter(kinds)
+    vertices = len({v for f in faces for v in f})
+    edges = sum(len(f) for f in faces) // 2
+    name, vtk = _standard(faces, kinds)
+    summary = ElementType(code, "", "", vertices, edges, len(faces), tuple(sorted(counts.items())), vtk)
+    if name is None:
+        name = f"{vertices}-vertex polyhedron ({summary.face_summary})"
+    return ElementType(code, type_id(code, vertices, len(faces)), name, vertices, edges, len(faces), summary.face_kinds, vtk)
+
+
+def _vtk_order(vtk: str, faces, kinds, order: tuple[int, ...]) -> tuple[int, ...]:
+    """Nodes in VTK order: the first face's right-hand normal points into the cell."""
+    rank = {v: i for i, v in enumerate(order)}
+    adjacent = _adjacency(faces)
+
+    def inward(face) -> list[int]:
+        # Faces run counter-clockwise from outside; reversed, their normal points inward.
+        cycle = list(reversed(face))
+        start = min(range(len(cycle)), key=lambda i: rank[cycle[i]])
+        return cycle[start:] + cycle[:start]
+
+    def opposite(bottom: list[int]) -> list[int]:
+        return [next(w for w in adjacent[v] if w not in bottom) for v in bottom]
+
+    if vtk == "tetra":
+        apex = order[3]
+        return (*inward(next(f for f in faces if apex not in f)), apex)
+    if vtk == "pyramid":
+        base = next(face for face, kind in zip(faces, kinds) if kind != "triangle")
+        return (*inward(base), next(v for v in order if v not in base))
+    if vtk == "wedge":
+        bottom = inward(next(f for f in faces if len(f) == 3 and order[0] in f))
+        return (*bottom, *opposite(bottom))
+    # hexahedron: the face on the far side of the reference order's first edge
+    first_edge = (order[1], order[0])
+    bottom_face = next(f for f in faces if any((f[i], f[(i + 1) % 4]) == first_edge for i in range(4)))
+    bottom = inward(bottom_face)
+    return (*bottom, *opposite(bottom))
+
+
+def classify(poly: Polyhedron) -> tuple[ElementType, tuple[int, ...]]:
+    """The element type of a polyhedron and its nodes in the type's reference order."""
+    form = canonical_form(poly.faces, poly.face_kinds)
+    etype = element_type(form.code, poly.faces, poly.face_kinds)
+    if etype.vtk is None:
+        return etype, form.order
+    return etype, _vtk_order(etype.vtk, poly.faces, poly.face_kinds, form.order)

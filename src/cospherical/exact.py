@@ -1,0 +1,134 @@
+"""Exact numbers for box lengths and Steiner parameters.
+
+Box lengths are square roots of positive rationals, which covers integers,
+decimals (``1.4142`` is the rational 7071/5000), fractions and ``sqrt(2)``.
+Only squared lengths ever enter a predicate (see :mod:`cospherical.geometry`),
+so every decision stays in rational arithmetic.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from fractions import Fraction
+
+__all__ = ["InputError", "Length", "parse_rational", "rational_text"]
+
+
+class InputError(ValueError):
+    """A value given by the user cannot be used; the message names it."""
+
+
+_SQRT = re.compile(r"^(?:(?P<factor>[^*]+)\*)?sqrt\((?P<radicand>[^()]+)\)$")
+
+
+def parse_rational(text: str | int | Fraction, what: str = "number") -> Fraction:
+    """Parse an integer, decimal or fraction exactly.
+
+    Examples
+    --------
+    >>> parse_rational("1.4142")
+    Fraction(7071, 5000)
+    >>> parse_rational("3/2")
+    Fraction(3, 2)
+    """
+    if isinstance(text, (int, Fraction)) and not isinstance(text, bool):
+        return Fraction(text)
+    if isinstance(text, float):
+        raise InputError(f"{what} {text!r}: give an exact value (a string such as '0.5' or '1/3'), not a float")
+    if not isinstance(text, str):
+        raise InputError(f"{what} {text!r}: not a number")
+    cleaned = text.strip().replace(" ", "")
+    try:
+        value = Fraction(cleaned)
+    except (ValueError, ZeroDivisionError):
+        raise InputError(f"{what} {text!r}: not an integer, decimal or fraction") from None
+    return value
+
+
+def rational_text(value: Fraction) -> str:
+    """Shortest exact text of a rational: ``1``, ``1.4142`` or ``1/3``.
+
+    >>> rational_text(Fraction(7071, 5000)), rational_text(Fraction(1, 3))
+    ('1.4142', '1/3')
+    """
+    if value.denominator == 1:
+        return str(value.numerator)
+    den = value.denominator
+    twos = fives = 0
+    while den % 2 == 0:
+        den //= 2
+        twos += 1
+    while den % 5 == 0:
+        den //= 5
+        fives += 1
+    if den == 1:  # a finite decimal
+        digits = max(twos, fives)
+        scaled = value * 10**digits
+        sign = "-" if scaled < 0 else ""
+        whole, frac = divmod(abs(scaled.numerator), 10**digits)
+        return f"{sign}{whole}.{frac:0{digits}d}"
+    return f"{value.numerator}/{value.denominator}"
+
+
+def _exact_sqrt(value: Fraction) -> Fraction | None:
+    num, den = math.isqrt(value.numerator), math.isqrt(value.denominator)
+    if num * num == value.numerator and den * den == value.denominator:
+        return Fraction(num, den)
+    return None
+
+
+@dataclass(frozen=True, order=True)
+class Length:
+    """A positive length known exactly through its square.
+
+    Examples
+    --------
+    >>> Length.parse("sqrt(2)").squared
+    Fraction(2, 1)
+    >>> Length.parse("1.4142").text
+    '1.4142'
+    >>> Length.parse("2*sqrt(2)").text
+    'sqrt(8)'
+    """
+
+    squared: Fraction
+
+    def __post_init__(self) -> None:
+        if self.squared <= 0:
+            raise InputError(f"squared box length {self.squared}: must be > 0")
+
+    @classmethod
+    def parse(cls, text: str | int | Fraction, what: str = "box length") -> "Length":
+        if isinstance(text, Length):
+            return text
+        if isinstance(text, str):
+            cleaned = text.strip().replace(" ", "").lower()
+            match = _SQRT.match(cleaned)
+            if match:
+                radicand = parse_rational(match["radicand"], what)
+                factor = parse_rational(match["factor"], what) if match["factor"] else Fraction(1)
+                if radicand <= 0 or factor <= 0:
+                    raise InputError(f"{what} {text!r}: must be > 0")
+                return cls(factor * factor * radicand)
+        value = parse_rational(text, what)
+        if value <= 0:
+            raise InputError(f"{what} {text!r}: must be > 0")
+        return cls(value * value)
+
+    @property
+    def text(self) -> str:
+        root = _exact_sqrt(self.squared)
+        if root is not None:
+            return rational_text(root)
+        return f"sqrt({rational_text(self.squared)})"
+
+    def __float__(self) -> float:
+        root = _exact_sqrt(self.squared)
+        if root is not None:
+            return float(root)
+        return math.sqrt(self.squared.numerator / self.squared.denominator)
+
+    def __str__(self) -> str:
+        return self.text

@@ -1,0 +1,107 @@
+"""Exact predicates on an integer frame.
+
+A point (s*a, t*b, u*c) of the box is stored as integers (S, T, U) = D*(s, t, u)
+with D the common denominator of all unit coordinates, and the squared box
+lengths as integer weights (wa, wb, wc) proportional to (a^2, b^2, c^2).
+The map (S, T, U) -> real point is a positive diagonal scaling, so planes,
+orientations, convexity and volume ratios are the same in both frames.
+Distances are not; they enter only through the lifted coordinate
+L = wa*S^2 + wb*T^2 + wc*U^2, which is a positive multiple of |x|^2.  A sphere
+through real points is a hyperplane through their lifted images, so
+co-sphericity and in-sphere tests are integer determinants.  Every decision in
+the project (coplanar, co-spherical, inside, right angle) is made here, with
+Python integers: no tolerance anywhere.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Mapping, Sequence
+
+__all__ = ["Frame", "Sphere", "cross", "dot", "sub"]
+
+Vector = tuple[int, int, int]
+
+
+def sub(p: Sequence[int], q: Sequence[int]) -> tuple[int, ...]:
+    return tuple(x - y for x, y in zip(p, q))
+
+
+def dot(p: Sequence[int], q: Sequence[int]) -> int:
+    return sum(x * y for x, y in zip(p, q))
+
+
+def cross(p: Sequence[int], q: Sequence[int]) -> Vector:
+    return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
+
+
+def _det3(r0, r1, r2) -> int:
+    return dot(r0, cross(r1, r2))
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """The sphere through four lifted points, as the hyperplane ``normal . (x - base) = 0``.
+
+    ``normal[3] > 0`` always, so ``side(x) < 0`` exactly when x is strictly inside.
+    """
+
+    base: tuple[int, int, int, int]
+    normal: tuple[int, int, int, int]
+
+    def side(self, lifted_point: Sequence[int]) -> int:
+        """Negative inside, zero on the sphere, positive outside (scaled, exact)."""
+        return dot(self.normal, sub(lifted_point, self.base))
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Integer coordinates of a point set in a box, with exact predicates."""
+
+    ids: tuple[int, ...]
+    coords: tuple[Vector, ...]
+    lifted: tuple[tuple[int, int, int, int], ...]
+    scale: int
+    weights: Vector
+
+    @classmethod
+    def build(cls, unit_points: Mapping[int, Sequence[Fraction]], squared_lengths: Sequence[Fraction]) -> "Frame":
+        """Frame for ``{node id: unit coordinates}`` in a box with the given squared lengths."""
+        ids = tuple(sorted(unit_points))
+        scale = math.lcm(*(Fraction(x).denominator for i in ids for x in unit_points[i]))
+        weight_den = math.lcm(*(Fraction(w).denominator for w in squared_lengths))
+        weights = tuple(int(Fraction(w) * weight_den) for w in squared_lengths)
+        coords = tuple(tuple(int(Fraction(x) * scale) for x in unit_points[i]) for i in ids)
+        lifted = tuple((*p, weights[0] * p[0] ** 2 + weights[1] * p[1] ** 2 + weights[2] * p[2] ** 2) for p in coords)
+        return cls(ids, coords, lifted, scale, weights)
+
+    def orient(self, i: int, j: int, k: int, m: int) -> int:
+        """Sign-bearing 6x volume of (i, j, k, m), indices into ``coords``; > 0 when right-handed."""
+        p = self.coords[i]
+        return _det3(sub(self.coords[j], p), sub(self.coords[k], p), sub(self.coords[m], p))
+
+    def sphere(self, i: int, j: int, k: int, m: int) -> Sphere | None:
+        """The sphere through four points, or ``None`` if they are coplanar."""
+        base = self.lifted[i]
+        rows = [sub(self.lifted[x], base) for x in (j, k, m)]
+        # Cofactors of a 4x4 determinant along its last row: normal . v = det(rows + [v]).
+        minors = [
+            _det3(*[tuple(r[c] for c in range(4) if c != skip) for r in rows]) for skip in range(4)
+        ]
+        normal = (-minors[0], minors[1], -minors[2], minors[3])
+        if normal[3] == 0:
+            return None
+        if normal[3] < 0:
+            normal = tuple(-x for x in normal)
+        return Sphere(base, normal)
+
+    def center(self, sphere: Sphere) -> tuple[Fraction, Fraction, Fraction]:
+        """Exact unit coordinates of a sphere's center."""
+        n = sphere.normal
+        return tuple(Fraction(-n[axis], 2 * self.weights[axis] * n[3] * self.scale) for axis in range(3))
+
+    def real_dot(self, u: Sequence[int], v: Sequence[int]) -> int:
+        """A positive multiple of the real dot product of two frame vectors."""
+        return sum(w * x * y for w, x, y in zip(self.weights, u, v))

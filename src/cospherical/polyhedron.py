@@ -1,0 +1,80 @@
+"""Polyhedra: a Delaunay cell with its face kinds, edges, volume and circumcenter."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+from .delaunay import Cell
+from .geometry import Frame, cross, dot, sub
+
+__all__ = ["FACE_KINDS", "Polyhedron", "face_kind", "polyhedron"]
+
+# Face labels of the canonical code; a four-gon is a rectangle only with four
+# exact right angles, otherwise a quadrilateral.
+FACE_KINDS = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon", 7: "heptagon", 8: "octagon"}
+
+
+def face_kind(frame: Frame, cycle: tuple[int, ...]) -> str:
+    """``triangle``, ``rectangle``, ``quadrilateral``, ``pentagon``, ... (frame indices)."""
+    n = len(cycle)
+    if n == 4:
+        pts = [frame.coords[i] for i in cycle]
+        edges = [sub(pts[(i + 1) % 4], pts[i]) for i in range(4)]
+        if all(frame.real_dot(edges[i], edges[(i + 1) % 4]) == 0 for i in range(4)):
+            return "rectangle"
+    return FACE_KINDS.get(n, f"{n}-gon")
+
+
+@dataclass(frozen=True)
+class Polyhedron:
+    """A convex polyhedron of the tessellation, exact.
+
+    ``faces`` are node-id cycles counter-clockwise seen from outside, with
+    ``face_kinds`` in the same order; ``unit_volume`` is the fraction of the box
+    volume; ``center`` the circumcenter in exact unit coordinates.
+    """
+
+    nodes: tuple[int, ...]
+    faces: tuple[tuple[int, ...], ...]
+    face_kinds: tuple[str, ...]
+    unit_volume: Fraction
+    center: tuple[Fraction, Fraction, Fraction]
+
+    @property
+    def edges(self) -> tuple[tuple[int, int], ...]:
+        pairs = {tuple(sorted((f[i], f[(i + 1) % len(f)]))) for f in self.faces for i in range(len(f))}
+        return tuple(sorted(pairs))
+
+    @property
+    def counts(self) -> tuple[int, int, int]:
+        """(vertices, edges, faces)."""
+        return len(self.nodes), len(self.edges), len(self.faces)
+
+    def center_in_box(self, closed: bool = True) -> bool:
+        """Whether the circumcenter lies in the closed (or open) box, decided exactly."""
+        if closed:
+            return all(0 <= x <= 1 for x in self.center)
+        return all(0 < x < 1 for x in self.center)
+
+
+def polyhedron(frame: Frame, cell: Cell) -> Polyhedron:
+    """Classify the faces of a cell and measure it exactly."""
+    index = {node: i for i, node in enumerate(frame.ids)}
+    cycles = [tuple(index[n] for n in face) for face in cell.faces]
+    apex = frame.coords[cycles[0][0]]
+    six_volume = 0
+    for cycle in cycles:
+        p = sub(frame.coords[cycle[0]], apex)
+        for a, b in zip(cycle[1:-1], cycle[2:]):
+            six_volume += dot(p, cross(sub(frame.coords[a], apex), sub(frame.coords[b], apex)))
+    # Faces run counter-clockwise from outside, so every fan tetrahedron from a
+    # vertex of the cell is right-handed (or flat): the sum is 6 V in the frame.
+    unit_volume = Fraction(six_volume, 6 * frame.scale**3)
+    return Polyhedron(
+        nodes=cell.nodes,
+        faces=cell.faces,
+        face_kinds=tuple(face_kind(frame, cycle) for cycle in cycles),
+        unit_volume=unit_volume,
+        center=cell.center,
+    )
