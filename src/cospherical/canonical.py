@@ -15,6 +15,7 @@ is the type's reference vertex order.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Sequence
 
 __all__ = ["CanonicalForm", "canonical_form", "KIND_LETTERS"]
@@ -62,6 +63,13 @@ def canonical_form(faces: Sequence[Sequence[int]], kinds: Sequence[str]) -> Cano
     >>> canonical_form(tetra, ["triangle"] * 4).code
     'v4:1t2t3t/0t3t2t/0t1t3t/0t2t1t'
     """
+    return _canonical_form(tuple(map(tuple, faces)), tuple(kinds))
+
+
+# The same cell (same node ids, same faces) recurs across the configurations of
+# a study, so the pure function is memoised on its exact input.
+@lru_cache(maxsize=1 << 16)
+def _canonical_form(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]) -> CanonicalForm:
     # For a face (..., u, v, w, ...) the next neighbour of v after w, turning
     # counter-clockwise seen from outside, is u; that face lies left of v->w.
     turn: dict[tuple[int, int], int] = {}
@@ -76,56 +84,53 @@ def canonical_form(faces: Sequence[Sequence[int]], kinds: Sequence[str]) -> Cano
     mirror_turn = {(v, u): w for (v, w), u in turn.items()}
     mirror_left = {(v, w): left[w, v] for (v, w) in left}
 
+    # A walk's list opens with the first vertex's neighbours 1..d and their face
+    # labels, then the end mark; only darts with the smallest such opening can
+    # give the smallest list, so only they are walked.
+    candidates = []
+    for rotation, label in ((turn, left), (mirror_turn, mirror_left)):
+        for start in turn:
+            v, w = start
+            opening = []
+            while True:
+                opening.append(label[v, w])
+                w = rotation[v, w]
+                if w == start[1]:
+                    break
+            candidates.append((len(opening), opening, start, rotation, label))
+    smallest = min(candidates, key=lambda c: c[:2])[:2]
     best: list[int] | None = None
     best_order: list[int] = []
-    for rotation, label in ((turn, left), (mirror_turn, mirror_left)):
-        for start in sorted(turn):
-            walk = _walk(start, rotation, label, best)
-            if walk is not None:
-                best, best_order = walk
+    for size, opening, start, rotation, label in candidates:
+        if (size, opening) != smallest:
+            continue
+        code, order = _walk(start, rotation, label)
+        if best is None or code < best:
+            best, best_order = code, order
     assert best is not None
     return CanonicalForm(_encode(best, len(best_order)), tuple(best_order))
 
 
-def _walk(start, rotation, label, best):
-    """The walk's list from ``start``, or ``None`` as soon as it exceeds ``best``."""
+def _walk(start, rotation, label) -> tuple[list[int], list[int]]:
+    """The walk's list from the dart ``start``, and the vertices in discovery order."""
     v0, w0 = start
     number = {v0: 0}
     order = [v0]
     entry = {v0: w0}
     code: list[int] = []
-    smaller = best is None  # once smaller than best, no more comparisons
-
-    def emit(x: int) -> bool:
-        nonlocal smaller
-        position = len(code)
-        code.append(x)
-        if not smaller:
-            if x < best[position]:
-                smaller = True
-            elif x > best[position]:
-                return False
-        return True
-
-    i = 0
-    while i < len(order):
-        v = order[i]
+    for v in order:  # grows while we walk
         first = w = entry[v]
         while True:
             if w not in number:
                 number[w] = len(order)
                 order.append(w)
                 entry[w] = v
-            if not (emit(number[w]) and emit(label[v, w])):
-                return None
+            code.append(number[w])
+            code.append(label[v, w])
             w = rotation[v, w]
             if w == first:
                 break
-        if not emit(_END):
-            return None
-        i += 1
-    if not smaller:  # equal to best: keep the first
-        return None
+        code.append(_END)
     return code, order
 
 

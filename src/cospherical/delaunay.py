@@ -52,10 +52,13 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
         normal = cross(sub(coords[j], coords[i]), sub(coords[k], coords[i]))
         if normal == (0, 0, 0):
             continue
+        nx, ny, nz = normal
+        offset = nx * coords[i][0] + ny * coords[i][1] + nz * coords[i][2]
         above = below = False
         on_plane = []
         for m in members:
-            side = dot(normal, sub(coords[m], coords[i]))
+            x, y, z = coords[m]
+            side = nx * x + ny * y + nz * z - offset
             if side > 0:
                 above = True
             elif side < 0:
@@ -69,7 +72,7 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
         if not (above or below):
             raise ValueError("points are coplanar: no 3D hull")
         if above:
-            normal = (-normal[0], -normal[1], -normal[2])
+            normal = (-nx, -ny, -nz)
         found.append(frozenset(on_plane))
         faces.append((_counter_clockwise(coords, on_plane, normal), normal))
     return faces
@@ -129,8 +132,9 @@ def delaunay_cells(frame: Frame) -> list[Cell]:
             if key in crossed:
                 continue
             crossed.add(key)
-            origin = coords[cycle[0]]
-            beyond = [m for m in range(len(coords)) if dot(normal, sub(coords[m], origin)) > 0]
+            nx, ny, nz = normal
+            offset = dot(normal, coords[cycle[0]])
+            beyond = [m for m, (x, y, z) in enumerate(coords) if nx * x + ny * y + nz * z > offset]
             if not beyond:
                 continue
             i, j, k = cycle[:3]
@@ -138,7 +142,7 @@ def delaunay_cells(frame: Frame) -> list[Cell]:
             for y in beyond[1:]:
                 if best.side(lifted[y]) < 0:
                     best = frame.sphere(i, j, k, y)
-            neighbour = [m for m in range(len(coords)) if best.side(lifted[m]) == 0]
+            neighbour = [m for m, point in enumerate(lifted) if best.side(point) == 0]
             if frozenset(neighbour) not in seen:
                 seen.add(frozenset(neighbour))
                 queue.append((neighbour, best))

@@ -43,17 +43,19 @@ def _det3(r0, r1, r2) -> int:
 
 @dataclass(frozen=True)
 class Sphere:
-    """The sphere through four lifted points, as the hyperplane ``normal . (x - base) = 0``.
+    """The sphere through four lifted points, as the hyperplane ``normal . x = offset``.
 
     ``normal[3] > 0`` always, so ``side(x) < 0`` exactly when x is strictly inside.
     """
 
-    base: tuple[int, int, int, int]
     normal: tuple[int, int, int, int]
+    offset: int
 
     def side(self, lifted_point: Sequence[int]) -> int:
         """Negative inside, zero on the sphere, positive outside (scaled, exact)."""
-        return dot(self.normal, sub(lifted_point, self.base))
+        a, b, c, d = self.normal
+        x, y, z, w = lifted_point
+        return a * x + b * y + c * z + d * w - self.offset
 
 
 @dataclass(frozen=True)
@@ -95,7 +97,7 @@ class Frame:
             return None
         if normal[3] < 0:
             normal = tuple(-x for x in normal)
-        return Sphere(base, normal)
+        return Sphere(normal, dot(normal, base))
 
     def center(self, sphere: Sphere) -> tuple[Fraction, Fraction, Fraction]:
         """Exact unit coordinates of a sphere's center."""
