@@ -120,34 +120,33 @@ def _new_type(code: str, faces, kinds) -> ElementType:
     return ElementType(code, type_id(code, vertices, len(faces)), name, vertices, edges, len(faces), summary.face_kinds, vtk)
 
 
-def _vtk_order(vtk: str, faces, kinds, order: tuple[int, ...]) -> tuple[int, ...]:
-    """Nodes in VTK order: the first face's right-hand normal points into the cell."""
-    rank = {v: i for i, v in enumerate(order)}
+def _vtk_order(vtk: str, faces, kinds) -> tuple[int, ...]:
+    """Nodes in VTK order (the first face's right-hand normal points into the cell).
+
+    Of the orderings VTK allows, the smallest tuple of node ids is taken, so a
+    plain box lists its corners as 0..7.
+    """
     adjacent = _adjacency(faces)
 
-    def inward(face) -> list[int]:
-        # Faces run counter-clockwise from outside; reversed, their normal points inward.
-        cycle = list(reversed(face))
-        start = min(range(len(cycle)), key=lambda i: rank[cycle[i]])
-        return cycle[start:] + cycle[:start]
+    def orderings(face, top):
+        cycle = list(reversed(face))  # counter-clockwise from outside, reversed: normal inward
+        for i in range(len(cycle)):
+            bottom = cycle[i:] + cycle[:i]
+            yield (*bottom, *top(bottom))
 
-    def opposite(bottom: list[int]) -> list[int]:
+    def opposite(bottom):
         return [next(w for w in adjacent[v] if w not in bottom) for v in bottom]
 
     if vtk == "tetra":
-        apex = order[3]
-        return (*inward(next(f for f in faces if apex not in f)), apex)
-    if vtk == "pyramid":
+        candidates = (o for f in faces for o in orderings(f, lambda b: [v for v in adjacent if v not in b]))
+    elif vtk == "pyramid":
         base = next(face for face, kind in zip(faces, kinds) if kind != "triangle")
-        return (*inward(base), next(v for v in order if v not in base))
-    if vtk == "wedge":
-        bottom = inward(next(f for f in faces if len(f) == 3 and order[0] in f))
-        return (*bottom, *opposite(bottom))
-    # hexahedron: the face on the far side of the reference order's first edge
-    first_edge = (order[1], order[0])
-    bottom_face = next(f for f in faces if any((f[i], f[(i + 1) % 4]) == first_edge for i in range(4)))
-    bottom = inward(bottom_face)
-    return (*bottom, *opposite(bottom))
+        candidates = orderings(base, lambda b: [v for v in adjacent if v not in b])
+    elif vtk == "wedge":
+        candidates = (o for f in faces if len(f) == 3 for o in orderings(f, opposite))
+    else:  # hexahedron
+        candidates = (o for f in faces for o in orderings(f, opposite))
+    return min(candidates)
 
 
 def classify(poly: Polyhedron) -> tuple[ElementType, tuple[int, ...]]:
@@ -156,4 +155,4 @@ def classify(poly: Polyhedron) -> tuple[ElementType, tuple[int, ...]]:
     etype = element_type(form.code, poly.faces, poly.face_kinds)
     if etype.vtk is None:
         return etype, form.order
-    return etype, _vtk_order(etype.vtk, poly.faces, poly.face_kinds, form.order)
+    return etype, _vtk_order(etype.vtk, poly.faces, poly.face_kinds)

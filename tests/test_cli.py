@@ -1,0 +1,67 @@
+"""The command line, run as a user runs it (a real subprocess)."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+import yaml
+
+
+def cospherical(*args):
+    return subprocess.run([sys.executable, "-m", "cospherical", *args], capture_output=True, text=True)
+
+
+def test_tessellate_json_contract():
+    result = cospherical("tessellate", "--box", "1", "1", "1", "--code", "800000000000")
+    assert result.returncode == 0, result.stderr
+    data = json.loads(result.stdout)
+    assert data["box"] == ["1", "1", "1"] and data["code"] == "800000000000"
+    assert data["nodes"]["8"] == [0.5, 0.0, 0.0]
+    assert set(data["nodes"]) == {str(i) for i in range(9)}
+    assert len(data["elements"]) == 4
+    for element in data["elements"]:
+        assert {"type", "name", "nodes", "vertices", "edges", "faces", "circumcenter"} <= set(element)
+        assert element["name"] == "rectangular pyramid" and len(element["nodes"]) == 5
+        assert (element["vertices"], element["edges"], element["faces"]) == (5, 8, 5)
+    assert data["fvm_adequate"] is True
+
+
+def test_tessellate_steiner_and_yaml_agree_with_code():
+    by_code = json.loads(cospherical("tessellate", "--box", "1", "sqrt(2)", "1.4142", "--code", "800080000008").stdout)
+    result = cospherical("tessellate", "--box", "1", "sqrt(2)", "1.4142", "--steiner", "0:1/2", "4:0.5", "11:8/16",
+                         "--format", "yaml")
+    assert result.returncode == 0, result.stderr
+    assert yaml.safe_load(result.stdout) == by_code
+
+
+def test_output_is_deterministic():
+    args = ("tessellate", "--box", "1", "2", "4", "--code", "88808a000c01", "--face-points", "none")
+    assert cospherical(*args).stdout == cospherical(*args).stdout
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["tessellate", "--box", "1", "1", "1", "--code", "80000000000"], "configuration code"),
+        (["tessellate", "--box", "1", "0", "1"], "box length '0'"),
+        (["tessellate", "--box", "1", "nan", "1"], "box length 'nan'"),
+        (["tessellate", "--box", "1", "1", "1", "--steiner", "0:3/2"], "edge 0"),
+        (["tessellate", "--box", "1", "1", "1", "--steiner", "12:1/2"], "edge '12'"),
+        (["tessellate", "--box", "1", "1", "1", "--steiner", "0"], "EDGE:T"),
+        (["tessellate", "--box", "1", "1", "1", "--steiner", "0:1/2", "0:1/3"], "given twice"),
+        (["tessellate", "--box", "1", "1"], "--box"),
+        (["tessellate", "--box", "1", "1", "1", "--face-points", "all"], "face-points"),
+        (["tessellate", "--box", "1", "1", "1", "--code", "800000000000", "--steiner", "0:1/2"], "not allowed"),
+        (["tessellate"], "--box"),
+        (["frobnicate"], "frobnicate"),
+        ([], "command"),
+    ],
+)
+def test_usage_errors_are_one_line_exit_2(args, needle):
+    result = cospherical(*args)
+    assert result.returncode == 2
+    assert result.stdout == ""
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert needle in lines[0] and "Traceback" not in result.stderr

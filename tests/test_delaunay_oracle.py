@@ -1,0 +1,82 @@
+"""Our cells against Qhull's merged Delaunay regions, and canonical codes against networkx."""
+
+from __future__ import annotations
+
+import random
+from collections import defaultdict
+
+import pytest
+
+from cospherical import Configuration, tessellate
+from cospherical.canonical import canonical_form
+from oracle import isomorphic, qhull_regions
+from strategies import random_configuration
+
+BOXES = {
+    "cube": ("1", "1", "1"),
+    "aspect4": ("1", "2", "4"),
+    "sqrt2-rounded": ("1", "1.4142", "1.4142"),
+    "sqrt2-exact": ("1", "sqrt(2)", "sqrt(2)"),
+}
+
+
+def bisection_codes():
+    for mask in range(4096):
+        yield "".join("8" if mask >> k & 1 else "0" for k in range(12))
+
+
+def check_canonical_codes(samples: dict[str, list]) -> None:
+    """Same code <=> isomorphic labelled face graphs (networkx), over every type met."""
+    for code, polys in samples.items():
+        for other in polys[1:]:
+            assert isomorphic(polys[0], other), f"same code {code} but not isomorphic"
+    codes = sorted(samples)
+    for i, a in enumerate(codes):
+        for b in codes[i + 1 :]:
+            pa, pb = samples[a][0], samples[b][0]
+            if len(pa[0]) == len(pb[0]) and sorted(pa[1]) == sorted(pb[1]):
+                assert not isomorphic(pa, pb), f"codes {a} and {b} differ but graphs are isomorphic"
+
+
+@pytest.mark.parametrize("policy", ["octree", "none"])
+@pytest.mark.parametrize("box", sorted(BOXES))
+def test_every_bisection_configuration_matches_qhull(box, policy):
+    samples: dict[str, list] = defaultdict(list)
+    for code in bisection_codes():
+        cfg = Configuration.from_code(code, BOXES[box], policy)
+        tess = tessellate(cfg)
+        ours = {frozenset(e.nodes) for e in tess.elements}
+        assert ours == qhull_regions(cfg.real_nodes()), f"{box} {policy} {code}"
+        for e in tess.elements:
+            poly = e.polyhedron
+            if len(samples[e.type.code]) < 3:
+                samples[e.type.code].append((poly.faces, poly.face_kinds))
+    check_canonical_codes(samples)
+
+
+def test_random_configurations_match_qhull():
+    rng = random.Random(20261123)
+    samples: dict[str, list] = defaultdict(list)
+    for _ in range(600):
+        cfg = random_configuration(rng)
+        tess = tessellate(cfg)
+        ours = {frozenset(e.nodes) for e in tess.elements}
+        assert ours == qhull_regions(cfg.real_nodes()), (cfg.box.texts, cfg.steiner, cfg.face_points)
+        for e in tess.elements:
+            if len(samples[e.type.code]) < 3:
+                samples[e.type.code].append((e.polyhedron.faces, e.polyhedron.face_kinds))
+    check_canonical_codes(samples)
+
+
+def test_code_is_invariant_under_relabelling_and_mirroring():
+    rng = random.Random(7)
+    tess = tessellate(Configuration.from_code("8888a0000808", ("1", "sqrt(2)", "sqrt(2)")))
+    for e in tess.elements:
+        faces, kinds = e.polyhedron.faces, e.polyhedron.face_kinds
+        relabel = {v: 100 + i for i, v in enumerate(rng.sample(e.polyhedron.nodes, len(e.polyhedron.nodes)))}
+        renamed = [tuple(relabel[v] for v in face) for face in faces]
+        mirrored = [tuple(reversed(face)) for face in renamed]
+        order = rng.sample(range(len(faces)), len(faces))
+        shuffled = [mirrored[i] for i in order], [kinds[i] for i in order]
+        assert canonical_form(renamed, kinds).code == e.type.code
+        assert canonical_form(*shuffled).code == e.type.code

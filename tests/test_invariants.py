@@ -1,0 +1,106 @@
+"""Properties every tessellation must have, checked on generated configurations."""
+
+from __future__ import annotations
+
+from collections import Counter
+from fractions import Fraction
+
+import networkx as nx
+from hypothesis import HealthCheck, given, settings
+
+from cospherical import Configuration, tessellate
+from strategies import configurations
+
+SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def squared_distance(p, q, squared_lengths) -> Fraction:
+    # Independent of the integer frame: plain Fractions in real units squared.
+    return sum(w * (x - y) ** 2 for w, x, y in zip(squared_lengths, p, q))
+
+
+@SETTINGS
+@given(configurations())
+def test_volumes_sum_to_the_box(cfg):
+    assert sum(e.polyhedron.unit_volume for e in tessellate(cfg).elements) == 1
+
+
+@SETTINGS
+@given(configurations())
+def test_every_sphere_is_empty_and_passes_through_its_cell(cfg):
+    tess = tessellate(cfg)
+    squared = cfg.box.squared
+    for e in tess.elements:
+        center = e.polyhedron.center
+        radius = {squared_distance(tess.nodes[v], center, squared) for v in e.polyhedron.nodes}
+        assert len(radius) == 1, "cell vertices not co-spherical"
+        (r2,) = radius
+        for node, point in tess.nodes.items():
+            d2 = squared_distance(point, center, squared)
+            assert d2 >= r2, f"node {node} strictly inside the sphere of {e.nodes}"
+            assert (d2 == r2) == (node in e.polyhedron.nodes), f"node {node} on the sphere but not in the cell"
+
+
+def _on_box_boundary(face, nodes) -> bool:
+    return any(len({nodes[v][axis] for v in face}) == 1 and nodes[face[0]][axis] in (0, 1) for axis in range(3))
+
+
+@SETTINGS
+@given(configurations())
+def test_cells_meet_face_to_face(cfg):
+    tess = tessellate(cfg)
+    uses = Counter()
+    directed = set()
+    for e in tess.elements:
+        for face in e.polyhedron.faces:
+            uses[frozenset(face)] += 1
+            directed.update((face[i], face[(i + 1) % len(face)]) for i in range(len(face)))
+    for face, count in uses.items():
+        if count == 1:
+            assert _on_box_boundary(tuple(face), tess.nodes), f"face {sorted(face)} is free inside the box"
+        else:
+            assert count == 2, f"face {sorted(face)} shared by {count} cells"
+    # A shared face is walked in opposite directions by its two cells.
+    for e in tess.elements:
+        for face in e.polyhedron.faces:
+            if uses[frozenset(face)] == 2:
+                assert all((face[(i + 1) % len(face)], face[i]) in directed for i in range(len(face)))
+
+
+@SETTINGS
+@given(configurations())
+def test_euler_formula_and_planar_embedding(cfg):
+    for e in tessellate(cfg).elements:
+        v, edges, f = e.polyhedron.counts
+        assert v - edges + f == 2
+        assert (v, edges, f) == (e.type.vertices, e.type.edges, e.type.faces)
+        embedding_of(e.polyhedron.faces).check_structure()
+
+
+def embedding_of(faces) -> nx.PlanarEmbedding:
+    """The faces (counter-clockwise from outside) as a networkx rotation system."""
+    turn = {}
+    for face in faces:
+        n = len(face)
+        for i in range(n):
+            turn[face[i], face[(i + 1) % n]] = face[i - 1]  # next neighbour counter-clockwise
+    embedding = nx.PlanarEmbedding()
+    for node in {v for face in faces for v in face}:
+        first = next(w for (u, w) in turn if u == node)
+        embedding.add_half_edge(node, first)
+        previous, w = first, turn[node, first]
+        while w != first:
+            embedding.add_half_edge(node, w, cw=previous)
+            previous, w = w, turn[node, w]
+    return embedding
+
+
+@SETTINGS
+@given(configurations(dyadic=True))
+def test_nodes_follow_the_numbering(cfg):
+    tess = tessellate(cfg)
+    for k, t in enumerate(cfg.steiner):
+        assert (8 + k in tess.nodes) == (t is not None)
+    used = {v for e in tess.elements for v in e.nodes}
+    assert used == set(tess.nodes), "every point is a vertex of some cell"
+    assert Configuration.from_code(cfg.code, cfg.box, cfg.face_points) == cfg

@@ -1,0 +1,79 @@
+"""Tessellations whose answer is known by hand, and the element types' node orders."""
+
+from collections import Counter
+from fractions import Fraction
+
+import pytest
+
+from cospherical import Configuration, tessellate
+from cospherical.element_types import type_id
+
+
+def names(code, box=("1", "1", "1"), policy="octree"):
+    return Counter(e.type.name for e in tessellate(Configuration.from_code(code, box, policy)).elements)
+
+
+def test_plain_box_is_one_cuboid():
+    tess = tessellate(Configuration.from_code("000000000000", ("1", "2", "4")))
+    (element,) = tess.elements
+    assert element.type.name == "cuboid" and element.nodes == (0, 1, 2, 3, 4, 5, 6, 7)
+    assert element.polyhedron.center == (Fraction(1, 2),) * 3
+    assert tess.circumcenter(element) == (0.5, 1.0, 2.0)
+
+
+def test_one_midpoint_gives_four_pyramids():
+    assert names("800000000000") == {"rectangular pyramid": 4}
+
+
+def test_all_midpoints_with_octree_points_give_eight_cuboids():
+    assert names("888888888888") == {"cuboid": 8}
+    assert names("888888888888", ("1", "2", "4")) == {"cuboid": 8}
+
+
+def test_exact_sqrt2_differs_from_rounded():
+    # More points become co-spherical at exactly sqrt(2): fewer, larger elements.
+    exact = tessellate(Configuration.from_code("880000000000", ("1", "sqrt(2)", "sqrt(2)")))
+    rounded = tessellate(Configuration.from_code("880000000000", ("1", "1.4142", "1.4142")))
+    assert len(exact.elements) < len(rounded.elements)
+
+
+def orientation(points):
+    (p0, p1, p2, p3) = points
+    u, v, w = ([b - a for a, b in zip(p0, q)] for q in (p1, p2, p3))
+    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]))
+
+
+@pytest.mark.parametrize("code", ["000000000000", "800000000000", "888888888888", "880080000000", "8888a0000808", "123456789abc"])
+@pytest.mark.parametrize("box", [("1", "1", "1"), ("1", "2", "4"), ("1", "sqrt(2)", "sqrt(2)")])
+def test_vtk_orders_have_the_first_face_normal_pointing_inside(code, box):
+    tess = tessellate(Configuration.from_code(code, box))
+    xyz = {i: tuple(float(x) for x in p) for i, p in tess.nodes.items()}  # unit frame: same signs
+    for e in tess.elements:
+        n = e.nodes
+        vtk = e.type.vtk
+        if vtk == "tetra":
+            assert orientation([xyz[i] for i in n]) > 0
+        elif vtk == "pyramid":
+            assert orientation([xyz[n[0]], xyz[n[1]], xyz[n[2]], xyz[n[4]]]) > 0
+        elif vtk == "wedge":
+            assert orientation([xyz[n[0]], xyz[n[1]], xyz[n[2]], xyz[n[3]]]) > 0
+            edges = set(map(frozenset, e.polyhedron.edges))
+            assert all(frozenset((n[i], n[i + 3])) in edges for i in range(3))
+        elif vtk == "hexahedron":
+            assert orientation([xyz[n[0]], xyz[n[1]], xyz[n[3]], xyz[n[4]]]) > 0
+            edges = set(map(frozenset, e.polyhedron.edges))
+            assert all(frozenset((n[i], n[i + 4])) in edges for i in range(4))
+
+
+def test_fvm_closed_and_open_box():
+    # On a 1 x 2 x 4 box with midpoints on the long edges, circumcenters leave the box.
+    tess = tessellate(Configuration.from_code("000000008888", ("4", "2", "1")))
+    assert tess.fvm_adequate == all(all(0 <= x <= 1 for x in e.polyhedron.center) for e in tess.elements)
+    plain = tessellate(Configuration.from_code("000000000000"))
+    assert plain.fvm_adequate and plain.fvm_adequate_open
+
+
+def test_type_ids_are_stable():
+    assert type_id("v4:1t2t3t/0t3t2t/0t1t3t/0t2t1t", 4, 4) == "v4f4-8f0284"
+    tess = tessellate(Configuration.from_code("000000000000"))
+    assert tess.elements[0].type.id.startswith("v8f6-")
