@@ -137,11 +137,23 @@ def delaunay_cells(frame: Frame) -> list[Cell]:
             beyond = [m for m, (x, y, z) in enumerate(coords) if nx * x + ny * y + nz * z > offset]
             if not beyond:
                 continue
+            # Spheres through the circle of i, j, k: sphere(lam) = first + lam * plane.
+            # Beyond the face, y lies inside sphere(lam) exactly when lam < lam_y
+            # = -first(y) / plane(y), so the neighbour's sphere has the largest lam_y.
             i, j, k = cycle[:3]
-            best = frame.sphere(i, j, k, beyond[0])
+            first = frame.sphere(i, j, k, beyond[0])
+            best_h, best_g = 0, 1  # beyond[0] lies on `first`: lam = 0
             for y in beyond[1:]:
-                if best.side(lifted[y]) < 0:
-                    best = frame.sphere(i, j, k, y)
+                h = first.side(lifted[y])
+                x, y_, z, _ = lifted[y]
+                g = nx * x + ny * y_ + nz * z - offset
+                if -h * best_g > -best_h * g:
+                    best_h, best_g = h, g
+            a, b, c, d = first.normal
+            best = Sphere(
+                (best_g * a - best_h * nx, best_g * b - best_h * ny, best_g * c - best_h * nz, best_g * d),
+                best_g * first.offset - best_h * offset,
+            )
             neighbour = [m for m, point in enumerate(lifted) if best.side(point) == 0]
             if frozenset(neighbour) not in seen:
                 seen.add(frozenset(neighbour))

@@ -86,18 +86,25 @@ class Frame:
 
     def sphere(self, i: int, j: int, k: int, m: int) -> Sphere | None:
         """The sphere through four points, or ``None`` if they are coplanar."""
-        base = self.lifted[i]
-        rows = [sub(self.lifted[x], base) for x in (j, k, m)]
-        # Cofactors of a 4x4 determinant along its last row: normal . v = det(rows + [v]).
-        minors = [
-            _det3(*[tuple(r[c] for c in range(4) if c != skip) for r in rows]) for skip in range(4)
-        ]
-        normal = (-minors[0], minors[1], -minors[2], minors[3])
+        b0, b1, b2, b3 = self.lifted[i]
+        (x1, y1, z1, w1), (x2, y2, z2, w2), (x3, y3, z3, w3) = (
+            (p[0] - b0, p[1] - b1, p[2] - b2, p[3] - b3) for p in (self.lifted[j], self.lifted[k], self.lifted[m])
+        )
+        # Cofactors of the 4x4 determinant [rows; v] along v: normal . v = det.
+        # 2x2 minors of the first two rows, shared by the four 3x3 minors.
+        xy, xz, xw = x1 * y2 - x2 * y1, x1 * z2 - x2 * z1, x1 * w2 - x2 * w1
+        yz, yw, zw = y1 * z2 - y2 * z1, y1 * w2 - y2 * w1, z1 * w2 - z2 * w1
+        normal = (
+            -(y3 * zw - z3 * yw + w3 * yz),
+            x3 * zw - z3 * xw + w3 * xz,
+            -(x3 * yw - y3 * xw + w3 * xy),
+            x3 * yz - y3 * xz + z3 * xy,
+        )
         if normal[3] == 0:
             return None
         if normal[3] < 0:
-            normal = tuple(-x for x in normal)
-        return Sphere(normal, dot(normal, base))
+            normal = (-normal[0], -normal[1], -normal[2], -normal[3])
+        return Sphere(normal, normal[0] * b0 + normal[1] * b1 + normal[2] * b2 + normal[3] * b3)
 
     def center(self, sphere: Sphere) -> tuple[Fraction, Fraction, Fraction]:
         """Exact unit coordinates of a sphere's center."""
