@@ -28,7 +28,8 @@ class Cell:
     """One Delaunay cell.
 
     ``nodes`` are node ids in increasing order; ``faces`` are node-id cycles,
-    counter-clockwise seen from outside; ``center`` is the exact circumcenter in
+    counter-clockwise seen from outside, each starting at its smallest id, in
+    increasing order; ``center`` is the exact circumcenter in
     unit coordinates.
     """
 
@@ -123,7 +124,7 @@ def delaunay_cells(frame: Frame) -> list[Cell]:
         cells.append(
             Cell(
                 nodes=tuple(frame.ids[i] for i in members),
-                faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle, _ in faces),
+                faces=tuple(sorted(tuple(frame.ids[i] for i in cycle) for cycle, _ in faces)),
                 center=frame.center(sphere),
             )
         )

@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 from collections import Counter
 from dataclasses import dataclass
+from functools import lru_cache
 
 from .canonical import canonical_form
 from .polyhedron import Polyhedron
@@ -151,8 +152,14 @@ def _vtk_order(vtk: str, faces, kinds) -> tuple[int, ...]:
 
 def classify(poly: Polyhedron) -> tuple[ElementType, tuple[int, ...]]:
     """The element type of a polyhedron and its nodes in the type's reference order."""
-    form = canonical_form(poly.faces, poly.face_kinds)
-    etype = element_type(form.code, poly.faces, poly.face_kinds)
+    return _classify(poly.faces, poly.face_kinds)
+
+
+# A study meets the same cell (same node ids and faces) in many configurations.
+@lru_cache(maxsize=1 << 16)
+def _classify(faces, kinds) -> tuple[ElementType, tuple[int, ...]]:
+    form = canonical_form(faces, kinds)
+    etype = element_type(form.code, faces, kinds)
     if etype.vtk is None:
         return etype, form.order
-    return etype, _vtk_order(etype.vtk, poly.faces, poly.face_kinds)
+    return etype, _vtk_order(etype.vtk, faces, kinds)

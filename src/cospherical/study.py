@@ -1,0 +1,134 @@
+"""Studies: tessellate every configuration of a family, one per symmetry orbit.
+
+A study tessellates only one member (the smallest code) of each orbit of the
+box's symmetry group.  Statistics count every configuration through the orbit
+sizes, since a symmetry maps element types and circumcenter tests to
+themselves.  A member's own tessellation is the representative's mapped
+through the symmetry and re-classified, so that its node orders are exactly
+what a direct call gives.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+from .configuration import Box, Configuration
+from .element_types import ElementType, classify
+from .symmetry import Symmetry, box_symmetries, orbit_representatives
+from .tessellation import Element, Tessellation, tessellate
+
+__all__ = ["Study", "TypeCount", "bisection_codes", "map_tessellation", "run_study"]
+
+Progress = Callable[[int], None]
+
+
+def bisection_codes() -> list[str]:
+    """The 4096 bisection configuration codes: a midpoint (``8``) or nothing on each edge."""
+    return ["".join("8" if mask >> k & 1 else "0" for k in range(12)) for mask in range(4096)]
+
+
+def map_tessellation(tess: Tessellation, sym: Symmetry, target: Configuration) -> Tessellation:
+    """The image of ``tess`` under ``sym``; ``target`` is the image configuration."""
+    elements = []
+    for element in tess.elements:
+        poly = sym.polyhedron(element.polyhedron)
+        etype, order = classify(poly)
+        elements.append(Element(etype, order, poly))
+    elements.sort(key=lambda e: e.polyhedron.nodes)
+    return Tessellation(target, target.nodes(), tuple(elements))
+
+
+@dataclass(frozen=True)
+class TypeCount:
+    type: ElementType
+    count: int
+    configurations: int
+
+
+@dataclass(frozen=True)
+class Study:
+    """Every configuration of one family on one box, tessellated once per orbit."""
+
+    name: str
+    box: Box
+    face_points: str
+    codes: tuple[str, ...]
+    representative: dict[str, tuple[str, Symmetry]]  # code -> (orbit representative, symmetry to it)
+    tessellations: dict[str, Tessellation]  # representative -> tessellation
+
+    @property
+    def configurations(self) -> int:
+        return len(self.codes)
+
+    @property
+    def orbits(self) -> int:
+        return len(self.tessellations)
+
+    def orbit_sizes(self) -> Counter:
+        return Counter(rep for rep, _ in self.representative.values())
+
+    def tessellation(self, code: str) -> Tessellation:
+        """The tessellation of any configuration of the study."""
+        rep, sym = self.representative[code]
+        if rep == code:
+            return self.tessellations[rep]
+        target = Configuration.from_code(code, self.box, self.face_points)
+        return map_tessellation(self.tessellations[rep], sym.inverse(), target)
+
+    def _count(self, predicate: Callable[[Tessellation], bool]) -> int:
+        return sum(size for rep, size in self.orbit_sizes().items() if predicate(self.tessellations[rep]))
+
+    @property
+    def fvm_adequate(self) -> int:
+        return self._count(lambda t: t.fvm_adequate)
+
+    @property
+    def fvm_adequate_open(self) -> int:
+        return self._count(lambda t: t.fvm_adequate_open)
+
+    @property
+    def total(self) -> int:
+        return sum(size * len(self.tessellations[rep].elements) for rep, size in self.orbit_sizes().items())
+
+    def type_counts(self) -> list[TypeCount]:
+        """Element types by decreasing count, then id."""
+        counts: Counter = Counter()
+        configurations: Counter = Counter()
+        types: dict[str, ElementType] = {}
+        for rep, size in self.orbit_sizes().items():
+            per_type = Counter(e.type.id for e in self.tessellations[rep].elements)
+            for element in self.tessellations[rep].elements:
+                types[element.type.id] = element.type
+            for type_id, n in per_type.items():
+                counts[type_id] += n * size
+                configurations[type_id] += size
+        return [
+            TypeCount(types[i], counts[i], configurations[i])
+            for i in sorted(counts, key=lambda i: (-counts[i], i))
+        ]
+
+
+def run_study(
+    name: str,
+    box: Box,
+    codes: Sequence[str],
+    face_points: str = "octree",
+    progress: Progress | None = None,
+) -> Study:
+    """Tessellate every configuration code, one per orbit of the box's symmetries.
+
+    ``progress(n)`` is called as orbits are done, with the number of
+    configurations they account for.
+    """
+    symmetries = box_symmetries(box)
+    reps, sym_index = orbit_representatives(codes, symmetries)
+    representative = {code: (rep, symmetries[i]) for code, rep, i in zip(codes, reps, sym_index)}
+    sizes = Counter(reps)
+    tessellations = {}
+    for rep in sorted(sizes):
+        tessellations[rep] = tessellate(Configuration.from_code(rep, box, face_points))
+        if progress:
+            progress(sizes[rep])
+    return Study(name, box, face_points, tuple(codes), representative, tessellations)

@@ -1,0 +1,148 @@
+"""The symmetry group of a box acting on node ids, configurations and tessellations.
+
+A symmetry permutes the axes (only axes of equal length may be swapped) and
+reflects any of them: 48 elements for a cube, 16 when exactly two lengths
+agree, 8 otherwise.  A study tessellates one representative per orbit and maps
+the result to every other member.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import lru_cache
+from itertools import permutations, product
+from typing import Sequence
+
+import numpy as np
+
+from .configuration import BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis
+from .polyhedron import Polyhedron
+
+__all__ = ["Symmetry", "box_symmetries", "orbit_representatives"]
+
+
+@dataclass(frozen=True)
+class Symmetry:
+    """``point -> q`` with ``q[i] = p[perm[i]]``, reflected (``1 - x``) where ``flips[i]``."""
+
+    perm: tuple[int, int, int]
+    flips: tuple[bool, bool, bool]
+
+    @property
+    def proper(self) -> bool:
+        """Whether it keeps orientation (a rotation rather than a reflection)."""
+        inversions = sum(1 for i in range(3) for j in range(i + 1, 3) if self.perm[i] > self.perm[j])
+        return (inversions + sum(self.flips)) % 2 == 0
+
+    def point(self, p):
+        return tuple(1 - p[a] if f else p[a] for a, f in zip(self.perm, self.flips))
+
+    @property
+    def node_map(self) -> tuple[int, ...]:
+        """Image of every node id 0..26."""
+        return _node_map(self)
+
+    @property
+    def edge_map(self) -> tuple[tuple[int, bool], ...]:
+        """For edge k: (image edge, whether t becomes 1 - t)."""
+        return _edge_map(self)
+
+    def configuration(self, cfg: Configuration) -> Configuration:
+        params: list[Fraction | None] = [None] * 12
+        for k, t in enumerate(cfg.steiner):
+            if t is not None:
+                image, reverse = self.edge_map[k]
+                params[image] = 1 - t if reverse else t
+        return Configuration(cfg.box, tuple(params), cfg.face_points)
+
+    def code(self, code: str) -> str:
+        """The image of a configuration code (digit n becomes 16 - n on a reversed edge)."""
+        digits = ["0"] * 12
+        for (image, reverse), digit in zip(self.edge_map, code):
+            digits[image] = _REVERSED_DIGIT[digit] if reverse else digit
+        return "".join(digits)
+
+    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
+        """The image of a polyhedron, faces normalised as the Delaunay stage writes them."""
+        nodes = self.node_map
+        faces = []
+        for face in poly.faces:
+            image = [nodes[v] for v in face]
+            if not self.proper:  # a reflection turns counter-clockwise into clockwise
+                image.reverse()
+            start = image.index(min(image))
+            faces.append(tuple(image[start:] + image[:start]))
+        order = sorted(range(len(faces)), key=lambda i: faces[i])
+        return Polyhedron(
+            nodes=tuple(sorted(nodes[v] for v in poly.nodes)),
+            faces=tuple(faces[i] for i in order),
+            face_kinds=tuple(poly.face_kinds[i] for i in order),
+            unit_volume=poly.unit_volume,
+            center=self.point(poly.center),
+        )
+
+    def inverse(self) -> "Symmetry":
+        perm = [0, 0, 0]
+        flips = [False] * 3
+        for i, a in enumerate(self.perm):
+            perm[a] = i
+            flips[a] = self.flips[i]
+        return Symmetry(tuple(perm), tuple(flips))
+
+
+_REVERSED_DIGIT = {"%x" % n: "%x" % ((16 - n) % 16) for n in range(16)}
+
+
+def _positions() -> dict[tuple[Fraction, ...], int]:
+    half = Fraction(1, 2)
+    positions = {tuple(map(Fraction, c)): i for i, c in enumerate(CORNERS)}
+    for k, (p, q) in enumerate(EDGES):
+        positions[tuple((Fraction(x) + y) / 2 for x, y in zip(CORNERS[p], CORNERS[q]))] = 8 + k
+    for f, corners in enumerate(FACES):
+        positions[tuple(sum(Fraction(CORNERS[c][a]) for c in corners) / 4 for a in range(3))] = 20 + f
+    positions[(half, half, half)] = BODY_NODE
+    return positions
+
+
+@lru_cache(maxsize=None)
+def _node_map(sym: Symmetry) -> tuple[int, ...]:
+    positions = _positions()
+    image = {node: positions[sym.point(p)] for p, node in positions.items()}
+    return tuple(image[i] for i in range(27))
+
+
+@lru_cache(maxsize=None)
+def _edge_map(sym: Symmetry) -> tuple[tuple[int, bool], ...]:
+    result = []
+    for k in range(12):
+        image = _node_map(sym)[8 + k] - 8
+        axis = edge_axis(k)
+        new_axis = sym.perm.index(axis)
+        result.append((image, sym.flips[new_axis]))
+    return tuple(result)
+
+
+def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
+    """All symmetries of the box, identity first."""
+    squared = box.squared
+    perms = [p for p in permutations(range(3)) if all(squared[i] == squared[p[i]] for i in range(3))]
+    return tuple(Symmetry(p, f) for p in perms for f in product((False, True), repeat=3))
+
+
+def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry]) -> tuple[list[str], list[int]]:
+    """For each code, its orbit's representative (the smallest image code) and the
+    index of a symmetry taking the code to it; vectorised over all codes at once."""
+    digits = np.array([[int(ch, 16) for ch in code] for code in codes], dtype=np.int64).reshape(-1, 12)
+    weights = 16 ** np.arange(11, -1, -1, dtype=np.int64)  # the code as a base-16 number
+    best = np.full(len(codes), np.iinfo(np.int64).max)
+    best_sym = np.zeros(len(codes), dtype=np.int64)
+    for index, sym in enumerate(symmetries):
+        image = np.zeros_like(digits)
+        for k, (target, reverse) in enumerate(sym.edge_map):
+            image[:, target] = (16 - digits[:, k]) % 16 if reverse else digits[:, k]
+        keys = image @ weights
+        better = keys < best
+        best = np.where(better, keys, best)
+        best_sym = np.where(better, index, best_sym)
+    return ["%012x" % key for key in best.tolist()], best_sym.tolist()
