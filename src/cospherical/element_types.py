@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import hashlib
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 from .canonical import canonical_form
@@ -28,6 +28,9 @@ _KIND_PLURAL = {
 class ElementType:
     """One element type: polyhedra whose labelled face graphs are isomorphic.
 
+    ``name`` is the catalogue's name when the shipped catalogue knows the type,
+    else ``structural`` (tetrahedron, n-gonal pyramid or bipyramid, triangular
+    prism, cuboid) when the face structure has one, else a systematic name.
     ``face_kinds`` counts faces per kind, e.g. ``(("rectangle", 1), ("triangle", 4))``.
     ``vtk`` names the VTK cell type when the type has one (its nodes then follow
     VTK order), else ``None``.
@@ -36,6 +39,7 @@ class ElementType:
     code: str
     id: str
     name: str
+    structural: str | None
     vertices: int
     edges: int
     faces: int
@@ -110,15 +114,20 @@ def element_type(code: str, faces, kinds) -> ElementType:
     return _TYPES[code]
 
 
+def systematic_name(vertices: int, face_summary: str) -> str:
+    return f"{vertices}-vertex polyhedron ({face_summary})"
+
+
 def _new_type(code: str, faces, kinds) -> ElementType:
-    counts = Counter(kinds)
+    from .catalogue import known_name  # the shipped catalogue names the types it knows
+
     vertices = len({v for f in faces for v in f})
     edges = sum(len(f) for f in faces) // 2
-    name, vtk = _standard(faces, kinds)
-    summary = ElementType(code, "", "", vertices, edges, len(faces), tuple(sorted(counts.items())), vtk)
-    if name is None:
-        name = f"{vertices}-vertex polyhedron ({summary.face_summary})"
-    return ElementType(code, type_id(code, vertices, len(faces)), name, vertices, edges, len(faces), summary.face_kinds, vtk)
+    structural, vtk = _standard(faces, kinds)
+    face_kinds = tuple(sorted(Counter(kinds).items()))
+    etype = ElementType(code, type_id(code, vertices, len(faces)), "", structural, vertices, edges, len(faces), face_kinds, vtk)
+    name = known_name(code) or structural or systematic_name(vertices, etype.face_summary)
+    return replace(etype, name=name)
 
 
 def _vtk_order(vtk: str, faces, kinds) -> tuple[int, ...]:

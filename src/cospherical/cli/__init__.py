@@ -6,11 +6,11 @@ import argparse
 import sys
 
 from ..exact import InputError
-from . import tessellate
+from . import reproduce, study, tessellate
 
 __all__ = ["main"]
 
-SUBCOMMANDS = (tessellate,)
+SUBCOMMANDS = (tessellate, study, reproduce)
 
 
 class UsageError(Exception):

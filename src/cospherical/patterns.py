@@ -1,0 +1,90 @@
+"""Pattern tables: per configuration code, the elements a mesh generator puts there.
+
+A table is YAML: a header (schema_version, generator and catalogue versions,
+study, box, point policy, scheme, criteria) and, for every configuration code,
+``fvm_adequate`` and per criterion the list of elements, each with its type id,
+node ids in the type's reference order (see the catalogue) and circumcenter.
+
+>>> table = load(pattern_path("bisection", ("1", "1", "1")))   # doctest: +SKIP
+>>> table.elements("800000000000")[0]["type"]                   # doctest: +SKIP
+'v5f5-b7421e'
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import __version__
+from .study import Study
+from .yamlio import FormatError, atomic_write, load_yaml, validate, yaml_float, yaml_text
+
+__all__ = ["PatternTable", "SCHEMA_VERSION", "load", "pattern_name", "patterns_text", "write_patterns"]
+
+SCHEMA_VERSION = 1
+SCHEMES = {"bisection": "midpoints: every Steiner point at t = 1/2"}
+
+
+def pattern_name(study: str, box_texts, face_points: str = "octree") -> str:
+    """File stem for a study's outputs, e.g. ``bisection-1x1.4142x1.4142``."""
+    box = "x".join(re.sub(r"[^0-9a-z./]+", "", text.replace("/", "_")) for text in box_texts)
+    return f"{study}-{box}" + ("" if face_points == "octree" else f"-{face_points}")
+
+
+def patterns_text(study: Study, catalogue_version: str, criteria=("optimal",)) -> str:
+    """The pattern table of a study as YAML text (deterministic)."""
+    header = {
+        "schema_version": SCHEMA_VERSION,
+        "generator": f"cospherical {__version__}",
+        "catalogue_version": catalogue_version,
+        "study": study.name,
+        "box": list(study.box.texts),
+        "face_points": study.face_points,
+        "scheme": SCHEMES.get(study.name, study.name),
+        "criteria": list(criteria),
+    }
+    lines = [yaml_text(header).rstrip("\n"), "configurations:"]
+    for code in sorted(study.codes):
+        tess = study.tessellation(code)
+        lines.append(f"  '{code}':")
+        lines.append(f"    fvm_adequate: {'true' if tess.fvm_adequate else 'false'}")
+        for criterion in criteria:
+            lines.append(f"    {criterion}:")
+            for element in tess.elements:
+                nodes = ", ".join(map(str, element.nodes))
+                center = ", ".join(yaml_float(x) for x in tess.circumcenter(element))
+                lines.append(f"    - {{type: {element.type.id}, nodes: [{nodes}], circumcenter: [{center}]}}")
+    return "\n".join(lines) + "\n"
+
+
+def write_patterns(study: Study, path: str | Path, catalogue_version: str, criteria=("optimal",)) -> None:
+    atomic_write(path, patterns_text(study, catalogue_version, criteria))
+
+
+@dataclass(frozen=True)
+class PatternTable:
+    """A loaded, validated pattern table."""
+
+    header: dict
+    configurations: dict[str, dict]
+
+    def elements(self, code: str, criterion: str = "optimal") -> list[dict]:
+        """The elements of one configuration: dicts with ``type``, ``nodes``, ``circumcenter``."""
+        if code not in self.configurations:
+            raise KeyError(f"configuration {code!r} is not in this table")
+        if criterion not in self.header["criteria"]:
+            raise KeyError(f"criterion {criterion!r} is not in this table: {', '.join(self.header['criteria'])}")
+        return self.configurations[code][criterion]
+
+
+def load(path: str | Path) -> PatternTable:
+    """Read a pattern table, validated against the JSON Schema; a bad file raises :class:`FormatError`."""
+    data = load_yaml(path)
+    validate(data, "patterns", path)
+    for code, entry in data["configurations"].items():
+        for criterion in data["criteria"]:
+            if criterion not in entry:
+                raise FormatError(f"{path}: configuration {code}: no {criterion!r} elements")
+    header = {k: v for k, v in data.items() if k != "configurations"}
+    return PatternTable(header, data["configurations"])

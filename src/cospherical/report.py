@@ -1,0 +1,177 @@
+"""Study summaries (the JSON shape of ``cospherical study``) and the paper side by side."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+from .paper import paper_class, paper_classes, paper_studies
+from .study import Study
+
+__all__ = ["PAPER_NOTES", "paper_comparison", "paper_study_key", "study_summary", "text_report"]
+
+# Why a published figure and ours differ; each comparison row cites one key.
+PAPER_NOTES = {
+    "fvm": "The paper does not say how it tested circumcenters; we report the closed box "
+    "(fvm_adequate) and the open box (fvm_adequate_open). Neither reproduces the paper's 132 "
+    "for test case B, which remains unexplained.",
+    "exact_sqrt2": "The paper's aspect-sqrt(2) figures come out at b = c = 1.4142 (a rounded "
+    "sqrt 2). At exactly sqrt(2) more points are co-spherical, so elements merge and the "
+    "counts differ: these columns compare a different box.",
+    "none_policy": "The paper's procedure places the face (and body) points of refined "
+    "neighbours (our default octree policy). With corners and edge points only (policy "
+    "none) the point sets differ, and so do the counts.",
+    "classes": "The paper names elements by V/E/F and face kinds, so one paper class can hold "
+    "several canonical types (they are summed here); a type outside every paper class is "
+    "listed under its own name.",
+}
+
+
+def _normalised(box) -> tuple[Fraction, ...]:
+    squared = sorted(box.squared)
+    return tuple(s / squared[0] for s in squared)
+
+
+def paper_study_key(study: Study) -> tuple[str | None, list[str]]:
+    """The paper's study to compare with, and the notes on why figures may differ."""
+    if study.name != "bisection":
+        return None, []
+    notes = ["classes"]
+    if study.face_points != "octree":
+        notes.append("none_policy")
+    ratios = _normalised(study.box)
+    for key, entry in paper_studies().items():
+        if not key.startswith("bisection"):
+            continue
+        lengths = [str(x) for x in entry["box"]]
+        from .configuration import Box
+
+        paper_box = Box.parse(["1.4142" if "sqrt" in x else x for x in lengths])
+        if ratios == _normalised(paper_box):
+            return key, notes
+        if "sqrt" in "".join(lengths) and ratios == _normalised(Box.parse(lengths)):
+            return key, notes + ["exact_sqrt2"]
+    return None, notes
+
+
+def study_summary(study: Study, names: dict[str, tuple[str, list[str]]] | None = None) -> dict:
+    """The study's statistics in the JSON shape of ``cospherical study --format json``."""
+    counts = study.type_counts()
+    total = study.total
+    types = {}
+    for entry in counts:
+        t = entry.type
+        name, aliases = names[t.id] if names else (t.name, [paper_class(t)["name"]] if paper_class(t) else [])
+        types[t.id] = {
+            "name": name,
+            "paper_class": aliases[0] if aliases else None,
+            "count": entry.count,
+            "share": round(entry.count / total, 6),
+            "configurations": entry.configurations,
+            "vertices": t.vertices,
+            "edges": t.edges,
+            "faces": t.faces,
+        }
+    summary = {
+        "study": study.name,
+        "box": list(study.box.texts),
+        "face_points": study.face_points,
+        "configurations": study.configurations,
+        "orbits": study.orbits,
+        "fvm_adequate": study.fvm_adequate,
+        "fvm_adequate_open": study.fvm_adequate_open,
+        "criteria": {
+            "optimal": {
+                "total": total,
+                "types_count": len(types),
+                "paper_classes_count": len({v["paper_class"] or k for k, v in types.items()}),
+                "types": types,
+            }
+        },
+    }
+    return summary
+
+
+def paper_comparison(summary: dict, key: str, criterion: str = "optimal") -> dict:
+    """Rows (paper class or type name, paper count, our count) for one criterion."""
+    paper = paper_studies()[key]
+    published = paper.get(criterion, {})
+    ours: dict[str, int] = {}
+    for type_id, entry in summary["criteria"][criterion]["types"].items():
+        label = entry["paper_class"] or entry["name"]
+        ours[label] = ours.get(label, 0) + entry["count"]
+    order = [c["name"] for c in paper_classes()]
+    labels = [n for n in order if n in published.get("counts", {}) or n in ours]
+    labels += sorted(n for n in ours if n not in labels)
+    rows = [
+        {"class": n, "paper": published.get("counts", {}).get(n), "ours": ours.get(n)}
+        for n in labels
+    ]
+    return {
+        "paper_study": key,
+        "criterion": criterion,
+        "rows": rows,
+        "total": {"paper": published.get("total"), "ours": summary["criteria"][criterion]["total"]},
+        "classes": {"paper": len(published.get("counts", {})) or None, "ours": len(ours)},
+        "fvm_adequate": {
+            "paper": paper.get("fvm_adequate_configurations"),
+            "closed": summary["fvm_adequate"],
+            "open": summary["fvm_adequate_open"],
+        },
+    }
+
+
+def _mark(paper, ours) -> str:
+    return "" if paper == ours else "  <- differs"
+
+
+def text_report(summary: dict, compare_paper: bool = False, study: Study | None = None) -> str:
+    """A plain-text report: the frequency table and, if asked, the paper beside it."""
+    lines = [
+        f"{summary['study']} study, box {' x '.join(summary['box'])}, face points {summary['face_points']}: "
+        f"{summary['configurations']} configurations ({summary['orbits']} orbits)",
+        f"FVM adequate: {summary['fvm_adequate']} (closed box), {summary['fvm_adequate_open']} (open box)",
+    ]
+    for criterion, data in summary["criteria"].items():
+        lines.append("")
+        lines.append(f"{criterion}: {data['total']} elements, {data['types_count']} element types "
+                     f"({data['paper_classes_count']} paper classes)")
+        lines.append(f"  {'id':<14} {'name':<48} {'paper class':<32} {'count':>8} {'share':>7} {'configs':>7}")
+        for type_id, entry in data["types"].items():
+            lines.append(
+                f"  {type_id:<14} {entry['name'][:48]:<48} {(entry['paper_class'] or '-')[:32]:<32} "
+                f"{entry['count']:>8} {100 * entry['share']:>6.2f}% {entry['configurations']:>7}"
+            )
+    if compare_paper and study is not None:
+        lines.append("")
+        lines.extend(comparison_lines(summary, study))
+    return "\n".join(lines) + "\n"
+
+
+def comparison_lines(summary: dict, study: Study) -> list[str]:
+    key, notes = paper_study_key(study)
+    if key is None:
+        return ["The paper has no study of this box to compare with."]
+    lines = [f"Beside the paper ({key}, box {' x '.join(str(x) for x in paper_studies()[key]['box'])}):"]
+    for criterion in summary["criteria"]:
+        if criterion not in paper_studies()[key]:
+            continue
+        table = paper_comparison(summary, key, criterion)
+        lines.append(f"  {criterion}:")
+        lines.append(f"    {'paper class / type':<48} {'paper':>8} {'ours':>8}")
+        for row in table["rows"]:
+            paper = "-" if row["paper"] is None else row["paper"]
+            ours = "-" if row["ours"] is None else row["ours"]
+            lines.append(f"    {row['class'][:48]:<48} {paper:>8} {ours:>8}{_mark(row['paper'], row['ours'])}")
+        total = table["total"]
+        lines.append(f"    {'total':<48} {total['paper']:>8} {total['ours']:>8}{_mark(total['paper'], total['ours'])}")
+        classes = table["classes"]
+        lines.append(f"    {'element classes':<48} {classes['paper']:>8} {classes['ours']:>8}"
+                     f"{_mark(classes['paper'], classes['ours'])}")
+    fvm = paper_comparison(summary, key)["fvm_adequate"]
+    lines.append(f"  FVM adequate configurations: paper {fvm['paper']}, ours {fvm['closed']} (closed box), "
+                 f"{fvm['open']} (open box){_mark(fvm['paper'], fvm['closed'])}")
+    if fvm["paper"] not in (fvm["closed"], fvm["open"]):
+        notes = notes + ["fvm"]
+    lines.append("  Notes:")
+    lines.extend(f"  - {PAPER_NOTES[n]}" for n in notes)
+    return lines
