@@ -4,10 +4,11 @@ A table is YAML: a header (schema_version, generator and catalogue versions,
 study, box, point policy, scheme, criteria) and, for every configuration code,
 ``fvm_adequate`` and per criterion the list of elements, each with its type id,
 node ids in the type's reference order (see the catalogue) and circumcenter.
+A mesh generator looks a configuration up like this::
 
->>> table = load(pattern_path("bisection", ("1", "1", "1")))   # doctest: +SKIP
->>> table.elements("800000000000")[0]["type"]                   # doctest: +SKIP
-'v5f5-b7421e'
+    table = cospherical.patterns.load("patterns/bisection-1x1x1.yaml")
+    for element in table.elements("800000000000"):
+        print(element["type"], element["nodes"])
 """
 
 from __future__ import annotations

@@ -1,0 +1,154 @@
+"""Studies: symmetry, the paper's tables, catalogue and pattern tables."""
+
+from __future__ import annotations
+
+import filecmp
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from cospherical import Box, Configuration, tessellate
+from cospherical.catalogue import catalogue_path, load_catalogue
+from cospherical.patterns import load, pattern_name
+from cospherical.report import paper_comparison, paper_study_key, study_summary
+from cospherical.study import bisection_codes, run_study
+from cospherical.symmetry import box_symmetries
+from cospherical.yamlio import FormatError, dump_yaml, load_yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("lengths, order", [(("1", "1", "1"), 48), (("1", "2", "2"), 16), (("1", "2", "4"), 8)])
+def test_group_orders(lengths, order):
+    symmetries = box_symmetries(Box.parse(lengths))
+    assert len(symmetries) == order
+    assert sum(s.proper for s in symmetries) == order // 2
+    # closed under inverse, and each node map is a bijection of 0..26
+    assert all(sorted(s.node_map) == list(range(27)) for s in symmetries)
+    assert all(s.inverse() in symmetries for s in symmetries)
+
+
+@pytest.mark.parametrize("lengths", [("1", "1", "1"), ("1", "2", "4")])
+def test_mapped_tessellations_equal_direct_ones(lengths):
+    box = Box.parse(lengths)
+    study = run_study("bisection", box, bisection_codes())
+    for code in bisection_codes():
+        direct = tessellate(Configuration.from_code(code, box))
+        assert study.tessellation(code) == direct, code
+
+
+def test_symmetry_maps_configurations_and_points():
+    box = Box.parse(("1", "1", "1"))
+    cfg = Configuration.from_steiner(box, {0: "1/4", 9: "3/16", 4: "1/4", 2: "1/4", 6: "1/4"})
+    for sym in box_symmetries(box):
+        image = sym.configuration(cfg)
+        assert image.code == sym.code(cfg.code)
+        nodes, image_nodes = cfg.nodes(), image.nodes()
+        assert {sym.node_map[i]: sym.point(p) for i, p in nodes.items()} == image_nodes
+
+
+@pytest.fixture(scope="module")
+def paper_studies():
+    return {
+        key: run_study("bisection", Box.parse(box), bisection_codes())
+        for key, box in (("bisection_A", ("1", "1", "1")), ("bisection_B", ("1", "2", "4")),
+                         ("bisection_C", ("1", "1.4142", "1.4142")))
+    }
+
+
+@pytest.mark.parametrize("key", ["bisection_A", "bisection_B", "bisection_C"])
+def test_paper_optimal_tables_row_by_row(paper_studies, key):
+    study = paper_studies[key]
+    assert paper_study_key(study)[0] == key
+    table = paper_comparison(study_summary(study), key)
+    assert table["rows"], "no rows"
+    for row in table["rows"]:
+        assert row["paper"] == row["ours"], row
+    assert table["total"]["paper"] == table["total"]["ours"]
+    assert table["classes"]["paper"] == table["classes"]["ours"]
+
+
+def test_exact_sqrt2_is_marked_as_a_different_box():
+    study = run_study("bisection", Box.parse(("1", "sqrt(2)", "sqrt(2)")), bisection_codes())
+    key, notes = paper_study_key(study)
+    assert key == "bisection_C" and "exact_sqrt2" in notes
+    assert paper_comparison(study_summary(study), key)["total"]["ours"] != 43035
+
+
+def test_committed_catalogue_and_patterns_validate():
+    catalogue = load_catalogue(catalogue_path())
+    ids = [t["id"] for t in catalogue["types"]]
+    assert len(ids) == len(set(ids)) and len({t["code"] for t in catalogue["types"]}) == len(ids)
+    assert len({t["name"] for t in catalogue["types"]}) == len(ids), "names are unique"
+    names = {t["name"] for t in catalogue["types"]}
+    assert {"tetrahedron", "cuboid", "rectangular pyramid", "Tetrahedron Complement", "Generic #8"} <= names
+    for stem in ("bisection-1x1x1", "bisection-1x2x4", "bisection-1x1.4142x1.4142", "bisection-1xsqrt2xsqrt2"):
+        table = load(ROOT / "patterns" / f"{stem}.yaml")
+        assert table.header["catalogue_version"] == catalogue["version"]
+        assert len(table.configurations) == 4096
+        known = set(ids)
+        assert all(e["type"] in known for entry in table.configurations.values() for e in entry["optimal"])
+
+
+def test_pattern_lookup_equals_tessellate():
+    table = load(ROOT / "patterns" / "bisection-1x2x4.yaml")
+    for code in bisection_codes()[::97]:
+        tess = tessellate(Configuration.from_code(code, ("1", "2", "4")))
+        assert table.elements(code) == [
+            {"type": e.type.id, "nodes": list(e.nodes), "circumcenter": list(tess.circumcenter(e))}
+            for e in tess.elements
+        ]
+        assert table.configurations[code]["fvm_adequate"] == tess.fvm_adequate
+
+
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        (lambda d: d.update(schema_version=7), "schema_version"),
+        (lambda d: d["configurations"].update({"xyz": d["configurations"]["000000000000"]}), "configurations"),
+        (lambda d: d["configurations"]["800000000000"]["optimal"][0].update(nodes=[1, 2]), "nodes"),
+        (lambda d: d["configurations"]["800000000000"]["optimal"][0].pop("type"), "type"),
+        (lambda d: d.pop("box"), "box"),
+    ],
+)
+def test_broken_pattern_tables_are_refused(tmp_path, edit, needle):
+    data = load_yaml(ROOT / "patterns" / "bisection-1x2x4.yaml")
+    data["configurations"] = {k: data["configurations"][k] for k in ("000000000000", "800000000000")}
+    edit(data)
+    path = tmp_path / "broken.yaml"
+    dump_yaml(data, path)
+    with pytest.raises(FormatError, match=needle):
+        load(path)
+
+
+def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "cospherical", "reproduce", "--root", str(tmp_path)],
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    for folder in ("catalogue", "patterns", "results"):
+        committed = sorted(p.name for p in (ROOT / folder).iterdir())
+        assert committed == sorted(p.name for p in (tmp_path / folder).iterdir())
+        for name in committed:
+            assert filecmp.cmp(ROOT / folder / name, tmp_path / folder / name, shallow=False), f"{folder}/{name}"
+
+
+def test_study_cli_json_shape(tmp_path):
+    result = subprocess.run(
+        [sys.executable, "-m", "cospherical", "study", "bisection", "--box", "1", "2", "4", "--format", "json",
+         "--out", str(tmp_path), "--compare-paper"],
+        capture_output=True, text=True,
+    )
+    assert result.returncode == 0, result.stderr
+    data = json.loads(result.stdout)
+    assert data["study"] == "bisection" and data["box"] == ["1", "2", "4"] and data["configurations"] == 4096
+    assert data["face_points"] == "octree"
+    optimal = data["criteria"]["optimal"]
+    assert optimal["total"] == 45581 == sum(t["count"] for t in optimal["types"].values())
+    assert data["fvm_adequate"] >= data["fvm_adequate_open"]
+    assert data["paper"]["fvm_adequate"]["paper"] == 132
+    stem = pattern_name("bisection", ("1", "2", "4"))
+    assert json.loads((tmp_path / f"{stem}.json").read_text())["criteria"] == data["criteria"]
+    assert len(load(tmp_path / f"{stem}.yaml").configurations) == 4096
