@@ -50,11 +50,12 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
     for i, j, k in combinations(members, 3):
         if any(i in f and j in f and k in f for f in found):
             continue
-        normal = cross(sub(coords[j], coords[i]), sub(coords[k], coords[i]))
-        if normal == (0, 0, 0):
+        (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = coords[i], coords[j], coords[k]
+        ux, uy, uz, vx, vy, vz = x1 - x0, y1 - y0, z1 - z0, x2 - x0, y2 - y0, z2 - z0
+        nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+        if nx == ny == nz == 0:
             continue
-        nx, ny, nz = normal
-        offset = nx * coords[i][0] + ny * coords[i][1] + nz * coords[i][2]
+        offset = nx * x0 + ny * y0 + nz * z0
         above = below = False
         on_plane = []
         for m in members:
@@ -72,11 +73,21 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
             continue
         if not (above or below):
             raise ValueError("points are coplanar: no 3D hull")
-        if above:
-            normal = (-nx, -ny, -nz)
+        normal = (-nx, -ny, -nz) if above else (nx, ny, nz)
         found.append(frozenset(on_plane))
-        faces.append((_counter_clockwise(coords, on_plane, normal), normal))
+        faces.append((_counter_clockwise(coords, on_plane, normal) if len(on_plane) > 3 else
+                      _triangle(on_plane, (ux, uy, uz), (vx, vy, vz), normal), normal))
     return faces
+
+
+def _triangle(points: list[int], u, v, normal) -> tuple[int, ...]:
+    # points are i < j < k and u, v run from i to j and k: keep the order when
+    # u x v already points along the outward normal, else swap j and k.
+    i, j, k = points
+    same = (u[1] * v[2] - u[2] * v[1]) * normal[0] + (u[2] * v[0] - u[0] * v[2]) * normal[1] + (
+        u[0] * v[1] - u[1] * v[0]
+    ) * normal[2]
+    return (i, j, k) if same > 0 else (i, k, j)
 
 
 def _counter_clockwise(coords, points: list[int], normal) -> tuple[int, ...]:

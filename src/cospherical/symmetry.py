@@ -133,7 +133,8 @@ def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
 def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry]) -> tuple[list[str], list[int]]:
     """For each code, its orbit's representative (the smallest image code) and the
     index of a symmetry taking the code to it; vectorised over all codes at once."""
-    digits = np.array([[int(ch, 16) for ch in code] for code in codes], dtype=np.int64).reshape(-1, 12)
+    text = np.frombuffer("".join(codes).lower().encode("ascii"), dtype=np.uint8).reshape(-1, 12)
+    digits = np.where(text >= ord("a"), text - ord("a") + 10, text - ord("0")).astype(np.int64)
     weights = 16 ** np.arange(11, -1, -1, dtype=np.int64)  # the code as a base-16 number
     best = np.full(len(codes), np.iinfo(np.int64).max)
     best_sym = np.zeros(len(codes), dtype=np.int64)

@@ -1,0 +1,58 @@
+"""The cube's bisection study against two baselines, all timed in this one run.
+
+    python benchmarks/bench_bisection.py [--box 1 1 1]
+
+(a) ``qdelaunay Qz Fv`` run once per configuration over the 4096 configurations
+    (Qhull's merged regions only: no classification, no statistics);
+(b) our pipeline without the symmetry reduction: ``tessellate`` on every configuration;
+(c) the study as ``cospherical study bisection`` runs it: one tessellation per orbit.
+
+The figures to compare are the ratios (a)/(c) and (b)/(c); the issue's target is (a)/(c) >= 20.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import subprocess
+import time
+
+from cospherical import Box, Configuration, tessellate
+from cospherical.catalogue import known_name
+from cospherical.study import bisection_codes, run_study
+
+
+def timed(function) -> float:
+    start = time.perf_counter()
+    function()
+    return time.perf_counter() - start
+
+
+def qhull_all(box: Box, codes) -> None:
+    for code in codes:
+        points = Configuration.from_code(code, box).real_nodes()
+        text = f"3\n{len(points)}\n" + "\n".join(" ".join(repr(x) for x in p) for p in points.values()) + "\n"
+        subprocess.run(["qdelaunay", "Qz", "Fv"], input=text, capture_output=True, text=True, check=True)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--box", nargs=3, default=["1", "1", "1"])
+    args = parser.parse_args()
+    if not shutil.which("qdelaunay"):
+        raise SystemExit("qdelaunay not found: install qhull-bin (scripts/setup.sh does)")
+    box = Box.parse(args.box)
+    codes = bisection_codes()
+    known_name("")  # load the shipped catalogue (once per process) before the clock starts
+    study = timed(lambda: run_study("bisection", box, codes))  # (c), on a cold cache
+    naive = timed(lambda: [tessellate(Configuration.from_code(code, box)) for code in codes])  # (b)
+    qhull = timed(lambda: qhull_all(box, codes))  # (a)
+    print(f"bisection study, box {' x '.join(box.texts)}, {len(codes)} configurations")
+    print(f"  (a) qdelaunay Qz Fv per configuration   {qhull:8.2f} s")
+    print(f"  (b) tessellate every configuration      {naive:8.2f} s")
+    print(f"  (c) study, one tessellation per orbit   {study:8.2f} s")
+    print(f"  (a)/(c) = {qhull / study:.1f}x   (b)/(c) = {naive / study:.1f}x")
+
+
+if __name__ == "__main__":
+    main()
