@@ -1,0 +1,120 @@
+"""The paper's criteria: which element types to keep, and how to split the rest.
+
+For a study and a splitting criterion, the kept set is the smallest set of
+element types such that every element of the study is kept or split (in one
+step or several, which is the same as one finer split) into kept types.  Ties
+go to the set that gives the fewest elements over all configurations, then to
+the smallest list of type ids.  The search is exact: branch and bound over the
+elements still not covered, always branching on the one with fewest options.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+from .element_types import classify
+from .geometry import Frame
+from .split import CRITERIA, SPLIT_CRITERIA, subdivisions
+from .tessellation import Element, Tessellation
+
+__all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "element_options", "minimal_kept_sets", "choose"]
+
+
+def element_options(tess: Tessellation, element: Element, criterion: str) -> tuple[tuple[Element, ...], ...]:
+    """Every split of an element under a criterion (the element itself first), pieces classified."""
+    points = tuple((n, tess.nodes[n]) for n in element.polyhedron.nodes)
+    return _options(points, tess.configuration.box.squared, element.polyhedron, criterion)
+
+
+# The same element (same node ids at the same places) recurs across configurations.
+@lru_cache(maxsize=1 << 14)
+def _options(points, squared, poly, criterion) -> tuple[tuple[Element, ...], ...]:
+    frame = Frame.build(dict(points), squared)
+    options = []
+    for split in subdivisions(frame, poly, criterion):
+        pieces = []
+        for piece in split:
+            etype, order = classify(piece)
+            pieces.append(Element(etype, order, piece))
+        options.append(tuple(pieces))
+    options.sort(key=lambda pieces: (len(pieces), [p.type.id for p in pieces], [p.polyhedron.nodes for p in pieces]))
+    return tuple(options)
+
+
+def minimal_kept_sets(instances: list[set[frozenset[str]]]) -> tuple[int, list[frozenset[str]]]:
+    """All smallest type sets K such that every instance has an option (a set of types) inside K.
+
+    Each instance is the set of its options; an option is the set of the types of a
+    split's pieces (the unsplit element is the option of its own type).
+    """
+    distinct = sorted({frozenset(options) for options in instances}, key=lambda o: sorted(map(sorted, o)))
+    best = [sum(1 for _ in set().union(*[min(o, key=len) for o in distinct]))] if distinct else [0]
+    best[0] = len(frozenset().union(*[next(iter(sorted(o, key=sorted))) for o in distinct])) if distinct else 0
+    solutions: set[frozenset[str]] = set()
+    visited: set[frozenset[str]] = set()
+
+    def search(kept: frozenset[str]) -> None:
+        if kept in visited or len(kept) > best[0]:
+            return
+        visited.add(kept)
+        open_instances = [options for options in distinct if not any(o <= kept for o in options)]
+        if not open_instances:
+            if len(kept) < best[0]:
+                best[0] = len(kept)
+                solutions.clear()
+            solutions.add(kept)
+            return
+        if len(kept) + 1 > best[0]:
+            return
+        options = min(open_instances, key=len)
+        for option in sorted(options, key=lambda o: (len(o - kept), sorted(o))):
+            search(kept | option)
+
+    search(frozenset())
+    return best[0], sorted(solutions, key=sorted)
+
+
+@dataclass(frozen=True)
+class Choice:
+    """A criterion applied to a study: the kept types and the pieces of every element."""
+
+    criterion: str
+    kept: frozenset[str]
+    tessellations: dict[str, Tessellation]  # orbit representative -> tessellation after splitting
+
+
+def _apply(tess: Tessellation, kept: frozenset[str], criterion: str) -> Tessellation | None:
+    elements = []
+    for element in tess.elements:
+        if element.type.id in kept:
+            elements.append(element)
+            continue
+        fitting = [o for o in element_options(tess, element, criterion) if all(p.type.id in kept for p in o)]
+        if not fitting:
+            return None
+        elements.extend(fitting[0])
+    elements.sort(key=lambda e: e.polyhedron.nodes)
+    return Tessellation(tess.configuration, tess.nodes, tuple(elements))
+
+
+def choose(tessellations: dict[str, Tessellation], sizes: dict[str, int], criterion: str) -> Choice:
+    """Apply a criterion to the orbit representatives of a study (``sizes``: orbit sizes)."""
+    if criterion == "optimal":
+        kept = frozenset(e.type.id for t in tessellations.values() for e in t.elements)
+        return Choice(criterion, kept, tessellations)
+    instances = [
+        {frozenset(p.type.id for p in option) for option in element_options(tess, element, criterion)}
+        for tess in tessellations.values()
+        for element in tess.elements
+    ]
+    _, candidates = minimal_kept_sets(instances)
+    best = None
+    for kept in candidates:
+        applied = {rep: _apply(tess, kept, criterion) for rep, tess in tessellations.items()}
+        total = sum(sizes[rep] * len(t.elements) for rep, t in applied.items())
+        key = (total, sorted(kept))
+        if best is None or key < best[0]:
+            best = (key, kept, applied)
+    _, kept, applied = best
+    return Choice(criterion, kept, applied)

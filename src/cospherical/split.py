@@ -1,0 +1,184 @@
+"""Splits of an element into smaller co-spherical elements (paper, section 4.2).
+
+A split cuts a convex element into pieces with no new vertex, and never cuts
+one of its boundary faces.  Two criteria:
+
+``internal_faces``
+    every edge of every piece is an edge of the element: new faces are spanned
+    by existing edges (a bipyramid's equator, for instance);
+``internal_edges_and_faces``
+    a piece may also have an edge through the element's interior, never one
+    lying on a boundary face.
+
+The vertices of an element are co-spherical, so every piece is again a
+Delaunay element with the same circumsphere.  The search grows a subdivision
+face to face from the first boundary face, as :mod:`cospherical.delaunay` does:
+the piece across an open face is the hull of the face and of some vertices
+beyond it.  Each subdivision is found exactly once; it is complete when no
+face is open and the pieces' volumes add up to the element's (a closed
+face-to-face complex with the element's boundary and its volume covers the
+element exactly once).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from itertools import combinations
+
+from .delaunay import hull_faces
+from .geometry import Frame, cross, dot, sub
+from .polyhedron import Polyhedron, face_kind
+
+__all__ = ["CRITERIA", "SPLIT_CRITERIA", "subdivisions"]
+
+CRITERIA = ("optimal", "internal_faces", "internal_edges_and_faces")
+SPLIT_CRITERIA = CRITERIA[1:]
+
+
+class _Element:
+    """An element in frame indices, with what the criteria need to know about it."""
+
+    def __init__(self, frame: Frame, poly: Polyhedron, criterion: str):
+        if criterion not in SPLIT_CRITERIA:
+            raise ValueError(f"criterion {criterion!r}: choose one of {', '.join(SPLIT_CRITERIA)}")
+        self.frame = frame
+        self.poly = poly
+        self.criterion = criterion
+        index = {node: i for i, node in enumerate(frame.ids)}
+        self.members = sorted(index[n] for n in poly.nodes)
+        self.faces = [tuple(index[n] for n in face) for face in poly.faces]
+        self.face_sets = [frozenset(face) for face in self.faces]
+        coords = frame.coords
+        self.planes = []
+        for face in self.faces:
+            normal = cross(sub(coords[face[1]], coords[face[0]]), sub(coords[face[2]], coords[face[0]]))
+            self.planes.append((normal, dot(normal, coords[face[0]])))
+        self.edges = {frozenset((f[i], f[(i + 1) % len(f)])) for f in self.faces for i in range(len(f))}
+        self.six_volume = _six_volume(coords, self.faces)
+        self._pieces: dict[frozenset[int], tuple | None] = {}
+
+    def _on_boundary_plane(self, cycle) -> int | None:
+        coords = self.frame.coords
+        for f, (normal, offset) in enumerate(self.planes):
+            if all(dot(normal, coords[v]) == offset for v in cycle):
+                return f
+        return None
+
+    def _edge_allowed(self, edge: frozenset[int]) -> bool:
+        if edge in self.edges:
+            return True
+        if self.criterion == "internal_faces":
+            return False
+        # An inner edge must pass through the interior: its ends share no face.
+        return not any(edge <= face for face in self.face_sets)
+
+    def piece(self, points: frozenset[int]):
+        """(faces with their kind of contact, 6 x volume) of the hull of ``points``, or None if not allowed."""
+        if points in self._pieces:
+            return self._pieces[points]
+        result = None
+        try:
+            faces = hull_faces(self.frame, sorted(points))
+        except ValueError:  # coplanar points span no piece
+            faces = None
+        if faces is not None:
+            result = self._check(faces)
+        self._pieces[points] = result
+        return result
+
+    def _check(self, faces):
+        checked = []
+        for cycle, normal in faces:
+            boundary = self._on_boundary_plane(cycle)
+            if boundary is not None and frozenset(cycle) != self.face_sets[boundary]:
+                return None  # part of a boundary face: the face would be cut
+            for i, v in enumerate(cycle):
+                if not self._edge_allowed(frozenset((v, cycle[(i + 1) % len(cycle)]))):
+                    return None
+            checked.append((cycle, normal, boundary))
+        return checked, _six_volume(self.frame.coords, [c for c, _, _ in checked])
+
+    def beyond(self, cycle, normal) -> list[int]:
+        coords = self.frame.coords
+        offset = dot(normal, coords[cycle[0]])
+        return [m for m in self.members if dot(normal, coords[m]) > offset]
+
+
+def _six_volume(coords, faces) -> int:
+    apex = coords[faces[0][0]]
+    total = 0
+    for face in faces:
+        p = sub(coords[face[0]], apex)
+        for a, b in zip(face[1:-1], face[2:]):
+            total += dot(p, cross(sub(coords[a], apex), sub(coords[b], apex)))
+    return total
+
+
+def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 200_000) -> list[tuple[Polyhedron, ...]]:
+    """Every split of ``poly`` allowed by ``criterion``, the element itself included.
+
+    Each split is a tuple of pieces sorted by node ids; splits come in a fixed order.
+    """
+    element = _Element(frame, poly, criterion)
+    found: list[tuple[frozenset[int], ...]] = []
+
+    def grow(pieces: list[frozenset[int]], open_faces: dict, volume: int, covered: frozenset[int]) -> None:
+        if len(found) >= limit:
+            raise RuntimeError(f"more than {limit} splits: the search was stopped")
+        if not open_faces:
+            if volume == element.six_volume and len(covered) == len(element.faces):
+                found.append(tuple(sorted(pieces, key=sorted)))
+            return
+        key = min(open_faces, key=sorted)
+        cycle, normal = open_faces[key]
+        far = element.beyond(cycle, normal)
+        for size in range(1, len(far) + 1):
+            for extra in combinations(far, size):
+                points = key | frozenset(extra)
+                _try(points, pieces, open_faces, volume, covered)
+
+    def _try(points, pieces, open_faces, volume, covered) -> None:
+        piece = element.piece(points)
+        if piece is None or points in pieces:
+            return
+        faces, six = piece
+        if volume + six > element.six_volume:
+            return
+        still_open = dict(open_faces)
+        now_covered = set(covered)
+        for cycle, normal, boundary in faces:
+            key = frozenset(cycle)
+            if boundary is not None:
+                if boundary in now_covered:
+                    return
+                now_covered.add(boundary)
+            elif key in still_open:
+                del still_open[key]  # matched face to face with the piece beyond
+            else:
+                still_open[key] = (cycle, normal)
+        grow(pieces + [points], still_open, volume + six, frozenset(now_covered))
+
+    first = element.faces[0]
+    first_normal = tuple(-x for x in element.planes[0][0])  # the element lies beyond its face, inward
+    for size in range(1, len(element.members) - len(first) + 1):
+        for extra in combinations(element.beyond(first, first_normal), size):
+            _try(frozenset(first) | frozenset(extra), [], {}, 0, frozenset())
+    return [_pieces(frame, poly, split) for split in found]
+
+
+def _pieces(frame: Frame, poly: Polyhedron, split) -> tuple[Polyhedron, ...]:
+    result = []
+    for points in split:
+        faces = hull_faces(frame, sorted(points))
+        cycles = sorted(faces, key=lambda f: f[0])
+        result.append(
+            Polyhedron(
+                nodes=tuple(frame.ids[i] for i in sorted(points)),
+                faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle, _ in cycles),
+                face_kinds=tuple(face_kind(frame, cycle) for cycle, _ in cycles),
+                unit_volume=poly.unit_volume * _six_volume(frame.coords, [c for c, _ in cycles]) / _six_volume(
+                    frame.coords, [[frame.ids.index(n) for n in f] for f in poly.faces]),
+                center=poly.center,
+            )
+        )
+    return tuple(result)
