@@ -20,6 +20,7 @@ from typing import Iterable
 
 from . import __version__
 from .element_types import ElementType, systematic_name
+from .split import SPLIT_CRITERIA
 from .paper import paper_class
 from .yamlio import dump_yaml, load_yaml, validate
 
@@ -80,17 +81,31 @@ def build_catalogue(studies) -> dict:
     examples: dict[str, tuple] = {}
     appears: dict[str, list[str]] = {}
     types: dict[str, ElementType] = {}
-    for study in studies:
-        label = _study_label(study)
-        for rep in sorted(study.tessellations):
-            tess = study.tessellations[rep]
-            for element in tess.elements:
-                t = element.type
-                types[t.id] = t
-                examples.setdefault(t.id, (study, tess, element))
-                if label not in appears.setdefault(t.id, []):
-                    appears[t.id].append(label)
+    # Optimal elements first, so that a type's example is an unsplit element where
+    # it has one; pieces of splits are element types too.
+    for criterion in ("optimal", *SPLIT_CRITERIA):
+        for study in studies:
+            if criterion not in study.choices:
+                continue
+            label = _study_label(study) + ("" if criterion == "optimal" else f" ({criterion})")
+            reps = study.choices[criterion].tessellations
+            for rep in sorted(reps):
+                for element in reps[rep].elements:
+                    t = element.type
+                    types[t.id] = t
+                    examples.setdefault(t.id, (study, reps[rep], element))
+                    if label not in appears.setdefault(t.id, []):
+                        appears[t.id].append(label)
     names = type_names(types.values())
+    splits: dict[str, dict[str, set]] = {}
+    kept: dict[str, set[str]] = {}
+    for study in studies:
+        for criterion, choice in study.choices.items():
+            if criterion == "optimal":
+                continue
+            kept.setdefault(criterion, set()).update(choice.kept)
+            for type_id, used in choice.splits.items():
+                splits.setdefault(type_id, {}).setdefault(criterion, set()).update(used)
     entries = []
     for type_id in sorted(types, key=lambda i: (types[i].vertices, types[i].faces, i)):
         t = types[type_id]
@@ -121,13 +136,21 @@ def build_catalogue(studies) -> dict:
                     "coordinates": [list(real[v]) for v in element.nodes],
                 },
                 "studies": appears[type_id],
+                "splits": {
+                    criterion: [
+                        [{"type": piece_type, "nodes": list(positions)} for piece_type, positions in split]
+                        for split in sorted(found)
+                    ]
+                    for criterion, found in sorted(splits.get(type_id, {}).items())
+                },
             }
         )
-    digest = hashlib.sha256(json.dumps(entries, sort_keys=True).encode()).hexdigest()[:12]
+    digest = hashlib.sha256(json.dumps([entries, sorted(kept.items())], sort_keys=True, default=sorted).encode()).hexdigest()[:12]
     return {
         "schema_version": SCHEMA_VERSION,
         "version": digest,
         "generator": f"cospherical {__version__}",
+        "criteria": {criterion: {"kept": sorted(ids)} for criterion, ids in sorted(kept.items())},
         "types": entries,
     }
 

@@ -10,6 +10,7 @@ elements still not covered, always branching on the one with fewest options.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -18,7 +19,7 @@ from .geometry import Frame
 from .split import CRITERIA, SPLIT_CRITERIA, subdivisions
 from .tessellation import Element, Tessellation
 
-__all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "element_options", "minimal_kept_sets", "choose"]
+__all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "choose", "element_options", "minimal_kept_sets", "split_tessellation"]
 
 
 def element_options(tess: Tessellation, element: Element, criterion: str) -> tuple[tuple[Element, ...], ...]:
@@ -49,8 +50,8 @@ def minimal_kept_sets(instances: list[set[frozenset[str]]]) -> tuple[int, list[f
     split's pieces (the unsplit element is the option of its own type).
     """
     distinct = sorted({frozenset(options) for options in instances}, key=lambda o: sorted(map(sorted, o)))
-    best = [sum(1 for _ in set().union(*[min(o, key=len) for o in distinct]))] if distinct else [0]
-    best[0] = len(frozenset().union(*[next(iter(sorted(o, key=sorted))) for o in distinct])) if distinct else 0
+    # Keeping every element whole is always a solution: an upper bound to start from.
+    best = [len(frozenset().union(*[min(o, key=len) for o in distinct])) if distinct else 0]
     solutions: set[frozenset[str]] = set()
     visited: set[frozenset[str]] = set()
 
@@ -77,32 +78,49 @@ def minimal_kept_sets(instances: list[set[frozenset[str]]]) -> tuple[int, list[f
 
 @dataclass(frozen=True)
 class Choice:
-    """A criterion applied to a study: the kept types and the pieces of every element."""
+    """A criterion applied to a study: the kept types and the pieces of every element.
+
+    ``splits`` counts, per element type that is not kept, the splits used, each
+    weighted by the configurations it occurs in.  A split is a tuple of pieces
+    ``(type id, positions)``, positions indexing the parent's reference order.
+    """
 
     criterion: str
     kept: frozenset[str]
     tessellations: dict[str, Tessellation]  # orbit representative -> tessellation after splitting
+    splits: dict[str, Counter]
 
 
-def _apply(tess: Tessellation, kept: frozenset[str], criterion: str) -> Tessellation | None:
+def split_tessellation(tess: Tessellation, kept: frozenset[str], criterion: str, strict: bool = True):
+    """Split every element whose type is not kept into kept types, fewest pieces first.
+
+    Returns ``(tessellation, used)`` with ``used`` the list of (element, pieces)
+    split; ``None`` when ``strict`` and some element has no such split (with
+    ``strict=False`` it stays whole).
+    """
     elements = []
+    used = []
     for element in tess.elements:
-        if element.type.id in kept:
+        if element.type.id in kept or criterion == "optimal":
             elements.append(element)
             continue
         fitting = [o for o in element_options(tess, element, criterion) if all(p.type.id in kept for p in o)]
         if not fitting:
-            return None
+            if strict:
+                return None
+            elements.append(element)
+            continue
         elements.extend(fitting[0])
+        used.append((element, fitting[0]))
     elements.sort(key=lambda e: e.polyhedron.nodes)
-    return Tessellation(tess.configuration, tess.nodes, tuple(elements))
+    return Tessellation(tess.configuration, tess.nodes, tuple(elements)), used
 
 
 def choose(tessellations: dict[str, Tessellation], sizes: dict[str, int], criterion: str) -> Choice:
     """Apply a criterion to the orbit representatives of a study (``sizes``: orbit sizes)."""
     if criterion == "optimal":
         kept = frozenset(e.type.id for t in tessellations.values() for e in t.elements)
-        return Choice(criterion, kept, tessellations)
+        return Choice(criterion, kept, tessellations, {})
     instances = [
         {frozenset(p.type.id for p in option) for option in element_options(tess, element, criterion)}
         for tess in tessellations.values()
@@ -111,10 +129,31 @@ def choose(tessellations: dict[str, Tessellation], sizes: dict[str, int], criter
     _, candidates = minimal_kept_sets(instances)
     best = None
     for kept in candidates:
-        applied = {rep: _apply(tess, kept, criterion) for rep, tess in tessellations.items()}
-        total = sum(sizes[rep] * len(t.elements) for rep, t in applied.items())
+        applied = {rep: split_tessellation(tess, kept, criterion) for rep, tess in tessellations.items()}
+        total = sum(sizes[rep] * len(result[0].elements) for rep, result in applied.items())
         key = (total, sorted(kept))
         if best is None or key < best[0]:
             best = (key, kept, applied)
     _, kept, applied = best
-    return Choice(criterion, kept, applied)
+    splits: dict[str, Counter] = {}
+    for rep, (_, used) in applied.items():
+        for element, pieces in used:
+            position = {node: i for i, node in enumerate(element.nodes)}
+            split = tuple(sorted((p.type.id, tuple(position[n] for n in p.nodes)) for p in pieces))
+            splits.setdefault(element.type.id, Counter())[split] += sizes[rep]
+    return Choice(criterion, kept, {rep: result[0] for rep, result in applied.items()}, splits)
+
+
+def apply_catalogue_criterion(tess: Tessellation, criterion: str) -> Tessellation:
+    """Split a tessellation's elements by the shipped catalogue's kept types for a criterion.
+
+    The catalogue keeps, per criterion, the union of its studies' kept sets. An
+    element of a type it does not keep is split into kept types, fewest pieces
+    first; an element with no such split (a type no study met) stays whole.
+    """
+    from .catalogue import catalogue_path, load_catalogue
+
+    if criterion == "optimal":
+        return tess
+    kept = frozenset(load_catalogue(catalogue_path()).get("criteria", {}).get(criterion, {}).get("kept", []))
+    return split_tessellation(tess, kept, criterion, strict=False)[0]

@@ -4,6 +4,8 @@ A table is YAML: a header (schema_version, generator and catalogue versions,
 study, box, point policy, scheme, criteria) and, for every configuration code,
 ``fvm_adequate`` and per criterion the list of elements, each with its type id,
 node ids in the type's reference order (see the catalogue) and circumcenter.
+Where a criterion gives the same elements as an earlier one, the entry is that
+criterion's name (``internal_faces: optimal``) instead of a copy.
 A mesh generator looks a configuration up like this::
 
     table = cospherical.patterns.load("patterns/bisection-1x1x1.yaml")
@@ -33,7 +35,7 @@ def pattern_name(study: str, box_texts, face_points: str = "octree") -> str:
     return f"{study}-{box}" + ("" if face_points == "octree" else f"-{face_points}")
 
 
-def patterns_text(study: Study, catalogue_version: str, criteria=("optimal",)) -> str:
+def patterns_text(study: Study, catalogue_version: str) -> str:
     """The pattern table of a study as YAML text (deterministic)."""
     header = {
         "schema_version": SCHEMA_VERSION,
@@ -43,14 +45,22 @@ def patterns_text(study: Study, catalogue_version: str, criteria=("optimal",)) -
         "box": list(study.box.texts),
         "face_points": study.face_points,
         "scheme": SCHEMES.get(study.name, study.name),
-        "criteria": list(criteria),
+        "criteria": list(study.criteria),
     }
     lines = [yaml_text(header).rstrip("\n"), "configurations:"]
     for code in sorted(study.codes):
-        tess = study.tessellation(code)
         lines.append(f"  '{code}':")
-        lines.append(f"    fvm_adequate: {'true' if tess.fvm_adequate else 'false'}")
-        for criterion in criteria:
+        lines.append(f"    fvm_adequate: {'true' if study.tessellation(code).fvm_adequate else 'false'}")
+        written: dict[tuple, str] = {}
+        for criterion in study.criteria:
+            rep, _ = study.representative[code]
+            tess = study.choices[criterion].tessellations[rep]
+            key = tuple(e.polyhedron.nodes for e in tess.elements)
+            if key in written:  # most configurations need no split: name the criterion it equals
+                lines.append(f"    {criterion}: {written[key]}")
+                continue
+            written[key] = criterion
+            tess = study.tessellation(code, criterion)
             lines.append(f"    {criterion}:")
             for element in tess.elements:
                 nodes = ", ".join(map(str, element.nodes))
@@ -59,8 +69,8 @@ def patterns_text(study: Study, catalogue_version: str, criteria=("optimal",)) -
     return "\n".join(lines) + "\n"
 
 
-def write_patterns(study: Study, path: str | Path, catalogue_version: str, criteria=("optimal",)) -> None:
-    atomic_write(path, patterns_text(study, catalogue_version, criteria))
+def write_patterns(study: Study, path: str | Path, catalogue_version: str) -> None:
+    atomic_write(path, patterns_text(study, catalogue_version))
 
 
 @dataclass(frozen=True)
@@ -76,16 +86,24 @@ class PatternTable:
             raise KeyError(f"configuration {code!r} is not in this table")
         if criterion not in self.header["criteria"]:
             raise KeyError(f"criterion {criterion!r} is not in this table: {', '.join(self.header['criteria'])}")
-        return self.configurations[code][criterion]
+        elements = self.configurations[code][criterion]
+        while isinstance(elements, str):  # the same elements as another criterion
+            elements = self.configurations[code][elements]
+        return elements
 
 
 def load(path: str | Path) -> PatternTable:
     """Read a pattern table, validated against the JSON Schema; a bad file raises :class:`FormatError`."""
     data = load_yaml(path)
     validate(data, "patterns", path)
+    criteria = data["criteria"]
     for code, entry in data["configurations"].items():
-        for criterion in data["criteria"]:
+        for i, criterion in enumerate(criteria):
             if criterion not in entry:
                 raise FormatError(f"{path}: configuration {code}: no {criterion!r} elements")
+            same = entry[criterion]
+            if isinstance(same, str) and same not in criteria[:i]:
+                raise FormatError(f"{path}: configuration {code}: {criterion} refers to {same!r}, "
+                                  "which is not an earlier criterion of the table")
     header = {k: v for k, v in data.items() if k != "configurations"}
     return PatternTable(header, data["configurations"])

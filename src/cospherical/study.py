@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Callable, Sequence
 
 from .configuration import Box, Configuration
+from .criteria import CRITERIA, Choice, choose
 from .element_types import ElementType, classify
 from .symmetry import Symmetry, box_symmetries, orbit_representatives
 from .tessellation import Element, Tessellation, tessellate
@@ -49,14 +50,23 @@ class TypeCount:
 
 @dataclass(frozen=True)
 class Study:
-    """Every configuration of one family on one box, tessellated once per orbit."""
+    """Every configuration of one family on one box, tessellated once per orbit, per criterion."""
 
     name: str
     box: Box
     face_points: str
     codes: tuple[str, ...]
     representative: dict[str, tuple[str, Symmetry]]  # code -> (orbit representative, symmetry to it)
-    tessellations: dict[str, Tessellation]  # representative -> tessellation
+    choices: dict[str, Choice]  # criterion -> kept types and the representatives' tessellations
+
+    @property
+    def criteria(self) -> tuple[str, ...]:
+        return tuple(self.choices)
+
+    @property
+    def tessellations(self) -> dict[str, Tessellation]:
+        """Orbit representative -> its (optimal) tessellation."""
+        return self.choices["optimal"].tessellations
 
     @property
     def configurations(self) -> int:
@@ -69,13 +79,14 @@ class Study:
     def orbit_sizes(self) -> Counter:
         return Counter(rep for rep, _ in self.representative.values())
 
-    def tessellation(self, code: str) -> Tessellation:
-        """The tessellation of any configuration of the study."""
+    def tessellation(self, code: str, criterion: str = "optimal") -> Tessellation:
+        """The tessellation of any configuration of the study under a criterion."""
         rep, sym = self.representative[code]
+        tess = self.choices[criterion].tessellations[rep]
         if rep == code:
-            return self.tessellations[rep]
+            return tess
         target = Configuration.from_code(code, self.box, self.face_points)
-        return map_tessellation(self.tessellations[rep], sym.inverse(), target)
+        return map_tessellation(tess, sym.inverse(), target)
 
     def _count(self, predicate: Callable[[Tessellation], bool]) -> int:
         return sum(size for rep, size in self.orbit_sizes().items() if predicate(self.tessellations[rep]))
@@ -88,18 +99,19 @@ class Study:
     def fvm_adequate_open(self) -> int:
         return self._count(lambda t: t.fvm_adequate_open)
 
-    @property
-    def total(self) -> int:
-        return sum(size * len(self.tessellations[rep].elements) for rep, size in self.orbit_sizes().items())
+    def total(self, criterion: str = "optimal") -> int:
+        reps = self.choices[criterion].tessellations
+        return sum(size * len(reps[rep].elements) for rep, size in self.orbit_sizes().items())
 
-    def type_counts(self) -> list[TypeCount]:
+    def type_counts(self, criterion: str = "optimal") -> list[TypeCount]:
         """Element types by decreasing count, then id."""
         counts: Counter = Counter()
         configurations: Counter = Counter()
         types: dict[str, ElementType] = {}
+        reps = self.choices[criterion].tessellations
         for rep, size in self.orbit_sizes().items():
-            per_type = Counter(e.type.id for e in self.tessellations[rep].elements)
-            for element in self.tessellations[rep].elements:
+            per_type = Counter(e.type.id for e in reps[rep].elements)
+            for element in reps[rep].elements:
                 types[element.type.id] = element.type
             for type_id, n in per_type.items():
                 counts[type_id] += n * size
@@ -116,11 +128,14 @@ def run_study(
     codes: Sequence[str],
     face_points: str = "octree",
     progress: Progress | None = None,
+    criteria: Sequence[str] = CRITERIA,
 ) -> Study:
     """Tessellate every configuration code, one per orbit of the box's symmetries.
 
     ``progress(n)`` is called as orbits are done, with the number of
-    configurations they account for.
+    configurations they account for.  Each criterion (``optimal``,
+    ``internal_faces``, ``internal_edges_and_faces``) gets its kept types and
+    split tessellations.
     """
     symmetries = box_symmetries(box)
     reps, sym_index = orbit_representatives(codes, symmetries)
@@ -131,4 +146,5 @@ def run_study(
         tessellations[rep] = tessellate(Configuration.from_code(rep, box, face_points))
         if progress:
             progress(sizes[rep])
-    return Study(name, box, face_points, tuple(codes), representative, tessellations)
+    choices = {criterion: choose(tessellations, sizes, criterion) for criterion in criteria}
+    return Study(name, box, face_points, tuple(codes), representative, choices)

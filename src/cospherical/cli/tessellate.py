@@ -6,6 +6,7 @@ import argparse
 
 from ..configuration import POINT_POLICIES, Configuration
 from ..exact import InputError
+from ..criteria import CRITERIA, apply_catalogue_criterion
 from ..tessellation import tessellate
 from .output import FORMATS, emit
 
@@ -31,6 +32,9 @@ def add_parser(commands) -> None:
     points.add_argument("--code", help="12 hexadecimal digits, digit k = 16*t on edge k (0 = no point)")
     parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree",
                         help="octree (default): add face and body points of refined neighbours; none: edges only")
+    parser.add_argument("--criterion", choices=CRITERIA, default="optimal",
+                        help="optimal (default): largest co-spherical elements; internal_faces / "
+                        "internal_edges_and_faces: split the types the catalogue does not keep for that criterion")
     parser.add_argument("--format", choices=FORMATS, default="json")
     parser.set_defaults(run=run)
 
@@ -45,5 +49,10 @@ def run(args) -> int:
                 raise InputError(f"edge {edge}: given twice")
             steiner[edge.strip()] = t
         configuration = Configuration.from_steiner(args.box, steiner, args.face_points)
-    emit(tessellate(configuration).to_dict(), args.format)
+    tess = tessellate(configuration)
+    if args.criterion != "optimal":
+        tess = apply_catalogue_criterion(tess, args.criterion)
+    data = tess.to_dict()
+    data["criterion"] = args.criterion
+    emit(data, args.format)
     return 0
