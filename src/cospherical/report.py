@@ -142,6 +142,31 @@ def paper_comparison(summary: dict, key: str, criterion: str = "optimal") -> dic
     }
 
 
+def paper_set_gaps(study: Study, key: str, criterion: str) -> list[dict]:
+    """Element types of the study that cannot be split into the paper's kept classes.
+
+    The paper's table for a criterion names the classes it keeps; an element whose
+    every split (the element itself included) has a piece outside those classes
+    proves that the paper's table cannot come out for this point set.
+    """
+    from .criteria import element_options
+
+    kept_classes = set(paper_studies()[key][criterion]["counts"])
+    sizes = study.orbit_sizes()
+    gaps: dict[str, dict] = {}
+    for rep, tess in study.tessellations.items():
+        for element in tess.elements:
+            options = element_options(tess, element, criterion)
+            if any(all((paper_class(p.type) or {}).get("name") in kept_classes for p in o) for o in options):
+                continue
+            entry = gaps.setdefault(element.type.id, {
+                "type": element.type.id, "name": element.type.name, "configurations": 0,
+                "splits": sorted({" + ".join(sorted(p.type.name for p in o)) for o in options}),
+            })
+            entry["configurations"] += sizes[rep]
+    return sorted(gaps.values(), key=lambda g: g["type"])
+
+
 def _mark(paper, ours) -> str:
     return "" if paper == ours else "  <- differs"
 
@@ -196,6 +221,13 @@ def comparison_lines(summary: dict, study: Study) -> list[str]:
         classes = table["classes"]
         lines.append(f"    {'element classes':<48} {classes['paper']:>8} {classes['ours']:>8}"
                      f"{_mark(classes['paper'], classes['ours'])}")
+        if criterion != "optimal":
+            gaps = paper_set_gaps(study, key, criterion)
+            if gaps:
+                lines.append("    The paper's kept classes cannot tessellate these elements (every split shown):")
+                for gap in gaps:
+                    lines.append(f"      {gap['name']} ({gap['configurations']} configurations): "
+                                 + "; ".join(gap["splits"]))
     if any(c != "optimal" and c in paper_studies()[key] for c in summary["criteria"]):
         notes = notes + ["splits"]
     fvm = paper_comparison(summary, key)["fvm_adequate"]
