@@ -13,7 +13,7 @@ import yaml
 
 from .exact import InputError
 
-__all__ = ["FormatError", "atomic_write", "dump_yaml", "load_yaml", "validate", "yaml_float"]
+__all__ = ["FormatError", "atomic_write", "dump_yaml", "load_yaml", "parse_yaml", "validate", "yaml_float"]
 
 _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
@@ -62,18 +62,23 @@ def yaml_float(x: float) -> str:
 
 
 def load_yaml(path: str | Path):
+    """Read a YAML file with safe loading; a missing, unreadable or malformed file raises FormatError."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
         raise FormatError(f"{path}: cannot read: {getattr(error, 'strerror', None) or error}") from None
+    return parse_yaml(text, str(path))
+
+
+def parse_yaml(text: str, name: str):
     try:
         return yaml.load(text, Loader=_Loader)
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark else ""
         problem = getattr(error, "problem", None) or "not valid YAML"
-        raise FormatError(f"{path}:{where}: {problem}") from None
+        raise FormatError(f"{name}:{where}: {problem}") from None
 
 
 @lru_cache(maxsize=None)

@@ -6,11 +6,11 @@ import argparse
 import sys
 
 from ..exact import InputError
-from . import reproduce, study, tessellate
+from . import diff, reproduce, study, tessellate
 
 __all__ = ["main"]
 
-SUBCOMMANDS = (tessellate, study, reproduce)
+SUBCOMMANDS = (tessellate, study, reproduce, diff)
 
 
 class UsageError(Exception):

@@ -1,0 +1,65 @@
+"""``cospherical diff``: what changed between two catalogue or pattern-table versions.
+
+Exit status as diff(1): 0 no difference, 1 differences, 2 trouble.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from ..diff import diff_documents, has_changes, text_report
+from ..yamlio import FormatError, load_yaml, parse_yaml
+from .output import dump
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser(
+        "diff",
+        help="compare two catalogue or pattern-table versions",
+        description="Compare two catalogues (types matched by canonical code) or two pattern tables "
+        "(configurations whose elements changed, per criterion). Exit status: 0 no difference, "
+        "1 differences, 2 trouble.",
+    )
+    parser.add_argument("files", nargs="+", metavar="FILE", help="OLD NEW, or with --rev just the file")
+    parser.add_argument("--rev", metavar="REV", help="read OLD from git at this revision (e.g. HEAD~3)")
+    parser.add_argument("--format", choices=("text", "json", "yaml"), default="text")
+    parser.set_defaults(run=run)
+
+
+def _from_git(rev: str, path: Path):
+    path = path.resolve()
+    try:
+        result = subprocess.run(["git", "show", f"{rev}:./{path.name}"], cwd=path.parent,
+                                capture_output=True, text=True)
+    except OSError as error:
+        raise FormatError(f"git: {error.strerror}") from None
+    if result.returncode != 0:
+        message = (result.stderr.strip().splitlines() or ["git show failed"])[-1]
+        raise FormatError(f"{path.name} at {rev}: {message}")
+    return parse_yaml(result.stdout, f"{path.name}@{rev}")
+
+
+def run(args) -> int:
+    from . import UsageError
+
+    if args.rev:
+        if len(args.files) != 1:
+            raise UsageError("cospherical diff: error: with --rev give one FILE (OLD is that file at REV)")
+        new_path = Path(args.files[0])
+        old_name, new_name = f"{new_path}@{args.rev}", str(new_path)
+        old = _from_git(args.rev, new_path)
+    else:
+        if len(args.files) != 2:
+            raise UsageError("cospherical diff: error: give OLD NEW (or --rev REV FILE)")
+        old_name, new_name = args.files
+        old = load_yaml(old_name)
+        new_path = Path(new_name)
+    new = load_yaml(new_path)
+    report = diff_documents(old, new, old_name, new_name)
+    if args.format == "text":
+        sys.stdout.write(text_report(report, old_name, new_name))
+    else:
+        sys.stdout.write(dump({"old": old_name, "new": new_name, **report}, args.format))
+    return 1 if has_changes(report) else 0
