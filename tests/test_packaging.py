@@ -28,3 +28,8 @@ def test_wheel_installs_and_runs_in_a_fresh_venv(tmp_path):
     assert result.returncode == 0, result.stderr
     names = {e["name"] for e in json.loads(result.stdout)["elements"]}
     assert "Deformed Prism (variant 2)" in names  # a name only the shipped catalogue knows
+    summary = ROOT / "results" / "bisection-1x2x4.json"
+    result = subprocess.run([str(env_dir / "bin" / "cospherical"), "render", "--summary", str(summary),
+                             "--out", str(away / "tex")], cwd=away, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr  # the templates ship in the wheel
+    assert "\\begin{longtable}" in (away / "tex" / "elements.tex").read_text()

@@ -49,10 +49,15 @@ class ElementType:
     @property
     def face_summary(self) -> str:
         """``4 triangles + 1 rectangle``."""
-        parts = []
-        for kind, count in sorted(self.face_kinds, key=lambda kc: (-kc[1], kc[0])):
-            parts.append(f"{count} {kind if count == 1 else _KIND_PLURAL.get(kind, kind + 's')}")
-        return " + ".join(parts)
+        return face_summary(dict(self.face_kinds))
+
+
+def face_summary(face_kinds: dict[str, int]) -> str:
+    """Face counts in words, most frequent first: ``4 triangles + 1 rectangle``."""
+    parts = []
+    for kind, count in sorted(face_kinds.items(), key=lambda kc: (-kc[1], kc[0])):
+        parts.append(f"{count} {kind if count == 1 else _KIND_PLURAL.get(kind, kind + 's')}")
+    return " + ".join(parts)
 
 
 def type_id(code: str, vertices: int, faces: int) -> str:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from fractions import Fraction
 
+from .configuration import Box
 from .paper import paper_class, paper_classes, paper_studies
 from .study import Study
 
@@ -36,24 +37,26 @@ def _normalised(box) -> tuple[Fraction, ...]:
     return tuple(s / squared[0] for s in squared)
 
 
-def paper_study_key(study: Study) -> tuple[str | None, list[str]]:
-    """The paper's study to compare with, and the notes on why figures may differ."""
-    if study.name != "bisection":
+def paper_study_key(summary: dict) -> tuple[str | None, list[str]]:
+    """The paper's study to compare a study summary with, and the notes on why figures may differ.
+
+    The paper computed its sqrt 2 case at 1.4142; a box at exactly sqrt 2 is
+    compared with it too, marked as a different box.
+    """
+    if summary["study"] != "bisection":
         return None, []
     notes = ["classes"]
-    if study.face_points != "octree":
+    if summary["face_points"] != "octree":
         notes.append("none_policy")
-    ratios = _normalised(study.box)
+    ratios = _normalised(Box.parse(summary["box"]))
     for key, entry in paper_studies().items():
         if not key.startswith("bisection"):
             continue
         lengths = [str(x) for x in entry["box"]]
-        from .configuration import Box
-
-        paper_box = Box.parse(["1.4142" if "sqrt" in x else x for x in lengths])
-        if ratios == _normalised(paper_box):
+        as_computed = Box.parse(["1.4142" if "sqrt" in x else x for x in lengths])
+        if ratios == _normalised(as_computed):
             return key, notes
-        if "sqrt" in "".join(lengths) and ratios == _normalised(Box.parse(lengths)):
+        if ratios == _normalised(Box.parse(lengths)):
             return key, notes + ["exact_sqrt2"]
     return None, notes
 
@@ -202,7 +205,7 @@ def text_report(summary: dict, compare_paper: bool = False, study: Study | None 
 
 
 def comparison_lines(summary: dict, study: Study) -> list[str]:
-    key, notes = paper_study_key(study)
+    key, notes = paper_study_key(summary)
     if key is None:
         return ["The paper has no study of this box to compare with."]
     lines = [f"Beside the paper ({key}, box {' x '.join(str(x) for x in paper_studies()[key]['box'])}):"]

@@ -6,11 +6,11 @@ import argparse
 import sys
 
 from ..exact import InputError
-from . import diff, reproduce, study, tessellate
+from . import diff, render, reproduce, study, tessellate
 
 __all__ = ["main"]
 
-SUBCOMMANDS = (tessellate, study, reproduce, diff)
+SUBCOMMANDS = (tessellate, study, reproduce, render, diff)
 
 
 class UsageError(Exception):

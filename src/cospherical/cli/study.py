@@ -48,7 +48,7 @@ def run(args) -> int:
         if args.compare_paper:
             from ..report import paper_comparison, paper_study_key
 
-            key, notes = paper_study_key(study)
+            key, notes = paper_study_key(summary)
             summary["paper"] = paper_comparison(summary, key) if key else None
         emit(summary, "json")
     else:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from ..configuration import POINT_POLICIES, Configuration
 from ..exact import InputError
@@ -36,6 +37,7 @@ def add_parser(commands) -> None:
                         help="optimal (default): largest co-spherical elements; internal_faces / "
                         "internal_edges_and_faces: split the types the catalogue does not keep for that criterion")
     parser.add_argument("--format", choices=FORMATS, default="json")
+    parser.add_argument("--vtu", type=Path, metavar="FILE", help="also write the tessellation as a VTU mesh (ParaView)")
     parser.set_defaults(run=run)
 
 
@@ -52,6 +54,10 @@ def run(args) -> int:
     tess = tessellate(configuration)
     if args.criterion != "optimal":
         tess = apply_catalogue_criterion(tess, args.criterion)
+    if args.vtu:
+        from ..mesh import write_vtu
+
+        write_vtu(tess, args.vtu)
     data = tess.to_dict()
     data["criterion"] = args.criterion
     emit(data, args.format)

@@ -1,0 +1,63 @@
+"""``cospherical render``: LaTeX tables (and a PDF) of a study, or of saved study summaries."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..catalogue import build_catalogue, catalogue_path, load_catalogue
+from ..configuration import POINT_POLICIES, Box
+from ..render import compile_pdf, render_tables
+from ..report import study_summary
+from ..study import bisection_codes, run_study
+from ..yamlio import FormatError, load_yaml
+from .progress import progress_bar
+
+SUMMARY_KEYS = ("study", "box", "face_points", "configurations", "fvm_adequate", "fvm_adequate_open", "criteria")
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser(
+        "render",
+        help="write LaTeX tables (and a PDF) of a study",
+        description="Render the element, frequency, FVM and paper-comparison tables of a study as LaTeX "
+        "(jinja2 templates), with a standalone document.tex that includes them all.",
+    )
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--study", choices=["bisection"], help="run this study first")
+    source.add_argument("--summary", nargs="+", type=Path, metavar="FILE",
+                        help="study summaries written by 'cospherical study --out' or 'reproduce'")
+    parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), help="box of the study (with --study)")
+    parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree")
+    parser.add_argument("--out", type=Path, required=True, metavar="DIR")
+    parser.add_argument("--pdf", action="store_true", help="compile document.tex with pdflatex into DIR")
+    parser.set_defaults(run=run)
+
+
+def _load_summary(path: Path) -> dict:
+    data = load_yaml(path)  # JSON is YAML
+    if not isinstance(data, dict) or any(key not in data for key in SUMMARY_KEYS):
+        missing = [k for k in SUMMARY_KEYS if not isinstance(data, dict) or k not in data]
+        raise FormatError(f"{path}: not a study summary (missing {', '.join(missing)})")
+    return data
+
+
+def run(args) -> int:
+    from . import UsageError
+
+    if args.study:
+        if not args.box:
+            raise UsageError("cospherical render: error: --study needs --box A B C")
+        codes = bisection_codes()
+        with progress_bar(len(codes), args.study) as advance:
+            study = run_study(args.study, Box.parse(args.box), codes, args.face_points, progress=advance)
+        catalogue = build_catalogue([study])
+        names = {t["id"]: (t["name"], t["aliases"]) for t in catalogue["types"]}
+        summaries = [study_summary(study, names)]
+    else:
+        summaries = [_load_summary(path) for path in args.summary]
+        catalogue = load_catalogue(catalogue_path())
+    written = render_tables(summaries, catalogue, args.out, "Delaunay tessellations of 1-irregular cuboids")
+    print(f"wrote {len(written)} files in {args.out}")
+    if args.pdf:
+        print(f"wrote {compile_pdf(args.out)}")
+    return 0

@@ -1,0 +1,56 @@
+"""Mesh export: a tessellation as a VTU file (meshio) that opens in ParaView.
+
+Standard elements are written as VTK tetra, pyramid, wedge and hexahedron cells.
+VTU cannot mix polyhedral cells with other kinds, so when any element has no
+VTK cell type every element is written as a VTK_POLYHEDRON with its faces.
+Cell data: ``type_hash`` (the 6 hex digits of the element type id, as an
+integer) and ``vertices``.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .tessellation import Tessellation
+
+__all__ = ["to_meshio", "write_vtu"]
+
+
+def to_meshio(tess: Tessellation):
+    import meshio
+
+    real = tess.configuration.real_nodes()
+    ids = sorted(real)
+    index = {node: i for i, node in enumerate(ids)}
+    points = np.array([real[i] for i in ids], dtype=float)
+    standard = all(e.type.vtk for e in tess.elements)
+    cells, type_hash, vertices = [], [], []
+    for element in tess.elements:
+        if standard:
+            cells.append(meshio.CellBlock(element.type.vtk, np.array([[index[n] for n in element.nodes]])))
+        else:
+            faces = [np.array([index[n] for n in face]) for face in element.polyhedron.faces]
+            cells.append(meshio.CellBlock(f"polyhedron{len(element.nodes)}", [faces]))
+        type_hash.append(np.array([int(element.type.id.rsplit("-", 1)[1], 16)]))
+        vertices.append(np.array([len(element.nodes)]))
+    return meshio.Mesh(points, cells, cell_data={"type_hash": type_hash, "vertices": vertices})
+
+
+def write_vtu(tess: Tessellation, path: str | Path) -> None:
+    """Write the tessellation to ``path`` atomically (temporary file, then rename)."""
+    import meshio
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".vtu", dir=path.parent)
+    os.close(fd)
+    try:
+        meshio.write(tmp, to_meshio(tess), file_format="vtu")
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -1,0 +1,233 @@
+"""LaTeX tables (jinja2 templates in ``templates/``), element pictures, and PDF compilation.
+
+Templates use ``\\BLOCK{...}`` for statements and ``\\VAR{...}`` for values, so
+that LaTeX's own braces need no escaping; every name goes through the ``tex``
+filter.  Pictures are generated from each element type's example geometry:
+one fixed oblique view, visible edges solid, hidden edges dashed.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+from importlib import resources
+from pathlib import Path
+
+import jinja2
+
+from . import __version__
+from .element_types import face_summary
+from .exact import InputError
+from .paper import paper_studies
+from .report import PAPER_NOTES, paper_comparison, paper_study_key
+from .yamlio import atomic_write
+
+__all__ = ["compile_pdf", "element_png", "render_tables", "tex", "tikz_picture"]
+
+_TEX = {
+    "\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_",
+    "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}",
+}
+
+
+def tex(value) -> str:
+    """Escape text for LaTeX.
+
+    >>> tex("Generic #5 (50% of a_b & c)")
+    'Generic \\\\#5 (50\\\\% of a\\\\_b \\\\& c)'
+    """
+    return "".join(_TEX.get(ch, ch) for ch in str(value))
+
+
+def template_dir() -> Path:
+    """The templates: package data in a wheel, ``templates/`` in a checkout."""
+    packaged = Path(str(resources.files("cospherical").joinpath("templates")))
+    if packaged.is_dir():
+        return packaged
+    return Path(__file__).resolve().parents[2] / "templates"
+
+
+def environment() -> jinja2.Environment:
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(template_dir())),
+        block_start_string=r"\BLOCK{", block_end_string="}",
+        variable_start_string=r"\VAR{", variable_end_string="}",
+        comment_start_string=r"\#{", comment_end_string="}",
+        trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
+        autoescape=False, undefined=jinja2.StrictUndefined,
+    )
+    env.filters["tex"] = tex
+    return env
+
+
+# The view: seen from the front, a little from the right and from above.
+_TOWARD_VIEWER = (0.35, -1.0, 0.55)
+
+
+def _normalise(v):
+    n = math.sqrt(sum(x * x for x in v))
+    return tuple(x / n for x in v)
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _projection(entry: dict, size: float):
+    """Screen coordinates of the example's vertices and each edge's visibility."""
+    d = _normalise(_TOWARD_VIEWER)
+    right = _normalise(_cross((0, 0, 1), d))
+    up = _cross(d, right)
+    points = entry["example"]["coordinates"]
+    screen = [(sum(a * b for a, b in zip(p, right)), sum(a * b for a, b in zip(p, up))) for p in points]
+    xs, ys = [s[0] for s in screen], [s[1] for s in screen]
+    scale = size / max(max(xs) - min(xs), max(ys) - min(ys))
+    cx, cy = (max(xs) + min(xs)) / 2, (max(ys) + min(ys)) / 2
+    screen = [((x - cx) * scale, (y - cy) * scale) for x, y in screen]
+    visible_edges, edges = set(), set()
+    for face in entry["reference_faces"]:
+        nodes = face["nodes"]
+        p0, p1, p2 = (points[i] for i in nodes[:3])
+        normal = _cross([b - a for a, b in zip(p0, p1)], [b - a for a, b in zip(p0, p2)])
+        front = sum(a * b for a, b in zip(normal, d)) > 0
+        for i, v in enumerate(nodes):
+            edge = tuple(sorted((v, nodes[(i + 1) % len(nodes)])))
+            edges.add(edge)
+            if front:
+                visible_edges.add(edge)
+    return screen, sorted(edges), visible_edges
+
+
+def tikz_picture(entry: dict, size: float = 1.6) -> str:
+    """A TikZ drawing of a catalogue entry's example (size in cm)."""
+    screen, edges, visible = _projection(entry, size)
+    lines = [r"\begin{tikzpicture}[line join=round]"]
+    for hidden in (True, False):  # hidden edges first, so that visible ones are drawn on top
+        for a, b in edges:
+            if ((a, b) in visible) == hidden:
+                continue
+            style = "[densely dashed, gray]" if hidden else "[thick]"
+            (x1, y1), (x2, y2) = screen[a], screen[b]
+            lines.append(rf"\draw{style} ({x1:.3f},{y1:.3f}) -- ({x2:.3f},{y2:.3f});")
+    for x, y in screen:
+        lines.append(rf"\fill ({x:.3f},{y:.3f}) circle (0.6pt);")
+    lines.append(r"\end{tikzpicture}")
+    return "\n".join(lines)
+
+
+def element_png(entry: dict, path: Path, size_px: int = 160) -> None:
+    """A PNG picture of a catalogue entry's example (matplotlib, deterministic metadata)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    screen, edges, visible = _projection(entry, 1.0)
+    fig = plt.figure(figsize=(size_px / 100, size_px / 100), dpi=100)
+    ax = fig.add_axes([0.05, 0.05, 0.9, 0.9])
+    for a, b in edges:
+        (x1, y1), (x2, y2) = screen[a], screen[b]
+        if (a, b) in visible:
+            ax.plot([x1, x2], [y1, y2], color="black", linewidth=1.4, solid_capstyle="round")
+        else:
+            ax.plot([x1, x2], [y1, y2], color="gray", linewidth=0.8, linestyle=(0, (3, 2)))
+    ax.plot([x for x, _ in screen], [y for _, y in screen], "o", color="black", markersize=2.5)
+    ax.set_xlim(-0.55, 0.55)
+    ax.set_ylim(-0.55, 0.55)
+    ax.set_aspect("equal")
+    ax.axis("off")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp")
+    fig.savefig(tmp, format="png", metadata={"Software": None})
+    plt.close(fig)
+    tmp.replace(path)
+
+
+def _type_rows(summaries: list[dict], catalogue: dict) -> list[dict]:
+    entries = {t["id"]: t for t in catalogue["types"]}
+    seen: dict[str, dict] = {}
+    for summary in summaries:
+        for data in summary["criteria"].values():
+            for type_id, t in data["types"].items():
+                seen.setdefault(type_id, t)
+    rows = []
+    for type_id in sorted(seen, key=lambda i: (seen[i]["vertices"], seen[i]["faces"], i)):
+        t = seen[type_id]
+        entry = entries.get(type_id)
+        rows.append({**t, "face_summary": face_summary(entry["face_kinds"]) if entry else "--",
+                     "picture": tikz_picture(entry) if entry else None})
+    return rows
+
+
+def _stem(summary: dict) -> str:
+    from .patterns import pattern_name
+
+    return pattern_name(summary["study"], summary["box"], summary["face_points"])
+
+
+def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str) -> list[Path]:
+    """Write every table of the studies' summaries, and ``document.tex`` including them all."""
+    env = environment()
+    written: list[Path] = []
+
+    def write(name: str, template: str, **context) -> str:
+        path = out / name
+        atomic_write(path, env.get_template(template).render(**context))
+        written.append(path)
+        return name
+
+    sections = [{"title": "Element types",
+                 "files": [write("elements.tex", "elements.tex.j2", types=_type_rows(summaries, catalogue),
+                                 caption="Element types met, with a picture of an example")]}]
+    fvm_rows = []
+    for summary in summaries:
+        stem = _stem(summary)
+        key, notes = paper_study_key(summary)
+        box = " x ".join(summary["box"])
+        files = []
+        for criterion, data in summary["criteria"].items():
+            rows = [{"name": t["name"], "paper_class": t["paper_class"], "count": t["count"], "share": t["share"],
+                     "configurations": t["configurations"]} for t in data["types"].values()]
+            files.append(write(f"frequencies-{stem}-{criterion}.tex", "frequencies.tex.j2", rows=rows,
+                               total=data["total"], types_count=data["types_count"],
+                               caption=f"Element frequencies, box {box}, {summary['face_points']} points, {criterion}"))
+            if key and criterion in paper_studies()[key]:
+                table = paper_comparison(summary, key, criterion)
+                crows = [{"label": r["class"], "paper": "--" if r["paper"] is None else f"{r['paper']:,}",
+                          "ours": "--" if r["ours"] is None else f"{r['ours']:,}",
+                          "differs": r["paper"] != r["ours"]} for r in table["rows"]]
+                total = {"paper": f"{table['total']['paper']:,}", "ours": f"{table['total']['ours']:,}",
+                         "differs": table["total"]["paper"] != table["total"]["ours"]}
+                fvm = table["fvm_adequate"]
+                extra = (["splits"] if criterion != "optimal" else
+                         ["fvm"] if fvm["paper"] not in (fvm["closed"], fvm["open"]) else [])
+                files.append(write(f"comparison-{stem}-{criterion}.tex", "comparison.tex.j2", rows=crows,
+                                   total=total, notes=[PAPER_NOTES[n] for n in notes + extra],
+                                   caption=f"Beside the paper ({key}), box {box}, {summary['face_points']} points, {criterion}"))
+        fvm_rows.append({"box": box, "face_points": summary["face_points"],
+                         "configurations": summary["configurations"], "closed": summary["fvm_adequate"],
+                         "open": summary["fvm_adequate_open"],
+                         "paper": paper_comparison(summary, key)["fvm_adequate"]["paper"] if key else None})
+        sections.append({"title": f"{summary['study'].capitalize()} study, box {box}, {summary['face_points']} points",
+                         "files": files})
+    sections.insert(1, {"title": "Finite-volume circumcenter test",
+                        "files": [write("fvm.tex", "fvm.tex.j2", rows=fvm_rows,
+                                        caption="Configurations whose element circumcenters all lie in the box")]})
+    write("document.tex", "document.tex.j2", title=title, version=__version__, sections=sections)
+    return written
+
+
+def compile_pdf(out: Path, document: str = "document.tex") -> Path:
+    """Compile with pdflatex (twice, for the long tables) and leave the PDF in ``out``."""
+    pdflatex = shutil.which("pdflatex")
+    if pdflatex is None:
+        raise InputError("pdflatex not found: install a TeX engine (Debian: texlive-latex-base, "
+                         "texlive-latex-recommended, texlive-pictures)")
+    for _ in range(2):
+        result = subprocess.run([pdflatex, "-interaction=nonstopmode", "-halt-on-error", document],
+                                cwd=out, capture_output=True, text=True)
+        if result.returncode != 0:
+            error = next((line for line in result.stdout.splitlines() if line.startswith("!")), "pdflatex failed")
+            raise InputError(f"{out / document}: {error} (see {out / Path(document).with_suffix('.log').name})")
+    return out / Path(document).with_suffix(".pdf")
