@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import filecmp
 import json
 import subprocess
@@ -12,7 +13,8 @@ import pytest
 
 from cospherical import Box, Configuration, tessellate
 from cospherical.catalogue import catalogue_path, load_catalogue
-from cospherical.patterns import load, pattern_name
+from cospherical.check import check_catalogue, check_patterns
+from cospherical.patterns import load, pattern_name, write_patterns
 from cospherical.report import paper_comparison, paper_study_key, study_summary
 from cospherical.study import bisection_codes, run_study
 from cospherical.symmetry import box_symmetries
@@ -78,23 +80,29 @@ def test_exact_sqrt2_is_marked_as_a_different_box():
     assert paper_comparison(study_summary(study), key)["total"]["ours"] != 43035
 
 
-def test_committed_catalogue_and_patterns_validate():
+@pytest.fixture(scope="module")
+def committed_tables():
+    """The committed pattern tables, each read once (a 4096-configuration table takes seconds)."""
+    stems = ("bisection-1x1x1", "bisection-1x2x4", "bisection-1x1.4142x1.4142", "bisection-1xsqrt2xsqrt2")
+    return {stem: load(ROOT / "patterns" / f"{stem}.yaml") for stem in stems}
+
+
+def test_committed_catalogue_and_patterns_validate(committed_tables):
     catalogue = load_catalogue(catalogue_path())
+    check_catalogue(catalogue, "catalogue")
     ids = [t["id"] for t in catalogue["types"]]
-    assert len(ids) == len(set(ids)) and len({t["code"] for t in catalogue["types"]}) == len(ids)
-    assert len({t["name"] for t in catalogue["types"]}) == len(ids), "names are unique"
     names = {t["name"] for t in catalogue["types"]}
     assert {"tetrahedron", "cuboid", "rectangular pyramid", "Tetrahedron Complement", "Generic #8"} <= names
-    for stem in ("bisection-1x1x1", "bisection-1x2x4", "bisection-1x1.4142x1.4142", "bisection-1xsqrt2xsqrt2"):
-        table = load(ROOT / "patterns" / f"{stem}.yaml")
+    for stem, table in committed_tables.items():
         assert table.header["catalogue_version"] == catalogue["version"]
         assert len(table.configurations) == 4096
         known = set(ids)
         assert all(e["type"] in known for entry in table.configurations.values() for e in entry["optimal"])
+        check_patterns(table, catalogue, stem)  # known types, node counts, and every configuration tiles the box
 
 
-def test_pattern_lookup_equals_tessellate():
-    table = load(ROOT / "patterns" / "bisection-1x2x4.yaml")
+def test_pattern_lookup_equals_tessellate(committed_tables):
+    table = committed_tables["bisection-1x2x4"]
     for code in bisection_codes()[::97]:
         tess = tessellate(Configuration.from_code(code, ("1", "2", "4")))
         assert table.elements(code) == [
@@ -102,6 +110,14 @@ def test_pattern_lookup_equals_tessellate():
             for e in tess.elements
         ]
         assert table.configurations[code]["fvm_adequate"] == tess.fvm_adequate
+
+
+@pytest.fixture(scope="module")
+def small_table(tmp_path_factory):
+    path = tmp_path_factory.mktemp("small") / "small.yaml"
+    study = run_study("bisection", Box.parse(("1", "2", "4")), ["000000000000", "800000000000", "880000000000"])
+    write_patterns(study, path, "000000000000")
+    return load_yaml(path)
 
 
 @pytest.mark.parametrize(
@@ -114,9 +130,8 @@ def test_pattern_lookup_equals_tessellate():
         (lambda d: d.pop("box"), "box"),
     ],
 )
-def test_broken_pattern_tables_are_refused(tmp_path, edit, needle):
-    data = load_yaml(ROOT / "patterns" / "bisection-1x2x4.yaml")
-    data["configurations"] = {k: data["configurations"][k] for k in ("000000000000", "800000000000")}
+def test_broken_pattern_tables_are_refused(tmp_path, small_table, edit, needle):
+    data = copy.deepcopy(small_table)
     edit(data)
     path = tmp_path / "broken.yaml"
     dump_yaml(data, path)

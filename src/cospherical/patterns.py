@@ -23,7 +23,7 @@ from . import __version__
 from .study import Study
 from .yamlio import FormatError, atomic_write, load_yaml, validate, yaml_float, yaml_text
 
-__all__ = ["PatternTable", "SCHEMA_VERSION", "load", "pattern_name", "patterns_text", "write_patterns"]
+__all__ = ["PatternTable", "SCHEMA_VERSION", "load", "pattern_name", "patterns_text", "table_from_data", "write_patterns"]
 
 SCHEMA_VERSION = 1
 SCHEMES = {"bisection": "midpoints: every Steiner point at t = 1/2"}
@@ -94,16 +94,20 @@ class PatternTable:
 
 def load(path: str | Path) -> PatternTable:
     """Read a pattern table, validated against the JSON Schema; a bad file raises :class:`FormatError`."""
-    data = load_yaml(path)
-    validate(data, "patterns", path)
+    return table_from_data(load_yaml(path), str(path))
+
+
+def table_from_data(data, name: str) -> PatternTable:
+    """A :class:`PatternTable` from parsed YAML, validated (schema, criteria references)."""
+    validate(data, "patterns", name)
     criteria = data["criteria"]
     for code, entry in data["configurations"].items():
         for i, criterion in enumerate(criteria):
             if criterion not in entry:
-                raise FormatError(f"{path}: configuration {code}: no {criterion!r} elements")
+                raise FormatError(f"{name}: configuration {code}: no {criterion!r} elements")
             same = entry[criterion]
             if isinstance(same, str) and same not in criteria[:i]:
-                raise FormatError(f"{path}: configuration {code}: {criterion} refers to {same!r}, "
+                raise FormatError(f"{name}: configuration {code}: {criterion} refers to {same!r}, "
                                   "which is not an earlier criterion of the table")
     header = {k: v for k, v in data.items() if k != "configurations"}
     return PatternTable(header, data["configurations"])

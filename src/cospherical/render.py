@@ -139,9 +139,14 @@ def element_png(entry: dict, path: Path, size_px: int = 160) -> None:
     ax.axis("off")
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp")
-    fig.savefig(tmp, format="png", metadata={"Software": None})
-    plt.close(fig)
-    tmp.replace(path)
+    try:
+        fig.savefig(tmp, format="png", metadata={"Software": None})
+        tmp.replace(path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    finally:
+        plt.close(fig)
 
 
 def _type_rows(summaries: list[dict], catalogue: dict) -> list[dict]:

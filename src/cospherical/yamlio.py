@@ -15,8 +15,25 @@ from .exact import InputError
 
 __all__ = ["FormatError", "atomic_write", "dump_yaml", "load_yaml", "parse_yaml", "validate", "yaml_float"]
 
-_Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+
+
+class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
+    """Safe loading that refuses a mapping with a repeated key (YAML would keep the last)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            try:
+                repeated = key in seen
+                seen.add(key)
+            except TypeError:
+                raise yaml.constructor.ConstructorError(None, None, "a mapping key that is not a plain value",
+                                                        key_node.start_mark) from None
+            if repeated:
+                raise yaml.constructor.ConstructorError(None, None, f"repeated key {key!r}", key_node.start_mark)
+        return super().construct_mapping(node, deep)
 
 
 class FormatError(InputError):

@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import argparse
+import importlib
+import signal
 import sys
+import threading
 
 from ..exact import InputError
-from . import diff, render, reproduce, study, tessellate
 
 __all__ = ["main"]
 
-SUBCOMMANDS = (tessellate, study, reproduce, render, diff)
+# One module per subcommand, imported inside main() so that an interrupt while
+# the heavy libraries load is handled like any other.
+SUBCOMMANDS = ("tessellate", "study", "reproduce", "render", "diff", "check")
 
 
 class UsageError(Exception):
@@ -32,12 +36,20 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"cospherical {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for module in SUBCOMMANDS:
-        module.add_parser(commands)
+    for name in SUBCOMMANDS:
+        importlib.import_module(f"{__name__}.{name}").add_parser(commands)
     return parser
 
 
+def _terminated(signum, frame):
+    # SIGTERM unwinds like an exception, so that temporary files are removed and
+    # every output stays either the old complete file or the new complete file.
+    raise SystemExit(128 + signum)
+
+
 def main(argv: list[str] | None = None) -> int:
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminated)
     try:
         args = build_parser().parse_args(argv)
         return args.run(args)
@@ -47,6 +59,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("cospherical: interrupted", file=sys.stderr)
         return 130
+    except SystemExit as exit:
+        if exit.code == 128 + signal.SIGTERM:
+            print("cospherical: terminated", file=sys.stderr)
+        raise
 
 
 if __name__ == "__main__":  # pragma: no cover

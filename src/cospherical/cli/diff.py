@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+from ..check import validated
 from ..diff import diff_documents, has_changes, text_report
 from ..yamlio import FormatError, load_yaml, parse_yaml
 from .output import dump
@@ -57,6 +58,8 @@ def run(args) -> int:
         old = load_yaml(old_name)
         new_path = Path(new_name)
     new = load_yaml(new_path)
+    validated(old, old_name)
+    validated(new, new_name)
     report = diff_documents(old, new, old_name, new_name)
     if args.format == "text":
         sys.stdout.write(text_report(report, old_name, new_name))

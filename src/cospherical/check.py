@@ -1,0 +1,126 @@
+"""Deep checks of catalogue and pattern-table files, beyond their JSON Schemas.
+
+A pattern table's elements are checked against the catalogue (known type ids,
+one node per vertex) and against geometry: every configuration's elements,
+with the nodes its code and the table's box and point policy give, must tile
+the box (exact volumes adding up to the box, every face shared by two
+elements or lying on the box's boundary).
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from fractions import Fraction
+
+from .configuration import Box, Configuration
+from .exact import InputError
+from .geometry import Frame, cross, dot, sub
+from .yamlio import FormatError
+
+__all__ = ["check_catalogue", "check_patterns"]
+
+
+def check_catalogue(data: dict, name: str) -> None:
+    """Ids, codes and names unique; faces consistent with V/E/F; splits name known types."""
+    ids = Counter(t["id"] for t in data["types"])
+    for field in ("id", "code", "name"):
+        repeated = [k for k, n in Counter(t[field] for t in data["types"]).items() if n > 1]
+        if repeated:
+            raise FormatError(f"{name}: types: {field} {repeated[0]!r} appears more than once")
+    for i, t in enumerate(data["types"]):
+        where = f"{name}: types/{i} ({t['id']})"
+        faces = [f["nodes"] for f in t["reference_faces"]]
+        if len(faces) != t["faces"] or any(not 0 <= v < t["vertices"] for f in faces for v in f):
+            raise FormatError(f"{where}: reference_faces do not match {t['vertices']} vertices and {t['faces']} faces")
+        edges = {frozenset((f[k], f[(k + 1) % len(f)])) for f in faces for k in range(len(f))}
+        if len(edges) != t["edges"] or t["vertices"] - t["edges"] + t["faces"] != 2:
+            raise FormatError(f"{where}: V/E/F {t['vertices']}/{t['edges']}/{t['faces']} do not fit its faces")
+        for criterion, splits in t.get("splits", {}).items():
+            for split in splits:
+                for piece in split:
+                    if piece["type"] not in ids:
+                        raise FormatError(f"{where}: splits/{criterion}: unknown type {piece['type']!r}")
+    for criterion, entry in data.get("criteria", {}).items():
+        unknown = [k for k in entry.get("kept", []) if k not in ids]
+        if unknown:
+            raise FormatError(f"{name}: criteria/{criterion}/kept: unknown type {unknown[0]!r}")
+
+
+def _elements(entry: dict, criterion: str):
+    elements = entry[criterion]
+    while isinstance(elements, str):
+        elements = entry[elements]
+    return elements
+
+
+def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True) -> None:
+    """Check a loaded :class:`~cospherical.patterns.PatternTable` against the catalogue and geometry."""
+    types = {t["id"]: t for t in catalogue["types"]} if catalogue else None
+    header = table.header
+    try:
+        box = Box.parse(header["box"])
+    except InputError as error:
+        raise FormatError(f"{name}: box: {error}") from None
+    for code, entry in table.configurations.items():
+        try:
+            cfg = Configuration.from_code(code, box, header["face_points"])
+        except InputError as error:
+            raise FormatError(f"{name}: configurations/{code}: {error}") from None
+        nodes = cfg.nodes()
+        frame = Frame.build(nodes, box.squared) if tiling and types else None
+        for criterion in header["criteria"]:
+            where = f"{name}: configurations/{code}/{criterion}"
+            elements = _elements(entry, criterion)
+            for k, element in enumerate(elements):
+                missing = [n for n in element["nodes"] if n not in nodes]
+                if missing:
+                    raise FormatError(f"{where}/{k}: node {missing[0]} is not a point of this configuration")
+                if len(set(element["nodes"])) != len(element["nodes"]):
+                    raise FormatError(f"{where}/{k}: a node appears twice")
+                if types is not None:
+                    t = types.get(element["type"])
+                    if t is None:
+                        raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
+                    if len(element["nodes"]) != t["vertices"]:
+                        raise FormatError(f"{where}/{k}: {len(element['nodes'])} nodes for a type with {t['vertices']} vertices")
+            if frame is not None:
+                _check_tiling(frame, elements, types, where)
+
+
+def _check_tiling(frame: Frame, elements, types, where: str) -> None:
+    index = {node: i for i, node in enumerate(frame.ids)}
+    coords = frame.coords
+    total = 0
+    faces: Counter = Counter()
+    for k, element in enumerate(elements):
+        nodes = element["nodes"]
+        cycles = [[index[nodes[p]] for p in face["nodes"]] for face in types[element["type"]]["reference_faces"]]
+        apex = coords[cycles[0][0]]
+        six = 0
+        for cycle in cycles:
+            p = sub(coords[cycle[0]], apex)
+            for a, b in zip(cycle[1:-1], cycle[2:]):
+                six += dot(p, cross(sub(coords[a], apex), sub(coords[b], apex)))
+        if six <= 0:
+            raise FormatError(f"{where}/{k}: the nodes do not make a proper element of type {element['type']}")
+        total += six
+        faces.update(frozenset(frame.ids[v] for v in cycle) for cycle in cycles)
+    if Fraction(total, 6 * frame.scale**3) != 1:
+        raise FormatError(f"{where}: the elements do not fill the box (volume {Fraction(total, 6 * frame.scale**3)} of 1)")
+    for face, count in faces.items():
+        on_boundary = any(
+            len({coords[index[v]][axis] for v in face}) == 1 and coords[index[next(iter(face))]][axis] in (0, frame.scale)
+            for axis in range(3)
+        )
+        if count != (1 if on_boundary else 2):
+            raise FormatError(f"{where}: face {sorted(face)} belongs to {count} elements: they do not meet face to face")
+
+
+def validated(data, name: str) -> tuple[str, dict]:
+    """The document's kind (``catalogue`` or ``patterns``), after schema validation."""
+    from .diff import document_kind
+    from .yamlio import validate
+
+    kind = document_kind(data, name)
+    validate(data, kind, name)
+    return kind, data

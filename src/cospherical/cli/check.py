@@ -1,0 +1,43 @@
+"""``cospherical check``: validate catalogue and pattern-table files, deeply."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..catalogue import catalogue_path, load_catalogue
+from ..check import check_catalogue, check_patterns, validated
+from ..patterns import table_from_data
+from ..yamlio import load_yaml
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser(
+        "check",
+        help="validate catalogue and pattern-table files",
+        description="Validate catalogues (schema, unique ids, consistent faces, known split types) and pattern "
+        "tables (schema, known types, node counts, and that every configuration's elements tile the box). "
+        "Exit status 0 when every file is valid, 2 at the first problem.",
+    )
+    parser.add_argument("files", nargs="+", type=Path, metavar="FILE")
+    parser.add_argument("--catalogue", type=Path, metavar="FILE",
+                        help="catalogue that pattern tables refer to (default: the shipped one)")
+    parser.add_argument("--no-tiling", action="store_true", help="skip the geometric tiling check (faster)")
+    parser.set_defaults(run=run)
+
+
+def run(args) -> int:
+    catalogue = None
+    for path in args.files:
+        kind, data = validated(load_yaml(path), str(path))
+        if kind == "catalogue":
+            check_catalogue(data, str(path))
+            print(f"{path}: ok, catalogue of {len(data['types'])} element types")
+            continue
+        if catalogue is None:
+            catalogue_file = args.catalogue or catalogue_path()
+            catalogue = load_catalogue(catalogue_file)
+            check_catalogue(catalogue, str(catalogue_file))
+        table = table_from_data(data, str(path))
+        check_patterns(table, catalogue, str(path), tiling=not args.no_tiling)
+        print(f"{path}: ok, pattern table of {len(table.configurations)} configurations")
+    return 0

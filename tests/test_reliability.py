@@ -1,0 +1,141 @@
+"""Bad input through the real CLI, deep checks of files, and interrupted runs."""
+
+from __future__ import annotations
+
+import copy
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from cospherical import Box
+from cospherical.catalogue import catalogue_path, load_catalogue
+from cospherical.patterns import write_patterns
+from cospherical.study import run_study
+from cospherical.yamlio import dump_yaml, load_yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def cospherical(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "cospherical", *args], capture_output=True, text=True, cwd=cwd)
+
+
+def one_clean_line(result, needle: str) -> None:
+    assert result.returncode == 2, (result.returncode, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.stderr, result.stderr
+    assert needle in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def small_table(tmp_path_factory):
+    """A pattern table of a few configurations of the 1x2x4 box, as data to break."""
+    path = tmp_path_factory.mktemp("small") / "small.yaml"
+    codes = ["000000000000", "800000000000", "880000000000", "888888888888"]
+    study = run_study("bisection", Box.parse(("1", "2", "4")), codes)
+    write_patterns(study, path, load_catalogue(catalogue_path())["version"])
+    return load_yaml(path)
+
+
+def write(tmp_path, name, data) -> str:
+    path = tmp_path / name
+    dump_yaml(data, path)
+    return str(path)
+
+
+def test_good_files_pass_the_deep_check(tmp_path, small_table):
+    result = cospherical("check", str(ROOT / "catalogue" / "catalogue.yaml"), write(tmp_path, "good.yaml", small_table))
+    assert result.returncode == 0, result.stderr
+    assert "ok, catalogue of" in result.stdout and "ok, pattern table of 4 configurations" in result.stdout
+
+
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        (lambda d: d["configurations"]["800000000000"]["optimal"][0].update(type="v5f5-ffffff"), "unknown element type"),
+        (lambda d: d["configurations"]["800000000000"]["optimal"][0].update(nodes=[0, 1, 2, 3, 26]), "node 26 is not a point"),
+        (lambda d: d["configurations"]["800000000000"]["optimal"][0].update(nodes=[0, 1, 2, 3, 40]), "800000000000"),
+        (lambda d: d["configurations"]["800000000000"]["optimal"].pop(), "do not fill the box"),
+        (lambda d: d["configurations"]["880000000000"]["optimal"][0].update(
+            nodes=list(reversed(d["configurations"]["880000000000"]["optimal"][0]["nodes"]))), "configurations/880000000000"),
+        (lambda d: d["configurations"]["800000000000"]["optimal"].append(
+            d["configurations"]["800000000000"]["optimal"][0]), "do not fill the box"),
+        (lambda d: d["configurations"]["000000000000"].update(internal_faces="internal_edges_and_faces"), "internal_faces"),
+        (lambda d: d.update(box=["1", "0", "4"]), "box"),
+        (lambda d: d.update(schema_version=2), "schema_version"),
+    ],
+)
+def test_bad_pattern_tables_are_refused(tmp_path, small_table, edit, needle):
+    data = copy.deepcopy(small_table)
+    edit(data)
+    one_clean_line(cospherical("check", write(tmp_path, "bad.yaml", data)), needle)
+
+
+def test_repeated_configuration_codes_are_refused(tmp_path, small_table):
+    text = Path(write(tmp_path, "good.yaml", small_table)).read_text().splitlines()
+    start = text.index("configurations:") + 1
+    end = next(i for i in range(start + 1, len(text)) if text[i].startswith("  '"))
+    duplicated = text[: end] + text[start:end] + text[end:]
+    path = tmp_path / "twice.yaml"
+    path.write_text("\n".join(duplicated[:200]) + "\n")
+    one_clean_line(cospherical("check", str(path)), "repeated key '000000000000'")
+
+
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        (lambda d: d["types"].append(copy.deepcopy(d["types"][0])), "appears more than once"),
+        (lambda d: d["types"][0].update(edges=99), "V/E/F"),
+        (lambda d: d["types"][0]["reference_faces"][0].update(nodes=[0, 1, 9]), "reference_faces"),
+        (lambda d: d["criteria"]["internal_faces"]["kept"].append("v4f4-000000"), "unknown type"),
+        (lambda d: d["types"][0].pop("code"), "code"),
+    ],
+)
+def test_bad_catalogues_are_refused(tmp_path, edit, needle):
+    data = load_yaml(ROOT / "catalogue" / "catalogue.yaml")
+    edit(data)
+    one_clean_line(cospherical("check", write(tmp_path, "bad-catalogue.yaml", data)), needle)
+
+
+@pytest.mark.parametrize(
+    "content, needle",
+    [("", "neither a catalogue"), ("[1, 2", "line"), ("a: !!python/object:os.system x\n", "line"),
+     ("\xff\xfe", "cannot read")],
+)
+def test_unreadable_files_are_refused(tmp_path, content, needle):
+    path = tmp_path / "junk.yaml"
+    path.write_bytes(content.encode("latin-1"))
+    one_clean_line(cospherical("check", str(path)), needle)
+    one_clean_line(cospherical("diff", str(path), str(path)), needle)
+
+
+def test_missing_files_are_refused(tmp_path):
+    one_clean_line(cospherical("check", str(tmp_path / "nothere.yaml")), "nothere.yaml: cannot read")
+    one_clean_line(cospherical("render", "--summary", str(tmp_path / "nothere.json"), "--out", str(tmp_path)),
+                   "cannot read")
+
+
+def snapshot(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_interrupted_study_leaves_complete_outputs_and_no_temporary_files(tmp_path, sig):
+    args = [sys.executable, "-m", "cospherical", "study", "bisection", "--box", "1", "2", "4", "--out", str(tmp_path)]
+    assert subprocess.run(args, capture_output=True).returncode == 0
+    before = snapshot(tmp_path)
+    assert len(before) == 2
+    for delay in (0.3, 1.0, 2.0, 3.0, 4.0, 5.0):
+        process = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        time.sleep(delay)
+        process.send_signal(sig)
+        _, stderr = process.communicate(timeout=60)
+        if process.returncode != 0:
+            assert process.returncode in (130, 143, -sig), process.returncode
+            assert b"Traceback" not in stderr, stderr
+        assert snapshot(tmp_path) == before, f"outputs changed after a signal at {delay} s"
+        assert not list(tmp_path.glob(".*")), f"temporary files left after a signal at {delay} s"
