@@ -1,0 +1,227 @@
+"""Exact thresholds along a ray of boxes, such as (1, r, r) or (1, 1, r).
+
+Along a ray the squared lengths are w0 + u*w1 with u = r^2.  Every quantity
+that decides a tessellation is then linear in u: an in-sphere determinant has
+one column (the lifted one, L0 + u*L1) that depends on u; a circumcenter
+coordinate compared with a box face is a linear form; a right angle is a dot
+product weighted by the squared lengths.  So a tessellation computed at one
+value of u stays the Delaunay subdivision, with the same FVM verdict and the
+same face kinds, on the open interval between the nearest roots of those
+linear forms: exact rationals.  Sweeping u interval by interval gives every
+value where something can change, exactly; a threshold is reported where the
+FVM count or the set of element types really changes, as r = sqrt(u).
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import lru_cache
+
+from .configuration import Box, Configuration
+from .exact import InputError, Length
+from .geometry import Frame
+from .symmetry import box_symmetries, orbit_representatives
+from .tessellation import tessellate
+
+__all__ = ["Ray", "code_pieces", "ray_profile"]
+
+
+@dataclass(frozen=True)
+class Ray:
+    """Box (a, b, c) with each length 1 or r; ``scaled[i]`` says which."""
+
+    scaled: tuple[bool, bool, bool]
+
+    @classmethod
+    def parse(cls, text: str) -> "Ray":
+        parts = [p.strip().lower() for p in text.split(",")]
+        if len(parts) != 3 or any(p not in ("1", "r") for p in parts) or "r" not in parts:
+            raise InputError(f"ray {text!r}: write three lengths, each 1 or r, for example 1,r,r")
+        return cls(tuple(p == "r" for p in parts))
+
+    @property
+    def text(self) -> str:
+        return ",".join("r" if s else "1" for s in self.scaled)
+
+    def box(self, u: Fraction) -> Box:
+        return Box(*(Length(u if s else Fraction(1)) for s in self.scaled))
+
+    @property
+    def w0(self) -> tuple[int, int, int]:
+        return tuple(0 if s else 1 for s in self.scaled)
+
+    @property
+    def w1(self) -> tuple[int, int, int]:
+        return tuple(1 if s else 0 for s in self.scaled)
+
+
+class Critical(Exception):
+    """The probed value of u is itself a root: probe elsewhere."""
+
+
+def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int]], tuple]:
+    """The linear forms a + b*u whose signs hold the tessellation at u, and its state there.
+
+    Raises :class:`Critical` when u is a root of one of them (a degenerate value).
+    """
+    cfg = Configuration.from_code(code, ray.box(u))
+    tess = tessellate(cfg)
+    f0 = Frame.build(tess.nodes, ray.w0)
+    f1 = Frame.build(tess.nodes, ray.w1)
+    index = {node: i for i, node in enumerate(f0.ids)}
+    forms: list[tuple[int, int]] = []
+    for element in tess.elements:
+        members = [index[n] for n in element.polyhedron.nodes]
+        quad = next(q for q in _quadruples(members) if f0.orient(*q) != 0)
+        s0, s1 = f0.sphere(*quad), f1.sphere(*quad)
+        for x in range(len(f0.ids)):
+            a, b = s0.side(f0.lifted[x]), s1.side(f1.lifted[x])
+            if x in members:
+                if a or b:  # co-spherical only at this u
+                    raise Critical
+            else:
+                forms.append((a, b))
+        # circumcenter between the box faces: 0 <= -N_axis(u) <= 2 w_axis(u) N_L D
+        n_l = s0.normal[3]
+        for axis in range(3):
+            n0, n1 = s0.normal[axis], s1.normal[axis]
+            forms.append((-n0, -n1))
+            forms.append((2 * ray.w0[axis] * n_l * f0.scale + n0, 2 * ray.w1[axis] * n_l * f0.scale + n1))
+        # right angles of four-sided faces
+        for face in element.polyhedron.faces:
+            if len(face) == 4:
+                pts = [f0.coords[index[n]] for n in face]
+                for i in range(4):
+                    e = [q - p for p, q in zip(pts[i], pts[(i + 1) % 4])]
+                    e2 = [q - p for p, q in zip(pts[(i + 1) % 4], pts[(i + 2) % 4])]
+                    forms.append((sum(w * x * y for w, x, y in zip(ray.w0, e, e2)),
+                                  sum(w * x * y for w, x, y in zip(ray.w1, e, e2))))
+    for a, b in forms:
+        if b and Fraction(-a, b) == u:
+            raise Critical
+    state = (tess.fvm_adequate, frozenset(e.type.id for e in tess.elements))
+    return forms, state
+
+
+def _quadruples(members):
+    from itertools import combinations
+
+    return combinations(members, 4)
+
+
+def _interval(forms, u: Fraction) -> tuple[Fraction | None, Fraction | None]:
+    lo = hi = None
+    for a, b in forms:
+        if b:
+            root = Fraction(-a, b)
+            if root < u and (lo is None or root > lo):
+                lo = root
+            elif root > u and (hi is None or root < hi):
+                hi = root
+    return lo, hi
+
+
+def _state_at(code: str, ray: Ray, u: Fraction) -> tuple:
+    tess = tessellate(Configuration.from_code(code, ray.box(u)))
+    return tess.fvm_adequate, frozenset(e.type.id for e in tess.elements)
+
+
+@lru_cache(maxsize=None)
+def code_pieces(code: str, ray: Ray, u_lo: Fraction, u_hi: Fraction) -> tuple:
+    """The configuration's state on [u_lo, u_hi] as pieces ``(u_from, u_to, state)``.
+
+    Open intervals alternate with single points (``u_from == u_to``), starting
+    and ending with the points u_lo and u_hi; a state is (fvm_adequate, types).
+    """
+    pieces = [(u_lo, u_lo, _state_at(code, ray, u_lo))]
+    pos = u_lo
+    while pos < u_hi:
+        probe = (pos + u_hi) / 2
+        while True:
+            try:
+                forms, state = _linear_forms(code, ray, probe)
+            except Critical:
+                probe = (pos + probe) / 2
+                continue
+            lo, hi = _interval(forms, probe)
+            if lo is not None and lo > pos:
+                probe = (pos + lo) / 2  # another critical value lies between pos and lo
+                continue
+            break
+        end = u_hi if hi is None or hi > u_hi else hi
+        pieces.append((pos, end, state))
+        pieces.append((end, end, _state_at(code, ray, end)))
+        pos = end
+    return tuple(pieces)
+
+
+@dataclass(frozen=True)
+class Step:
+    """The study's state for u = r^2 from ``lo`` to ``hi`` (each end in or out as the flags say)."""
+
+    lo: Fraction
+    hi: Fraction
+    lo_closed: bool
+    hi_closed: bool
+    fvm_adequate: int
+    types: frozenset[str]
+
+    def contains(self, u: Fraction) -> bool:
+        return (self.lo < u or (self.lo_closed and u == self.lo)) and (u < self.hi or (self.hi_closed and u == self.hi))
+
+    def describe(self) -> str:
+        """``[sqrt(2), 2)`` in r."""
+        lo, hi = Length(self.lo).text, Length(self.hi).text
+        if self.lo == self.hi:
+            return f"r = {lo}"
+        return f"{'[' if self.lo_closed else '('}{lo}, {hi}{']' if self.hi_closed else ')'}"
+
+
+def ray_profile(ray: Ray, r_lo: Fraction, r_hi: Fraction, progress=None) -> list[Step]:
+    """The bisection study along the ray for r in [r_lo, r_hi], exactly, as steps in u = r^2."""
+    from .study import bisection_codes
+
+    u_lo, u_hi = r_lo * r_lo, r_hi * r_hi
+    codes = bisection_codes()
+    # symmetries common to every box of the ray (those of a generic member)
+    generic = ray.box((u_lo + u_hi) / 2 if u_lo != u_hi else u_lo + 1)
+    reps, _ = orbit_representatives(codes, box_symmetries(generic))
+    sizes = Counter(reps)
+    per_code = {}
+    for rep in sorted(sizes):
+        per_code[rep] = code_pieces(rep, ray, u_lo, u_hi)
+        if progress:
+            progress(sizes[rep])
+    cuts = sorted({p[0] for pieces in per_code.values() for p in pieces})
+    spans = []
+    for i, cut in enumerate(cuts):
+        spans.append((cut, cut, cut))
+        if i + 1 < len(cuts):
+            spans.append((cut, cuts[i + 1], (cut + cuts[i + 1]) / 2))
+    steps = []
+    for u_from, u_to, probe in spans:
+        fvm, types = 0, set()
+        for rep, pieces in per_code.items():
+            state = _state_in(pieces, probe)
+            fvm += sizes[rep] * state[0]
+            types |= state[1]
+        point = u_from == u_to
+        steps.append(Step(u_from, u_to, point, point, fvm, frozenset(types)))
+    merged = [steps[0]]
+    for step in steps[1:]:
+        last = merged[-1]
+        if (step.fvm_adequate, step.types) == (last.fvm_adequate, last.types):
+            merged[-1] = Step(last.lo, step.hi, last.lo_closed, step.hi_closed, last.fvm_adequate, last.types)
+        else:
+            merged.append(step)
+    return merged
+
+
+def _state_in(pieces, u: Fraction):
+    """The state at u: of the point piece at u, else of the open interval around u."""
+    for start, end, state in pieces:
+        if start == end == u or start < u < end:
+            return state
+    raise ValueError(f"u = {u} is outside the pieces")
