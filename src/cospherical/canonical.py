@@ -36,10 +36,17 @@ _END = -1  # closes one vertex's neighbour list
 
 @dataclass(frozen=True)
 class CanonicalForm:
-    """``code``: the canonical string; ``order``: vertices in reference order."""
+    """``code``: the canonical string; ``order``: vertices in reference order.
+
+    ``mirrored`` is True when only the mirror image's walk gives the code: the
+    polyhedron is then the mirror image of the type's direct form (a chiral
+    type met in its other handedness), so its faces, listed in the reference
+    order, run the other way round.  A mirror-symmetric type is never mirrored.
+    """
 
     code: str
     order: tuple[int, ...]
+    mirrored: bool = False
 
 
 def _kind_rank(kind: str) -> int:
@@ -97,18 +104,20 @@ def _canonical_form(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]) 
                 w = rotation[v, w]
                 if w == start[1]:
                     break
-            candidates.append((len(opening), opening, start, rotation, label))
+            candidates.append((len(opening), opening, start, rotation, label, rotation is mirror_turn))
     smallest = min(candidates, key=lambda c: c[:2])[:2]
     best: list[int] | None = None
     best_order: list[int] = []
-    for size, opening, start, rotation, label in candidates:
+    best_mirrored = False
+    for size, opening, start, rotation, label, mirrored in candidates:
         if (size, opening) != smallest:
             continue
         code, order = _walk(start, rotation, label)
+        # direct walks come first, so a tie keeps the direct orientation
         if best is None or code < best:
-            best, best_order = code, order
+            best, best_order, best_mirrored = code, order, mirrored
     assert best is not None
-    return CanonicalForm(_encode(best, len(best_order)), tuple(best_order))
+    return CanonicalForm(_encode(best, len(best_order)), tuple(best_order), best_mirrored)
 
 
 def _walk(start, rotation, label) -> tuple[list[int], list[int]]:

@@ -72,6 +72,14 @@ def type_names(types: Iterable[ElementType]) -> dict[str, tuple[str, list[str]]]
     return names
 
 
+def _chiral(element) -> bool:
+    """Whether the type differs from its mirror image (its canonical walks need one handedness)."""
+    from .canonical import canonical_form
+
+    mirror = [tuple(reversed(face)) for face in element.polyhedron.faces]
+    return canonical_form(mirror, element.polyhedron.face_kinds).mirrored != element.mirrored
+
+
 def _study_label(study) -> str:
     return f"{study.name} {'x'.join(study.box.texts)} {study.face_points}"
 
@@ -112,10 +120,14 @@ def build_catalogue(studies) -> dict:
         study, tess, element = examples[type_id]
         position = {v: i for i, v in enumerate(element.nodes)}
         real = tess.configuration.real_nodes()
+        # Faces of the type's direct form, counter-clockwise seen from outside: an
+        # example that is the mirror image gives them the other way round.
         faces = sorted(
-            ([position[v] for v in face], kind)
+            ([position[v] for v in (reversed(face) if element.mirrored else face)], kind)
             for face, kind in zip(element.polyhedron.faces, element.polyhedron.face_kinds)
         )
+        faces = [(nodes[nodes.index(min(nodes)):] + nodes[: nodes.index(min(nodes))], kind) for nodes, kind in faces]
+        faces.sort()
         entries.append(
             {
                 "id": t.id,
@@ -127,6 +139,7 @@ def build_catalogue(studies) -> dict:
                 "faces": t.faces,
                 "face_kinds": dict(t.face_kinds),
                 "vtk": t.vtk,
+                "chiral": t.vtk is None and _chiral(element),
                 "reference_faces": [{"nodes": nodes, "kind": kind} for nodes, kind in faces],
                 "example": {
                     "configuration": tess.configuration.code,

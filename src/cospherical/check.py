@@ -101,6 +101,8 @@ def _check_tiling(frame: Frame, elements, types, where: str) -> None:
             p = sub(coords[cycle[0]], apex)
             for a, b in zip(cycle[1:-1], cycle[2:]):
                 six += dot(p, cross(sub(coords[a], apex), sub(coords[b], apex)))
+        if element.get("mirror"):  # the mirror image: its reference faces run the other way round
+            six = -six
         if six <= 0:
             raise FormatError(f"{where}/{k}: the nodes do not make a proper element of type {element['type']}")
         total += six

@@ -101,7 +101,9 @@ def _parse_parameter(edge: int, value) -> Fraction:
 
 def _parse_edge(edge) -> int:
     text = str(edge).strip()
-    if isinstance(edge, bool) or not isinstance(edge, (int, str)) or not text.isdigit() or int(text) > 11:
+    # isascii: str.isdigit() also accepts digits such as '²' that int() refuses
+    if isinstance(edge, bool) or not isinstance(edge, (int, str)) or not (text.isascii() and text.isdigit()) \
+            or int(text) > 11:
         raise InputError(f"edge {edge!r}: not an edge number 0..11")
     return int(text)
 

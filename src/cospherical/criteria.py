@@ -36,8 +36,8 @@ def _options(points, squared, poly, criterion) -> tuple[tuple[Element, ...], ...
     for split in subdivisions(frame, poly, criterion):
         pieces = []
         for piece in split:
-            etype, order = classify(piece)
-            pieces.append(Element(etype, order, piece))
+            etype, order, mirrored = classify(piece)
+            pieces.append(Element(etype, order, piece, mirrored))
         options.append(tuple(pieces))
     options.sort(key=lambda pieces: (len(pieces), [p.type.id for p in pieces], [p.polyhedron.nodes for p in pieces]))
     return tuple(options)

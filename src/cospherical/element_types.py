@@ -164,16 +164,18 @@ def _vtk_order(vtk: str, faces, kinds) -> tuple[int, ...]:
     return min(candidates)
 
 
-def classify(poly: Polyhedron) -> tuple[ElementType, tuple[int, ...]]:
-    """The element type of a polyhedron and its nodes in the type's reference order."""
+def classify(poly: Polyhedron) -> tuple[ElementType, tuple[int, ...], bool]:
+    """The element type of a polyhedron, its nodes in the type's reference order, and
+    whether it is the mirror image of the type's direct form (never for VTK types,
+    whose node order is fixed by orientation)."""
     return _classify(poly.faces, poly.face_kinds)
 
 
 # A study meets the same cell (same node ids and faces) in many configurations.
 @lru_cache(maxsize=1 << 16)
-def _classify(faces, kinds) -> tuple[ElementType, tuple[int, ...]]:
+def _classify(faces, kinds) -> tuple[ElementType, tuple[int, ...], bool]:
     form = canonical_form(faces, kinds)
     etype = element_type(form.code, faces, kinds)
     if etype.vtk is None:
-        return etype, form.order
-    return etype, _vtk_order(etype.vtk, faces, kinds)
+        return etype, form.order, form.mirrored
+    return etype, _vtk_order(etype.vtk, faces, kinds), False

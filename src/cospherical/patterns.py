@@ -65,7 +65,8 @@ def patterns_text(study: Study, catalogue_version: str) -> str:
             for element in tess.elements:
                 nodes = ", ".join(map(str, element.nodes))
                 center = ", ".join(yaml_float(x) for x in tess.circumcenter(element))
-                lines.append(f"    - {{type: {element.type.id}, nodes: [{nodes}], circumcenter: [{center}]}}")
+                mirror = ", mirror: true" if element.mirrored else ""
+                lines.append(f"    - {{type: {element.type.id}, nodes: [{nodes}], circumcenter: [{center}]{mirror}}}")
     return "\n".join(lines) + "\n"
 
 

@@ -225,3 +225,28 @@ def _state_in(pieces, u: Fraction):
         if start == end == u or start < u < end:
             return state
     raise ValueError(f"u = {u} is outside the pieces")
+
+
+def profile_summary(ray: Ray, r_lo: Fraction, r_hi: Fraction, steps: list[Step]) -> dict:
+    """The JSON shape of ``cospherical sweep --ray``: steps in r, thresholds, largest fully adequate r."""
+    def text(u: Fraction) -> str:
+        return Length(u).text
+
+    rows = [
+        {"r_from": text(s.lo), "r_to": text(s.hi), "from_closed": s.lo_closed, "to_closed": s.hi_closed,
+         "u_from": str(s.lo), "u_to": str(s.hi), "fvm_adequate": s.fvm_adequate, "types": len(s.types)}
+        for s in steps
+    ]
+    thresholds = sorted({s.lo for s in steps[1:]} | {s.hi for s in steps[:-1]})
+    largest = None
+    for step in steps:
+        if step.fvm_adequate != 4096:
+            break
+        largest = {"r": text(step.hi), "attained": step.hi_closed}
+    return {
+        "ray": ray.text,
+        "range": [Length(r_lo * r_lo).text, Length(r_hi * r_hi).text],
+        "steps": rows,
+        "thresholds": [{"r": text(u), "u": str(u)} for u in thresholds],
+        "largest_fully_adequate": largest,
+    }

@@ -35,8 +35,8 @@ def map_tessellation(tess: Tessellation, sym: Symmetry, target: Configuration) -
     elements = []
     for element in tess.elements:
         poly = sym.polyhedron(element.polyhedron)
-        etype, order = classify(poly)
-        elements.append(Element(etype, order, poly))
+        etype, order, mirrored = classify(poly)
+        elements.append(Element(etype, order, poly, mirrored))
     elements.sort(key=lambda e: e.polyhedron.nodes)
     return Tessellation(target, target.nodes(), tuple(elements))
 

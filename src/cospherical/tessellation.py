@@ -16,11 +16,16 @@ __all__ = ["Element", "Tessellation", "tessellate"]
 
 @dataclass(frozen=True)
 class Element:
-    """One element of a tessellation: its type and its nodes in the type's reference order."""
+    """One element of a tessellation: its type and its nodes in the type's reference order.
+
+    ``mirrored``: the element is the mirror image of its (chiral) type's direct
+    form, so the catalogue's reference faces run the other way round on it.
+    """
 
     type: ElementType
     nodes: tuple[int, ...]
     polyhedron: Polyhedron
+    mirrored: bool = False
 
 
 @dataclass(frozen=True)
@@ -65,6 +70,7 @@ class Tessellation:
                     "edges": e.type.edges,
                     "faces": e.type.faces,
                     "circumcenter": list(self.circumcenter(e)),
+                    **({"mirror": True} if e.mirrored else {}),
                 }
                 for e in self.elements
             ],
@@ -90,6 +96,6 @@ def tessellate(configuration: Configuration) -> Tessellation:
     elements = []
     for cell in delaunay_cells(frame):
         poly = polyhedron(frame, cell)
-        etype, order = classify(poly)
-        elements.append(Element(etype, order, poly))
+        etype, order, mirrored = classify(poly)
+        elements.append(Element(etype, order, poly, mirrored))
     return Tessellation(configuration, nodes, tuple(elements))

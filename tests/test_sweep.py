@@ -1,0 +1,91 @@
+"""Aspect-ratio sweeps: grid points against direct studies, exact thresholds against boxes on both sides."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from fractions import Fraction
+
+import pytest
+
+from cospherical.exact import Length, rational_text
+from cospherical.ray import Ray, profile_summary, ray_profile
+from cospherical.sweep import box_statistics, grid_values
+
+RANGES = {"1,r,r": (Fraction(1), Fraction(9, 5)), "1,1,r": (Fraction(3, 2), Fraction(2))}
+
+
+@pytest.fixture(scope="module")
+def profiles():
+    return {ray: ray_profile(Ray.parse(ray), *RANGES[ray]) for ray in RANGES}
+
+
+def box_of(ray: str, r_text: str) -> tuple[str, str, str]:
+    return tuple(r_text if part == "r" else "1" for part in ray.split(","))
+
+
+def rational_inside(lo: Fraction, hi: Fraction) -> Fraction:
+    """A simple rational r with lo < r^2 < hi (u = r^2 bounds)."""
+    target = (Length(lo).__float__() + Length(hi).__float__()) / 2
+    for den in (10, 100, 1000, 10000, 100000):
+        r = Fraction(round(target * den), den)
+        if lo < r * r < hi:
+            return r
+    raise AssertionError("no rational found")
+
+
+@pytest.mark.parametrize("ray", sorted(RANGES))
+def test_each_threshold_holds_on_both_sides_and_at_itself(profiles, ray):
+    steps = profiles[ray]
+    assert len(steps) >= 3
+    for step in steps:
+        if step.lo == step.hi:
+            probes = [Length(step.lo).text]  # exactly at the threshold: a sqrt box
+        else:
+            probes = [rational_text(rational_inside(step.lo, step.hi))]
+        for probe in probes:
+            direct = box_statistics(box_of(ray, probe))
+            assert (direct["fvm_adequate"], direct["types"]) == (step.fvm_adequate, len(step.types)), (ray, probe)
+
+
+def test_largest_fully_adequate_ratios():
+    summary = profile_summary(Ray.parse("1,r,r"), Fraction(1), Fraction(9, 5), ray_profile(Ray.parse("1,r,r"), Fraction(1), Fraction(9, 5)))
+    assert summary["largest_fully_adequate"] == {"r": "sqrt(2)", "attained": True}
+    # just above sqrt 2 some configuration fails
+    assert box_statistics(("1", "1.4143", "1.4143"))["fvm_adequate"] < 4096
+
+
+def test_grid_points_agree_with_the_ray(profiles):
+    ray = "1,1,r"
+    for c in grid_values("3/2:2:3"):
+        direct = box_statistics(("1", "1", rational_text(c)))
+        step = next(s for s in profiles[ray] if s.contains(c * c))
+        assert (direct["fvm_adequate"], direct["types"]) == (step.fvm_adequate, len(step.types)), c
+
+
+def test_sweep_cli_json_and_figures(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "cospherical", "sweep", "--ratios", "1:2:2", "2:2:1",
+                             "--format", "json", "--out", str(tmp_path), "--jobs", "2"], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    data = json.loads(result.stdout)
+    assert [b["box"] for b in data["boxes"]] == [["1", "1", "2"], ["1", "2", "2"]]
+    for entry in data["boxes"]:
+        direct = box_statistics(tuple(entry["box"]))
+        assert {k: entry[k] for k in ("fvm_adequate", "types", "total")} == \
+               {k: direct[k] for k in ("fvm_adequate", "types", "total")}
+    assert (tmp_path / "heatmap.png").read_bytes()[:4] == b"\x89PNG"
+    assert subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "figures.tex"],
+                          cwd=tmp_path, capture_output=True).returncode == 0
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--ratios", "1:2", "1:2:2"], "MIN:MAX:STEPS"),
+    (["--ratios", "2:1:3", "1:2:2"], "MIN <= MAX"),
+    (["--ratios", "1:x:3", "1:2:2"], "b range"),
+    (["--ray", "1,2,r"], "each 1 or r"),
+    (["--ray", "1,r,r", "--range", "0:2"], "R_MIN"),
+])
+def test_sweep_usage_errors(args, needle):
+    result = subprocess.run([sys.executable, "-m", "cospherical", "sweep", *args], capture_output=True, text=True)
+    assert result.returncode == 2 and needle in result.stderr and len(result.stderr.strip().splitlines()) == 1
