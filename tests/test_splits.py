@@ -55,7 +55,6 @@ def sphere_of(points, squared):
 
 
 def check_split(tess, parent, pieces, criterion):
-    nodes = tess.nodes
     parent_faces = {frozenset(f) for f in parent.polyhedron.faces}
     parent_edges = {frozenset(e) for e in parent.polyhedron.edges}
     assert sum(p.polyhedron.unit_volume for p in pieces) == parent.polyhedron.unit_volume

@@ -14,7 +14,7 @@ from fractions import Fraction
 
 from .configuration import Box, Configuration
 from .exact import InputError
-from .geometry import Frame, cross, dot, sub
+from .geometry import Frame, six_volume
 from .yamlio import FormatError
 
 __all__ = ["check_catalogue", "check_patterns"]
@@ -95,12 +95,7 @@ def _check_tiling(frame: Frame, elements, types, where: str) -> None:
     for k, element in enumerate(elements):
         nodes = element["nodes"]
         cycles = [[index[nodes[p]] for p in face["nodes"]] for face in types[element["type"]]["reference_faces"]]
-        apex = coords[cycles[0][0]]
-        six = 0
-        for cycle in cycles:
-            p = sub(coords[cycle[0]], apex)
-            for a, b in zip(cycle[1:-1], cycle[2:]):
-                six += dot(p, cross(sub(coords[a], apex), sub(coords[b], apex)))
+        six = six_volume(coords, cycles)
         if element.get("mirror"):  # the mirror image: its reference faces run the other way round
             six = -six
         if six <= 0:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .exact import Length
-from .render import environment
+from .render import environment, save_png
 from .yamlio import atomic_write
 
 __all__ = ["heatmap_png", "heatmap_tex", "steps_png", "steps_tex"]
@@ -13,21 +13,6 @@ __all__ = ["heatmap_png", "heatmap_tex", "steps_png", "steps_tex"]
 
 def _value(text: str) -> float:
     return float(Length.parse(text))
-
-
-def _save(fig, path: Path) -> None:
-    import matplotlib.pyplot as plt
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:
-        fig.savefig(tmp, format="png", metadata={"Software": None}, dpi=100)
-        tmp.replace(path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    finally:
-        plt.close(fig)
 
 
 def _pyplot():
@@ -62,7 +47,7 @@ def heatmap_png(boxes: list[dict], path: Path) -> None:
     ax.set_title("Boxes (1, b, c), bisection configurations")
     ax.set_aspect("equal")
     fig.tight_layout()
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def heatmap_tex(boxes: list[dict], path: Path) -> None:
@@ -102,7 +87,7 @@ def steps_png(profile: dict, path: Path) -> None:
     ax.grid(True, alpha=0.3)
     ax.set_title(f"Boxes ({profile['ray']}), bisection configurations")
     fig.tight_layout()
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def steps_tex(profile: dict, path: Path) -> None:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Mapping, Sequence
 
-__all__ = ["Frame", "Sphere", "cross", "dot", "sub"]
+__all__ = ["Frame", "Sphere", "cross", "dot", "six_volume", "sub"]
 
 Vector = tuple[int, int, int]
 
@@ -35,6 +35,22 @@ def dot(p: Sequence[int], q: Sequence[int]) -> int:
 
 def cross(p: Sequence[int], q: Sequence[int]) -> Vector:
     return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
+
+
+def six_volume(coords, cycles) -> int:
+    """Six times the volume of a polyhedron from its face cycles (indices into ``coords``).
+
+    With the cycles counter-clockwise seen from outside every fan tetrahedron
+    from a vertex is right-handed or flat, so the sum is positive; reversed
+    cycles (a mirror image's faces) give the negative.
+    """
+    apex = coords[cycles[0][0]]
+    total = 0
+    for cycle in cycles:
+        p = sub(coords[cycle[0]], apex)
+        for a, b in zip(cycle[1:-1], cycle[2:]):
+            total += dot(p, cross(sub(coords[a], apex), sub(coords[b], apex)))
+    return total
 
 
 def _det3(r0, r1, r2) -> int:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from .delaunay import Cell
-from .geometry import Frame, cross, dot, sub
+from .geometry import Frame, six_volume, sub
 
 __all__ = ["FACE_KINDS", "Polyhedron", "face_kind", "polyhedron"]
 
@@ -62,15 +62,7 @@ def polyhedron(frame: Frame, cell: Cell) -> Polyhedron:
     """Classify the faces of a cell and measure it exactly."""
     index = {node: i for i, node in enumerate(frame.ids)}
     cycles = [tuple(index[n] for n in face) for face in cell.faces]
-    apex = frame.coords[cycles[0][0]]
-    six_volume = 0
-    for cycle in cycles:
-        p = sub(frame.coords[cycle[0]], apex)
-        for a, b in zip(cycle[1:-1], cycle[2:]):
-            six_volume += dot(p, cross(sub(frame.coords[a], apex), sub(frame.coords[b], apex)))
-    # Faces run counter-clockwise from outside, so every fan tetrahedron from a
-    # vertex of the cell is right-handed (or flat): the sum is 6 V in the frame.
-    unit_volume = Fraction(six_volume, 6 * frame.scale**3)
+    unit_volume = Fraction(six_volume(frame.coords, cycles), 6 * frame.scale**3)
     return Polyhedron(
         nodes=cell.nodes,
         faces=cell.faces,

@@ -137,10 +137,17 @@ def element_png(entry: dict, path: Path, size_px: int = 160) -> None:
     ax.set_ylim(-0.55, 0.55)
     ax.set_aspect("equal")
     ax.axis("off")
+    save_png(fig, path)
+
+
+def save_png(fig, path: Path, dpi: int = 100) -> None:
+    """Save a matplotlib figure atomically (temporary file, then rename), without a version stamp."""
+    import matplotlib.pyplot as plt
+
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp")
     try:
-        fig.savefig(tmp, format="png", metadata={"Software": None})
+        fig.savefig(tmp, format="png", metadata={"Software": None}, dpi=dpi)
         tmp.replace(path)
     except BaseException:
         tmp.unlink(missing_ok=True)

@@ -22,11 +22,10 @@ element exactly once).
 
 from __future__ import annotations
 
-from functools import lru_cache
 from itertools import combinations
 
 from .delaunay import hull_faces
-from .geometry import Frame, cross, dot, sub
+from .geometry import Frame, cross, dot, six_volume, sub
 from .polyhedron import Polyhedron, face_kind
 
 __all__ = ["CRITERIA", "SPLIT_CRITERIA", "subdivisions"]
@@ -54,7 +53,7 @@ class _Element:
             normal = cross(sub(coords[face[1]], coords[face[0]]), sub(coords[face[2]], coords[face[0]]))
             self.planes.append((normal, dot(normal, coords[face[0]])))
         self.edges = {frozenset((f[i], f[(i + 1) % len(f)])) for f in self.faces for i in range(len(f))}
-        self.six_volume = _six_volume(coords, self.faces)
+        self.six_volume = six_volume(coords, self.faces)
         self._pieces: dict[frozenset[int], tuple | None] = {}
 
     def _on_boundary_plane(self, cycle) -> int | None:
@@ -96,22 +95,12 @@ class _Element:
                 if not self._edge_allowed(frozenset((v, cycle[(i + 1) % len(cycle)]))):
                     return None
             checked.append((cycle, normal, boundary))
-        return checked, _six_volume(self.frame.coords, [c for c, _, _ in checked])
+        return checked, six_volume(self.frame.coords, [c for c, _, _ in checked])
 
     def beyond(self, cycle, normal) -> list[int]:
         coords = self.frame.coords
         offset = dot(normal, coords[cycle[0]])
         return [m for m in self.members if dot(normal, coords[m]) > offset]
-
-
-def _six_volume(coords, faces) -> int:
-    apex = coords[faces[0][0]]
-    total = 0
-    for face in faces:
-        p = sub(coords[face[0]], apex)
-        for a, b in zip(face[1:-1], face[2:]):
-            total += dot(p, cross(sub(coords[a], apex), sub(coords[b], apex)))
-    return total
 
 
 def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 200_000) -> list[tuple[Polyhedron, ...]]:
@@ -176,7 +165,7 @@ def _pieces(frame: Frame, poly: Polyhedron, split) -> tuple[Polyhedron, ...]:
                 nodes=tuple(frame.ids[i] for i in sorted(points)),
                 faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle, _ in cycles),
                 face_kinds=tuple(face_kind(frame, cycle) for cycle, _ in cycles),
-                unit_volume=poly.unit_volume * _six_volume(frame.coords, [c for c, _ in cycles]) / _six_volume(
+                unit_volume=poly.unit_volume * six_volume(frame.coords, [c for c, _ in cycles]) / six_volume(
                     frame.coords, [[frame.ids.index(n) for n in f] for f in poly.faces]),
                 center=poly.center,
             )
