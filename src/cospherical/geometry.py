@@ -44,12 +44,15 @@ def six_volume(coords, cycles) -> int:
     from a vertex is right-handed or flat, so the sum is positive; reversed
     cycles (a mirror image's faces) give the negative.
     """
-    apex = coords[cycles[0][0]]
+    ax, ay, az = coords[cycles[0][0]]
     total = 0
     for cycle in cycles:
-        p = sub(coords[cycle[0]], apex)
+        x0, y0, z0 = coords[cycle[0]]
+        px, py, pz = x0 - ax, y0 - ay, z0 - az
         for a, b in zip(cycle[1:-1], cycle[2:]):
-            total += dot(p, cross(sub(coords[a], apex), sub(coords[b], apex)))
+            (x1, y1, z1), (x2, y2, z2) = coords[a], coords[b]
+            ux, uy, uz, vx, vy, vz = x1 - ax, y1 - ay, z1 - az, x2 - ax, y2 - ay, z2 - az
+            total += px * (uy * vz - uz * vy) + py * (uz * vx - ux * vz) + pz * (ux * vy - uy * vx)
     return total
 
 

@@ -57,9 +57,9 @@ class _Element:
         self._pieces: dict[frozenset[int], tuple | None] = {}
 
     def _on_boundary_plane(self, cycle) -> int | None:
-        coords = self.frame.coords
-        for f, (normal, offset) in enumerate(self.planes):
-            if all(dot(normal, coords[v]) == offset for v in cycle):
+        points = [self.frame.coords[v] for v in cycle]
+        for f, ((nx, ny, nz), offset) in enumerate(self.planes):
+            if all(nx * x + ny * y + nz * z == offset for x, y, z in points):
                 return f
         return None
 
@@ -108,6 +108,8 @@ def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 20
 
     Each split is a tuple of pieces sorted by node ids; splits come in a fixed order.
     """
+    if len(poly.nodes) == 4:  # a tetrahedron has no split without new vertices
+        return [(poly,)]
     element = _Element(frame, poly, criterion)
     found: list[tuple[frozenset[int], ...]] = []
 
@@ -152,22 +154,17 @@ def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 20
     for size in range(1, len(element.members) - len(first) + 1):
         for extra in combinations(element.beyond(first, first_normal), size):
             _try(frozenset(first) | frozenset(extra), [], {}, 0, frozenset())
-    return [_pieces(frame, poly, split) for split in found]
+    return [tuple(_piece(element, points) for points in split) for split in found]
 
 
-def _pieces(frame: Frame, poly: Polyhedron, split) -> tuple[Polyhedron, ...]:
-    result = []
-    for points in split:
-        faces = hull_faces(frame, sorted(points))
-        cycles = sorted(faces, key=lambda f: f[0])
-        result.append(
-            Polyhedron(
-                nodes=tuple(frame.ids[i] for i in sorted(points)),
-                faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle, _ in cycles),
-                face_kinds=tuple(face_kind(frame, cycle) for cycle, _ in cycles),
-                unit_volume=poly.unit_volume * six_volume(frame.coords, [c for c, _ in cycles]) / six_volume(
-                    frame.coords, [[frame.ids.index(n) for n in f] for f in poly.faces]),
-                center=poly.center,
-            )
-        )
-    return tuple(result)
+def _piece(element: _Element, points: frozenset[int]) -> Polyhedron:
+    frame, poly = element.frame, element.poly
+    faces, six = element.piece(points)
+    cycles = sorted(cycle for cycle, _, _ in faces)
+    return Polyhedron(
+        nodes=tuple(frame.ids[i] for i in sorted(points)),
+        faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle in cycles),
+        face_kinds=tuple(face_kind(frame, cycle) for cycle in cycles),
+        unit_volume=poly.unit_volume * six / element.six_volume,
+        center=poly.center,  # every piece lies on the element's sphere
+    )
