@@ -19,7 +19,7 @@ import numpy as np
 from .configuration import BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis
 from .polyhedron import Polyhedron
 
-__all__ = ["Symmetry", "box_symmetries", "orbit_representatives"]
+__all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "orbit_keys", "orbit_representatives"]
 
 
 @dataclass(frozen=True)
@@ -130,20 +130,34 @@ def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
     return tuple(Symmetry(p, f) for p in perms for f in product((False, True), repeat=3))
 
 
-def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry]) -> tuple[list[str], list[int]]:
-    """For each code, its orbit's representative (the smallest image code) and the
-    index of a symmetry taking the code to it; vectorised over all codes at once."""
-    text = np.frombuffer("".join(codes).lower().encode("ascii"), dtype=np.uint8).reshape(-1, 12)
-    digits = np.where(text >= ord("a"), text - ord("a") + 10, text - ord("0")).astype(np.int64)
-    weights = 16 ** np.arange(11, -1, -1, dtype=np.int64)  # the code as a base-16 number
-    best = np.full(len(codes), np.iinfo(np.int64).max)
-    best_sym = np.zeros(len(codes), dtype=np.int64)
+def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry]) -> tuple[np.ndarray, np.ndarray]:
+    """For rows of 12 hex digits: the orbit representative's code as a base-16 number (the
+    smallest image) and the index of a symmetry taking the row to it; vectorised."""
+    digits = np.asarray(digits, dtype=np.int64).reshape(-1, 12)
+    reversed_digits = (16 - digits) % 16
+    best = np.full(len(digits), np.iinfo(np.int64).max)
+    best_sym = np.zeros(len(digits), dtype=np.int64)
     for index, sym in enumerate(symmetries):
-        image = np.zeros_like(digits)
+        keys = np.zeros(len(digits), dtype=np.int64)  # the image code as a base-16 number
         for k, (target, reverse) in enumerate(sym.edge_map):
-            image[:, target] = (16 - digits[:, k]) % 16 if reverse else digits[:, k]
-        keys = image @ weights
+            keys |= (reversed_digits[:, k] if reverse else digits[:, k]) << (4 * (11 - target))
         better = keys < best
         best = np.where(better, keys, best)
         best_sym = np.where(better, index, best_sym)
-    return ["%012x" % key for key in best.tolist()], best_sym.tolist()
+    return best, best_sym
+
+
+def code_digits(codes: Sequence[str]) -> np.ndarray:
+    text = np.frombuffer("".join(codes).lower().encode("ascii"), dtype=np.uint8).reshape(-1, 12)
+    return np.where(text >= ord("a"), text - ord("a") + 10, text - ord("0")).astype(np.int64)
+
+
+def key_code(key: int) -> str:
+    return "%012x" % key
+
+
+def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry]) -> tuple[list[str], list[int]]:
+    """For each code, its orbit's representative (the smallest image code) and the
+    index of a symmetry taking the code to it."""
+    keys, sym_index = orbit_keys(code_digits(codes), symmetries)
+    return [key_code(k) for k in keys.tolist()], sym_index.tolist()
