@@ -50,7 +50,7 @@ def minimal_kept_sets(instances: list[set[frozenset[str]]]) -> tuple[int, list[f
     split's pieces (the unsplit element is the option of its own type).
     """
     distinct = sorted({frozenset(options) for options in instances}, key=lambda o: sorted(map(sorted, o)))
-    # Keeping every element whole is always a solution: an upper bound to start from.
+    # One option per element, the one with fewest types, is always a solution: an upper bound.
     best = [len(frozenset().union(*[min(o, key=len) for o in distinct])) if distinct else 0]
     solutions: set[frozenset[str]] = set()
     visited: set[frozenset[str]] = set()
