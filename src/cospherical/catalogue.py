@@ -24,7 +24,7 @@ from .split import SPLIT_CRITERIA
 from .paper import paper_class
 from .yamlio import dump_yaml, load_yaml, validate
 
-__all__ = ["SCHEMA_VERSION", "build_catalogue", "catalogue_path", "known_name", "load_catalogue", "type_names"]
+__all__ = ["SCHEMA_VERSION", "build_catalogue", "catalogue_path", "known_name", "load_catalogue", "shipped_catalogue", "type_names"]
 
 SCHEMA_VERSION = 1
 
@@ -38,11 +38,17 @@ def catalogue_path() -> Path:
 
 
 @lru_cache(maxsize=None)
-def _known_names() -> dict[str, str]:
+def shipped_catalogue() -> dict:
+    """The shipped catalogue, read and validated once per process (empty if there is none)."""
     path = catalogue_path()
     if not path.exists():
-        return {}
-    return {entry["code"]: entry["name"] for entry in load_catalogue(path)["types"]}
+        return {"schema_version": SCHEMA_VERSION, "version": "none", "types": []}
+    return load_catalogue(path)
+
+
+@lru_cache(maxsize=None)
+def _known_names() -> dict[str, str]:
+    return {entry["code"]: entry["name"] for entry in shipped_catalogue()["types"]}
 
 
 def known_name(code: str) -> str | None:

@@ -151,9 +151,9 @@ def apply_catalogue_criterion(tess: Tessellation, criterion: str) -> Tessellatio
     element of a type it does not keep is split into kept types, fewest pieces
     first; an element with no such split (a type no study met) stays whole.
     """
-    from .catalogue import catalogue_path, load_catalogue
+    from .catalogue import shipped_catalogue
 
     if criterion == "optimal":
         return tess
-    kept = frozenset(load_catalogue(catalogue_path()).get("criteria", {}).get(criterion, {}).get("kept", []))
+    kept = frozenset(shipped_catalogue().get("criteria", {}).get(criterion, {}).get("kept", []))
     return split_tessellation(tess, kept, criterion, strict=False)[0]

@@ -18,6 +18,7 @@ from collections import Counter
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import lru_cache
+from itertools import combinations
 
 from .configuration import Box, Configuration
 from .exact import InputError, Length
@@ -74,7 +75,7 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
     forms: list[tuple[int, int]] = []
     for element in tess.elements:
         members = [index[n] for n in element.polyhedron.nodes]
-        quad = next(q for q in _quadruples(members) if f0.orient(*q) != 0)
+        quad = next(q for q in combinations(members, 4) if f0.orient(*q) != 0)
         s0, s1 = f0.sphere(*quad), f1.sphere(*quad)
         for x in range(len(f0.ids)):
             a, b = s0.side(f0.lifted[x]), s1.side(f1.lifted[x])
@@ -103,12 +104,6 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
             raise Critical
     state = (tess.fvm_adequate, frozenset(e.type.id for e in tess.elements))
     return forms, state
-
-
-def _quadruples(members):
-    from itertools import combinations
-
-    return combinations(members, 4)
 
 
 def _interval(forms, u: Fraction) -> tuple[Fraction | None, Fraction | None]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..catalogue import build_catalogue, catalogue_path, load_catalogue
+from ..catalogue import build_catalogue, shipped_catalogue
 from ..configuration import POINT_POLICIES, Box
 from ..render import compile_pdf, render_tables
 from ..report import study_summary
@@ -55,7 +55,7 @@ def run(args) -> int:
         summaries = [study_summary(study, names)]
     else:
         summaries = [_load_summary(path) for path in args.summary]
-        catalogue = load_catalogue(catalogue_path())
+        catalogue = shipped_catalogue()
     written = render_tables(summaries, catalogue, args.out, "Delaunay tessellations of 1-irregular cuboids")
     print(f"wrote {len(written)} files in {args.out}")
     if args.pdf:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..catalogue import catalogue_path, load_catalogue
+from ..catalogue import shipped_catalogue
 from ..configuration import POINT_POLICIES, Box
 from ..patterns import pattern_name, write_patterns
 from ..report import study_summary, text_report
@@ -42,8 +42,7 @@ def run(args) -> int:
     if args.out:
         stem = pattern_name("bisection", box.texts, args.face_points)
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
-        version = load_catalogue(catalogue_path())["version"] if catalogue_path().exists() else "none"
-        write_patterns(study, args.out / f"{stem}.yaml", version)
+        write_patterns(study, args.out / f"{stem}.yaml", shipped_catalogue()["version"])
     if args.format == "json":
         if args.compare_paper:
             from ..report import paper_comparison, paper_study_key
