@@ -1,11 +1,13 @@
-"""``cospherical study bisection``: every bisection configuration of a box, with statistics."""
+"""``cospherical study bisection|intersection``: every configuration of a family, with statistics."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from ..catalogue import shipped_catalogue
 from ..configuration import POINT_POLICIES, Box
+from ..intersection import INSERTION_ORDERS, intersection_codes, run_intersection
 from ..patterns import pattern_name, write_patterns
 from ..report import study_summary, text_report
 from ..study import bisection_codes, run_study
@@ -21,9 +23,19 @@ def add_parser(commands) -> None:
         description="Tessellate every configuration of a family (one per symmetry orbit) and report "
         "the frequency of every element type.",
     )
-    parser.add_argument("family", choices=["bisection"], help="bisection: a midpoint or nothing on each of the 12 edges")
-    parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), required=True,
-                        help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2)")
+    parser.add_argument("family", choices=["bisection", "intersection"],
+                        help="bisection: a midpoint or nothing on each of the 12 edges; intersection: the paper's "
+                        "section 5, points at multiples of 1/RESOLUTION placed by the midpoint scheme, on the cube")
+    parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), default=["1", "1", "1"],
+                        help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2) (default: the cube)")
+    parser.add_argument("--resolution", type=int, default=16, help="intersection: positions at multiples of 1/R (2, 4, 8, 16)")
+    parser.add_argument("--order", choices=INSERTION_ORDERS, default="edge",
+                        help="intersection: the order in which the midpoint scheme inserts the levels (default edge)")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="intersection: worker processes")
+    parser.add_argument("--chunk-size", type=int, default=2000, metavar="N",
+                        help="intersection: orbits per work unit and checkpoint (default 2000)")
+    parser.add_argument("--resume", action="store_true",
+                        help="intersection: keep finished chunks in DIR/checkpoints and reuse them (needs --out)")
     parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree")
     parser.add_argument("--out", type=Path, metavar="DIR",
                         help="also write the summary (JSON) and the pattern table (YAML) into DIR")
@@ -34,6 +46,8 @@ def add_parser(commands) -> None:
 
 
 def run(args) -> int:
+    if args.family == "intersection":
+        return _intersection(args)
     box = Box.parse(args.box)
     codes = bisection_codes()
     with progress_bar(len(codes), "bisection") as advance:
@@ -52,4 +66,40 @@ def run(args) -> int:
         emit(summary, "json")
     else:
         print(text_report(summary, compare_paper=args.compare_paper, study=study), end="")
+    return 0
+
+
+def _intersection(args) -> int:
+    from . import UsageError
+
+    if Box.parse(args.box).squared != (1, 1, 1) or args.face_points != "octree":
+        raise UsageError("cospherical study: error: the intersection study is the paper's: the cube, octree points")
+    if args.resolution not in (2, 4, 8, 16):
+        raise UsageError(f"cospherical study: error: --resolution {args.resolution}: choose 2, 4, 8 or 16")
+    if args.resume and not args.out:
+        raise UsageError("cospherical study: error: --resume keeps its checkpoints in --out DIR")
+    checkpoints = args.out / "checkpoints" if args.out else None
+    total = len(intersection_codes(args.resolution, args.order))
+    with progress_bar(total, f"intersection 1/{args.resolution}") as advance:
+        summary = run_intersection(args.resolution, args.order, jobs=max(1, args.jobs),
+                                   checkpoints=checkpoints if args.resume else None, progress=advance,
+                                   chunk=max(1, args.chunk_size))
+    if args.out:
+        atomic_write(args.out / f"intersection-r{args.resolution}-{args.order}.json", dump(summary, "json"))
+    if args.compare_paper:
+        from ..report import paper_comparison
+
+        summary["paper"] = paper_comparison(summary, "intersection_cube")
+    if args.format == "json":
+        emit(summary, "json")
+    else:
+        print(text_report(summary), end="")
+        if args.compare_paper:
+            table = summary["paper"]
+            print(f"\nBeside the paper (section 5; insertion order {args.order}, resolution 1/{args.resolution}):")
+            for row in table["rows"]:
+                paper = "-" if row["paper"] is None else row["paper"]
+                ours = "-" if row["ours"] is None else row["ours"]
+                print(f"    {row['class'][:48]:<48} {paper:>10} {ours:>10}{'  <- differs' if row['paper'] != row['ours'] else ''}")
+            print(f"    {'total':<48} {table['total']['paper']:>10} {table['total']['ours']:>10}")
     return 0
