@@ -121,8 +121,17 @@ def _first_cell(frame: Frame) -> tuple[list[int], Sphere]:
     raise ValueError("no empty sphere: the points do not span 3D")
 
 
-def delaunay_cells(frame: Frame) -> list[Cell]:
-    """The Delaunay subdivision of the frame's points, cells sorted by node ids."""
+def delaunay_cells(frame: Frame, compiled: bool = True) -> list[Cell]:
+    """The Delaunay subdivision of the frame's points, cells sorted by node ids.
+
+    ``compiled``: take the compiled int64 walk (:mod:`cospherical.fastwalk`)
+    when its numbers provably fit; the Python walk below gives the same cells
+    on any frame.
+    """
+    if compiled:
+        cells = _compiled_cells(frame)
+        if cells is not None:
+            return cells
     coords, lifted = frame.coords, frame.lifted
     members, sphere = _first_cell(frame)
     seen = {frozenset(members)}
@@ -170,5 +179,36 @@ def delaunay_cells(frame: Frame) -> list[Cell]:
             if frozenset(neighbour) not in seen:
                 seen.add(frozenset(neighbour))
                 queue.append((neighbour, best))
+    cells.sort(key=lambda cell: cell.nodes)
+    return cells
+
+
+def _compiled_cells(frame: Frame) -> list[Cell] | None:
+    import numpy as np
+
+    from . import fastwalk
+
+    if not fastwalk.fits(frame.coords, frame.weights, frame.scale):
+        return None
+    out = fastwalk.buffers(len(frame.coords))
+    ncells, nfaces = fastwalk.walk(
+        np.array(frame.coords, dtype=np.int64), np.array(frame.lifted, dtype=np.int64),
+        np.array(frame.weights, dtype=np.int64), *out)
+    if ncells < 0:
+        return None
+    masks, spheres = out[0][:ncells].tolist(), out[1][:ncells].tolist()
+    face_cell, face_nodes, face_len = (a[:nfaces].tolist() for a in out[2:5])
+    ids = frame.ids
+    faces: list[list[tuple[int, ...]]] = [[] for _ in range(ncells)]
+    for f in range(nfaces):
+        faces[face_cell[f]].append(tuple(ids[i] for i in face_nodes[f][:face_len[f]]))
+    cells = []
+    for c in range(ncells):
+        a, b, cc, d, offset = spheres[c]
+        cells.append(Cell(
+            nodes=tuple(ids[i] for i in range(len(ids)) if masks[c] >> i & 1),
+            faces=tuple(sorted(faces[c])),
+            center=frame.center(Sphere((a, b, cc, d), offset)),
+        ))
     cells.sort(key=lambda cell: cell.nodes)
     return cells
