@@ -19,18 +19,21 @@ from .geometry import Frame
 from .split import CRITERIA, SPLIT_CRITERIA, subdivisions
 from .tessellation import Element, Tessellation
 
-__all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "choose", "element_options", "minimal_kept_sets", "split_tessellation"]
+__all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "choose", "element_options", "minimal_kept_sets", "split_options",
+           "split_tessellation"]
 
 
 def element_options(tess: Tessellation, element: Element, criterion: str) -> tuple[tuple[Element, ...], ...]:
     """Every split of an element under a criterion (the element itself first), pieces classified."""
     points = tuple((n, tess.nodes[n]) for n in element.polyhedron.nodes)
-    return _options(points, tess.configuration.box.squared, element.polyhedron, criterion)
+    return split_options(points, tess.configuration.box.squared, element.polyhedron, criterion)
 
 
 # The same element (same node ids at the same places) recurs across configurations.
 @lru_cache(maxsize=1 << 14)
-def _options(points, squared, poly, criterion) -> tuple[tuple[Element, ...], ...]:
+def split_options(points, squared, poly, criterion) -> tuple[tuple[Element, ...], ...]:
+    """Every split of the polyhedron ``poly`` with ``points`` ((node, unit coordinates) pairs)
+    under a criterion, the element itself first, pieces classified."""
     frame = Frame.build(dict(points), squared)
     options = []
     for split in subdivisions(frame, poly, criterion):
@@ -39,7 +42,9 @@ def _options(points, squared, poly, criterion) -> tuple[tuple[Element, ...], ...
             etype, order, mirrored = classify(piece)
             pieces.append(Element(etype, order, piece, mirrored))
         options.append(tuple(pieces))
-    options.sort(key=lambda pieces: (len(pieces), [p.type.id for p in pieces], [p.polyhedron.nodes for p in pieces]))
+    # Fewest pieces, then the smallest multiset of piece types: a rule a symmetry cannot change,
+    # so every member of an orbit is split alike (node lists only break the remaining ties).
+    options.sort(key=lambda pieces: (len(pieces), sorted(p.type.id for p in pieces), [p.polyhedron.nodes for p in pieces]))
     return tuple(options)
 
 

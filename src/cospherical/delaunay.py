@@ -124,7 +124,7 @@ def _first_cell(frame: Frame) -> tuple[list[int], Sphere]:
 def delaunay_cells(frame: Frame, compiled: bool = True) -> list[Cell]:
     """The Delaunay subdivision of the frame's points, cells sorted by node ids.
 
-    ``compiled``: take the compiled int64 walk (:mod:`cospherical.fastwalk`)
+    ``compiled``: take the compiled int64 walk (:mod:`cospherical.compiled`)
     when its numbers provably fit; the Python walk below gives the same cells
     on any frame.
     """
@@ -186,12 +186,12 @@ def delaunay_cells(frame: Frame, compiled: bool = True) -> list[Cell]:
 def _compiled_cells(frame: Frame) -> list[Cell] | None:
     import numpy as np
 
-    from . import fastwalk
+    from . import compiled
 
-    if not fastwalk.fits(frame.coords, frame.weights, frame.scale):
+    if not compiled.fits(frame.coords, frame.weights, frame.scale):
         return None
-    out = fastwalk.buffers(len(frame.coords))
-    ncells, nfaces = fastwalk.walk(
+    out = compiled.buffers(len(frame.coords))
+    ncells, nfaces = compiled.walk(
         np.array(frame.coords, dtype=np.int64), np.array(frame.lifted, dtype=np.int64),
         np.array(frame.weights, dtype=np.int64), *out)
     if ncells < 0:

@@ -98,11 +98,20 @@ def intersection_codes(resolution: int = 16, order: str = "edge") -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------
-# Running the study: one tessellation per orbit representative, in chunks that
-# worker processes take, each chunk's statistics checkpointed so that an
-# interrupted run resumes where it stopped.
+# Running the study, in two stages that worker processes (or Dask workers) take
+# in chunks, each chunk checkpointed so that an interrupted run resumes:
+#
+# 1. cells: the compiled kernel tessellates every orbit representative and
+#    keeps, per configuration, its tetrahedra count, the circumcenter tests and
+#    each other cell as (node mask, code masked to the digits its points depend
+#    on): equal pairs are the same element at the same place.
+# 2. elements: each distinct non-tetrahedral element is classified once, with
+#    its splits under every criterion (the exact Python path).
+#
+# The statistics then count every configuration through the orbit sizes.
 
-CHUNK = 2000
+CHUNK = 5000
+ELEMENT_CHUNK = 500
 
 
 def orbits(resolution: int = 16, order: str = "edge") -> tuple[np.ndarray, np.ndarray, int]:
@@ -121,104 +130,289 @@ def orbits(resolution: int = 16, order: str = "edge") -> tuple[np.ndarray, np.nd
     return reps, sizes, len(digits)
 
 
-def chunk_statistics(reps: list[int], sizes: list[int]) -> dict:
-    """Statistics of a chunk of orbit representatives, each counted with its orbit size."""
+def all_configurations(resolution: int = 16, order: str = "edge") -> np.ndarray:
+    """Every configuration's code as a base-16 number, sorted (the brute-force run, no orbits)."""
+    digits = intersection_codes(resolution, order).astype(np.int64)
+    return np.sort((digits << (4 * np.arange(11, -1, -1))).sum(axis=1))
+
+
+def tessellate_chunk(codes: np.ndarray) -> dict[str, np.ndarray]:
+    """Stage 1 on base-16 codes: per configuration ``tets``, ``closed``, ``open``, ``polys``;
+    per other cell ``poly_mask`` and ``poly_code`` (see :func:`cospherical.compiled.cube_batch`)."""
+    from . import compiled
+
+    codes = np.ascontiguousarray(codes, dtype=np.int64)
+    n = len(codes)
+    tets, polys = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    closed, open_ = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
+    # A cell has at least four of the at most 27 points, so 27 other cells per configuration is ample.
+    poly_mask, poly_code = np.empty(27 * n, dtype=np.int64), np.empty(27 * n, dtype=np.int64)
+    written = compiled.cube_batch(codes, *_cube_tables(), tets, closed, open_, polys, poly_mask, poly_code)
+    if written < 0:
+        raise RuntimeError(f"configuration {codes[-1 - written]:012x}: beyond the compiled walk's buffers")
+    return {"tets": tets, "closed": closed, "open": open_, "polys": polys,
+            "poly_mask": poly_mask[:written], "poly_code": poly_code[:written]}
+
+
+_TABLES = None
+
+
+def _cube_tables():
+    global _TABLES
+    if _TABLES is None:
+        from .compiled import _cube_tables as tables
+
+        _TABLES = tables()
+    return _TABLES
+
+
+def element_entries(elements: list[tuple[int, int]]) -> tuple[list[list], dict[str, list]]:
+    """Stage 2: per (node mask, code of a configuration holding it), the element's type id and,
+    per split criterion, its options as type-id tuples (the element itself first, in the order
+    :func:`cospherical.criteria.split_options` prefers them); and the types met, described."""
     from .configuration import Configuration
-    from .paper import paper_class
+    from .criteria import split_options
+    from .delaunay import delaunay_cells
+    from .element_types import classify
+    from .geometry import Frame
+    from .polyhedron import polyhedron
     from .symmetry import key_code
-    from .tessellation import tessellate
 
-    counts: dict[str, int] = {}
-    configurations: dict[str, int] = {}
-    types: dict[str, list] = {}
-    closed = open_ = total = 0
-    for key, size in zip(reps, sizes):
-        tess = tessellate(Configuration.from_code(key_code(key)))
-        closed += size * tess.fvm_adequate
-        open_ += size * tess.fvm_adequate_open
-        total += size * len(tess.elements)
-        seen = set()
-        for element in tess.elements:
-            t = element.type
-            counts[t.id] = counts.get(t.id, 0) + size
-            types[t.id] = [t.name, t.vertices, t.edges, t.faces, (paper_class(t) or {}).get("name")]
-            seen.add(t.id)
-        for type_id in seen:
-            configurations[type_id] = configurations.get(type_id, 0) + size
-    return {"orbits": len(reps), "fvm_adequate": closed, "fvm_adequate_open": open_, "total": total,
-            "counts": counts, "configurations": configurations, "types": types}
+    squared = (1, 1, 1)
+    entries, types = [], {}
+    for node_mask, code in elements:
+        nodes = Configuration.from_code(key_code(code)).nodes()
+        points = tuple((n, nodes[n]) for n in sorted(nodes) if node_mask >> n & 1)
+        frame = Frame.build(dict(points), squared)
+        (cell,) = delaunay_cells(frame)  # the points are co-spherical: one cell
+        poly = polyhedron(frame, cell)
+        etype = classify(poly)[0]
+        entry = [etype.id]
+        _describe(etype, types)
+        for criterion in SPLIT_CRITERIA:
+            options = split_options(points, squared, poly, criterion)
+            for option in options:
+                for piece in option:
+                    _describe(piece.type, types)
+            entry.append(list(dict.fromkeys(tuple(sorted(p.type.id for p in o)) for o in options)))
+        entries.append(entry)
+    return entries, types
 
 
-def _merge(parts) -> dict:
-    merged = {"orbits": 0, "fvm_adequate": 0, "fvm_adequate_open": 0, "total": 0,
-              "counts": {}, "configurations": {}, "types": {}}
-    for part in parts:
-        for key in ("orbits", "fvm_adequate", "fvm_adequate_open", "total"):
-            merged[key] += part[key]
-        for key in ("counts", "configurations"):
-            for type_id, n in part[key].items():
-                merged[key][type_id] = merged[key].get(type_id, 0) + n
-        merged["types"].update(part["types"])
-    return merged
+def _describe(etype, types: dict) -> None:
+    if etype.id not in types:
+        from .paper import paper_class
+
+        types[etype.id] = [etype.name, etype.vertices, etype.edges, etype.faces, (paper_class(etype) or {}).get("name")]
+
+
+def _tetrahedron():
+    """The entry of the tetrahedron (every 4-point cell has this one type; no split)."""
+    corners = (0, 1, 3, 4)  # of the cube with no Steiner point (code 0)
+    return element_entries([(sum(1 << n for n in corners), 0)])
+
+
+SPLIT_CRITERIA = ("internal_faces", "internal_edges_and_faces")
+
+
+def _completed(function, tasks: dict, jobs: int, scheduler: str | None, dask_workers: int | None):
+    """Yield ``(key, function(*args))`` for every task, as they finish, on the chosen backend."""
+    if scheduler or dask_workers:
+        from dask.distributed import Client, LocalCluster, as_completed
+
+        cluster = None if scheduler else LocalCluster(n_workers=dask_workers, threads_per_worker=1,
+                                                      processes=True, dashboard_address=None)
+        client = Client(scheduler or cluster)
+        try:
+            futures = {client.submit(function, *args, pure=False): key for key, args in tasks.items()}
+            for future in as_completed(futures):
+                yield futures[future], future.result()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    elif jobs <= 1:
+        for key, args in tasks.items():
+            yield key, function(*args)
+    else:
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        pool = ProcessPoolExecutor(max_workers=jobs)
+        try:
+            futures = {pool.submit(function, *args): key for key, args in tasks.items()}
+            for future in as_completed(futures):
+                yield futures[future], future.result()
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, checkpoints=None,
-                     progress=None, chunk: int = CHUNK) -> dict:
-    """The intersection study's summary (optimal criterion), in the shape of the bisection study's.
+                     progress=None, chunk: int = CHUNK, scheduler: str | None = None,
+                     dask_workers: int | None = None, brute_force: bool = False) -> dict:
+    """The intersection study's summary, all criteria, in the shape of the bisection study's.
 
-    ``checkpoints``: a folder keeping each finished chunk's statistics; chunks found
-    there are not computed again, so an interrupted run resumes.
+    ``checkpoints``: a folder keeping each finished chunk; chunks found there are
+    not computed again, so an interrupted run resumes.  ``scheduler`` (a Dask
+    scheduler address) or ``dask_workers`` (a local Dask cluster of that many
+    processes) run the chunks on Dask instead of ``jobs`` local processes.
+    ``brute_force``: tessellate every configuration, not one per orbit (a check).
+    ``progress(stage, n)`` is told as work finishes: ``cells`` in configurations,
+    ``elements`` in distinct elements.
     """
     import json
-    from concurrent.futures import ProcessPoolExecutor
     from pathlib import Path
 
     from .yamlio import atomic_write
 
-    reps, sizes, configurations = orbits(resolution, order)
-    chunks = [(reps[i:i + chunk].tolist(), sizes[i:i + chunk].tolist()) for i in range(0, len(reps), chunk)]
+    if brute_force:
+        reps = all_configurations(resolution, order)
+        sizes, configurations = np.ones(len(reps), dtype=np.int64), len(reps)
+    else:
+        reps, sizes, configurations = orbits(resolution, order)
     folder = Path(checkpoints) if checkpoints else None
-    tag = f"r{resolution}-{order}-c{chunk}"
-    parts: dict[int, dict] = {}
+    tag = f"r{resolution}-{order}-c{chunk}{'-brute' if brute_force else ''}"
     if folder:
         folder.mkdir(parents=True, exist_ok=True)
-        for i in range(len(chunks)):
-            path = folder / f"{tag}-chunk{i:05d}.json"
-            if path.exists():
-                parts[i] = json.loads(path.read_text())
-                if progress:
-                    progress(sum(chunks[i][1]))
-    todo = [i for i in range(len(chunks)) if i not in parts]
+    backend = dict(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
+    report = progress or (lambda stage, n: None)
 
-    def done(i: int, part: dict) -> None:
-        parts[i] = part
+    # Stage 1: cells.
+    starts = range(0, len(reps), chunk)
+    stage1: dict[int, dict] = {}
+    for i, start in enumerate(starts):
+        path = folder / f"{tag}-cells-{i:05d}.npz" if folder else None
+        if path and path.exists():
+            with np.load(path) as data:
+                stage1[i] = {name: data[name] for name in data.files}
+            report("cells", int(sizes[start:start + chunk].sum()))
+    todo = {i: (reps[start:start + chunk],) for i, start in enumerate(starts) if i not in stage1}
+    for i, part in _completed(tessellate_chunk, todo, **backend):
+        stage1[i] = part
         if folder:
-            atomic_write(folder / f"{tag}-chunk{i:05d}.json", json.dumps(part, sort_keys=True))
-        if progress:
-            progress(sum(chunks[i][1]))
+            atomic_write(folder / f"{tag}-cells-{i:05d}.npz", _npz_bytes(part))
+        report("cells", int(sizes[i * chunk:(i + 1) * chunk].sum()))
+    cells = {name: np.concatenate([stage1[i][name] for i in range(len(starts))]) if starts else np.zeros(0, np.int64)
+             for name in ("tets", "closed", "open", "polys", "poly_mask", "poly_code")}
 
-    if jobs <= 1:
-        for i in todo:
-            done(i, chunk_statistics(*chunks[i]))
-    else:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for i, part in zip(todo, pool.map(chunk_statistics, *zip(*[chunks[i] for i in todo]))):
-                done(i, part)
-    merged = _merge(parts[i] for i in range(len(chunks)))
-    total = merged["total"]
-    type_rows = {}
-    for type_id in sorted(merged["counts"], key=lambda k: (-merged["counts"][k], k)):
-        name, v, e, f, cls = merged["types"][type_id]
-        type_rows[type_id] = {"name": name, "paper_class": cls, "count": merged["counts"][type_id],
-                              "share": round(merged["counts"][type_id] / total, 6),
-                              "configurations": merged["configurations"][type_id],
-                              "vertices": v, "edges": e, "faces": f}
+    # Stage 2: every distinct non-tetrahedral element, once.
+    pairs = np.stack([cells["poly_mask"], cells["poly_code"]], axis=1)
+    distinct, first, element_of = np.unique(pairs, axis=0, return_index=True, return_inverse=True)
+    element_of = element_of.reshape(-1)
+    owner = np.repeat(reps, cells["polys"])[first]  # a configuration holding each element
+    work = [(int(mask), int(code)) for (mask, _), code in zip(distinct.tolist(), owner.tolist())]
+    element_starts = range(0, len(work), ELEMENT_CHUNK)
+    stage2: dict[int, tuple] = {}
+    for i in range(len(element_starts)):
+        path = folder / f"{tag}-elements-{i:05d}.json" if folder else None
+        if path and path.exists():
+            stage2[i] = tuple(json.loads(path.read_text()))
+            report("elements", len(stage2[i][0]))
+    todo = {i: (work[start:start + ELEMENT_CHUNK],) for i, start in enumerate(element_starts) if i not in stage2}
+    for i, part in _completed(element_entries, todo, **backend):
+        stage2[i] = part
+        if folder:
+            atomic_write(folder / f"{tag}-elements-{i:05d}.json", json.dumps(part, sort_keys=True))
+        report("elements", len(part[0]))
+    tetrahedron, types = _tetrahedron()
+    entries = tetrahedron + [entry for i in range(len(element_starts)) for entry in stage2[i][0]]
+    for i in range(len(element_starts)):
+        types.update(stage2[i][1])
+    summary = statistics(sizes, cells, element_of + 1, entries, types)
     return {
         "study": "intersection", "box": ["1", "1", "1"], "face_points": "octree",
         "resolution": resolution, "insertion_order": order,
-        "configurations": configurations, "orbits": merged["orbits"],
-        "fvm_adequate": merged["fvm_adequate"], "fvm_adequate_open": merged["fvm_adequate_open"],
-        "criteria": {"optimal": {"total": total, "types_count": len(type_rows),
-                                 "paper_classes_count": len({r["paper_class"] or k for k, r in type_rows.items()}),
-                                 "types": type_rows}},
+        "configurations": configurations, "orbits": len(reps),
+        **summary,
     }
+
+
+def _npz_bytes(arrays: dict) -> bytes:
+    import io
+
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    return buffer.getvalue()
+
+
+def statistics(sizes: np.ndarray, cells: dict, element_of: np.ndarray, entries: list, types: dict) -> dict:
+    """FVM counts and, per criterion, the kept types, totals, frequencies and splits.
+
+    ``entries[e]`` is ``[type id, options per split criterion]`` of element e
+    (entry 0 the tetrahedron); ``element_of`` gives each non-tetrahedral cell's
+    entry, in the order of ``cells``.
+    """
+    from .criteria import minimal_kept_sets
+
+    sizes = np.asarray(sizes, dtype=np.int64)
+    n = len(sizes)
+    # One row per (configuration, element), tetrahedra as one row with their count.
+    config = np.concatenate([np.arange(n), np.repeat(np.arange(n), cells["polys"])])
+    element = np.concatenate([np.zeros(n, dtype=np.int64), element_of])
+    multiplicity = np.concatenate([cells["tets"], np.ones(len(element_of), dtype=np.int64)])
+    keep = multiplicity > 0
+    config, element, multiplicity = config[keep], element[keep], multiplicity[keep]
+    weight = np.bincount(element, weights=sizes[config] * multiplicity, minlength=len(entries)).astype(np.int64)
+
+    criteria = {}
+    for index, criterion in enumerate(("optimal", *SPLIT_CRITERIA)):
+        if criterion == "optimal":
+            pieces = [(entry[0],) for entry in entries]
+            splits: dict = {}
+        else:
+            used = [e for e in range(len(entries)) if weight[e] > 0]
+            instances = [{frozenset(option) for option in map(tuple, entries[e][index])} for e in used]
+            _, candidates = minimal_kept_sets(instances)
+            best = None
+            for kept in candidates:
+                chosen = [next((tuple(o) for o in entry[index] if set(o) <= kept), None) for entry in entries]
+                total = sum(int(weight[e]) * len(chosen[e]) for e in used)
+                key = (total, sorted(kept))
+                if best is None or key < best[0]:
+                    best = (key, chosen)
+            pieces = best[1]
+            splits = {}
+            for e in used:
+                if pieces[e] != (entries[e][0],):
+                    splits.setdefault(entries[e][0], {}).setdefault(pieces[e], 0)
+                    splits[entries[e][0]][pieces[e]] += int(weight[e])
+        criteria[criterion] = _frequencies(pieces, weight, sizes, config, element, types, splits)
+    return {
+        "fvm_adequate": int(sizes[cells["closed"]].sum()),
+        "fvm_adequate_open": int(sizes[cells["open"]].sum()),
+        "criteria": criteria,
+    }
+
+
+def _frequencies(pieces, weight, sizes, config, element, types, splits) -> dict:
+    type_ids = sorted({t for e in range(len(pieces)) if weight[e] > 0 for t in pieces[e]})
+    index = {t: i for i, t in enumerate(type_ids)}
+    counts = np.zeros(len(type_ids), dtype=np.int64)
+    for e, element_pieces in enumerate(pieces):
+        if weight[e] > 0:
+            for t in element_pieces:
+                counts[index[t]] += weight[e]
+    # Configurations holding a type: distinct (configuration, type) pairs, weighted by orbit size.
+    distinct_types = [sorted({index[t] for t in p}) if p else [] for p in pieces]
+    per_element = np.array([len(d) for d in distinct_types], dtype=np.int64)
+    flat = np.array([t for d in distinct_types for t in d], dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum(per_element)])
+    repeat = per_element[element]
+    rows = np.repeat(config, repeat)
+    within = np.arange(len(rows)) - np.repeat(np.cumsum(repeat) - repeat, repeat)
+    type_of = flat[np.repeat(offsets[element], repeat) + within]
+    pairs = np.unique(rows * len(type_ids) + type_of)
+    configurations = np.bincount(pairs % len(type_ids), weights=sizes[pairs // len(type_ids)],
+                                 minlength=len(type_ids)).astype(np.int64)
+    total = int(counts.sum())
+    rows_out = {}
+    for i in sorted(range(len(type_ids)), key=lambda i: (-counts[i], type_ids[i])):
+        name, v, e, f, cls = types[type_ids[i]]
+        rows_out[type_ids[i]] = {"name": name, "paper_class": cls, "count": int(counts[i]),
+                                 "share": round(int(counts[i]) / total, 6),
+                                 "configurations": int(configurations[i]), "vertices": v, "edges": e, "faces": f}
+    data = {"total": total, "types_count": len(rows_out),
+            "paper_classes_count": len({r["paper_class"] or k for k, r in rows_out.items()}), "types": rows_out}
+    if splits:
+        data["splits"] = {type_id: [{"pieces": list(p), "configurations": n} for p, n in sorted(used.items())]
+                          for type_id, used in sorted(splits.items())}
+    return data

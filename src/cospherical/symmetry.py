@@ -132,19 +132,13 @@ def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
 
 def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry]) -> tuple[np.ndarray, np.ndarray]:
     """For rows of 12 hex digits: the orbit representative's code as a base-16 number (the
-    smallest image) and the index of a symmetry taking the row to it; vectorised."""
-    digits = np.asarray(digits, dtype=np.int64).reshape(-1, 12)
-    reversed_digits = (16 - digits) % 16
-    best = np.full(len(digits), np.iinfo(np.int64).max)
-    best_sym = np.zeros(len(digits), dtype=np.int64)
-    for index, sym in enumerate(symmetries):
-        keys = np.zeros(len(digits), dtype=np.int64)  # the image code as a base-16 number
-        for k, (target, reverse) in enumerate(sym.edge_map):
-            keys |= (reversed_digits[:, k] if reverse else digits[:, k]) << (4 * (11 - target))
-        better = keys < best
-        best = np.where(better, keys, best)
-        best_sym = np.where(better, index, best_sym)
-    return best, best_sym
+    smallest image) and the index of the first symmetry taking the row to it (compiled)."""
+    from .compiled import orbit_keys as kernel
+
+    digits = np.ascontiguousarray(digits, dtype=np.int64).reshape(-1, 12)
+    targets = np.array([[target for target, _ in sym.edge_map] for sym in symmetries], dtype=np.int64).reshape(-1, 12)
+    reverse = np.array([[rev for _, rev in sym.edge_map] for sym in symmetries], dtype=np.bool_).reshape(-1, 12)
+    return kernel(digits, targets, reverse)
 
 
 def code_digits(codes: Sequence[str]) -> np.ndarray:

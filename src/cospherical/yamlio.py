@@ -40,14 +40,19 @@ class FormatError(InputError):
     """A file does not have the expected format; the message names the file and the place."""
 
 
-def atomic_write(path: str | Path, text: str) -> None:
-    """Write through a temporary file in the same folder and rename: never a half-written file."""
+def atomic_write(path: str | Path, text: str | bytes) -> None:
+    """Write text (UTF-8) or bytes through a temporary file in the same folder and rename: never a
+    half-written file."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-            handle.write(text)
+        if isinstance(text, bytes):
+            with os.fdopen(fd, "wb") as handle:
+                handle.write(text)
+        else:
+            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
+                handle.write(text)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file ordinary permissions
         os.replace(tmp, path)
     except BaseException:

@@ -1,4 +1,6 @@
-"""The Delaunay walk of :mod:`cospherical.delaunay`, compiled (numba), in exact int64.
+"""Compiled kernels (numba), exact int64: the Delaunay walk, the cube at 1/16 in bulk, orbit keys.
+
+The Delaunay walk is the one of :mod:`cospherical.delaunay`, compiled.
 
 Same algorithm, same integer predicates, step for step: a first empty sphere
 through the lexicographically smallest point, then from cell to cell across
@@ -20,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["fits", "walk"]
+__all__ = ["cube_batch", "fits", "orbit_keys", "walk"]
 
 MAX_POINTS = 62
 MAX_CELLS = 1024
@@ -299,3 +301,162 @@ def buffers(points: int):
         np.empty(MAX_FACES, dtype=np.int64),
         np.empty((MAX_FACES, 3), dtype=np.int64),
     )
+
+
+# ---------------------------------------------------------------------------
+# Many configurations of the cube at 1/16 positions in one call (the
+# intersection study): points built from the code digits, the walk, and per
+# cell what the statistics need.
+
+
+def _cube_tables():
+    """Point tables of the cube in 16ths: corner coordinates, edge start corners and axes, faces' edge pairs."""
+    from .configuration import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
+
+    corners = np.array(CORNERS, dtype=np.int64) * 16
+    starts = np.array([min((CORNERS[i] for i in EDGES[k])) for k in range(12)], dtype=np.int64) * 16
+    axes = np.array([edge_axis(k) for k in range(12)], dtype=np.int64)
+    # Per face: its four edges with the two of one axis first, and its first corner.
+    face_edges = np.array([sorted(FACE_EDGES[f], key=lambda k: (edge_axis(k), k)) for f in range(6)], dtype=np.int64)
+    face_base = corners[[FACES[f][0] for f in range(6)]]
+    return corners, starts, axes, face_edges, face_base
+
+
+@njit(cache=True)
+def _cube_points(digits, corners, starts, axes, face_edges, face_base, ids, coords, lifted):
+    """The octree point set of one configuration (digits in 16ths); returns the point count."""
+    n = 0
+    for c in range(8):
+        ids[n] = c
+        coords[n, 0], coords[n, 1], coords[n, 2] = corners[c, 0], corners[c, 1], corners[c, 2]
+        n += 1
+    for k in range(12):
+        if digits[k] != 0:
+            ids[n] = 8 + k
+            coords[n, 0], coords[n, 1], coords[n, 2] = starts[k, 0], starts[k, 1], starts[k, 2]
+            coords[n, axes[k]] = digits[k]
+            n += 1
+    faces = 0
+    for f in range(6):
+        e0, e1, e2, e3 = face_edges[f, 0], face_edges[f, 1], face_edges[f, 2], face_edges[f, 3]
+        if digits[e0] != 0 and digits[e0] == digits[e1] and digits[e2] != 0 and digits[e2] == digits[e3]:
+            ids[n] = 20 + f
+            coords[n, 0], coords[n, 1], coords[n, 2] = face_base[f, 0], face_base[f, 1], face_base[f, 2]
+            coords[n, axes[e0]] = digits[e0]
+            coords[n, axes[e2]] = digits[e2]
+            n += 1
+            faces += 1
+    if faces == 6:
+        ids[n] = 26
+        for k in range(12):
+            coords[n, axes[k]] = digits[k]
+        n += 1
+    for p in range(n):
+        lifted[p, 0], lifted[p, 1], lifted[p, 2] = coords[p, 0], coords[p, 1], coords[p, 2]
+        lifted[p, 3] = coords[p, 0] ** 2 + coords[p, 1] ** 2 + coords[p, 2] ** 2
+    return n
+
+
+@njit(cache=True)
+def cube_batch(codes, corners, starts, axes, face_edges, face_base, tets, closed, open_, polys, poly_mask, poly_code):
+    """Tessellate the cube configurations ``codes`` (base-16 numbers, 1/16 positions, octree points).
+
+    Per configuration: ``tets`` the number of tetrahedra, ``closed``/``open_``
+    whether every circumcenter lies in the closed/open box, ``polys`` the number
+    of other cells; each other cell is written as its node-id bit mask and the
+    code masked to the digits its points depend on (equal pairs mean equal
+    geometry: same nodes at the same places).  Returns the number of other
+    cells written, or -1 - i when configuration i needs the Python walk.
+    """
+    ids = np.empty(27, dtype=np.int64)
+    coords = np.zeros((27, 3), dtype=np.int64)
+    lifted = np.empty((27, 4), dtype=np.int64)
+    weights = np.ones(3, dtype=np.int64)
+    cell_mask = np.empty(MAX_CELLS, dtype=np.int64)
+    cell_sphere = np.empty((MAX_CELLS, 5), dtype=np.int64)
+    face_cell = np.empty(MAX_FACES, dtype=np.int64)
+    face_nodes = np.empty((MAX_FACES, 27), dtype=np.int64)
+    face_len = np.empty(MAX_FACES, dtype=np.int64)
+    face_normal = np.empty((MAX_FACES, 3), dtype=np.int64)
+    digits = np.empty(12, dtype=np.int64)
+    face_digits = np.zeros(6, dtype=np.int64)
+    for f in range(6):
+        for t in range(4):
+            face_digits[f] |= np.int64(1) << face_edges[f, t]
+    written = 0
+    for i in range(codes.shape[0]):
+        for k in range(12):
+            digits[k] = codes[i] >> (4 * (11 - k)) & 15
+        n = _cube_points(digits, corners, starts, axes, face_edges, face_base, ids, coords, lifted)
+        ncells, _ = walk(coords[:n], lifted[:n], weights, cell_mask, cell_sphere, face_cell, face_nodes,
+                         face_len, face_normal)
+        if ncells < 0:
+            return -1 - i
+        tets[i] = 0
+        polys[i] = 0
+        closed[i] = True
+        open_[i] = True
+        for c in range(ncells):
+            mask = cell_mask[c]
+            d = cell_sphere[c, 3]
+            # circumcenter (unit) = -normal[axis] / (2 d 16): in [0, 1] iff 0 <= -normal[axis] <= 32 d.
+            for axis in range(3):
+                x = -cell_sphere[c, axis]
+                if x < 0 or x > 32 * d:
+                    closed[i] = False
+                if x <= 0 or x >= 32 * d:
+                    open_[i] = False
+            count = 0
+            node_mask = np.int64(0)
+            relevant = np.int64(0)
+            for p in range(n):
+                if mask >> p & 1:
+                    count += 1
+                    node = ids[p]
+                    node_mask |= np.int64(1) << node
+                    if node == 26:
+                        relevant = np.int64(4095)
+                    elif node >= 20:
+                        relevant |= face_digits[node - 20]
+                    elif node >= 8:
+                        relevant |= np.int64(1) << (node - 8)
+            if count == 4:
+                tets[i] += 1
+                continue
+            if written >= poly_mask.shape[0]:
+                return -1 - i
+            masked = np.int64(0)
+            for k in range(12):
+                if relevant >> k & 1:
+                    masked |= digits[k] << (4 * (11 - k))
+            poly_mask[written] = node_mask
+            poly_code[written] = masked
+            polys[i] += 1
+            written += 1
+    return written
+
+
+@njit(cache=True)
+def orbit_keys(digits, targets, reverse):
+    """Per row of 12 digits: the smallest image code (base 16) under the symmetries and the first
+    symmetry reaching it.  Symmetry s sends edge k to ``targets[s, k]``, reversed (t -> 1 - t)
+    where ``reverse[s, k]``."""
+    n = digits.shape[0]
+    best = np.empty(n, dtype=np.int64)
+    best_sym = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        low = np.int64(-1)
+        which = 0
+        for s in range(targets.shape[0]):
+            key = np.int64(0)
+            for k in range(12):
+                d = np.int64(digits[i, k])
+                if reverse[s, k] and d != 0:
+                    d = 16 - d
+                key |= d << (4 * (11 - targets[s, k]))
+            if low < 0 or key < low:
+                low = key
+                which = s
+        best[i] = low
+        best_sym[i] = which
+    return best, best_sym
