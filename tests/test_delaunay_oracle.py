@@ -68,6 +68,32 @@ def test_random_configurations_match_qhull():
     check_canonical_codes(samples)
 
 
+@pytest.mark.parametrize("order", ["edge", "rank", "reverse"])
+def test_random_intersection_configurations_match_qhull(order):
+    from cospherical.intersection import intersection_codes
+
+    digits = intersection_codes(16, order)
+    rng = random.Random(order)
+    for index in rng.sample(range(len(digits)), 200):
+        cfg = Configuration.from_code("".join("%x" % d for d in digits[index]))
+        ours = {frozenset(e.nodes) for e in tessellate(cfg).elements}
+        assert ours == qhull_regions(cfg.real_nodes()), cfg.code
+
+
+def test_the_python_walk_matches_qhull():
+    # tessellate() takes the compiled walk whenever it provably fits in int64; the
+    # Python walk (any frame) is checked against the oracle on its own here.
+    from cospherical.delaunay import delaunay_cells
+    from cospherical.geometry import Frame
+
+    rng = random.Random(11)
+    for _ in range(150):
+        cfg = random_configuration(rng)
+        frame = Frame.build(cfg.nodes(), cfg.box.squared)
+        ours = {frozenset(cell.nodes) for cell in delaunay_cells(frame, compiled=False)}
+        assert ours == qhull_regions(cfg.real_nodes()), (cfg.box.texts, cfg.steiner, cfg.face_points)
+
+
 def test_code_is_invariant_under_relabelling_and_mirroring():
     rng = random.Random(7)
     tess = tessellate(Configuration.from_code("8888a0000808", ("1", "sqrt(2)", "sqrt(2)")))

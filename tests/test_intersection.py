@@ -32,40 +32,71 @@ def test_insertion_orders_differ_and_follow_the_midpoint_scheme():
 
 
 def test_resolution_2_is_the_bisection_study():
+    # The compiled two-stage pipeline against the Python path (exact walk in Python
+    # integers, Study, choose) on the 4096 bisection configurations, every criterion.
     ours = run_intersection(2, jobs=1)
     codes = sorted("".join("%x" % d for d in row) for row in intersection_codes(2))
     assert codes == sorted(bisection_codes())
-    bisection = study_summary(run_study("bisection", Box.parse(("1", "1", "1")), bisection_codes(),
-                                        criteria=("optimal",)))
-    assert ours["criteria"]["optimal"]["total"] == bisection["criteria"]["optimal"]["total"] == 37259
-    assert {k: v["count"] for k, v in ours["criteria"]["optimal"]["types"].items()} == \
-           {k: v["count"] for k, v in bisection["criteria"]["optimal"]["types"].items()}
-    assert ours["fvm_adequate"] == bisection["fvm_adequate"]
+    bisection = study_summary(run_study("bisection", Box.parse(("1", "1", "1")), bisection_codes()))
+    assert ours["criteria"]["optimal"]["total"] == 37259
+    for criterion, data in bisection["criteria"].items():
+        mine = ours["criteria"][criterion]
+        assert mine["total"] == data["total"] and mine.get("splits") == data.get("splits"), criterion
+        assert {k: (v["count"], v["configurations"]) for k, v in mine["types"].items()} == \
+               {k: (v["count"], v["configurations"]) for k, v in data["types"].items()}, criterion
+    assert (ours["fvm_adequate"], ours["fvm_adequate_open"]) == (bisection["fvm_adequate"], bisection["fvm_adequate_open"])
 
 
-def test_process_pool_equals_one_process_and_brute_force_on_a_sample():
-    one = run_intersection(4, jobs=1)
-    two = run_intersection(4, jobs=2)
-    assert one == two
-    assert one["configurations"] == 66**3 and one["orbits"] < one["configurations"]
-    # brute force (no orbits) on a sample: each sampled configuration's own tessellation
-    from cospherical import Configuration, tessellate
-    from cospherical.intersection import orbits
-    from cospherical.symmetry import box_symmetries, key_code, orbit_keys
+@pytest.fixture(scope="module")
+def pool_run():
+    return run_intersection(4, jobs=2)
 
-    digits = intersection_codes(4)
-    sample = digits[np.random.default_rng(1).choice(len(digits), 150, replace=False)]
-    keys, sym_index = orbit_keys(sample, box_symmetries(Box.parse(("1", "1", "1"))))
-    symmetries = box_symmetries(Box.parse(("1", "1", "1")))
-    for row, key, index in zip(sample, keys.tolist(), sym_index.tolist()):
-        code = "".join("%x" % d for d in row)
-        direct = tessellate(Configuration.from_code(code))
-        rep = tessellate(Configuration.from_code(key_code(key)))
-        assert symmetries[index].code(code) == key_code(key)
-        assert sorted(e.type.id for e in direct.elements) == sorted(e.type.id for e in rep.elements)
-        assert direct.fvm_adequate == rep.fvm_adequate
-    reps, sizes, total = orbits(4)
-    assert sizes.sum() == total == 66**3
+
+def test_process_pool_dask_and_brute_force_agree(pool_run):
+    dask = run_intersection(4, dask_workers=2)
+    brute = run_intersection(4, jobs=2, brute_force=True)
+    assert pool_run["configurations"] == 66**3 and pool_run["orbits"] == 32077
+    assert dask == pool_run
+    assert brute["orbits"] == brute["configurations"] == 66**3
+    assert {**brute, "orbits": pool_run["orbits"]} == pool_run
+    assert set(pool_run["criteria"]) == {"optimal", "internal_faces", "internal_edges_and_faces"}
+
+
+def test_compiled_stage_agrees_with_the_python_walk_on_a_sample():
+    # Stage 1 (the compiled kernel on many codes) against tessellate() with the Python walk.
+    from cospherical import Configuration
+    from cospherical.delaunay import delaunay_cells
+    from cospherical.geometry import Frame
+    from cospherical.intersection import all_configurations, tessellate_chunk
+    from cospherical.polyhedron import polyhedron
+    from cospherical.symmetry import key_code
+
+    codes = all_configurations(16)
+    sample = np.sort(codes[np.random.default_rng(16).choice(len(codes), 300, replace=False)])
+    cells = tessellate_chunk(sample)
+    for i, code in enumerate(sample.tolist()):
+        cfg = Configuration.from_code(key_code(code))
+        frame = Frame.build(cfg.nodes(), cfg.box.squared)
+        python = [polyhedron(frame, cell) for cell in delaunay_cells(frame, compiled=False)]
+        assert cells["tets"][i] == sum(len(p.nodes) == 4 for p in python)
+        assert cells["polys"][i] == sum(len(p.nodes) > 4 for p in python)
+        assert cells["closed"][i] == all(p.center_in_box(closed=True) for p in python)
+        assert cells["open"][i] == all(p.center_in_box(closed=False) for p in python)
+    offsets = np.concatenate([[0], np.cumsum(cells["polys"])])
+    i = int(np.argmax(cells["polys"]))
+    cfg = Configuration.from_code(key_code(int(sample[i])))
+    frame = Frame.build(cfg.nodes(), cfg.box.squared)
+    masks = {sum(1 << n for n in cell.nodes) for cell in delaunay_cells(frame, compiled=False) if len(cell.nodes) > 4}
+    assert set(cells["poly_mask"][offsets[i]:offsets[i + 1]].tolist()) == masks
+
+
+def test_the_paper_figures_beside_ours(pool_run):
+    from cospherical.report import paper_comparison, paper_study_key
+
+    key, notes = paper_study_key(pool_run)
+    assert key == "intersection_cube" and "insertion_order" in notes
+    table = paper_comparison(pool_run, key)
+    assert table["total"] == {"paper": 46491970, "ours": pool_run["criteria"]["optimal"]["total"]}
 
 
 def test_an_interrupted_run_resumes_to_the_same_result(tmp_path):
@@ -73,9 +104,9 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path):
             "--chunk-size", "16", "--out", str(tmp_path), "--resume", "--format", "json"]
     full = json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
     assert full["criteria"]["optimal"]["total"] == 37259
-    chunks = sorted((tmp_path / "checkpoints").glob("*.json"))
-    assert len(chunks) > 3
-    for chunk in chunks[::2]:  # as if the run had stopped before these
-        chunk.unlink()
+    chunks = sorted((tmp_path / "checkpoints").glob("*-cells-*.npz"))
+    assert len(chunks) > 3 and list((tmp_path / "checkpoints").glob("*-elements-*.json"))
+    for chunk in chunks[::2] + sorted((tmp_path / "checkpoints").glob("*-elements-*.json"))[:1]:
+        chunk.unlink()  # as if the run had stopped before these
     resumed = json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
     assert resumed == full

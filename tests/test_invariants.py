@@ -104,3 +104,23 @@ def test_nodes_follow_the_numbering(cfg):
     used = {v for e in tess.elements for v in e.nodes}
     assert used == set(tess.nodes), "every point is a vertex of some cell"
     assert Configuration.from_code(cfg.code, cfg.box, cfg.face_points) == cfg
+
+
+@SETTINGS
+@given(configurations())
+def test_compiled_and_python_walks_give_the_same_cells(cfg):
+    from cospherical.delaunay import delaunay_cells
+    from cospherical.geometry import Frame
+
+    frame = Frame.build(cfg.nodes(), cfg.box.squared)
+    assert delaunay_cells(frame, compiled=True) == delaunay_cells(frame, compiled=False)
+
+
+def test_the_compiled_walk_takes_only_frames_that_fit_in_int64():
+    from cospherical.compiled import fits
+
+    cube = [(0, 0, 0), (16, 16, 16)]
+    assert fits(cube, (1, 1, 1), 16)
+    assert not fits([(0, 0, 0), (1 << 10, 0, 0)], (1, 1, 1), 1 << 10)  # 2**17 * 2**80 overflows
+    assert not fits(cube, (1 << 40, 1, 1), 16)
+    assert not fits([(i, 0, 0) for i in range(63)], (1, 1, 1), 63)  # a bit mask holds 62 points

@@ -175,6 +175,8 @@ def _type_rows(summaries: list[dict], catalogue: dict) -> list[dict]:
 def _stem(summary: dict) -> str:
     from .patterns import pattern_name
 
+    if summary["study"] == "intersection":
+        return f"intersection-r{summary['resolution']}-{summary['insertion_order']}"
     return pattern_name(summary["study"], summary["box"], summary["face_points"])
 
 

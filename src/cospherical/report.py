@@ -25,6 +25,10 @@ PAPER_NOTES = {
     "classes": "The paper names elements by V/E/F and face kinds, so one paper class can hold "
     "several canonical types (they are summed here); a type outside every paper class is "
     "listed under its own name.",
+    "insertion_order": "The paper's midpoint scheme does not say in which order the levels of a set of "
+    "parallel edges are placed; the positions, and so the elements, depend on it. Every order we tried "
+    "reproduces the paper's 531 cuboids; none reproduces its element total (see the README). The paper "
+    "also prints 187^3+1 configurations where its rule gives 150^3.",
     "splits": "The paper chose its splits by hand and counts classes; we choose the smallest set "
     "of canonical types (ties: fewest elements), found by exhaustive search, and list every "
     "split used above. Where the paper's split is geometrically impossible, or a smaller set "
@@ -43,6 +47,8 @@ def paper_study_key(summary: dict) -> tuple[str | None, list[str]]:
     The paper computed its sqrt 2 case at 1.4142; a box at exactly sqrt 2 is
     compared with it too, marked as a different box.
     """
+    if summary["study"] == "intersection":
+        return "intersection_cube", ["classes", "insertion_order"]
     if summary["study"] != "bisection":
         return None, []
     notes = ["classes"]

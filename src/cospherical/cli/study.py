@@ -13,7 +13,7 @@ from ..report import study_summary, text_report
 from ..study import bisection_codes, run_study
 from ..yamlio import atomic_write
 from .output import dump, emit
-from .progress import progress_bar
+from .progress import progress_bar, stage_bars
 
 
 def add_parser(commands) -> None:
@@ -32,8 +32,15 @@ def add_parser(commands) -> None:
     parser.add_argument("--order", choices=INSERTION_ORDERS, default="edge",
                         help="intersection: the order in which the midpoint scheme inserts the levels (default edge)")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="intersection: worker processes")
-    parser.add_argument("--chunk-size", type=int, default=2000, metavar="N",
-                        help="intersection: orbits per work unit and checkpoint (default 2000)")
+    parser.add_argument("--chunk-size", type=int, default=5000, metavar="N",
+                        help="intersection: orbits per work unit and checkpoint (default 5000)")
+    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                        help="intersection: run the work units on this Dask scheduler's workers")
+    parser.add_argument("--dask-workers", type=int, metavar="N",
+                        help="intersection: run the work units on a local Dask cluster of N processes")
+    parser.add_argument("--no-orbits", action="store_true",
+                        help="intersection: tessellate every configuration, not one per symmetry orbit (a check; "
+                        "the statistics must not change)")
     parser.add_argument("--resume", action="store_true",
                         help="intersection: keep finished chunks in DIR/checkpoints and reuse them (needs --out)")
     parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree")
@@ -78,14 +85,32 @@ def _intersection(args) -> int:
         raise UsageError(f"cospherical study: error: --resolution {args.resolution}: choose 2, 4, 8 or 16")
     if args.resume and not args.out:
         raise UsageError("cospherical study: error: --resume keeps its checkpoints in --out DIR")
+    if args.scheduler and args.dask_workers:
+        raise UsageError("cospherical study: error: give --scheduler or --dask-workers, not both")
+    if args.dask_workers is not None and args.dask_workers < 1:
+        raise UsageError(f"cospherical study: error: --dask-workers {args.dask_workers}: at least 1")
+    if args.scheduler or args.dask_workers:
+        try:
+            import distributed  # noqa: F401
+        except ImportError:
+            raise UsageError("cospherical study: error: the Dask backend needs dask.distributed: "
+                             "pip install 'cospherical[dask]'") from None
     checkpoints = args.out / "checkpoints" if args.out else None
     total = len(intersection_codes(args.resolution, args.order))
-    with progress_bar(total, f"intersection 1/{args.resolution}") as advance:
+    with stage_bars({"cells": (total, f"intersection 1/{args.resolution}: cells", "cfg"),
+                     "elements": (None, "distinct elements classified and split", "el")}) as advance:
         summary = run_intersection(args.resolution, args.order, jobs=max(1, args.jobs),
                                    checkpoints=checkpoints if args.resume else None, progress=advance,
-                                   chunk=max(1, args.chunk_size))
+                                   chunk=max(1, args.chunk_size), scheduler=args.scheduler,
+                                   dask_workers=args.dask_workers, brute_force=args.no_orbits)
     if args.out:
-        atomic_write(args.out / f"intersection-r{args.resolution}-{args.order}.json", dump(summary, "json"))
+        stem = f"intersection-r{args.resolution}-{args.order}"
+        atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
+        atomic_write(args.out / f"{stem}.yaml", dump(summary, "yaml"))
+        from ..render import render_tables
+
+        render_tables([summary], shipped_catalogue(), args.out / "latex",
+                      f"Intersection study at 1/{args.resolution}, insertion order {args.order}")
     if args.compare_paper:
         from ..report import paper_comparison
 
