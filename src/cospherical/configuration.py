@@ -55,6 +55,10 @@ def _face_edges(face: int) -> tuple[int, ...]:
 
 
 FACE_EDGES = tuple(_face_edges(f) for f in range(6))
+EDGE_AXES = tuple(edge_axis(k) for k in range(12))
+# Unit coordinates of the corners, and of each edge's lower-coordinate end.
+_CORNER_POINTS = tuple(tuple(Fraction(x) for x in corner) for corner in CORNERS)
+_EDGE_STARTS = tuple(min((_CORNER_POINTS[i] for i in EDGES[k])) for k in range(12))
 
 
 @dataclass(frozen=True)
@@ -175,12 +179,12 @@ class Configuration:
 
     def nodes(self) -> dict[int, tuple[Fraction, Fraction, Fraction]]:
         """Node id -> exact unit coordinates (s, t, u), ids in increasing order."""
-        nodes = {i: tuple(Fraction(x) for x in corner) for i, corner in enumerate(CORNERS)}
+        nodes = dict(enumerate(_CORNER_POINTS))
         for k, t in enumerate(self.steiner):
             if t is not None:
-                start = list(CORNERS[min(EDGES[k], key=lambda i: CORNERS[i])])
-                start[edge_axis(k)] = t
-                nodes[8 + k] = tuple(Fraction(x) for x in start)
+                start = list(_EDGE_STARTS[k])
+                start[EDGE_AXES[k]] = t
+                nodes[8 + k] = tuple(start)
         if self.face_points == "octree":
             faces = [self._face_point(f) for f in range(6)]
             for f, point in enumerate(faces):
@@ -191,7 +195,7 @@ class Configuration:
         return nodes
 
     def _parallel_parameter(self, axis: int) -> Fraction:
-        return next(t for k, t in enumerate(self.steiner) if edge_axis(k) == axis)
+        return next(t for k, t in enumerate(self.steiner) if EDGE_AXES[k] == axis)
 
     def _face_point(self, face: int) -> tuple[Fraction, Fraction, Fraction] | None:
         # The face of a refined neighbour: exists when the four edges are split
@@ -199,9 +203,9 @@ class Configuration:
         edges = FACE_EDGES[face]
         if any(self.steiner[k] is None for k in edges):
             return None
-        point = [Fraction(x) for x in CORNERS[FACES[face][0]]]
-        for axis in {edge_axis(k) for k in edges}:
-            values = {self.steiner[k] for k in edges if edge_axis(k) == axis}
+        point = list(_CORNER_POINTS[FACES[face][0]])
+        for axis in {EDGE_AXES[k] for k in edges}:
+            values = {self.steiner[k] for k in edges if EDGE_AXES[k] == axis}
             if len(values) != 1:
                 return None
             point[axis] = values.pop()

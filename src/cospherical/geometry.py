@@ -91,10 +91,13 @@ class Frame:
     def build(cls, unit_points: Mapping[int, Sequence[Fraction]], squared_lengths: Sequence[Fraction]) -> "Frame":
         """Frame for ``{node id: unit coordinates}`` in a box with the given squared lengths."""
         ids = tuple(sorted(unit_points))
-        scale = math.lcm(*(Fraction(x).denominator for i in ids for x in unit_points[i]))
-        weight_den = math.lcm(*(Fraction(w).denominator for w in squared_lengths))
-        weights = tuple(int(Fraction(w) * weight_den) for w in squared_lengths)
-        coords = tuple(tuple(int(Fraction(x) * scale) for x in unit_points[i]) for i in ids)
+        # Integer arithmetic on numerators and denominators: a mesher calls this per configuration.
+        points = [[x if isinstance(x, (int, Fraction)) else Fraction(x) for x in unit_points[i]] for i in ids]
+        scale = math.lcm(*(x.denominator for point in points for x in point))
+        squared = [w if isinstance(w, (int, Fraction)) else Fraction(w) for w in squared_lengths]
+        weight_den = math.lcm(*(w.denominator for w in squared))
+        weights = tuple(w.numerator * (weight_den // w.denominator) for w in squared)
+        coords = tuple(tuple(x.numerator * (scale // x.denominator) for x in point) for point in points)
         lifted = tuple((*p, weights[0] * p[0] ** 2 + weights[1] * p[1] ** 2 + weights[2] * p[2] ** 2) for p in coords)
         return cls(ids, coords, lifted, scale, weights)
 

@@ -135,7 +135,7 @@ def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry]) -> tuple[np.n
     smallest image) and the index of the first symmetry taking the row to it (compiled)."""
     from .compiled import orbit_keys as kernel
 
-    digits = np.ascontiguousarray(digits, dtype=np.int64).reshape(-1, 12)
+    digits = np.ascontiguousarray(digits).reshape(-1, 12)  # any integer type: millions of rows stay small
     targets = np.array([[target for target, _ in sym.edge_map] for sym in symmetries], dtype=np.int64).reshape(-1, 12)
     reverse = np.array([[rev for _, rev in sym.edge_map] for sym in symmetries], dtype=np.bool_).reshape(-1, 12)
     return kernel(digits, targets, reverse)
