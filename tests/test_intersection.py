@@ -110,3 +110,26 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path):
         chunk.unlink()  # as if the run had stopped before these
     resumed = json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
     assert resumed == full
+
+
+def test_pattern_table_of_the_representatives(tmp_path):
+    from cospherical import Configuration, tessellate
+    from cospherical.catalogue import shipped_catalogue
+    from cospherical.cli import main
+    from cospherical.intersection import orbits, write_pattern_table
+    from cospherical.patterns import load
+    from cospherical.symmetry import key_code
+
+    summary = run_intersection(2, jobs=1)
+    path = tmp_path / "patterns.yaml"
+    write_pattern_table(summary, path, shipped_catalogue()["version"], jobs=2, chunk=40)
+    table = load(path)
+    reps, _, _ = orbits(2)
+    assert sorted(table.configurations) == [key_code(k) for k in reps.tolist()]
+    assert "smallest" in table.header["symmetry"] and table.header["criteria"][0] == "optimal"
+    for code in sorted(table.configurations)[::7]:
+        direct = tessellate(Configuration.from_code(code))
+        assert [(e["type"], e["nodes"]) for e in table.elements(code)] == \
+               [(e.type.id, list(e.nodes)) for e in direct.elements]
+    # every criterion's elements tile the cube exactly (the deep check)
+    assert main(["check", str(path)]) == 0

@@ -230,7 +230,6 @@ def walk(coords, lifted, weights, cell_mask, cell_sphere, face_cell, face_nodes,
             return -1, -1
         for f in range(first_face, nfaces):
             face_cell[f] = done
-        a0, b0, c0, d0, off0 = cell_sphere[done, 0], cell_sphere[done, 1], cell_sphere[done, 2], cell_sphere[done, 3], cell_sphere[done, 4]
         done += 1
         for f in range(first_face, nfaces):
             key = np.int64(0)

@@ -369,13 +369,15 @@ def statistics(sizes: np.ndarray, cells: dict, element_of: np.ndarray, entries: 
                 key = (total, sorted(kept))
                 if best is None or key < best[0]:
                     best = (key, chosen)
-            pieces = best[1]
+            kept, pieces = best[0][1], best[1]
             splits = {}
             for e in used:
                 if pieces[e] != (entries[e][0],):
                     splits.setdefault(entries[e][0], {}).setdefault(pieces[e], 0)
                     splits[entries[e][0]][pieces[e]] += int(weight[e])
         criteria[criterion] = _frequencies(pieces, weight, sizes, config, element, types, splits)
+        if criterion != "optimal":
+            criteria[criterion]["kept"] = kept
     return {
         "fvm_adequate": int(sizes[cells["closed"]].sum()),
         "fvm_adequate_open": int(sizes[cells["open"]].sum()),
@@ -416,3 +418,71 @@ def _frequencies(pieces, weight, sizes, config, element, types, splits) -> dict:
         data["splits"] = {type_id: [{"pieces": list(p), "configurations": n} for p, n in sorted(used.items())]
                           for type_id, used in sorted(splits.items())}
     return data
+
+
+# ---------------------------------------------------------------------------
+# The pattern table of the orbit representatives (large: written on request).
+
+SYMMETRY_CONVENTION = (
+    "One entry per orbit of the cube's 48 symmetries. The representative is the configuration "
+    "whose code, read as a base-16 number, is the smallest of its images; a symmetry sends the "
+    "point at t on an edge to the image edge at t or, where the edge is reversed, at 1 - t. "
+    "To use an entry for another configuration: cospherical.symmetry.orbit_keys(digits, "
+    "box_symmetries(cube)) gives its representative and the index of a symmetry taking it there; "
+    "map the representative's nodes back with that symmetry's inverse (Symmetry.node_map).")
+
+
+def pattern_chunk(codes: list[int], kept: dict[str, list[str]]) -> str:
+    """Pattern-table entries (YAML text) of some representatives, every criterion of ``kept``."""
+    from .configuration import Configuration
+    from .criteria import split_tessellation
+    from .patterns import element_lines
+    from .symmetry import key_code
+    from .tessellation import tessellate
+
+    lines = []
+    for code in codes:
+        text = key_code(code)
+        tess = tessellate(Configuration.from_code(text))
+        lines.append(f"  '{text}':")
+        lines.append(f"    fvm_adequate: {'true' if tess.fvm_adequate else 'false'}")
+        written: dict[tuple, str] = {}
+        for criterion in ("optimal", *kept):
+            split = tess if criterion == "optimal" else split_tessellation(tess, frozenset(kept[criterion]), criterion)[0]
+            key = tuple(e.polyhedron.nodes for e in split.elements)
+            if key in written:
+                lines.append(f"    {criterion}: {written[key]}")
+                continue
+            written[key] = criterion
+            lines.extend(element_lines(criterion, split))
+    return "\n".join(lines) + "\n" if lines else ""
+
+
+def write_pattern_table(summary: dict, path, catalogue_version: str, jobs: int = 1, progress=None,
+                        chunk: int = 2000, scheduler: str | None = None, dask_workers: int | None = None) -> None:
+    """Write the pattern table of the study's orbit representatives (``summary`` gives the kept sets)."""
+    from . import __version__
+    from .patterns import SCHEMA_VERSION
+    from .yamlio import atomic_open, yaml_text
+
+    resolution, order = summary["resolution"], summary["insertion_order"]
+    reps, _, _ = orbits(resolution, order)
+    kept = {c: data["kept"] for c, data in summary["criteria"].items() if c != "optimal"}
+    header = {
+        "schema_version": SCHEMA_VERSION, "generator": f"cospherical {__version__}",
+        "catalogue_version": catalogue_version, "study": "intersection", "box": ["1", "1", "1"],
+        "face_points": "octree",
+        "scheme": f"midpoint scheme at multiples of 1/{resolution}, insertion order {order} (paper, section 5)",
+        "symmetry": SYMMETRY_CONVENTION, "criteria": ["optimal", *kept],
+    }
+    with atomic_open(path) as handle:
+        handle.write(yaml_text(header) + "configurations:\n")
+        tasks = {i: (reps[i:i + chunk].tolist(), kept) for i in range(0, len(reps), chunk)}
+        waiting, next_start = {}, 0
+        for start, text in _completed(pattern_chunk, tasks, jobs, scheduler, dask_workers):
+            waiting[start] = text
+            while next_start in waiting:  # in code order, whatever order the chunks finish in
+                handle.write(waiting.pop(next_start))
+                if progress:
+                    progress(len(tasks[next_start][0]))
+                next_start += chunk

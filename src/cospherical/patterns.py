@@ -23,7 +23,7 @@ from . import __version__
 from .study import Study
 from .yamlio import FormatError, atomic_write, load_yaml, validate, yaml_float, yaml_text
 
-__all__ = ["PatternTable", "SCHEMA_VERSION", "load", "pattern_name", "patterns_text", "table_from_data", "write_patterns"]
+__all__ = ["PatternTable", "SCHEMA_VERSION", "load", "pattern_name", "element_lines", "patterns_text", "table_from_data", "write_patterns"]
 
 SCHEMA_VERSION = 1
 SCHEMES = {"bisection": "midpoints: every Steiner point at t = 1/2"}
@@ -61,14 +61,19 @@ def patterns_text(study: Study, catalogue_version: str) -> str:
                 lines.append(f"    {criterion}: {written[key]}")
                 continue
             written[key] = criterion
-            tess = study.tessellation(code, criterion)
-            lines.append(f"    {criterion}:")
-            for element in tess.elements:
-                nodes = ", ".join(map(str, element.nodes))
-                center = ", ".join(yaml_float(x) for x in tess.circumcenter(element))
-                mirror = ", mirror: true" if element.mirrored else ""
-                lines.append(f"    - {{type: {element.type.id}, nodes: [{nodes}], circumcenter: [{center}]{mirror}}}")
+            lines.extend(element_lines(criterion, study.tessellation(code, criterion)))
     return "\n".join(lines) + "\n"
+
+
+def element_lines(criterion: str, tess) -> list[str]:
+    """The YAML lines of one configuration's elements under a criterion (inside its entry)."""
+    lines = [f"    {criterion}:"]
+    for element in tess.elements:
+        nodes = ", ".join(map(str, element.nodes))
+        center = ", ".join(yaml_float(x) for x in tess.circumcenter(element))
+        mirror = ", mirror: true" if element.mirrored else ""
+        lines.append(f"    - {{type: {element.type.id}, nodes: [{nodes}], circumcenter: [{center}]{mirror}}}")
+    return lines
 
 
 def write_patterns(study: Study, path: str | Path, catalogue_version: str) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -40,24 +41,30 @@ class FormatError(InputError):
     """A file does not have the expected format; the message names the file and the place."""
 
 
-def atomic_write(path: str | Path, text: str | bytes) -> None:
-    """Write text (UTF-8) or bytes through a temporary file in the same folder and rename: never a
-    half-written file."""
+@contextmanager
+def atomic_open(path: str | Path, binary: bool = False):
+    """A file to write, in place at ``path`` only when the block ends without an error.
+
+    It is a temporary file in the same folder, renamed at the end: never a
+    half-written file, and no temporary file left behind.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        if isinstance(text, bytes):
-            with os.fdopen(fd, "wb") as handle:
-                handle.write(text)
-        else:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-                handle.write(text)
+        with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding="utf-8", newline="\n")) as handle:
+            yield handle
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file ordinary permissions
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def atomic_write(path: str | Path, text: str | bytes) -> None:
+    """Write text (UTF-8) or bytes atomically (see :func:`atomic_open`)."""
+    with atomic_open(path, binary=isinstance(text, bytes)) as handle:
+        handle.write(text)
 
 
 def _umask() -> int:

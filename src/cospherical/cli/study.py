@@ -43,6 +43,9 @@ def add_parser(commands) -> None:
                         "the statistics must not change)")
     parser.add_argument("--resume", action="store_true",
                         help="intersection: keep finished chunks in DIR/checkpoints and reuse them (needs --out)")
+    parser.add_argument("--patterns", action="store_true",
+                        help="intersection: also write the pattern table of the orbit representatives into DIR "
+                        "(large: one tessellation per orbit in Python, about 1 ms each)")
     parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree")
     parser.add_argument("--out", type=Path, metavar="DIR",
                         help="also write the summary (JSON) and the pattern table (YAML) into DIR")
@@ -83,6 +86,8 @@ def _intersection(args) -> int:
         raise UsageError("cospherical study: error: the intersection study is the paper's: the cube, octree points")
     if args.resolution not in (2, 4, 8, 16):
         raise UsageError(f"cospherical study: error: --resolution {args.resolution}: choose 2, 4, 8 or 16")
+    if args.patterns and not args.out:
+        raise UsageError("cospherical study: error: --patterns writes into --out DIR")
     if args.resume and not args.out:
         raise UsageError("cospherical study: error: --resume keeps its checkpoints in --out DIR")
     if args.scheduler and args.dask_workers:
@@ -90,11 +95,11 @@ def _intersection(args) -> int:
     if args.dask_workers is not None and args.dask_workers < 1:
         raise UsageError(f"cospherical study: error: --dask-workers {args.dask_workers}: at least 1")
     if args.scheduler or args.dask_workers:
-        try:
-            import distributed  # noqa: F401
-        except ImportError:
+        from importlib.util import find_spec
+
+        if find_spec("distributed") is None:
             raise UsageError("cospherical study: error: the Dask backend needs dask.distributed: "
-                             "pip install 'cospherical[dask]'") from None
+                             "pip install 'cospherical[dask]'")
     checkpoints = args.out / "checkpoints" if args.out else None
     total = len(intersection_codes(args.resolution, args.order))
     with stage_bars({"cells": (total, f"intersection 1/{args.resolution}: cells", "cfg"),
@@ -111,6 +116,13 @@ def _intersection(args) -> int:
 
         render_tables([summary], shipped_catalogue(), args.out / "latex",
                       f"Intersection study at 1/{args.resolution}, insertion order {args.order}")
+        if args.patterns:
+            from ..intersection import write_pattern_table
+
+            with progress_bar(summary["orbits"], "pattern table") as advance:
+                write_pattern_table(summary, args.out / f"{stem}-patterns.yaml", shipped_catalogue()["version"],
+                                    jobs=max(1, args.jobs), progress=advance, scheduler=args.scheduler,
+                                    dask_workers=args.dask_workers)
     if args.compare_paper:
         from ..report import paper_comparison
 
