@@ -133,3 +133,12 @@ def test_pattern_table_of_the_representatives(tmp_path):
                [(e.type.id, list(e.nodes)) for e in direct.elements]
     # every criterion's elements tile the cube exactly (the deep check)
     assert main(["check", str(path)]) == 0
+
+
+def test_rank_and_reverse_are_mirror_families():
+    # t -> 1 - t turns the scheme inserting from the lowest level into the one inserting
+    # from the highest: the two families are reflections, so their statistics agree.
+    reflected = {tuple(16 - d if d else 0 for d in p) for p in set_patterns(16, "rank")}
+    assert reflected == set(set_patterns(16, "reverse"))
+    a, b = run_intersection(4, "rank", jobs=2), run_intersection(4, "reverse", jobs=2)
+    assert a["criteria"] == b["criteria"] and a["orbits"] == b["orbits"]
