@@ -72,6 +72,15 @@ def _side(a, b, c, d, offset, lifted, p):
 
 
 @njit(cache=True)
+def _contains(values, count, key):
+    """Whether ``key`` is among ``values[:count]`` (a few dozen: a scan beats a hash set)."""
+    for g in range(count):
+        if values[g] == key:
+            return True
+    return False
+
+
+@njit(cache=True)
 def _hull(coords, members, count, face_nodes, face_len, face_normal, start):
     """Append the hull faces of ``members[:count]`` from row ``start``; the new row count, or -1."""
     found = np.zeros(64, dtype=np.int64)
@@ -235,12 +244,7 @@ def walk(coords, lifted, weights, cell_mask, cell_sphere, face_cell, face_nodes,
             key = np.int64(0)
             for t in range(face_len[f]):
                 key |= np.int64(1) << face_nodes[f, t]
-            seen = False
-            for g in range(ncrossed):
-                if crossed[g] == key:
-                    seen = True
-                    break
-            if seen:
+            if _contains(crossed, ncrossed, key):
                 continue
             crossed[ncrossed] = key
             ncrossed += 1
@@ -274,12 +278,7 @@ def walk(coords, lifted, weights, cell_mask, cell_sphere, face_cell, face_nodes,
             for p in range(n):
                 if _side(sa, sb, sc, sd, so, lifted, p) == 0:
                     neighbour |= np.int64(1) << p
-            known = False
-            for g in range(ncells):
-                if cell_mask[g] == neighbour:
-                    known = True
-                    break
-            if known:
+            if _contains(cell_mask, ncells, neighbour):
                 continue
             if ncells >= cell_mask.shape[0]:
                 return -1, -1
