@@ -25,6 +25,7 @@ from itertools import combinations, product
 import numpy as np
 
 from .configuration import edge_axis
+from .split import SPLIT_CRITERIA
 
 __all__ = ["INSERTION_ORDERS", "PARALLEL_EDGES", "intersection_codes", "set_patterns"]
 
@@ -210,9 +211,6 @@ def _tetrahedron():
     """The entry of the tetrahedron (every 4-point cell has this one type; no split)."""
     corners = (0, 1, 3, 4)  # of the cube with no Steiner point (code 0)
     return element_entries([(sum(1 << n for n in corners), 0)])
-
-
-SPLIT_CRITERIA = ("internal_faces", "internal_edges_and_faces")
 
 
 def _completed(function, tasks: dict, jobs: int, scheduler: str | None, dask_workers: int | None):
