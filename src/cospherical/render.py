@@ -21,7 +21,7 @@ from .element_types import face_summary
 from .exact import InputError
 from .paper import paper_studies
 from .report import PAPER_NOTES, paper_comparison, paper_study_key
-from .yamlio import atomic_write
+from .yamlio import atomic_open, atomic_write
 
 __all__ = ["compile_pdf", "element_png", "render_tables", "tex", "tikz_picture"]
 
@@ -144,14 +144,9 @@ def save_png(fig, path: Path, dpi: int = 100) -> None:
     """Save a matplotlib figure atomically (temporary file, then rename), without a version stamp."""
     import matplotlib.pyplot as plt
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
     try:
-        fig.savefig(tmp, format="png", metadata={"Software": None}, dpi=dpi)
-        tmp.replace(path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+        with atomic_open(path, binary=True) as handle:
+            fig.savefig(handle, format="png", metadata={"Software": None}, dpi=dpi)
     finally:
         plt.close(fig)
 
