@@ -204,13 +204,15 @@ def text_report(summary: dict, compare_paper: bool = False, study: Study | None 
                 for split in used:
                     pieces = " + ".join(names.get(p, p) for p in split["pieces"])
                     lines.append(f"    {names.get(type_id, type_id)} -> {pieces}  ({split['configurations']})")
-    if compare_paper and study is not None:
+    if compare_paper:
         lines.append("")
         lines.extend(comparison_lines(summary, study))
     return "\n".join(lines) + "\n"
 
 
-def comparison_lines(summary: dict, study: Study) -> list[str]:
+def comparison_lines(summary: dict, study: Study | None = None) -> list[str]:
+    """The paper's figures beside ours; with the ``study``, also the elements the paper's kept
+    classes cannot tessellate."""
     key, notes = paper_study_key(summary)
     if key is None:
         return ["The paper has no study of this box to compare with."]
@@ -230,7 +232,7 @@ def comparison_lines(summary: dict, study: Study) -> list[str]:
         classes = table["classes"]
         lines.append(f"    {'element classes':<48} {classes['paper']:>8} {classes['ours']:>8}"
                      f"{_mark(classes['paper'], classes['ours'])}")
-        if criterion != "optimal":
+        if criterion != "optimal" and study is not None:
             gaps = paper_set_gaps(study, key, criterion)
             if gaps:
                 lines.append("    The paper's kept classes cannot tessellate these elements (every split shown):")
@@ -240,10 +242,11 @@ def comparison_lines(summary: dict, study: Study) -> list[str]:
     if any(c != "optimal" and c in paper_studies()[key] for c in summary["criteria"]):
         notes = notes + ["splits"]
     fvm = paper_comparison(summary, key)["fvm_adequate"]
-    lines.append(f"  FVM adequate configurations: paper {fvm['paper']}, ours {fvm['closed']} (closed box), "
-                 f"{fvm['open']} (open box){_mark(fvm['paper'], fvm['closed'])}")
-    if fvm["paper"] not in (fvm["closed"], fvm["open"]):
-        notes = notes + ["fvm"]
+    if fvm["paper"] is not None:  # the paper gives no FVM count for its intersection study
+        lines.append(f"  FVM adequate configurations: paper {fvm['paper']}, ours {fvm['closed']} (closed box), "
+                     f"{fvm['open']} (open box){_mark(fvm['paper'], fvm['closed'])}")
+        if fvm["paper"] not in (fvm["closed"], fvm["open"]):
+            notes = notes + ["fvm"]
     lines.append("  Notes:")
     lines.extend(f"  - {PAPER_NOTES[n]}" for n in notes)
     return lines

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..catalogue import shipped_catalogue
 from ..configuration import POINT_POLICIES, Box
-from ..intersection import INSERTION_ORDERS, intersection_codes, run_intersection
+from ..intersection import INSERTION_ORDERS, run_intersection, set_patterns
 from ..patterns import pattern_name, write_patterns
 from ..report import study_summary, text_report
 from ..study import bisection_codes, run_study
@@ -67,11 +67,16 @@ def run(args) -> int:
         stem = pattern_name("bisection", box.texts, args.face_points)
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
         write_patterns(study, args.out / f"{stem}.yaml", shipped_catalogue()["version"])
+    return _report(summary, args, study)
+
+
+def _report(summary: dict, args, study=None) -> int:
+    """The summary on stdout, as JSON or text, with the paper beside it if asked."""
     if args.format == "json":
         if args.compare_paper:
             from ..report import paper_comparison, paper_study_key
 
-            key, notes = paper_study_key(summary)
+            key, _ = paper_study_key(summary)
             summary["paper"] = paper_comparison(summary, key) if key else None
         emit(summary, "json")
     else:
@@ -101,7 +106,7 @@ def _intersection(args) -> int:
             raise UsageError("cospherical study: error: the Dask backend needs dask.distributed: "
                              "pip install 'cospherical[dask]'")
     checkpoints = args.out / "checkpoints" if args.out else None
-    total = len(intersection_codes(args.resolution, args.order))
+    total = len(set_patterns(args.resolution, args.order)) ** 3  # one pattern per set of parallel edges
     with stage_bars({"cells": (total, f"intersection 1/{args.resolution}: cells", "cfg"),
                      "elements": (None, "distinct elements classified and split", "el")}) as advance:
         summary = run_intersection(args.resolution, args.order, jobs=max(1, args.jobs),
@@ -123,20 +128,4 @@ def _intersection(args) -> int:
                 write_pattern_table(summary, args.out / f"{stem}-patterns.yaml", shipped_catalogue()["version"],
                                     jobs=max(1, args.jobs), progress=advance, scheduler=args.scheduler,
                                     dask_workers=args.dask_workers)
-    if args.compare_paper:
-        from ..report import paper_comparison
-
-        summary["paper"] = paper_comparison(summary, "intersection_cube")
-    if args.format == "json":
-        emit(summary, "json")
-    else:
-        print(text_report(summary), end="")
-        if args.compare_paper:
-            table = summary["paper"]
-            print(f"\nBeside the paper (section 5; insertion order {args.order}, resolution 1/{args.resolution}):")
-            for row in table["rows"]:
-                paper = "-" if row["paper"] is None else row["paper"]
-                ours = "-" if row["ours"] is None else row["ours"]
-                print(f"    {row['class'][:48]:<48} {paper:>10} {ours:>10}{'  <- differs' if row['paper'] != row['ours'] else ''}")
-            print(f"    {'total':<48} {table['total']['paper']:>10} {table['total']['ours']:>10}")
-    return 0
+    return _report(summary, args)
