@@ -21,7 +21,7 @@ import time
 
 from cospherical import Box, Configuration, tessellate
 from cospherical.catalogue import known_name
-from cospherical.study import bisection_codes, run_study
+from cospherical.studies.bisection import bisection_codes, run_study
 
 
 def timed(function) -> float:

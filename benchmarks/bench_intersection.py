@@ -29,7 +29,7 @@ import threading
 import time
 
 from cospherical import Configuration, tessellate
-from cospherical.intersection import intersection_codes, run_intersection
+from cospherical.studies.intersection import intersection_codes, run_intersection
 
 
 def tree_rss(pid: int) -> int:
@@ -79,7 +79,7 @@ def codes_of(digits) -> list[str]:
 
 
 def naive(code: str) -> None:
-    from cospherical.criteria import element_options
+    from cospherical.catalogue import element_options
 
     tess = tessellate(Configuration.from_code(code))
     for element in tess.elements:
@@ -94,11 +94,11 @@ def qhull(code: str) -> None:
 
 
 def median_call(configurations, walk_compiled: bool) -> float:
-    from cospherical import delaunay
+    from cospherical.core import delaunay
 
     original = delaunay.delaunay_cells
     delaunay_cells = (lambda frame, compiled=walk_compiled: original(frame, compiled))
-    import cospherical.tessellation as module
+    import cospherical.core.tessellation as module
 
     module.delaunay_cells = delaunay_cells
     try:

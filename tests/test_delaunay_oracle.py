@@ -6,11 +6,11 @@ import random
 from collections import defaultdict
 
 import pytest
-
-from cospherical import Configuration, tessellate
-from cospherical.canonical import canonical_form
 from oracle import isomorphic, qhull_regions
 from strategies import random_configuration
+
+from cospherical import Configuration, tessellate
+from cospherical.core.canonical import canonical_form
 
 BOXES = {
     "cube": ("1", "1", "1"),
@@ -70,7 +70,7 @@ def test_random_configurations_match_qhull():
 
 @pytest.mark.parametrize("order", ["edge", "rank", "reverse"])
 def test_random_intersection_configurations_match_qhull(order):
-    from cospherical.intersection import intersection_codes
+    from cospherical.studies.intersection import intersection_codes
 
     digits = intersection_codes(16, order)
     rng = random.Random(order)
@@ -83,8 +83,8 @@ def test_random_intersection_configurations_match_qhull(order):
 def test_the_python_walk_matches_qhull():
     # tessellate() takes the compiled walk whenever it provably fits in int64; the
     # Python walk (any frame) is checked against the oracle on its own here.
-    from cospherical.delaunay import delaunay_cells
-    from cospherical.geometry import Frame
+    from cospherical.core.delaunay import delaunay_cells
+    from cospherical.core.geometry import Frame
 
     rng = random.Random(11)
     for _ in range(150):

@@ -14,10 +14,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from cospherical import Configuration, InputError, Length
-from cospherical.check import check_catalogue, check_patterns, validated
 from cospherical.cli import main
-from cospherical.patterns import table_from_data
-from cospherical.yamlio import FormatError, parse_yaml
+from cospherical.errors import FormatError
+from cospherical.files.yamlio import parse_yaml
+from cospherical.formats.check import check_catalogue, check_patterns, validated
+from cospherical.formats.patterns import table_from_data
 
 
 def fuzz(n: int):

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from cospherical import Box
-from cospherical.intersection import INSERTION_ORDERS, intersection_codes, run_intersection, set_patterns
-from cospherical.report import study_summary
-from cospherical.study import bisection_codes, run_study
+from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.intersection import INSERTION_ORDERS, intersection_codes, run_intersection, set_patterns
+from cospherical.studies.summary import study_summary
 
 
 @pytest.mark.parametrize("order", INSERTION_ORDERS)
@@ -65,11 +65,11 @@ def test_process_pool_dask_and_brute_force_agree(pool_run):
 def test_compiled_stage_agrees_with_the_python_walk_on_a_sample():
     # Stage 1 (the compiled kernel on many codes) against tessellate() with the Python walk.
     from cospherical import Configuration
-    from cospherical.delaunay import delaunay_cells
-    from cospherical.geometry import Frame
-    from cospherical.intersection import all_configurations, tessellate_chunk
-    from cospherical.polyhedron import polyhedron
-    from cospherical.symmetry import key_code
+    from cospherical.core.delaunay import delaunay_cells
+    from cospherical.core.geometry import Frame
+    from cospherical.core.polyhedron import polyhedron
+    from cospherical.core.symmetry import key_code
+    from cospherical.studies.intersection import all_configurations, tessellate_chunk
 
     codes = all_configurations(16)
     sample = np.sort(codes[np.random.default_rng(16).choice(len(codes), 300, replace=False)])
@@ -91,7 +91,7 @@ def test_compiled_stage_agrees_with_the_python_walk_on_a_sample():
 
 
 def test_the_paper_figures_beside_ours(pool_run):
-    from cospherical.report import paper_comparison, paper_study_key
+    from cospherical.paper import paper_comparison, paper_study_key
 
     key, notes = paper_study_key(pool_run)
     assert key == "intersection_cube" and "insertion_order" in notes
@@ -116,9 +116,9 @@ def test_pattern_table_of_the_representatives(tmp_path):
     from cospherical import Configuration, tessellate
     from cospherical.catalogue import shipped_catalogue
     from cospherical.cli import main
-    from cospherical.intersection import orbits, write_pattern_table
-    from cospherical.patterns import load
-    from cospherical.symmetry import key_code
+    from cospherical.core.symmetry import key_code
+    from cospherical.formats.patterns import load, write_pattern_table
+    from cospherical.studies.intersection import orbits
 
     summary = run_intersection(2, jobs=1)
     path = tmp_path / "patterns.yaml"

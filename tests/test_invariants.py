@@ -7,9 +7,9 @@ from fractions import Fraction
 
 import networkx as nx
 from hypothesis import HealthCheck, given, settings
+from strategies import configurations
 
 from cospherical import Configuration, tessellate
-from strategies import configurations
 
 SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
@@ -109,15 +109,15 @@ def test_nodes_follow_the_numbering(cfg):
 @SETTINGS
 @given(configurations())
 def test_compiled_and_python_walks_give_the_same_cells(cfg):
-    from cospherical.delaunay import delaunay_cells
-    from cospherical.geometry import Frame
+    from cospherical.core.delaunay import delaunay_cells
+    from cospherical.core.geometry import Frame
 
     frame = Frame.build(cfg.nodes(), cfg.box.squared)
     assert delaunay_cells(frame, compiled=True) == delaunay_cells(frame, compiled=False)
 
 
 def test_the_compiled_walk_takes_only_frames_that_fit_in_int64():
-    from cospherical.compiled import fits
+    from cospherical.core.compiled import fits
 
     cube = [(0, 0, 0), (16, 16, 16)]
     assert fits(cube, (1, 1, 1), 16)

@@ -13,8 +13,8 @@ from matplotlib.image import imread
 
 from cospherical import Configuration, tessellate
 from cospherical.catalogue import catalogue_path, load_catalogue
-from cospherical.mesh import write_vtu
-from cospherical.render import tikz_picture
+from cospherical.formats.vtu import write_vtu
+from cospherical.outputs.latex import tikz_picture
 
 ROOT = Path(__file__).resolve().parents[1]
 SUMMARIES = [ROOT / "results" / f"bisection-{box}.json" for box in ("1x1x1", "1x2x4", "1x1.4142x1.4142")]

@@ -10,10 +10,10 @@ import pytest
 from scipy.optimize import Bounds, LinearConstraint, milp
 
 from cospherical import Box
-from cospherical.criteria import element_options, minimal_kept_sets
-from cospherical.paper import paper_class
-from cospherical.report import paper_comparison, study_summary
-from cospherical.study import bisection_codes, run_study
+from cospherical.catalogue import element_options, minimal_kept_sets
+from cospherical.paper import paper_class, paper_comparison
+from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.summary import study_summary
 
 BOXES = {"A": ("1", "1", "1"), "B": ("1", "2", "4"), "C": ("1", "1.4142", "1.4142")}
 

@@ -13,12 +13,14 @@ import pytest
 
 from cospherical import Box, Configuration, tessellate
 from cospherical.catalogue import catalogue_path, load_catalogue
-from cospherical.check import check_catalogue, check_patterns
-from cospherical.patterns import load, pattern_name, write_patterns
-from cospherical.report import paper_comparison, paper_study_key, study_summary
-from cospherical.study import bisection_codes, run_study
-from cospherical.symmetry import box_symmetries
-from cospherical.yamlio import FormatError, dump_yaml, load_yaml
+from cospherical.core.symmetry import box_symmetries
+from cospherical.errors import FormatError
+from cospherical.files.yamlio import dump_yaml, load_yaml
+from cospherical.formats.check import check_catalogue, check_patterns
+from cospherical.formats.patterns import load, pattern_name, write_patterns
+from cospherical.paper import paper_comparison, paper_study_key
+from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.summary import study_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 

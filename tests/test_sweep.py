@@ -9,9 +9,9 @@ from fractions import Fraction
 
 import pytest
 
-from cospherical.exact import Length, rational_text
-from cospherical.ray import Ray, profile_summary, ray_profile
-from cospherical.sweep import box_statistics, grid_values
+from cospherical.core.exact import Length, rational_text
+from cospherical.studies.ray import Ray, profile_summary, ray_profile
+from cospherical.studies.sweep import box_statistics, grid_values
 
 RANGES = {"1,r,r": (Fraction(1), Fraction(9, 5)), "1,1,r": (Fraction(3, 2), Fraction(2))}
 

@@ -6,7 +6,7 @@ from fractions import Fraction
 import pytest
 
 from cospherical import Configuration, tessellate
-from cospherical.element_types import type_id
+from cospherical.core.element_types import type_id
 
 
 def names(code, box=("1", "1", "1"), policy="octree"):

@@ -9,17 +9,13 @@ import signal
 import sys
 import threading
 
-from ..exact import InputError
+from ..errors import CosphericalError, UsageError
 
 __all__ = ["main"]
 
 # One module per subcommand, imported inside main() so that an interrupt while
 # the heavy libraries load is handled like any other.
 SUBCOMMANDS = ("tessellate", "study", "reproduce", "render", "diff", "check", "sweep")
-
-
-class UsageError(Exception):
-    """A command-line usage error (exit code 2)."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -33,7 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="cospherical",
         description="Delaunay tessellations of 1-irregular cuboids with co-spherical elements.",
     )
-    from .. import __version__
+    from ..version import __version__
 
     parser.add_argument("--version", action="version", version=f"cospherical {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -54,8 +50,11 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = build_parser().parse_args(argv)
         return args.run(args)
-    except (UsageError, InputError) as error:
-        print(f"cospherical: error: {error}" if isinstance(error, InputError) else error, file=sys.stderr)
+    except UsageError as error:  # the message already names the command
+        print(error, file=sys.stderr)
+        return 2
+    except CosphericalError as error:
+        print(f"cospherical: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("cospherical: interrupted", file=sys.stderr)

@@ -5,9 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..catalogue import catalogue_path, load_catalogue
-from ..check import check_catalogue, check_patterns, validated
-from ..patterns import table_from_data
-from ..yamlio import load_yaml
+from ..files.yamlio import load_yaml
+from ..formats.check import check_catalogue, check_patterns, validated
+from ..formats.patterns import table_from_data
 
 
 def add_parser(commands) -> None:

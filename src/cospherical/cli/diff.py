@@ -9,9 +9,10 @@ import subprocess
 import sys
 from pathlib import Path
 
-from ..check import validated
-from ..diff import diff_documents, has_changes, text_report
-from ..yamlio import FormatError, load_yaml, parse_yaml
+from ..errors import FormatError, UsageError
+from ..files.yamlio import load_yaml, parse_yaml
+from ..formats.check import validated
+from ..formats.diff import diff_documents, has_changes, text_report
 from .output import dump
 
 
@@ -43,7 +44,6 @@ def _from_git(rev: str, path: Path):
 
 
 def run(args) -> int:
-    from . import UsageError
 
     if args.rev:
         if len(args.files) != 1:

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..catalogue import build_catalogue, shipped_catalogue
-from ..configuration import POINT_POLICIES, Box
-from ..render import compile_pdf, render_tables
-from ..report import study_summary
-from ..study import bisection_codes, run_study
-from ..yamlio import FormatError, load_yaml
+from ..catalogue import shipped_catalogue
+from ..core.configuration import POINT_POLICIES, Box
+from ..errors import FormatError, UsageError
+from ..files.yamlio import load_yaml
+from ..formats.catalogue_file import build_catalogue
+from ..outputs.latex import compile_pdf, render_tables
+from ..studies.bisection import bisection_codes, run_study
+from ..studies.summary import study_summary
 from .progress import progress_bar
 
 SUMMARY_KEYS = ("study", "box", "face_points", "configurations", "fvm_adequate", "fvm_adequate_open", "criteria")
@@ -42,7 +44,6 @@ def _load_summary(path: Path) -> dict:
 
 
 def run(args) -> int:
-    from . import UsageError
 
     if args.study:
         if not args.box:

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..catalogue import build_catalogue, write_catalogue
-from ..configuration import POINT_POLICIES, Box
-from ..patterns import pattern_name, write_patterns
-from ..render import element_png, render_tables
-from ..report import comparison_lines, study_summary, text_report
-from ..study import bisection_codes, run_study
-from ..yamlio import atomic_write
+from ..core.configuration import POINT_POLICIES, Box
+from ..files.yamlio import atomic_write
+from ..formats.catalogue_file import build_catalogue, write_catalogue
+from ..formats.patterns import pattern_name, write_patterns
+from ..outputs.latex import element_png, render_tables
+from ..outputs.report import comparison_lines, text_report
+from ..studies.bisection import bisection_codes, run_study
+from ..studies.summary import study_summary
 from .output import dump
 from .progress import progress_bar
 

@@ -6,12 +6,14 @@ import os
 from pathlib import Path
 
 from ..catalogue import shipped_catalogue
-from ..configuration import POINT_POLICIES, Box
-from ..intersection import INSERTION_ORDERS, run_intersection, set_patterns
-from ..patterns import pattern_name, write_patterns
-from ..report import study_summary, text_report
-from ..study import bisection_codes, run_study
-from ..yamlio import atomic_write
+from ..core.configuration import POINT_POLICIES, Box
+from ..errors import UsageError
+from ..files.yamlio import atomic_write
+from ..formats.patterns import pattern_name, write_patterns
+from ..outputs.report import text_report
+from ..studies.bisection import bisection_codes, run_study
+from ..studies.intersection import INSERTION_ORDERS, run_intersection, set_patterns
+from ..studies.summary import study_summary
 from .output import dump, emit
 from .progress import progress_bar, stage_bars
 
@@ -74,7 +76,7 @@ def _report(summary: dict, args, study=None) -> int:
     """The summary on stdout, as JSON or text, with the paper beside it if asked."""
     if args.format == "json":
         if args.compare_paper:
-            from ..report import paper_comparison, paper_study_key
+            from ..paper import paper_comparison, paper_study_key
 
             key, _ = paper_study_key(summary)
             summary["paper"] = paper_comparison(summary, key) if key else None
@@ -85,7 +87,6 @@ def _report(summary: dict, args, study=None) -> int:
 
 
 def _intersection(args) -> int:
-    from . import UsageError
 
     if Box.parse(args.box).squared != (1, 1, 1) or args.face_points != "octree":
         raise UsageError("cospherical study: error: the intersection study is the paper's: the cube, octree points")
@@ -117,12 +118,12 @@ def _intersection(args) -> int:
         stem = f"intersection-r{args.resolution}-{args.order}"
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
         atomic_write(args.out / f"{stem}.yaml", dump(summary, "yaml"))
-        from ..render import render_tables
+        from ..outputs.latex import render_tables
 
         render_tables([summary], shipped_catalogue(), args.out / "latex",
                       f"Intersection study at 1/{args.resolution}, insertion order {args.order}")
         if args.patterns:
-            from ..intersection import write_pattern_table
+            from ..formats.patterns import write_pattern_table
 
             with progress_bar(summary["orbits"], "pattern table") as advance:
                 write_pattern_table(summary, args.out / f"{stem}-patterns.yaml", shipped_catalogue()["version"],

@@ -5,12 +5,12 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..exact import InputError
-from ..figures import heatmap_png, heatmap_tex, steps_png, steps_tex
-from ..ray import Ray, profile_summary, ray_profile
-from ..render import environment
-from ..sweep import grid_values, sweep
-from ..yamlio import atomic_write
+from ..errors import InputError
+from ..files.yamlio import atomic_write
+from ..outputs.figures import heatmap_png, heatmap_tex, steps_png, steps_tex
+from ..outputs.latex import environment
+from ..studies.ray import Ray, profile_summary, ray_profile
+from ..studies.sweep import grid_values, sweep
 from .output import dump, emit
 from .progress import progress_bar
 
@@ -64,7 +64,7 @@ def _ray(args) -> int:
     parts = args.range.split(":")
     if len(parts) != 2:
         raise InputError(f"range {args.range!r}: write R_MIN:R_MAX, for example 1:4")
-    from ..exact import parse_rational
+    from ..core.exact import parse_rational
 
     r_lo, r_hi = (parse_rational(p, "ray range") for p in parts)
     if not 0 < r_lo <= r_hi:

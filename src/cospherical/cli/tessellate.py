@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..configuration import POINT_POLICIES, Configuration
-from ..exact import InputError
-from ..criteria import CRITERIA, apply_catalogue_criterion
-from ..tessellation import tessellate
+from ..catalogue import CRITERIA, apply_catalogue_criterion
+from ..core.configuration import POINT_POLICIES, Configuration
+from ..core.tessellation import tessellate
+from ..errors import InputError
+from ..formats.tessellation import tessellation_data
 from .output import FORMATS, emit
 
 
@@ -55,10 +56,10 @@ def run(args) -> int:
     if args.criterion != "optimal":
         tess = apply_catalogue_criterion(tess, args.criterion)
     if args.vtu:
-        from ..mesh import write_vtu
+        from ..formats.vtu import write_vtu
 
         write_vtu(tess, args.vtu)
-    data = tess.to_dict()
+    data = tessellation_data(tess)
     data["criterion"] = args.criterion
     emit(data, args.format)
     return 0

@@ -14,11 +14,11 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
-from .configuration import Box, Configuration
-from .criteria import CRITERIA, Choice, choose
-from .element_types import ElementType, classify
-from .symmetry import Symmetry, box_symmetries, orbit_representatives
-from .tessellation import Element, Tessellation, tessellate
+from ..catalogue import CRITERIA, Choice, choose
+from ..core.configuration import Box, Configuration
+from ..core.element_types import ElementType, classify
+from ..core.symmetry import Symmetry, box_symmetries, orbit_representatives
+from ..core.tessellation import Element, Tessellation, tessellate
 
 __all__ = ["Study", "TypeCount", "bisection_codes", "map_tessellation", "run_study"]
 

@@ -24,8 +24,8 @@ from itertools import combinations, product
 
 import numpy as np
 
-from .configuration import edge_axis
-from .split import SPLIT_CRITERIA
+from ..core.configuration import edge_axis
+from ..core.split import SPLIT_CRITERIA
 
 __all__ = ["INSERTION_ORDERS", "PARALLEL_EDGES", "intersection_codes", "set_patterns"]
 
@@ -122,8 +122,8 @@ def orbits(resolution: int = 16, order: str = "edge") -> tuple[np.ndarray, np.nd
     has positions 1 - t, which the midpoint scheme does not produce), so an orbit
     here collects only the family's members that map onto each other.
     """
-    from .configuration import Box
-    from .symmetry import box_symmetries, orbit_keys
+    from ..core.configuration import Box
+    from ..core.symmetry import box_symmetries, orbit_keys
 
     digits = intersection_codes(resolution, order)
     keys, _ = orbit_keys(digits, box_symmetries(Box.parse(["1", "1", "1"])))
@@ -140,7 +140,7 @@ def all_configurations(resolution: int = 16, order: str = "edge") -> np.ndarray:
 def tessellate_chunk(codes: np.ndarray) -> dict[str, np.ndarray]:
     """Stage 1 on base-16 codes: per configuration ``tets``, ``closed``, ``open``, ``polys``;
     per other cell ``poly_mask`` and ``poly_code`` (see :func:`cospherical.compiled.cube_batch`)."""
-    from . import compiled
+    from ..core import compiled
 
     codes = np.ascontiguousarray(codes, dtype=np.int64)
     n = len(codes)
@@ -161,7 +161,7 @@ _TABLES = None
 def _cube_tables():
     global _TABLES
     if _TABLES is None:
-        from .compiled import _cube_tables as tables
+        from ..core.compiled import _cube_tables as tables
 
         _TABLES = tables()
     return _TABLES
@@ -171,13 +171,13 @@ def element_entries(elements: list[tuple[int, int]]) -> tuple[list[list], dict[s
     """Stage 2: per (node mask, code of a configuration holding it), the element's type id and,
     per split criterion, its options as type-id tuples (the element itself first, in the order
     :func:`cospherical.criteria.split_options` prefers them); and the types met, described."""
-    from .configuration import Configuration
-    from .criteria import split_options
-    from .delaunay import delaunay_cells
-    from .element_types import classify
-    from .geometry import Frame
-    from .polyhedron import polyhedron
-    from .symmetry import key_code
+    from ..catalogue import split_options
+    from ..core.configuration import Configuration
+    from ..core.delaunay import delaunay_cells
+    from ..core.element_types import classify
+    from ..core.geometry import Frame
+    from ..core.polyhedron import polyhedron
+    from ..core.symmetry import key_code
 
     squared = (1, 1, 1)
     entries, types = [], {}
@@ -202,9 +202,10 @@ def element_entries(elements: list[tuple[int, int]]) -> tuple[list[list], dict[s
 
 def _describe(etype, types: dict) -> None:
     if etype.id not in types:
-        from .paper import paper_class
+        from ..catalogue import type_name
+        from ..paper import paper_class
 
-        types[etype.id] = [etype.name, etype.vertices, etype.edges, etype.faces, (paper_class(etype) or {}).get("name")]
+        types[etype.id] = [type_name(etype), etype.vertices, etype.edges, etype.faces, (paper_class(etype) or {}).get("name")]
 
 
 def _tetrahedron():
@@ -260,7 +261,7 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     import json
     from pathlib import Path
 
-    from .yamlio import atomic_write
+    from ..files.yamlio import atomic_write
 
     if brute_force:
         reps = all_configurations(resolution, order)
@@ -339,7 +340,7 @@ def statistics(sizes: np.ndarray, cells: dict, element_of: np.ndarray, entries: 
     (entry 0 the tetrahedron); ``element_of`` gives each non-tetrahedral cell's
     entry, in the order of ``cells``.
     """
-    from .criteria import minimal_kept_sets
+    from ..catalogue import minimal_kept_sets
 
     sizes = np.asarray(sizes, dtype=np.int64)
     n = len(sizes)
@@ -416,71 +417,3 @@ def _frequencies(pieces, weight, sizes, config, element, types, splits) -> dict:
         data["splits"] = {type_id: [{"pieces": list(p), "configurations": n} for p, n in sorted(used.items())]
                           for type_id, used in sorted(splits.items())}
     return data
-
-
-# ---------------------------------------------------------------------------
-# The pattern table of the orbit representatives (large: written on request).
-
-SYMMETRY_CONVENTION = (
-    "One entry per orbit of the cube's 48 symmetries. The representative is the configuration "
-    "whose code, read as a base-16 number, is the smallest of its images; a symmetry sends the "
-    "point at t on an edge to the image edge at t or, where the edge is reversed, at 1 - t. "
-    "To use an entry for another configuration: cospherical.symmetry.orbit_keys(digits, "
-    "box_symmetries(cube)) gives its representative and the index of a symmetry taking it there; "
-    "map the representative's nodes back with that symmetry's inverse (Symmetry.node_map).")
-
-
-def pattern_chunk(codes: list[int], kept: dict[str, list[str]]) -> str:
-    """Pattern-table entries (YAML text) of some representatives, every criterion of ``kept``."""
-    from .configuration import Configuration
-    from .criteria import split_tessellation
-    from .patterns import element_lines
-    from .symmetry import key_code
-    from .tessellation import tessellate
-
-    lines = []
-    for code in codes:
-        text = key_code(code)
-        tess = tessellate(Configuration.from_code(text))
-        lines.append(f"  '{text}':")
-        lines.append(f"    fvm_adequate: {'true' if tess.fvm_adequate else 'false'}")
-        written: dict[tuple, str] = {}
-        for criterion in ("optimal", *kept):
-            split = tess if criterion == "optimal" else split_tessellation(tess, frozenset(kept[criterion]), criterion)[0]
-            key = tuple(e.polyhedron.nodes for e in split.elements)
-            if key in written:
-                lines.append(f"    {criterion}: {written[key]}")
-                continue
-            written[key] = criterion
-            lines.extend(element_lines(criterion, split))
-    return "\n".join(lines) + "\n" if lines else ""
-
-
-def write_pattern_table(summary: dict, path, catalogue_version: str, jobs: int = 1, progress=None,
-                        chunk: int = 2000, scheduler: str | None = None, dask_workers: int | None = None) -> None:
-    """Write the pattern table of the study's orbit representatives (``summary`` gives the kept sets)."""
-    from . import __version__
-    from .patterns import SCHEMA_VERSION
-    from .yamlio import atomic_open, yaml_text
-
-    resolution, order = summary["resolution"], summary["insertion_order"]
-    reps, _, _ = orbits(resolution, order)
-    kept = {c: data["kept"] for c, data in summary["criteria"].items() if c != "optimal"}
-    header = {
-        "schema_version": SCHEMA_VERSION, "generator": f"cospherical {__version__}",
-        "catalogue_version": catalogue_version, "study": "intersection", "box": ["1", "1", "1"],
-        "face_points": "octree",
-        "scheme": f"midpoint scheme at multiples of 1/{resolution}, insertion order {order} (paper, section 5)",
-        "symmetry": SYMMETRY_CONVENTION, "criteria": ["optimal", *kept],
-    }
-    with atomic_open(path) as handle:
-        handle.write(yaml_text(header) + "configurations:\n")
-        tasks = {i: (reps[i:i + chunk].tolist(), kept) for i in range(0, len(reps), chunk)}
-        waiting, next_start = {}, 0
-        for start, text in _completed(pattern_chunk, tasks, jobs, scheduler, dask_workers):
-            waiting[start] = text
-            while next_start in waiting:  # in code order, whatever order the chunks finish in
-                handle.write(waiting.pop(next_start))
-                if progress:
-                    progress(len(tasks[next_start][0]))
-                next_start += chunk

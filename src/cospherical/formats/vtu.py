@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .tessellation import Tessellation
+from ..core.tessellation import Tessellation
 
 __all__ = ["to_meshio", "write_vtu"]
 

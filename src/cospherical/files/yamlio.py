@@ -7,12 +7,12 @@ import os
 import tempfile
 from contextlib import contextmanager
 from functools import lru_cache
-from importlib import resources
 from pathlib import Path
 
 import yaml
 
-from .exact import InputError
+from ..errors import FormatError
+from .data import data_path
 
 __all__ = ["FormatError", "atomic_write", "dump_yaml", "load_yaml", "parse_yaml", "validate", "yaml_float"]
 
@@ -35,10 +35,6 @@ class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
             if repeated:
                 raise yaml.constructor.ConstructorError(None, None, f"repeated key {key!r}", key_node.start_mark)
         return super().construct_mapping(node, deep)
-
-
-class FormatError(InputError):
-    """A file does not have the expected format; the message names the file and the place."""
 
 
 @contextmanager
@@ -116,7 +112,7 @@ def _validator(name: str):
     # table validates in a fraction of a second instead of seconds.
     import fastjsonschema
 
-    schema = json.loads(resources.files("cospherical").joinpath(f"data/schemas/{name}.schema.json").read_text())
+    schema = json.loads(data_path(f"schemas/{name}.schema.json").read_text(encoding="utf-8"))
     return fastjsonschema.compile(schema)
 
 

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Iterable, Mapping
 
-from .exact import InputError, Length, parse_rational
+from ..errors import InputError
+from .exact import Length, parse_rational
 
 __all__ = [
     "BODY_NODE",

@@ -20,11 +20,12 @@ from fractions import Fraction
 from functools import lru_cache
 from itertools import combinations
 
-from .configuration import Box, Configuration
-from .exact import InputError, Length
-from .geometry import Frame
-from .symmetry import box_symmetries, orbit_representatives
-from .tessellation import tessellate
+from ..core.configuration import Box, Configuration
+from ..core.exact import Length
+from ..core.geometry import Frame
+from ..core.symmetry import box_symmetries, orbit_representatives
+from ..core.tessellation import tessellate
+from ..errors import InputError
 
 __all__ = ["Ray", "code_pieces", "ray_profile"]
 
@@ -176,7 +177,7 @@ class Step:
 
 def ray_profile(ray: Ray, r_lo: Fraction, r_hi: Fraction, progress=None) -> list[Step]:
     """The bisection study along the ray for r in [r_lo, r_hi], exactly, as steps in u = r^2."""
-    from .study import bisection_codes
+    from .bisection import bisection_codes
 
     u_lo, u_hi = r_lo * r_lo, r_hi * r_hi
     codes = bisection_codes()

@@ -12,10 +12,9 @@ from __future__ import annotations
 from collections import Counter
 from fractions import Fraction
 
-from .configuration import Box, Configuration
-from .exact import InputError
-from .geometry import Frame, six_volume
-from .yamlio import FormatError
+from ..core.configuration import Box, Configuration
+from ..core.geometry import Frame, six_volume
+from ..errors import FormatError, InputError
 
 __all__ = ["check_catalogue", "check_patterns"]
 
@@ -115,8 +114,8 @@ def _check_tiling(frame: Frame, elements, types, where: str) -> None:
 
 def validated(data, name: str) -> tuple[str, dict]:
     """The document's kind (``catalogue`` or ``patterns``), after schema validation."""
+    from ..files.yamlio import validate
     from .diff import document_kind
-    from .yamlio import validate
 
     kind = document_kind(data, name)
     validate(data, kind, name)

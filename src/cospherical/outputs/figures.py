@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .exact import Length
-from .render import environment, save_png
-from .yamlio import atomic_write
+from ..core.exact import Length
+from ..files.yamlio import atomic_write
+from .latex import environment, save_png
 
 __all__ = ["heatmap_png", "heatmap_tex", "steps_png", "steps_tex"]
 

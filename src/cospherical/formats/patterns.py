@@ -19,11 +19,18 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import __version__
-from .study import Study
-from .yamlio import FormatError, atomic_write, load_yaml, validate, yaml_float, yaml_text
+from ..catalogue import split_tessellation
+from ..core.configuration import Configuration
+from ..core.symmetry import key_code
+from ..core.tessellation import tessellate
+from ..errors import FormatError
+from ..files.yamlio import atomic_open, atomic_write, load_yaml, validate, yaml_float, yaml_text
+from ..studies.bisection import Study
+from ..studies.intersection import _completed, orbits
+from ..version import __version__
 
-__all__ = ["PatternTable", "SCHEMA_VERSION", "load", "pattern_name", "element_lines", "patterns_text", "table_from_data", "write_patterns"]
+__all__ = ["PatternTable", "SCHEMA_VERSION", "element_lines", "load", "pattern_chunk", "pattern_name", "patterns_text",
+           "table_from_data", "write_pattern_table", "write_patterns"]
 
 SCHEMA_VERSION = 1
 SCHEMES = {"bisection": "midpoints: every Steiner point at t = 1/2"}
@@ -118,3 +125,62 @@ def table_from_data(data, name: str) -> PatternTable:
                                   "which is not an earlier criterion of the table")
     header = {k: v for k, v in data.items() if k != "configurations"}
     return PatternTable(header, data["configurations"])
+
+
+# ---------------------------------------------------------------------------
+# The intersection study's pattern table: one entry per orbit representative
+# (large: written on request, in chunks on the workers).
+
+SYMMETRY_CONVENTION = (
+    "One entry per orbit of the cube's 48 symmetries. The representative is the configuration "
+    "whose code, read as a base-16 number, is the smallest of its images; a symmetry sends the "
+    "point at t on an edge to the image edge at t or, where the edge is reversed, at 1 - t. "
+    "To use an entry for another configuration: cospherical.symmetry.orbit_keys(digits, "
+    "box_symmetries(cube)) gives its representative and the index of a symmetry taking it there; "
+    "map the representative's nodes back with that symmetry's inverse (Symmetry.node_map).")
+
+
+def pattern_chunk(codes: list[int], kept: dict[str, list[str]]) -> str:
+    """Pattern-table entries (YAML text) of some representatives, every criterion of ``kept``."""
+    lines = []
+    for code in codes:
+        text = key_code(code)
+        tess = tessellate(Configuration.from_code(text))
+        lines.append(f"  '{text}':")
+        lines.append(f"    fvm_adequate: {'true' if tess.fvm_adequate else 'false'}")
+        written: dict[tuple, str] = {}
+        for criterion in ("optimal", *kept):
+            split = tess if criterion == "optimal" else split_tessellation(tess, frozenset(kept[criterion]), criterion)[0]
+            key = tuple(e.polyhedron.nodes for e in split.elements)
+            if key in written:
+                lines.append(f"    {criterion}: {written[key]}")
+                continue
+            written[key] = criterion
+            lines.extend(element_lines(criterion, split))
+    return "\n".join(lines) + "\n" if lines else ""
+
+
+def write_pattern_table(summary: dict, path, catalogue_version: str, jobs: int = 1, progress=None,
+                        chunk: int = 2000, scheduler: str | None = None, dask_workers: int | None = None) -> None:
+    """Write the pattern table of the study's orbit representatives (``summary`` gives the kept sets)."""
+    resolution, order = summary["resolution"], summary["insertion_order"]
+    reps, _, _ = orbits(resolution, order)
+    kept = {c: data["kept"] for c, data in summary["criteria"].items() if c != "optimal"}
+    header = {
+        "schema_version": SCHEMA_VERSION, "generator": f"cospherical {__version__}",
+        "catalogue_version": catalogue_version, "study": "intersection", "box": ["1", "1", "1"],
+        "face_points": "octree",
+        "scheme": f"midpoint scheme at multiples of 1/{resolution}, insertion order {order} (paper, section 5)",
+        "symmetry": SYMMETRY_CONVENTION, "criteria": ["optimal", *kept],
+    }
+    with atomic_open(path) as handle:
+        handle.write(yaml_text(header) + "configurations:\n")
+        tasks = {i: (reps[i:i + chunk].tolist(), kept) for i in range(0, len(reps), chunk)}
+        waiting, next_start = {}, 0
+        for start, text in _completed(pattern_chunk, tasks, jobs, scheduler, dask_workers):
+            waiting[start] = text
+            while next_start in waiting:  # in code order, whatever order the chunks finish in
+                handle.write(waiting.pop(next_start))
+                if progress:
+                    progress(len(tasks[next_start][0]))
+                next_start += chunk

@@ -6,9 +6,10 @@ from concurrent.futures import ProcessPoolExecutor
 from fractions import Fraction
 from typing import Callable, Iterable
 
-from .configuration import Box
-from .exact import InputError, parse_rational, rational_text
-from .study import bisection_codes, run_study
+from ..core.configuration import Box
+from ..core.exact import parse_rational, rational_text
+from ..errors import InputError
+from .bisection import bisection_codes, run_study
 
 __all__ = ["box_statistics", "grid_values", "sweep"]
 

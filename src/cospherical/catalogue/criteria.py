@@ -14,10 +14,11 @@ from collections import Counter
 from dataclasses import dataclass
 from functools import lru_cache
 
-from .element_types import classify
-from .geometry import Frame
-from .split import CRITERIA, SPLIT_CRITERIA, subdivisions
-from .tessellation import Element, Tessellation
+from ..core.element_types import classify
+from ..core.geometry import Frame
+from ..core.split import CRITERIA, SPLIT_CRITERIA, subdivisions
+from ..core.tessellation import Element, Tessellation
+from .store import shipped_catalogue
 
 __all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "choose", "element_options", "minimal_kept_sets", "split_options",
            "split_tessellation"]
@@ -156,8 +157,6 @@ def apply_catalogue_criterion(tess: Tessellation, criterion: str) -> Tessellatio
     element of a type it does not keep is split into kept types, fewest pieces
     first; an element with no such split (a type no study met) stays whole.
     """
-    from .catalogue import shipped_catalogue
-
     if criterion == "optimal":
         return tess
     kept = frozenset(shipped_catalogue().get("criteria", {}).get(criterion, {}).get("kept", []))

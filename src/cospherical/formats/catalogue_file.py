@@ -1,87 +1,23 @@
-"""The element catalogue: every element type met, named, with an example geometry.
-
-The catalogue is versioned data (``catalogue/catalogue.yaml``, shipped in the
-wheel as ``cospherical/data/catalogue.yaml``).  Names follow one rule, applied
-when the catalogue is built: a type's structural name (tetrahedron, pyramids,
-bipyramids, triangular prism, cuboid) if it has one; else its paper class's name
-when the class is not structural (numbered variants when several types share
-it); else a systematic name.  The paper class is kept as an alias, which is
-what comparisons with the paper use.
-"""
+"""The catalogue file, built from studies: every element type met, named, with an example geometry."""
 
 from __future__ import annotations
 
 import hashlib
 import json
-from functools import lru_cache
-from importlib import resources
 from pathlib import Path
-from typing import Iterable
 
-from . import __version__
-from .element_types import ElementType, systematic_name
-from .split import SPLIT_CRITERIA
-from .paper import paper_class
-from .yamlio import dump_yaml, load_yaml, validate
+from ..catalogue import SCHEMA_VERSION, type_names
+from ..core.canonical import canonical_form
+from ..core.element_types import ElementType
+from ..core.split import SPLIT_CRITERIA
+from ..files.yamlio import dump_yaml
+from ..version import __version__
 
-__all__ = ["SCHEMA_VERSION", "build_catalogue", "catalogue_path", "known_name", "load_catalogue", "shipped_catalogue", "type_names"]
-
-SCHEMA_VERSION = 1
-
-
-def catalogue_path() -> Path:
-    """The shipped catalogue: package data in a wheel, ``catalogue/`` in a checkout."""
-    packaged = Path(str(resources.files("cospherical").joinpath("data/catalogue.yaml")))
-    if packaged.exists():
-        return packaged
-    return Path(__file__).resolve().parents[2] / "catalogue" / "catalogue.yaml"
-
-
-@lru_cache(maxsize=None)
-def shipped_catalogue() -> dict:
-    """The shipped catalogue, read and validated once per process (empty if there is none)."""
-    path = catalogue_path()
-    if not path.exists():
-        return {"schema_version": SCHEMA_VERSION, "version": "none", "types": []}
-    return load_catalogue(path)
-
-
-@lru_cache(maxsize=None)
-def _known_names() -> dict[str, str]:
-    return {entry["code"]: entry["name"] for entry in shipped_catalogue()["types"]}
-
-
-def known_name(code: str) -> str | None:
-    """The catalogue's name of a canonical code, if the shipped catalogue has it."""
-    return _known_names().get(code)
-
-
-def type_names(types: Iterable[ElementType]) -> dict[str, tuple[str, list[str]]]:
-    """Type id -> (name, aliases) by the catalogue's naming rule; names are unique."""
-    types = sorted(types, key=lambda t: t.id)
-    base = {}
-    aliases = {}
-    for t in types:
-        cls = paper_class(t)
-        aliases[t.id] = [cls["name"]] if cls else []
-        if t.structural:
-            base[t.id] = t.structural
-        elif cls and not cls.get("structural"):
-            base[t.id] = cls["name"]
-        else:
-            base[t.id] = systematic_name(t.vertices, t.face_summary)
-    names = {}
-    for t in types:
-        sharing = [u.id for u in types if base[u.id] == base[t.id]]
-        suffix = f" (variant {sharing.index(t.id) + 1})" if len(sharing) > 1 else ""
-        names[t.id] = (base[t.id] + suffix, aliases[t.id])
-    return names
+__all__ = ["build_catalogue", "write_catalogue"]
 
 
 def _chiral(element) -> bool:
     """Whether the type differs from its mirror image (its canonical walks need one handedness)."""
-    from .canonical import canonical_form
-
     mirror = [tuple(reversed(face)) for face in element.polyhedron.faces]
     return canonical_form(mirror, element.polyhedron.face_kinds).mirrored != element.mirrored
 
@@ -172,13 +108,6 @@ def build_catalogue(studies) -> dict:
         "criteria": {criterion: {"kept": sorted(ids)} for criterion, ids in sorted(kept.items())},
         "types": entries,
     }
-
-
-def load_catalogue(path: str | Path) -> dict:
-    """Read and validate a catalogue file."""
-    data = load_yaml(path)
-    validate(data, "catalogue", path)
-    return data
 
 
 def write_catalogue(catalogue: dict, path: str | Path) -> None:

@@ -11,17 +11,16 @@ from __future__ import annotations
 import math
 import shutil
 import subprocess
-from importlib import resources
 from pathlib import Path
 
 import jinja2
 
-from . import __version__
-from .element_types import face_summary
-from .exact import InputError
-from .paper import paper_studies
-from .report import PAPER_NOTES, paper_comparison, paper_study_key
-from .yamlio import atomic_open, atomic_write
+from ..core.element_types import face_summary
+from ..errors import InputError
+from ..files.data import data_path
+from ..files.yamlio import atomic_open, atomic_write
+from ..paper import comparison_notes, paper_comparison, paper_notes, paper_studies, paper_study_key
+from ..version import __version__
 
 __all__ = ["compile_pdf", "element_png", "render_tables", "tex", "tikz_picture"]
 
@@ -40,17 +39,9 @@ def tex(value) -> str:
     return "".join(_TEX.get(ch, ch) for ch in str(value))
 
 
-def template_dir() -> Path:
-    """The templates: package data in a wheel, ``templates/`` in a checkout."""
-    packaged = Path(str(resources.files("cospherical").joinpath("templates")))
-    if packaged.is_dir():
-        return packaged
-    return Path(__file__).resolve().parents[2] / "templates"
-
-
 def environment() -> jinja2.Environment:
     env = jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(template_dir())),
+        loader=jinja2.FileSystemLoader(str(data_path("templates"))),
         block_start_string=r"\BLOCK{", block_end_string="}",
         variable_start_string=r"\VAR{", variable_end_string="}",
         comment_start_string=r"\#{", comment_end_string="}",
@@ -168,7 +159,7 @@ def _type_rows(summaries: list[dict], catalogue: dict) -> list[dict]:
 
 
 def _stem(summary: dict) -> str:
-    from .patterns import pattern_name
+    from ..formats.patterns import pattern_name
 
     if summary["study"] == "intersection":
         return f"intersection-r{summary['resolution']}-{summary['insertion_order']}"
@@ -192,7 +183,7 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str)
     fvm_rows = []
     for summary in summaries:
         stem = _stem(summary)
-        key, notes = paper_study_key(summary)
+        key, _ = paper_study_key(summary)
         box = " x ".join(summary["box"])
         files = []
         for criterion, data in summary["criteria"].items():
@@ -208,11 +199,9 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str)
                           "differs": r["paper"] != r["ours"]} for r in table["rows"]]
                 total = {"paper": f"{table['total']['paper']:,}", "ours": f"{table['total']['ours']:,}",
                          "differs": table["total"]["paper"] != table["total"]["ours"]}
-                fvm = table["fvm_adequate"]
-                extra = (["splits"] if criterion != "optimal" else
-                         ["fvm"] if fvm["paper"] not in (fvm["closed"], fvm["open"]) else [])
+                notes = [paper_notes()[n] for n in comparison_notes(summary, key, [criterion])]
                 files.append(write(f"comparison-{stem}-{criterion}.tex", "comparison.tex.j2", rows=crows,
-                                   total=total, notes=[PAPER_NOTES[n] for n in notes + extra],
+                                   total=total, notes=notes,
                                    caption=f"Beside the paper ({key}), box {box}, {summary['face_points']} points, {criterion}"))
         fvm_rows.append({"box": box, "face_points": summary["face_points"],
                          "configurations": summary["configurations"], "closed": summary["fvm_adequate"],

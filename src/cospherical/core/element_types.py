@@ -28,9 +28,10 @@ _KIND_PLURAL = {
 class ElementType:
     """One element type: polyhedra whose labelled face graphs are isomorphic.
 
-    ``name`` is the catalogue's name when the shipped catalogue knows the type,
-    else ``structural`` (tetrahedron, n-gonal pyramid or bipyramid, triangular
-    prism, cuboid) when the face structure has one, else a systematic name.
+    ``name`` is ``structural`` (tetrahedron, n-gonal pyramid or bipyramid,
+    triangular prism, cuboid) when the face structure has one, else a systematic
+    name from the face counts.  It depends on the polyhedron alone; the catalogue
+    (:func:`cospherical.catalogue.type_name`) adds the names of the types it knows.
     ``face_kinds`` counts faces per kind, e.g. ``(("rectangle", 1), ("triangle", 4))``.
     ``vtk`` names the VTK cell type when the type has one (its nodes then follow
     VTK order), else ``None``.
@@ -124,14 +125,12 @@ def systematic_name(vertices: int, face_summary: str) -> str:
 
 
 def _new_type(code: str, faces, kinds) -> ElementType:
-    from .catalogue import known_name  # the shipped catalogue names the types it knows
-
     vertices = len({v for f in faces for v in f})
     edges = sum(len(f) for f in faces) // 2
     structural, vtk = _standard(faces, kinds)
     face_kinds = tuple(sorted(Counter(kinds).items()))
     etype = ElementType(code, type_id(code, vertices, len(faces)), "", structural, vertices, edges, len(faces), face_kinds, vtk)
-    name = known_name(code) or structural or systematic_name(vertices, etype.face_summary)
+    name = structural or systematic_name(vertices, etype.face_summary)
     return replace(etype, name=name)
 
 

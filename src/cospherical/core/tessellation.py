@@ -51,33 +51,6 @@ class Tessellation:
         scale = self.configuration.box.to_float()
         return tuple(float(x) * s for x, s in zip(element.polyhedron.center, scale))
 
-    def to_dict(self) -> dict:
-        """The JSON/YAML shape of ``cospherical tessellate``."""
-        cfg = self.configuration
-        real = cfg.real_nodes()
-        return {
-            "box": list(cfg.box.texts),
-            "code": cfg.code,
-            "face_points": cfg.face_points,
-            "steiner": {str(k): str(t) for k, t in enumerate(cfg.steiner) if t is not None},
-            "nodes": {str(i): list(p) for i, p in real.items()},
-            "elements": [
-                {
-                    "type": e.type.id,
-                    "name": e.type.name,
-                    "nodes": list(e.nodes),
-                    "vertices": e.type.vertices,
-                    "edges": e.type.edges,
-                    "faces": e.type.faces,
-                    "circumcenter": list(self.circumcenter(e)),
-                    **({"mirror": True} if e.mirrored else {}),
-                }
-                for e in self.elements
-            ],
-            "fvm_adequate": self.fvm_adequate,
-            "fvm_adequate_open": self.fvm_adequate_open,
-        }
-
 
 def tessellate(configuration: Configuration) -> Tessellation:
     """The Delaunay tessellation of a configuration, its elements the largest co-spherical sets.

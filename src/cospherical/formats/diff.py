@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections import Counter
 
-from .yamlio import FormatError
+from ..errors import FormatError
 
 __all__ = ["diff_catalogues", "diff_documents", "diff_patterns", "document_kind", "text_report"]
 

@@ -13,11 +13,9 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 
-__all__ = ["InputError", "Length", "parse_rational", "rational_text"]
+from ..errors import InputError
 
-
-class InputError(ValueError):
-    """A value given by the user cannot be used; the message names it."""
+__all__ = ["Length", "parse_rational", "rational_text"]
 
 
 _SQRT = re.compile(r"^(?:(?P<factor>[^*]+)\*)?sqrt\((?P<radicand>[^()]+)\)$")

@@ -1,0 +1,18 @@
+"""The element catalogue: names of the known types, and the paper's criteria (kept sets, splits)."""
+
+from .criteria import (
+                       CRITERIA,
+                       SPLIT_CRITERIA,
+                       Choice,
+                       apply_catalogue_criterion,
+                       choose,
+                       element_options,
+                       minimal_kept_sets,
+                       split_options,
+                       split_tessellation,
+)
+from .store import SCHEMA_VERSION, catalogue_path, known_name, load_catalogue, shipped_catalogue, type_name, type_names
+
+__all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "catalogue_path",
+           "choose", "element_options", "known_name", "load_catalogue", "minimal_kept_sets", "shipped_catalogue",
+           "split_options", "split_tessellation", "type_name", "type_names"]

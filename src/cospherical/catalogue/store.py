@@ -1,0 +1,92 @@
+"""The element catalogue: every element type met, named, with an example geometry.
+
+The catalogue is versioned data (``catalogue/catalogue.yaml``, shipped in the
+wheel as ``cospherical/data/catalogue.yaml``; built from studies by
+:mod:`cospherical.formats.catalogue_file`).  Names follow one rule, applied
+when the catalogue is built: a type's structural name (tetrahedron, pyramids,
+bipyramids, triangular prism, cuboid) if it has one; else its paper class's name
+when the class is not structural (numbered variants when several types share
+it); else a systematic name.  The paper class is kept as an alias, which is
+what comparisons with the paper use.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+from typing import Iterable
+
+from ..core.element_types import ElementType, systematic_name
+from ..files.data import data_path
+from ..files.yamlio import load_yaml, validate
+from ..paper import paper_class
+
+__all__ = ["SCHEMA_VERSION", "catalogue_path", "known_name", "load_catalogue", "shipped_catalogue", "type_name",
+           "type_names"]
+
+SCHEMA_VERSION = 1
+
+
+def catalogue_path() -> Path:
+    """The shipped catalogue: package data in a wheel, ``catalogue/`` in a checkout."""
+    return data_path("catalogue.yaml")
+
+
+@lru_cache(maxsize=None)
+def shipped_catalogue() -> dict:
+    """The shipped catalogue, read and validated once per process (empty if there is none)."""
+    path = catalogue_path()
+    if not path.exists():
+        return {"schema_version": SCHEMA_VERSION, "version": "none", "types": []}
+    return load_catalogue(path)
+
+
+@lru_cache(maxsize=None)
+def _known_names() -> dict[str, str]:
+    return {entry["code"]: entry["name"] for entry in shipped_catalogue()["types"]}
+
+
+def known_name(code: str) -> str | None:
+    """The catalogue's name of a canonical code, if the shipped catalogue has it."""
+    return _known_names().get(code)
+
+
+def type_name(etype: ElementType) -> str:
+    """The name of an element type: the shipped catalogue's, else its structural or systematic name.
+
+    Examples
+    --------
+    >>> from cospherical import Configuration, tessellate
+    >>> type_name(tessellate(Configuration.from_code("000000000000")).elements[0].type)
+    'cuboid'
+    """
+    return known_name(etype.code) or etype.name
+
+
+def type_names(types: Iterable[ElementType]) -> dict[str, tuple[str, list[str]]]:
+    """Type id -> (name, aliases) by the catalogue's naming rule; names are unique."""
+    types = sorted(types, key=lambda t: t.id)
+    base = {}
+    aliases = {}
+    for t in types:
+        cls = paper_class(t)
+        aliases[t.id] = [cls["name"]] if cls else []
+        if t.structural:
+            base[t.id] = t.structural
+        elif cls and not cls.get("structural"):
+            base[t.id] = cls["name"]
+        else:
+            base[t.id] = systematic_name(t.vertices, t.face_summary)
+    names = {}
+    for t in types:
+        sharing = [u.id for u in types if base[u.id] == base[t.id]]
+        suffix = f" (variant {sharing.index(t.id) + 1})" if len(sharing) > 1 else ""
+        names[t.id] = (base[t.id] + suffix, aliases[t.id])
+    return names
+
+
+def load_catalogue(path: str | Path) -> dict:
+    """Read and validate a catalogue file."""
+    data = load_yaml(path)
+    validate(data, "catalogue", path)
+    return data

@@ -1,0 +1,30 @@
+"""One error hierarchy for the whole library; the CLI turns it into exit codes.
+
+Every error the library raises on purpose is a :class:`CosphericalError`, and its
+message names the value, or the file and the place in it, so that one line on
+stderr tells a user what to fix.  The library never exits; ``cospherical.cli``
+maps these to exit status 2.
+
+>>> issubclass(FormatError, InputError), issubclass(UsageError, CosphericalError)
+(True, True)
+"""
+
+from __future__ import annotations
+
+__all__ = ["CosphericalError", "FormatError", "InputError", "UsageError"]
+
+
+class CosphericalError(Exception):
+    """Base class of every error cospherical raises on purpose."""
+
+
+class InputError(CosphericalError, ValueError):
+    """A value given by the user cannot be used; the message names it."""
+
+
+class FormatError(InputError):
+    """A file does not have the expected format; the message names the file and the place."""
+
+
+class UsageError(CosphericalError):
+    """A command-line usage error: a missing, conflicting or malformed option."""

@@ -1,0 +1,104 @@
+"""Text reports of study summaries, with the paper's figures beside ours."""
+
+from __future__ import annotations
+
+from ..catalogue import element_options, type_name
+from ..paper import comparison_notes, paper_class, paper_comparison, paper_notes, paper_studies, paper_study_key
+from ..studies.bisection import Study
+
+__all__ = ["comparison_lines", "paper_set_gaps", "text_report"]
+
+
+def paper_set_gaps(study: Study, key: str, criterion: str) -> list[dict]:
+    """Element types of the study that cannot be split into the paper's kept classes.
+
+    The paper's table for a criterion names the classes it keeps; an element whose
+    every split (the element itself included) has a piece outside those classes
+    proves that the paper's table cannot come out for this point set.
+    """
+    kept_classes = set(paper_studies()[key][criterion]["counts"])
+    sizes = study.orbit_sizes()
+    gaps: dict[str, dict] = {}
+    for rep, tess in study.tessellations.items():
+        for element in tess.elements:
+            options = element_options(tess, element, criterion)
+            if any(all((paper_class(p.type) or {}).get("name") in kept_classes for p in o) for o in options):
+                continue
+            entry = gaps.setdefault(element.type.id, {
+                "type": element.type.id, "name": type_name(element.type), "configurations": 0,
+                "splits": sorted({" + ".join(sorted(type_name(p.type) for p in o)) for o in options}),
+            })
+            entry["configurations"] += sizes[rep]
+    return sorted(gaps.values(), key=lambda g: g["type"])
+
+
+def _mark(paper, ours) -> str:
+    return "" if paper == ours else "  <- differs"
+
+
+def text_report(summary: dict, compare_paper: bool = False, study: Study | None = None) -> str:
+    """A plain-text report: the frequency table and, if asked, the paper beside it."""
+    lines = [
+        f"{summary['study']} study, box {' x '.join(summary['box'])}, face points {summary['face_points']}: "
+        f"{summary['configurations']} configurations ({summary['orbits']} orbits)",
+        f"FVM adequate: {summary['fvm_adequate']} (closed box), {summary['fvm_adequate_open']} (open box)",
+    ]
+    names = {i: t["name"] for data in summary["criteria"].values() for i, t in data["types"].items()}
+    for criterion, data in summary["criteria"].items():
+        lines.append("")
+        lines.append(f"{criterion}: {data['total']} elements, {data['types_count']} element types "
+                     f"({data['paper_classes_count']} paper classes)")
+        lines.append(f"  {'id':<14} {'name':<48} {'paper class':<32} {'count':>8} {'share':>7} {'configs':>7}")
+        for type_id, entry in data["types"].items():
+            lines.append(
+                f"  {type_id:<14} {entry['name'][:48]:<48} {(entry['paper_class'] or '-')[:32]:<32} "
+                f"{entry['count']:>8} {100 * entry['share']:>6.2f}% {entry['configurations']:>7}"
+            )
+        if data.get("splits"):
+            lines.append("  splits used (type -> pieces, configurations):")
+            for type_id, used in data["splits"].items():
+                for split in used:
+                    pieces = " + ".join(names.get(p, p) for p in split["pieces"])
+                    lines.append(f"    {names.get(type_id, type_id)} -> {pieces}  ({split['configurations']})")
+    if compare_paper:
+        lines.append("")
+        lines.extend(comparison_lines(summary, study))
+    return "\n".join(lines) + "\n"
+
+
+def comparison_lines(summary: dict, study: Study | None = None) -> list[str]:
+    """The paper's figures beside ours; with the ``study``, also the elements the paper's kept
+    classes cannot tessellate."""
+    key, _ = paper_study_key(summary)
+    if key is None:
+        return ["The paper has no study of this box to compare with."]
+    lines = [f"Beside the paper ({key}, box {' x '.join(str(x) for x in paper_studies()[key]['box'])}):"]
+    for criterion in summary["criteria"]:
+        if criterion not in paper_studies()[key]:
+            continue
+        table = paper_comparison(summary, key, criterion)
+        lines.append(f"  {criterion}:")
+        lines.append(f"    {'paper class / type':<48} {'paper':>8} {'ours':>8}")
+        for row in table["rows"]:
+            paper = "-" if row["paper"] is None else row["paper"]
+            ours = "-" if row["ours"] is None else row["ours"]
+            lines.append(f"    {row['class'][:48]:<48} {paper:>8} {ours:>8}{_mark(row['paper'], row['ours'])}")
+        total = table["total"]
+        lines.append(f"    {'total':<48} {total['paper']:>8} {total['ours']:>8}{_mark(total['paper'], total['ours'])}")
+        classes = table["classes"]
+        lines.append(f"    {'element classes':<48} {classes['paper']:>8} {classes['ours']:>8}"
+                     f"{_mark(classes['paper'], classes['ours'])}")
+        if criterion != "optimal" and study is not None:
+            gaps = paper_set_gaps(study, key, criterion)
+            if gaps:
+                lines.append("    The paper's kept classes cannot tessellate these elements (every split shown):")
+                for gap in gaps:
+                    lines.append(f"      {gap['name']} ({gap['configurations']} configurations): "
+                                 + "; ".join(gap["splits"]))
+    fvm = paper_comparison(summary, key)["fvm_adequate"]
+    if fvm["paper"] is not None:  # the paper gives no FVM count for its intersection study
+        lines.append(f"  FVM adequate configurations: paper {fvm['paper']}, ours {fvm['closed']} (closed box), "
+                     f"{fvm['open']} (open box){_mark(fvm['paper'], fvm['closed'])}")
+    lines.append("  Notes:")
+    lines.extend(f"  - {paper_notes()[n]}" for n in comparison_notes(summary, key, summary["criteria"]))
+    return lines

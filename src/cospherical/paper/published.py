@@ -1,0 +1,48 @@
+"""The paper's element classes, published figures and notes (package data, reference only)."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import yaml
+
+from ..core.element_types import ElementType
+from ..files.data import data_path
+
+__all__ = ["paper_class", "paper_classes", "paper_notes", "paper_studies"]
+
+
+@lru_cache(maxsize=None)
+def _data() -> dict:
+    return yaml.safe_load(data_path("paper.yaml").read_text(encoding="utf-8"))
+
+
+def paper_classes() -> list[dict]:
+    """The paper's element classes: name, short name, V/E/F counts, the face kinds they admit."""
+    return _data()["classes"]
+
+
+def paper_studies() -> dict:
+    """The paper's studies by key (``bisection_A``, ...): box, configurations, published counts."""
+    return _data()["studies"]
+
+
+def paper_notes() -> dict[str, str]:
+    """Why a published figure and ours differ, by key; each comparison cites the ones that apply."""
+    return _data()["notes"]
+
+
+def paper_class(etype: ElementType) -> dict | None:
+    """The paper's class of an element type: same V/E/F and face kinds, or ``None``.
+
+    Examples
+    --------
+    >>> from cospherical import Configuration, tessellate
+    >>> paper_class(tessellate(Configuration.from_code("800000000000")).elements[0].type)["name"]
+    'Quadrilateral Pyramid'
+    """
+    kinds = dict(etype.face_kinds)
+    for entry in paper_classes():
+        if list(entry["counts"]) == [etype.vertices, etype.edges, etype.faces] and kinds in entry["face_kinds"]:
+            return entry
+    return None

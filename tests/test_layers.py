@@ -1,0 +1,38 @@
+"""The layers hold: import-linter's contracts pass, and a wrong import breaks them."""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+LINT = Path(sys.executable).with_name("lint-imports")
+
+
+def lint(source: Path, cwd: Path) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(source)}
+    return subprocess.run([str(LINT), "--config", str(ROOT / "pyproject.toml"), "--no-cache"], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_contracts_are_kept():
+    result = lint(ROOT / "src", ROOT)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "0 broken" in result.stdout
+
+
+def test_wrong_imports_break_the_contracts(tmp_path):
+    # The core reaching up into the catalogue is exactly the circle the layers forbid;
+    # one command importing another breaks "one module per subcommand".
+    shutil.copytree(ROOT / "src" / "cospherical", tmp_path / "cospherical",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc"))
+    geometry = tmp_path / "cospherical" / "core" / "geometry.py"
+    geometry.write_text(geometry.read_text() + "\nfrom ..catalogue import type_name  # wrong on purpose\n")
+    check = tmp_path / "cospherical" / "cli" / "check.py"
+    check.write_text(check.read_text() + "\nfrom . import diff  # wrong on purpose\n")
+    result = lint(tmp_path, tmp_path)
+    assert result.returncode != 0
+    assert "Contracts: 0 kept, 2 broken." in result.stdout
+    assert "cospherical.core.geometry -> cospherical.catalogue" in result.stdout
+    assert "cospherical.cli.check -> cospherical.cli.diff" in result.stdout
