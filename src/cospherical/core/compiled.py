@@ -435,15 +435,18 @@ def cube_batch(codes, corners, starts, axes, face_edges, face_base, tets, closed
 
 
 @njit(cache=True)
-def orbit_keys(digits, targets, reverse):
-    """Per row of 12 digits: the smallest image code (base 16) under the symmetries and the first
-    symmetry reaching it.  Symmetry s sends edge k to ``targets[s, k]``, reversed (t -> 1 - t)
-    where ``reverse[s, k]``."""
+def orbit_keys(digits, targets, reverse, masks, faces):
+    """Per row of 12 digits and a point mask: the smallest image (code as base 16, then
+    mask) under the symmetries, its mask, and the first symmetry reaching it.  Symmetry s
+    sends edge k to ``targets[s, k]``, reversed (t -> 1 - t) where ``reverse[s, k]``, and
+    face f to ``faces[s, f]``; mask bit f is face f, bit 6 the body point (fixed)."""
     n = digits.shape[0]
     best = np.empty(n, dtype=np.int64)
+    best_mask = np.empty(n, dtype=np.int64)
     best_sym = np.empty(n, dtype=np.int64)
     for i in range(n):
         low = np.int64(-1)
+        low_mask = np.int64(0)
         which = 0
         for s in range(targets.shape[0]):
             key = np.int64(0)
@@ -452,9 +455,16 @@ def orbit_keys(digits, targets, reverse):
                 if reverse[s, k] and d != 0:
                     d = 16 - d
                 key |= d << (4 * (11 - targets[s, k]))
-            if low < 0 or key < low:
+            mask = masks[i] & 64
+            if masks[i] != 0:  # most rows (bare codes) have no face points to map
+                for f in range(6):
+                    if masks[i] >> f & 1:
+                        mask |= np.int64(1) << faces[s, f]
+            if low < 0 or key < low or (key == low and mask < low_mask):
                 low = key
+                low_mask = mask
                 which = s
         best[i] = low
+        best_mask[i] = low_mask
         best_sym[i] = which
-    return best, best_sym
+    return best, best_mask, best_sym

@@ -9,6 +9,7 @@ hexahedron order.  Positions are kept in *unit* coordinates (s, t, u) in
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Iterable, Mapping
@@ -23,8 +24,11 @@ __all__ = [
     "Configuration",
     "EDGES",
     "FACES",
+    "FACE_POINT_SOURCES",
     "POINT_POLICIES",
     "edge_axis",
+    "parse_point_suffix",
+    "point_suffix",
 ]
 
 CORNERS: tuple[tuple[int, int, int], ...] = (
@@ -113,12 +117,75 @@ def _parse_edge(edge) -> int:
     return int(text)
 
 
+FACE_POINT_SOURCES = (*POINT_POLICIES, "explicit")
+# The whole-point-set code: 12 edge digits, then optionally "+f", the faces carrying a
+# point in increasing order, and "b" for the body point.  One point set, one code.
+_CODE = re.compile(r"^(?P<edges>[0-9a-fA-F]{12})(?:\+(?P<suffix>.*))?$", re.DOTALL)
+_SUFFIX = re.compile(r"^f(?P<faces>[0-5]*)(?P<body>b?)$")
+
+
+def _face_numbers(faces: Iterable, where: str) -> frozenset[int]:
+    numbers = []
+    for face in faces:
+        text = str(face).strip()
+        # isascii: str.isdigit() also accepts digits such as '²' that int() refuses
+        if isinstance(face, bool) or not isinstance(face, (int, str)) or not (text.isascii() and text.isdigit()) \
+                or int(text) > 5:
+            raise InputError(f"{where}: face {face!r}: not a face number 0..5")
+        if int(text) in numbers:
+            raise InputError(f"{where}: face {int(text)} given twice")
+        numbers.append(int(text))
+    return frozenset(numbers)
+
+
+def parse_point_suffix(code: str, suffix: str) -> tuple[frozenset[int], bool]:
+    """The faces and body point named by a code's point suffix (the text after ``+``).
+
+    Examples
+    --------
+    >>> parse_point_suffix("888888888888+f04", "f04")
+    (frozenset({0, 4}), False)
+    >>> parse_point_suffix("888888888888+f40", "f40")
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.InputError: configuration code '888888888888+f40': list the faces of the suffix in increasing order (+f04)
+    """
+    match = _SUFFIX.match(suffix)
+    if not match:
+        raise InputError(f"configuration code {code!r}: malformed point suffix {'+' + suffix!r}: write +f, then "
+                         "the faces carrying a point (0..5, increasing), then b for the body point, e.g. +f04")
+    digits = match["faces"]
+    if len(set(digits)) != len(digits):
+        raise InputError(f"configuration code {code!r}: a face is given twice in the suffix")
+    if list(digits) != sorted(digits):
+        # one point set, one code: pattern tables are looked up by the code's text
+        raise InputError(f"configuration code {code!r}: list the faces of the suffix in increasing order "
+                         f"(+f{''.join(sorted(digits))})")
+    return frozenset(int(d) for d in digits), bool(match["body"])
+
+
+def point_suffix(faces: Iterable[int], body: bool) -> str:
+    """The point suffix (without ``+``) naming a set of face points and the body point.
+
+    >>> point_suffix({4, 0}, False), point_suffix(range(6), True), point_suffix((), False)
+    ('f04', 'f012345b', 'f')
+    """
+    return "f" + "".join(str(f) for f in sorted(faces)) + ("b" if body else "")
+
+
 @dataclass(frozen=True)
 class Configuration:
-    """A 1-irregular cuboid: a box, at most one Steiner point per edge, and a point policy.
+    """A 1-irregular cuboid: a box, at most one Steiner point per edge, and its face and body points.
 
     ``steiner[k]`` is the parameter t in (0, 1) of the point on edge k (measured
-    from the edge's lower-coordinate end), or ``None``.
+    from the edge's lower-coordinate end), or ``None``.  ``face_points`` says how
+    the face points (nodes 20-25) and the body point (node 26) are given: by a
+    policy, ``octree`` (the paper's: every admissible face, the body point when
+    all six) or ``none``, or ``explicit``: then ``faces`` is the set of faces
+    carrying a point and ``body`` whether the body point is there.  A face may
+    carry a point only where its four edges are split with opposite edges at the
+    same parameter (its point lies where the two cut lines cross); the body
+    point needs all six face points (a cuboid refined into eight).
 
     Examples
     --------
@@ -127,17 +194,39 @@ class Configuration:
     (Fraction(1, 2), '800000000000')
     >>> sorted(Configuration.from_code("888888888888").nodes())[-1]
     26
+    >>> leaf = Configuration.from_code("888888888888", faces=[0, 4])
+    >>> leaf.code, sorted(leaf.nodes())[-2:]
+    ('888888888888+f04', [20, 24])
+    >>> Configuration.from_code("888888888888").point_set_code
+    '888888888888+f012345b'
     """
 
     box: Box
     steiner: tuple[Fraction | None, ...]
     face_points: str = "octree"
+    faces: frozenset[int] | None = None
+    body: bool = False
 
     def __post_init__(self) -> None:
         if len(self.steiner) != 12:
             raise InputError(f"steiner: needs 12 entries, got {len(self.steiner)}")
-        if self.face_points not in POINT_POLICIES:
+        if self.face_points not in FACE_POINT_SOURCES:
             raise InputError(f"face-point policy {self.face_points!r}: choose one of {', '.join(POINT_POLICIES)}")
+        if (self.faces is not None) != (self.face_points == "explicit"):
+            raise InputError("face points: give the set of faces exactly when face_points is 'explicit'")
+        if self.body and self.face_points != "explicit":
+            raise InputError(f"body point: the {self.face_points} policy decides it; give the faces explicitly")
+        if self.faces is None:
+            return
+        object.__setattr__(self, "faces", _face_numbers(self.faces, "face points"))
+        for face in sorted(self.faces):
+            reason = self._inadmissible(face)
+            if reason:
+                corners = " ".join(map(str, FACES[face]))
+                raise InputError(f"face {face} (corners {corners}) cannot carry a point: {reason}")
+        if self.body and len(self.faces) != 6:
+            raise InputError("body point: needs all six face points (a cuboid refined into eight), "
+                             f"got faces {', '.join(map(str, sorted(self.faces))) or 'none'}")
 
     @classmethod
     def from_steiner(
@@ -145,29 +234,60 @@ class Configuration:
         box: Box | Iterable = ("1", "1", "1"),
         steiner: Mapping | None = None,
         face_points: str = "octree",
+        faces: Iterable | None = None,
+        body: bool = False,
     ) -> "Configuration":
-        """Build from ``{edge: t}``; t may be a string, int or Fraction."""
+        """Build from ``{edge: t}``; t may be a string, int or Fraction.
+
+        ``faces`` (face numbers 0..5) and ``body`` give the face and body points
+        explicitly; then ``face_points`` is ignored.
+        """
         box = box if isinstance(box, Box) else Box.parse(box)
         params: list[Fraction | None] = [None] * 12
         for edge, value in (steiner or {}).items():
             k = _parse_edge(edge)
             params[k] = _parse_parameter(k, value)
-        return cls(box, tuple(params), face_points)
+        return cls._build(box, tuple(params), face_points, faces, body)
 
     @classmethod
     def from_code(
-        cls, code: str, box: Box | Iterable = ("1", "1", "1"), face_points: str = "octree"
+        cls,
+        code: str,
+        box: Box | Iterable = ("1", "1", "1"),
+        face_points: str = "octree",
+        faces: Iterable | None = None,
+        body: bool = False,
     ) -> "Configuration":
-        """Build from the 12-hex-digit configuration code (digit k: t = n/16 on edge k, 0 = none)."""
-        if not isinstance(code, str) or len(code) != 12 or any(ch not in "0123456789abcdefABCDEF" for ch in code):
-            raise InputError(f"configuration code {code!r}: needs exactly 12 hexadecimal digits")
+        """Build from a configuration code: 12 hex digits (digit k: t = n/16 on edge k, 0 = none),
+        optionally followed by the point suffix ``+f<faces>[b]``.
+
+        A suffix names every face and body point, whatever ``face_points`` says; a
+        bare code takes them from the policy (``octree`` or ``none``), or from
+        ``faces`` and ``body``.  ``face_points="explicit"`` asks for a suffix.
+        """
+        match = _CODE.match(code) if isinstance(code, str) else None
+        if not match:
+            raise InputError(f"configuration code {code!r}: needs exactly 12 hexadecimal digits, "
+                             "optionally followed by a point suffix such as +f04")
         box = box if isinstance(box, Box) else Box.parse(box)
-        params = tuple(Fraction(int(ch, 16), 16) if ch != "0" else None for ch in code)
+        params = tuple(Fraction(int(ch, 16), 16) if ch != "0" else None for ch in match["edges"])
+        if match["suffix"] is not None:
+            if faces is not None or body:
+                raise InputError(f"configuration code {code!r}: its suffix gives the face points; "
+                                 "do not give them again")
+            faces, body = parse_point_suffix(code, match["suffix"])
+        elif face_points == "explicit" and faces is None:
+            raise InputError(f"configuration code {code!r}: needs a point suffix (+f<faces>[b]) "
+                             "where the face points are explicit")
+        return cls._build(box, params, face_points, faces, body)
+
+    @classmethod
+    def _build(cls, box, params, face_points, faces, body) -> "Configuration":
+        if faces is not None or body:  # __post_init__ checks and normalises the faces
+            return cls(box, params, "explicit", tuple(faces or ()), body)
         return cls(box, params, face_points)
 
-    @property
-    def code(self) -> str | None:
-        """The configuration code, or ``None`` when some t is not a multiple of 1/16."""
+    def _edge_digits(self) -> str | None:
         digits = []
         for t in self.steiner:
             if t is None:
@@ -178,6 +298,46 @@ class Configuration:
                 return None
         return "".join(digits)
 
+    @property
+    def code(self) -> str | None:
+        """The configuration code as its own policy reads it: 12 hex digits under ``octree``
+        or ``none``, with the point suffix when the points are explicit; ``None`` when some
+        t is not a multiple of 1/16."""
+        if self.face_points == "explicit":
+            return self.point_set_code
+        return self._edge_digits()
+
+    @property
+    def point_set_code(self) -> str | None:
+        """The code of the whole point set, the same under every policy (always suffixed)."""
+        digits = self._edge_digits()
+        if digits is None:
+            return None
+        return f"{digits}+{point_suffix(self.point_faces, self.has_body_point)}"
+
+    @property
+    def admissible_faces(self) -> frozenset[int]:
+        """The faces that may carry a point: four split edges, opposite ones at the same t."""
+        return frozenset(f for f in range(6) if not self._inadmissible(f))
+
+    @property
+    def point_faces(self) -> frozenset[int]:
+        """The faces carrying a point, under any policy."""
+        if self.face_points == "explicit":
+            return self.faces
+        return self.admissible_faces if self.face_points == "octree" else frozenset()
+
+    @property
+    def has_body_point(self) -> bool:
+        """Whether node 26 is there: explicit, or under ``octree`` when all six faces carry a point."""
+        if self.face_points == "explicit":
+            return self.body
+        return self.face_points == "octree" and len(self.point_faces) == 6
+
+    def explicit(self) -> "Configuration":
+        """The same point set with its face and body points given explicitly."""
+        return Configuration(self.box, self.steiner, "explicit", self.point_faces, self.has_body_point)
+
     def nodes(self) -> dict[int, tuple[Fraction, Fraction, Fraction]]:
         """Node id -> exact unit coordinates (s, t, u), ids in increasing order."""
         nodes = dict(enumerate(_CORNER_POINTS))
@@ -186,30 +346,33 @@ class Configuration:
                 start = list(_EDGE_STARTS[k])
                 start[EDGE_AXES[k]] = t
                 nodes[8 + k] = tuple(start)
-        if self.face_points == "octree":
-            faces = [self._face_point(f) for f in range(6)]
-            for f, point in enumerate(faces):
-                if point is not None:
-                    nodes[20 + f] = point
-            if all(point is not None for point in faces):
-                nodes[BODY_NODE] = tuple(self._parallel_parameter(axis) for axis in range(3))
+        for f in sorted(self.point_faces):
+            nodes[20 + f] = self._face_point(f)
+        if self.has_body_point:
+            nodes[BODY_NODE] = tuple(self._parallel_parameter(axis) for axis in range(3))
         return nodes
 
     def _parallel_parameter(self, axis: int) -> Fraction:
         return next(t for k, t in enumerate(self.steiner) if EDGE_AXES[k] == axis)
 
-    def _face_point(self, face: int) -> tuple[Fraction, Fraction, Fraction] | None:
-        # The face of a refined neighbour: exists when the four edges are split
-        # and opposite edges agree, at the crossing of the two cut lines.
+    def _inadmissible(self, face: int) -> str | None:
+        """Why face ``face`` cannot carry a point, or ``None`` when it can."""
         edges = FACE_EDGES[face]
-        if any(self.steiner[k] is None for k in edges):
-            return None
+        unsplit = [k for k in edges if self.steiner[k] is None]
+        if unsplit:
+            return f"edge {unsplit[0]} carries no Steiner point"
+        for axis in sorted({EDGE_AXES[k] for k in edges}):
+            p, q = (k for k in edges if EDGE_AXES[k] == axis)
+            if self.steiner[p] != self.steiner[q]:
+                return (f"opposite edges {p} and {q} are split at different parameters, "
+                        f"{self.steiner[p]} and {self.steiner[q]}")
+        return None
+
+    def _face_point(self, face: int) -> tuple[Fraction, Fraction, Fraction]:
+        # The face of a refined neighbour, where the two cut lines cross.
         point = list(_CORNER_POINTS[FACES[face][0]])
-        for axis in {EDGE_AXES[k] for k in edges}:
-            values = {self.steiner[k] for k in edges if EDGE_AXES[k] == axis}
-            if len(values) != 1:
-                return None
-            point[axis] = values.pop()
+        for k in FACE_EDGES[face]:
+            point[EDGE_AXES[k]] = self.steiner[k]
         return tuple(point)
 
     def real_nodes(self) -> dict[int, tuple[float, float, float]]:

@@ -16,10 +16,12 @@ from typing import Sequence
 
 import numpy as np
 
-from .configuration import BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis
+from .configuration import (BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis, parse_point_suffix,
+                            point_suffix)
 from .polyhedron import Polyhedron
 
-__all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "orbit_keys", "orbit_representatives"]
+__all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "orbit_keys", "orbit_point_keys",
+           "orbit_representatives"]
 
 
 @dataclass(frozen=True)
@@ -49,19 +51,33 @@ class Symmetry:
         return _edge_map(self)
 
     def configuration(self, cfg: Configuration) -> Configuration:
+        """The image of a configuration; explicit face and body points go with it."""
         params: list[Fraction | None] = [None] * 12
         for k, t in enumerate(cfg.steiner):
             if t is not None:
                 image, reverse = self.edge_map[k]
                 params[image] = 1 - t if reverse else t
-        return Configuration(cfg.box, tuple(params), cfg.face_points)
+        if cfg.face_points != "explicit":
+            return Configuration(cfg.box, tuple(params), cfg.face_points)
+        faces = frozenset(self.face_map[f] for f in cfg.faces)
+        return Configuration(cfg.box, tuple(params), "explicit", faces, cfg.body)
+
+    @property
+    def face_map(self) -> tuple[int, ...]:
+        """Image of every face 0..5 (face f carries node 20+f)."""
+        return tuple(self.node_map[20 + f] - 20 for f in range(6))
 
     def code(self, code: str) -> str:
-        """The image of a configuration code (digit n becomes 16 - n on a reversed edge)."""
+        """The image of a configuration code (digit n becomes 16 - n on a reversed edge; the
+        faces of a point suffix map with their nodes)."""
+        edges, plus, suffix = code.partition("+")
         digits = ["0"] * 12
-        for (image, reverse), digit in zip(self.edge_map, code):
+        for (image, reverse), digit in zip(self.edge_map, edges):
             digits[image] = _REVERSED_DIGIT[digit] if reverse else digit
-        return "".join(digits)
+        if not plus:
+            return "".join(digits)
+        faces, body = parse_point_suffix(code, suffix)
+        return "".join(digits) + "+" + point_suffix({self.face_map[f] for f in faces}, body)
 
     def polyhedron(self, poly: Polyhedron) -> Polyhedron:
         """The image of a polyhedron, faces normalised as the Delaunay stage writes them."""
@@ -89,6 +105,20 @@ class Symmetry:
             perm[a] = i
             flips[a] = self.flips[i]
         return Symmetry(tuple(perm), tuple(flips))
+
+
+# The orbit kernel takes a configuration's face and body points as a mask: bit f for
+# face f, this bit for the body point (no symmetry moves it).
+_BODY_BIT = 1 << 6
+
+
+def _point_mask(code: str) -> int:
+    faces, body = parse_point_suffix(code, code[13:])
+    return sum(1 << f for f in faces) | (_BODY_BIT if body else 0)
+
+
+def _mask_suffix(mask: int) -> str:
+    return point_suffix((f for f in range(6) if mask >> f & 1), bool(mask & _BODY_BIT))
 
 
 _REVERSED_DIGIT = {"%x" % n: "%x" % ((16 - n) % 16) for n in range(16)}
@@ -133,16 +163,29 @@ def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
 def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry]) -> tuple[np.ndarray, np.ndarray]:
     """For rows of 12 hex digits: the orbit representative's code as a base-16 number (the
     smallest image) and the index of the first symmetry taking the row to it (compiled)."""
+    keys, _, sym_index = orbit_point_keys(digits, None, symmetries)
+    return keys, sym_index
+
+
+def orbit_point_keys(
+    digits: np.ndarray, masks: np.ndarray | None, symmetries: Sequence[Symmetry]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`orbit_keys` for whole point sets: rows of 12 hex digits with a point mask each
+    (bit f: face f carries a point, bit 6: the body point; ``None``: no face points).  The smallest image compares the
+    edge digits first, then the mask; returns its code as a base-16 number, its mask, and
+    the first symmetry reaching it.  A zero mask gives exactly the keys of the 12 digits."""
     from .compiled import orbit_keys as kernel
 
     digits = np.ascontiguousarray(digits).reshape(-1, 12)  # any integer type: millions of rows stay small
+    masks = np.zeros(len(digits), dtype=np.int64) if masks is None else np.ascontiguousarray(masks, dtype=np.int64)
     targets = np.array([[target for target, _ in sym.edge_map] for sym in symmetries], dtype=np.int64).reshape(-1, 12)
     reverse = np.array([[rev for _, rev in sym.edge_map] for sym in symmetries], dtype=np.bool_).reshape(-1, 12)
-    return kernel(digits, targets, reverse)
+    faces = np.array([sym.face_map for sym in symmetries], dtype=np.int64).reshape(-1, 6)
+    return kernel(digits, targets, reverse, masks, faces)
 
 
 def code_digits(codes: Sequence[str]) -> np.ndarray:
-    text = np.frombuffer("".join(codes).lower().encode("ascii"), dtype=np.uint8).reshape(-1, 12)
+    text = np.frombuffer("".join(code[:12] for code in codes).lower().encode("ascii"), dtype=np.uint8).reshape(-1, 12)
     return np.where(text >= ord("a"), text - ord("a") + 10, text - ord("0")).astype(np.int64)
 
 
@@ -152,6 +195,11 @@ def key_code(key: int) -> str:
 
 def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry]) -> tuple[list[str], list[int]]:
     """For each code, its orbit's representative (the smallest image code) and the
-    index of a symmetry taking the code to it."""
-    keys, sym_index = orbit_keys(code_digits(codes), symmetries)
-    return [key_code(k) for k in keys.tolist()], sym_index.tolist()
+    index of a symmetry taking the code to it.  A code with a point suffix
+    (``+f...``) has a representative with one."""
+    suffixed = ["+" in code for code in codes]
+    masks = np.array([_point_mask(code) if s else 0 for code, s in zip(codes, suffixed)], dtype=np.int64)
+    keys, image_masks, sym_index = orbit_point_keys(code_digits(codes), masks, symmetries)
+    reps = [key_code(k) + ("+" + _mask_suffix(m) if s else "")
+            for k, m, s in zip(keys.tolist(), image_masks.tolist(), suffixed)]
+    return reps, sym_index.tolist()

@@ -25,6 +25,8 @@ def tessellation_data(tess: Tessellation) -> dict:
         "box": list(cfg.box.texts),
         "code": cfg.code,
         "face_points": cfg.face_points,
+        "faces": sorted(cfg.point_faces),
+        "body_point": cfg.has_body_point,
         "steiner": {str(k): str(t) for k, t in enumerate(cfg.steiner) if t is not None},
         "nodes": {str(i): list(p) for i, p in real.items()},
         "elements": [

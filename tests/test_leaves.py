@@ -1,0 +1,235 @@
+"""Face points as data, the whole-point-set code, and the octree-leaf family (issue 13)."""
+
+from __future__ import annotations
+
+import json
+import random
+import subprocess
+import sys
+from fractions import Fraction
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cospherical import Box, Configuration, InputError, tessellate
+from cospherical.core.symmetry import box_symmetries, orbit_representatives
+from oracle import qhull_regions
+from strategies import configurations
+
+CUBE = ("1", "1", "1")
+
+
+def cospherical(*args):
+    return subprocess.run([sys.executable, "-m", "cospherical", *args], capture_output=True, text=True)
+
+
+def cells(tess) -> list[tuple]:
+    """What a tessellation is, apart from how its configuration was written down."""
+    return [(e.type.id, e.nodes, e.mirrored, e.polyhedron) for e in tess.elements]
+
+
+# --- face points as data ---------------------------------------------------------------------------
+
+
+def test_explicit_faces_place_exactly_those_points():
+    cfg = Configuration.from_code("888888888888", CUBE, faces=[0, 4])
+    assert cfg.face_points == "explicit" and cfg.point_faces == frozenset({0, 4}) and not cfg.has_body_point
+    assert set(cfg.nodes()) == set(range(20)) | {20, 24}
+    assert cfg.nodes()[24] == (Fraction(1, 2), Fraction(1, 2), 0)
+    assert cfg.code == cfg.point_set_code == "888888888888+f04"
+
+
+def test_face_points_sit_where_the_cut_lines_cross():
+    # Face 4 (z = 0): edges 0, 2 along x at 1/4, edges 1, 3 along y at 3/4.
+    cfg = Configuration.from_steiner(CUBE, {0: "1/4", 2: "1/4", 1: "3/4", 3: "3/4"}, faces=[4])
+    assert cfg.nodes()[24] == (Fraction(1, 4), Fraction(3, 4), 0)
+    assert cfg.code == "4c4c00000000+f4"
+
+
+def test_policies_are_shorthands_for_explicit_sets():
+    octree = Configuration.from_code("888888888888", CUBE)
+    assert octree.code == "888888888888" and octree.point_set_code == "888888888888+f012345b"
+    assert octree.point_faces == frozenset(range(6)) and octree.has_body_point
+    none = Configuration.from_code("888888888888", CUBE, face_points="none")
+    assert none.point_set_code == "888888888888+f" and none.point_faces == frozenset()
+    assert octree.explicit().nodes() == octree.nodes() and octree.explicit().face_points == "explicit"
+    assert Configuration.from_code("888800000000", CUBE).point_set_code == "888800000000+f4"
+
+
+def test_a_suffixed_code_names_every_point_whatever_the_policy():
+    for policy in ("octree", "none", "explicit"):
+        cfg = Configuration.from_code("888888888888+f25", CUBE, face_points=policy)
+        assert cfg.point_faces == frozenset({2, 5}) and cfg.code == "888888888888+f25"
+
+
+def test_explicit_policy_needs_a_suffix():
+    with pytest.raises(InputError, match="suffix"):
+        Configuration.from_code("888888888888", CUBE, face_points="explicit")
+
+
+@pytest.mark.parametrize(
+    "code, needle",
+    [
+        ("888888888888+f66", "face"),
+        ("888888888888+f44", "twice"),
+        ("888888888888+f40", "increasing"),
+        ("888888888888+f6", "face"),
+        ("888888888888+", "suffix"),
+        ("888888888888+g0", "suffix"),
+        ("888888888888f0", "configuration code"),
+        ("888888888888+f0+f1", "suffix"),
+        ("888888888888+fb", "body point"),
+        ("888888888888+f01234b", "body point"),
+        ("800000000000+f0", "face 0"),
+        ("888888888888+F0", "suffix"),
+    ],
+)
+def test_malformed_codes_are_refused(code, needle):
+    with pytest.raises(InputError, match=needle):
+        Configuration.from_code(code, CUBE)
+
+
+@pytest.mark.parametrize(
+    "steiner, faces, needle",
+    [
+        ({0: "1/2", 4: "1/2", 8: "1/2"}, [0], "face 0 .*edge 9"),  # edge 9 is not split
+        ({0: "1/4", 4: "1/2", 8: "1/2", 9: "1/2"}, [0], "face 0 .*edges 0 and 4 .*1/4 .*1/2"),
+        ({}, [7], "face 7"),
+        ({0: "1/2", 4: "1/2", 8: "1/2", 9: "1/2"}, [0, 0], "face 0 .*twice"),
+    ],
+)
+def test_inadmissible_face_points_name_the_face(steiner, faces, needle):
+    with pytest.raises(InputError, match=needle):
+        Configuration.from_steiner(CUBE, steiner, faces=faces)
+
+
+def test_the_body_point_needs_all_six_faces():
+    Configuration.from_code("888888888888", CUBE, faces=range(6), body=True)
+    with pytest.raises(InputError, match="body point"):
+        Configuration.from_code("888888888888", CUBE, faces=range(5), body=True)
+    with pytest.raises(InputError, match="body point"):
+        Configuration.from_code("888888888888", CUBE, face_points="octree", body=True)
+
+
+def test_symmetries_map_face_points():
+    box = Box.parse(CUBE)
+    cfg = Configuration.from_steiner(box, {0: "1/4", 2: "1/4", 1: "3/4", 3: "3/4", 4: "1/4", 8: "1/2", 9: "1/2"},
+                                     faces=[0, 4])
+    images = set()
+    for sym in box_symmetries(box):
+        image = sym.configuration(cfg)
+        assert image.code == sym.code(cfg.code) and image.point_faces == {sym.face_map[0], sym.face_map[4]}
+        assert {sym.node_map[i]: sym.point(p) for i, p in cfg.nodes().items()} == image.nodes()
+        images.add(image.code)
+    representative, _ = orbit_representatives([cfg.code], box_symmetries(box))
+    assert representative[0] in images
+
+
+# --- hypothesis: shorthands and codes ---------------------------------------------------------------
+
+
+@settings(max_examples=60, deadline=None)
+@given(configurations(dyadic=True))
+def test_a_policy_and_its_explicit_point_set_tessellate_identically(cfg):
+    explicit = cfg.explicit()
+    assert explicit.nodes() == cfg.nodes()
+    assert cells(tessellate(explicit)) == cells(tessellate(cfg))
+
+
+@st.composite
+def explicit_configurations(draw):
+    """Configurations at 1/16 positions with any admissible set of face points."""
+    cfg = draw(configurations(dyadic=True))
+    admissible = sorted(cfg.admissible_faces)
+    faces = draw(st.sets(st.sampled_from(admissible))) if admissible else set()
+    body = len(faces) == 6 and draw(st.booleans())
+    return Configuration.from_steiner(cfg.box, {k: t for k, t in enumerate(cfg.steiner) if t is not None},
+                                      faces=faces, body=body)
+
+
+@settings(max_examples=200, deadline=None)
+@given(explicit_configurations())
+def test_whole_point_set_codes_round_trip(cfg):
+    code = cfg.point_set_code
+    again = Configuration.from_code(code, cfg.box)
+    assert again == cfg and again.point_set_code == code
+
+
+# --- the Qhull oracle on face subsets at general positions -------------------------------------------
+
+
+def test_random_face_subsets_at_sixteenths_match_qhull():
+    rng = random.Random(1313)
+    boxes = [CUBE, ("1", "2", "4"), ("1", "sqrt(2)", "sqrt(2)"), ("3", "1", "2")]
+    checked = 0
+    while checked < 300:
+        steiner = {}
+        for axis_edges in ((0, 2, 4, 6), (1, 3, 5, 7), (8, 9, 10, 11)):
+            t = Fraction(rng.randint(1, 15), 16)
+            for k in axis_edges:
+                roll = rng.random()
+                if roll < 0.6:
+                    steiner[k] = t  # equal parameters on parallel edges: admissible faces
+                elif roll < 0.8:
+                    steiner[k] = Fraction(rng.randint(1, 15), 16)
+        admissible = sorted(Configuration.from_steiner(CUBE, steiner).admissible_faces)
+        if not admissible:
+            continue
+        faces = [f for f in admissible if rng.random() < 0.5]
+        body = len(faces) == 6 and rng.random() < 0.5
+        cfg = Configuration.from_steiner(rng.choice(boxes), steiner, faces=faces, body=body)
+        ours = {frozenset(e.nodes) for e in tessellate(cfg).elements}
+        assert ours == qhull_regions(cfg.real_nodes()), (cfg.box.texts, cfg.point_set_code)
+        checked += 1
+
+
+# --- the command line ------------------------------------------------------------------------------
+
+
+def test_tessellate_with_faces_on_the_command_line():
+    by_flag = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--faces", "0", "4")
+    assert by_flag.returncode == 0, by_flag.stderr
+    data = json.loads(by_flag.stdout)
+    assert data["code"] == "888888888888+f04" and data["face_points"] == "explicit"
+    assert data["faces"] == [0, 4] and data["body_point"] is False
+    assert set(data["nodes"]) == {str(i) for i in range(20)} | {"20", "24"}
+    by_code = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888+f04")
+    assert by_code.stdout == by_flag.stdout
+    by_steiner = cospherical("tessellate", "--box", "1", "1", "1", "--steiner", *(f"{k}:1/2" for k in range(12)),
+                             "--faces", "0", "4")
+    assert json.loads(by_steiner.stdout)["elements"] == data["elements"]
+
+
+def test_no_faces_given_explicitly_is_policy_none():
+    explicit = json.loads(cospherical("tessellate", "--box", "1", "2", "4", "--code", "888888888888", "--faces").stdout)
+    none = json.loads(cospherical("tessellate", "--box", "1", "2", "4", "--code", "888888888888",
+                                  "--face-points", "none").stdout)
+    assert explicit["code"] == "888888888888+f" and none["code"] == "888888888888"
+    assert explicit["elements"] == none["elements"] and explicit["nodes"] == none["nodes"]
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--code", "800000000000", "--faces", "0"], "face 0"),
+        (["--steiner", "0:1/4", "4:1/2", "8:1/2", "9:1/2", "--faces", "0"], "different parameters"),
+        (["--code", "888888888888", "--faces", "0", "0"], "twice"),
+        (["--code", "888888888888", "--faces", "6"], "face"),
+        (["--code", "888888888888", "--faces", "x"], "face"),
+        (["--code", "888888888888+f4x"], "suffix"),
+        (["--code", "888888888888+f44"], "twice"),
+        (["--code", "888888888888+f"], None),
+        (["--code", "888888888888+f0", "--faces", "4"], "suffix"),
+        (["--code", "888888888888", "--faces", "0", "--face-points", "none"], "not allowed"),
+        (["--code", "888888888888", "--body"], "body point"),
+    ],
+)
+def test_bad_face_points_on_the_command_line_exit_2_in_one_line(args, needle):
+    result = cospherical("tessellate", "--box", "1", "1", "1", *args)
+    if needle is None:  # the empty suffix is a valid code
+        assert result.returncode == 0, result.stderr
+        return
+    assert result.returncode == 2 and result.stdout == ""
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0] and "Traceback" not in result.stderr, result.stderr
