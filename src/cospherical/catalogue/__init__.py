@@ -6,13 +6,15 @@ from .criteria import (
                        Choice,
                        apply_catalogue_criterion,
                        choose,
+                       choose_kept,
                        element_options,
                        minimal_kept_sets,
+                       option_types,
                        split_options,
                        split_tessellation,
 )
 from .store import SCHEMA_VERSION, catalogue_path, known_name, load_catalogue, shipped_catalogue, type_name, type_names
 
 __all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "catalogue_path",
-           "choose", "element_options", "known_name", "load_catalogue", "minimal_kept_sets", "shipped_catalogue",
-           "split_options", "split_tessellation", "type_name", "type_names"]
+           "choose", "choose_kept", "element_options", "known_name", "load_catalogue", "minimal_kept_sets",
+           "option_types", "shipped_catalogue", "split_options", "split_tessellation", "type_name", "type_names"]

@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Sequence
 
 from ..core.element_types import classify
 from ..core.geometry import Frame
@@ -20,8 +21,8 @@ from ..core.split import CRITERIA, SPLIT_CRITERIA, subdivisions
 from ..core.tessellation import Element, Tessellation
 from .store import shipped_catalogue
 
-__all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "choose", "element_options", "minimal_kept_sets", "split_options",
-           "split_tessellation"]
+__all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "choose", "choose_kept",
+           "element_options", "minimal_kept_sets", "option_types", "split_options", "split_tessellation"]
 
 
 def element_options(tess: Tessellation, element: Element, criterion: str) -> tuple[tuple[Element, ...], ...]:
@@ -122,32 +123,66 @@ def split_tessellation(tess: Tessellation, kept: frozenset[str], criterion: str,
     return Tessellation(tess.configuration, tess.nodes, tuple(elements)), used
 
 
+def option_types(option: Sequence[Element]) -> tuple[str, ...]:
+    """The sorted type ids of a split's pieces: what a kept set must contain for the split to be usable."""
+    return tuple(sorted(piece.type.id for piece in option))
+
+
+def choose_kept(instances: Sequence[Sequence[tuple[str, ...]]], weights: Sequence[int]) -> tuple[frozenset[str], list[int]]:
+    """The kept set of a criterion, and the option each element uses: the rule every study follows.
+
+    Parameters
+    ----------
+    instances : sequence of sequences of type-id tuples
+        Per element (or per distinct element), its options in the order they are
+        preferred (:func:`split_options`: the element itself first, then fewest
+        pieces), each as :func:`option_types`.
+    weights : sequence of int
+        How many elements of the study each instance stands for.
+
+    Returns
+    -------
+    kept : frozenset of str
+        Among the smallest type sets into which every instance splits
+        (:func:`minimal_kept_sets`), the one that gives the fewest elements in
+        all, then the smallest sorted list of ids.
+    chosen : list of int
+        Per instance, the index of its first option inside ``kept``.
+
+    Examples
+    --------
+    >>> kept, chosen = choose_kept([[("a",), ("b", "c")], [("b",)], [("c",), ("a", "b")]], [1, 1, 5])
+    >>> sorted(kept), chosen
+    (['b', 'c'], [1, 0, 0])
+    """
+    _, candidates = minimal_kept_sets([{frozenset(option) for option in options} for options in instances])
+    best = None
+    for kept in candidates:
+        chosen = [next(i for i, option in enumerate(options) if set(option) <= kept) for options in instances]
+        total = sum(weight * len(options[i]) for weight, options, i in zip(weights, instances, chosen))
+        if best is None or (total, sorted(kept)) < best[0]:
+            best = ((total, sorted(kept)), kept, chosen)
+    return best[1], best[2]
+
+
 def choose(tessellations: dict[str, Tessellation], sizes: dict[str, int], criterion: str) -> Choice:
     """Apply a criterion to the orbit representatives of a study (``sizes``: orbit sizes)."""
     if criterion == "optimal":
         kept = frozenset(e.type.id for t in tessellations.values() for e in t.elements)
         return Choice(criterion, kept, tessellations, {})
-    instances = [
-        {frozenset(p.type.id for p in option) for option in element_options(tess, element, criterion)}
-        for tess in tessellations.values()
-        for element in tess.elements
-    ]
-    _, candidates = minimal_kept_sets(instances)
-    best = None
-    for kept in candidates:
-        applied = {rep: split_tessellation(tess, kept, criterion) for rep, tess in tessellations.items()}
-        total = sum(sizes[rep] * len(result[0].elements) for rep, result in applied.items())
-        key = (total, sorted(kept))
-        if best is None or key < best[0]:
-            best = (key, kept, applied)
-    _, kept, applied = best
+    elements = [(rep, element_options(tess, element, criterion))
+                for rep, tess in tessellations.items() for element in tess.elements]
+    kept, _ = choose_kept([[option_types(o) for o in options] for _, options in elements],
+                          [sizes[rep] for rep, _ in elements])
+    split: dict[str, Tessellation] = {}
     splits: dict[str, Counter] = {}
-    for rep, (_, used) in applied.items():
+    for rep, tess in tessellations.items():
+        split[rep], used = split_tessellation(tess, kept, criterion)
         for element, pieces in used:
             position = {node: i for i, node in enumerate(element.nodes)}
-            split = tuple(sorted((p.type.id, tuple(position[n] for n in p.nodes)) for p in pieces))
-            splits.setdefault(element.type.id, Counter())[split] += sizes[rep]
-    return Choice(criterion, kept, {rep: result[0] for rep, result in applied.items()}, splits)
+            pieces_at = tuple(sorted((p.type.id, tuple(position[n] for n in p.nodes)) for p in pieces))
+            splits.setdefault(element.type.id, Counter())[pieces_at] += sizes[rep]
+    return Choice(criterion, kept, split, splits)
 
 
 def apply_catalogue_criterion(tess: Tessellation, criterion: str) -> Tessellation:

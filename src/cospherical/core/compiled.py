@@ -19,6 +19,8 @@ index, exactly as :func:`cospherical.delaunay.hull_faces` orders them.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from numba import njit
 
@@ -307,7 +309,8 @@ def buffers(points: int):
 # cell what the statistics need.
 
 
-def _cube_tables():
+@lru_cache(maxsize=None)  # built once per process, shared by every chunk
+def cube_tables():
     """Point tables of the cube in 16ths: corner coordinates, edge start corners and axes, faces' edge pairs."""
     from .configuration import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
 

@@ -15,6 +15,7 @@ from fractions import Fraction
 from ..core.configuration import Box, Configuration
 from ..core.geometry import Frame, six_volume
 from ..errors import FormatError, InputError
+from .patterns import entry_elements
 
 __all__ = ["check_catalogue", "check_patterns"]
 
@@ -45,13 +46,6 @@ def check_catalogue(data: dict, name: str) -> None:
             raise FormatError(f"{name}: criteria/{criterion}/kept: unknown type {unknown[0]!r}")
 
 
-def _elements(entry: dict, criterion: str):
-    elements = entry[criterion]
-    while isinstance(elements, str):
-        elements = entry[elements]
-    return elements
-
-
 def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True) -> None:
     """Check a loaded :class:`~cospherical.patterns.PatternTable` against the catalogue and geometry."""
     types = {t["id"]: t for t in catalogue["types"]} if catalogue else None
@@ -69,7 +63,7 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
         frame = Frame.build(nodes, box.squared) if tiling and types else None
         for criterion in header["criteria"]:
             where = f"{name}: configurations/{code}/{criterion}"
-            elements = _elements(entry, criterion)
+            elements = entry_elements(entry, criterion)
             for k, element in enumerate(elements):
                 missing = [n for n in element["nodes"] if n not in nodes]
                 if missing:

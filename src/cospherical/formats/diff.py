@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections import Counter
 
 from ..errors import FormatError
+from .patterns import entry_elements
 
 __all__ = ["diff_catalogues", "diff_documents", "diff_patterns", "document_kind", "text_report"]
 
@@ -64,13 +65,6 @@ def _split_text(split) -> str:
     return " + ".join(f"{piece['type']}{piece['nodes']}" for piece in split)
 
 
-def _elements(entry: dict, criterion: str):
-    elements = entry.get(criterion)
-    while isinstance(elements, str):
-        elements = entry.get(elements)
-    return elements
-
-
 def _types(elements) -> list[str]:
     counts = Counter(e["type"] for e in elements or [])
     return [f"{n} x {t}" if n > 1 else t for t, n in sorted(counts.items())]
@@ -99,7 +93,7 @@ def diff_patterns(old: dict, new: dict) -> dict:
         if a.get("fvm_adequate") != b.get("fvm_adequate"):
             fvm.append({"code": code, "old": a.get("fvm_adequate"), "new": b.get("fvm_adequate")})
         for criterion in criteria:
-            before, after = _elements(a, criterion), _elements(b, criterion)
+            before, after = entry_elements(a, criterion), entry_elements(b, criterion)
             if before != after:
                 changed.setdefault(criterion, []).append(
                     {"code": code, "old": _types(before), "new": _types(after), "what": _what_changed(before, after)}

@@ -18,18 +18,19 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable, Mapping
 
 from ..catalogue import split_tessellation
 from ..core.configuration import Configuration
 from ..core.symmetry import key_code
-from ..core.tessellation import tessellate
+from ..core.tessellation import Tessellation, tessellate
 from ..errors import FormatError
 from ..files.yamlio import atomic_open, atomic_write, load_yaml, validate, yaml_float, yaml_text
 from ..studies.bisection import Study
-from ..studies.intersection import _completed, orbits
+from ..studies.intersection import completed, orbits
 from ..version import __version__
 
-__all__ = ["PatternTable", "SCHEMA_VERSION", "element_lines", "load", "pattern_chunk", "pattern_name", "patterns_text",
+__all__ = ["PatternTable", "SCHEMA_VERSION", "configuration_lines", "element_lines", "entry_elements", "load", "pattern_chunk", "pattern_name", "patterns_text",
            "table_from_data", "write_pattern_table", "write_patterns"]
 
 SCHEMA_VERSION = 1
@@ -57,19 +58,33 @@ def patterns_text(study: Study, catalogue_version: str) -> str:
     lines = [yaml_text(header).rstrip("\n"), "configurations:"]
     for code in sorted(study.codes):
         rep, _ = study.representative[code]
-        adequate = study.tessellations[rep].fvm_adequate  # a symmetry keeps circumcenters in the box
-        lines.append(f"  '{code}':")
-        lines.append(f"    fvm_adequate: {'true' if adequate else 'false'}")
-        written: dict[tuple, str] = {}
-        for criterion in study.criteria:
-            tess = study.choices[criterion].tessellations[rep]
-            key = tuple(e.polyhedron.nodes for e in tess.elements)
-            if key in written:  # most configurations need no split: name the criterion it equals
-                lines.append(f"    {criterion}: {written[key]}")
-                continue
-            written[key] = criterion
-            lines.extend(element_lines(criterion, study.tessellation(code, criterion)))
+        lines.extend(configuration_lines(
+            code,
+            study.tessellations[rep].fvm_adequate,  # a symmetry keeps circumcenters in the box
+            {criterion: study.choices[criterion].tessellations[rep] for criterion in study.criteria},
+            lambda tess: study.member_tessellation(code, tess)))
     return "\n".join(lines) + "\n"
+
+
+def configuration_lines(code: str, fvm_adequate: bool, tessellations: Mapping[str, Tessellation],
+                        image: Callable[[Tessellation], Tessellation] = lambda tess: tess) -> list[str]:
+    """The YAML lines of one configuration's entry in a pattern table, every table's.
+
+    ``tessellations``: per criterion, in the table's order.  Where a criterion
+    gives the same elements as an earlier one (most configurations need no
+    split), the entry names that criterion instead of a copy.  ``image`` maps a
+    tessellation to the configuration ``code`` (a study keeps one per orbit).
+    """
+    lines = [f"  '{code}':", f"    fvm_adequate: {'true' if fvm_adequate else 'false'}"]
+    written: dict[tuple, str] = {}
+    for criterion, tess in tessellations.items():
+        key = tuple(e.polyhedron.nodes for e in tess.elements)
+        if key in written:
+            lines.append(f"    {criterion}: {written[key]}")
+            continue
+        written[key] = criterion
+        lines.extend(element_lines(criterion, image(tess)))
+    return lines
 
 
 def element_lines(criterion: str, tess) -> list[str]:
@@ -100,10 +115,22 @@ class PatternTable:
             raise KeyError(f"configuration {code!r} is not in this table")
         if criterion not in self.header["criteria"]:
             raise KeyError(f"criterion {criterion!r} is not in this table: {', '.join(self.header['criteria'])}")
-        elements = self.configurations[code][criterion]
-        while isinstance(elements, str):  # the same elements as another criterion
-            elements = self.configurations[code][elements]
-        return elements
+        return entry_elements(self.configurations[code], criterion)
+
+
+def entry_elements(entry: dict, criterion: str) -> list[dict] | None:
+    """The elements of a configuration's entry under a criterion, following a reference to the
+    criterion with the same elements (``internal_faces: optimal``); ``None`` where there are none.
+
+    >>> entry_elements({"optimal": [{"type": "v4f4-8f0284"}], "internal_faces": "optimal"}, "internal_faces")
+    [{'type': 'v4f4-8f0284'}]
+    """
+    elements = entry.get(criterion)
+    for _ in range(len(entry)):  # a chain of references is never longer than the entry; a cycle ends here
+        if not isinstance(elements, str):
+            return elements
+        elements = entry.get(elements)
+    return None
 
 
 def load(path: str | Path) -> PatternTable:
@@ -146,17 +173,10 @@ def pattern_chunk(codes: list[int], kept: dict[str, list[str]]) -> str:
     for code in codes:
         text = key_code(code)
         tess = tessellate(Configuration.from_code(text))
-        lines.append(f"  '{text}':")
-        lines.append(f"    fvm_adequate: {'true' if tess.fvm_adequate else 'false'}")
-        written: dict[tuple, str] = {}
-        for criterion in ("optimal", *kept):
-            split = tess if criterion == "optimal" else split_tessellation(tess, frozenset(kept[criterion]), criterion)[0]
-            key = tuple(e.polyhedron.nodes for e in split.elements)
-            if key in written:
-                lines.append(f"    {criterion}: {written[key]}")
-                continue
-            written[key] = criterion
-            lines.extend(element_lines(criterion, split))
+        tessellations = {"optimal": tess}
+        for criterion, types in kept.items():
+            tessellations[criterion] = split_tessellation(tess, frozenset(types), criterion)[0]
+        lines.extend(configuration_lines(text, tess.fvm_adequate, tessellations))
     return "\n".join(lines) + "\n" if lines else ""
 
 
@@ -177,7 +197,7 @@ def write_pattern_table(summary: dict, path, catalogue_version: str, jobs: int =
         handle.write(yaml_text(header) + "configurations:\n")
         tasks = {i: (reps[i:i + chunk].tolist(), kept) for i in range(0, len(reps), chunk)}
         waiting, next_start = {}, 0
-        for start, text in _completed(pattern_chunk, tasks, jobs, scheduler, dask_workers):
+        for start, text in completed(pattern_chunk, tasks, jobs, scheduler, dask_workers):
             waiting[start] = text
             while next_start in waiting:  # in code order, whatever order the chunks finish in
                 handle.write(waiting.pop(next_start))

@@ -81,8 +81,12 @@ class Study:
 
     def tessellation(self, code: str, criterion: str = "optimal") -> Tessellation:
         """The tessellation of any configuration of the study under a criterion."""
+        rep, _ = self.representative[code]
+        return self.member_tessellation(code, self.choices[criterion].tessellations[rep])
+
+    def member_tessellation(self, code: str, tess: Tessellation) -> Tessellation:
+        """A tessellation of ``code``'s orbit representative, mapped onto ``code`` itself."""
         rep, sym = self.representative[code]
-        tess = self.choices[criterion].tessellations[rep]
         if rep == code:
             return tess
         target = Configuration.from_code(code, self.box, self.face_points)

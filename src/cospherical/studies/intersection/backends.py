@@ -1,0 +1,59 @@
+"""Where the work units of the intersection study run: in this process, a local process pool, or Dask."""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Hashable, Iterator
+
+__all__ = ["completed"]
+
+
+def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, scheduler: str | None = None,
+              dask_workers: int | None = None) -> Iterator[tuple[Hashable, Any]]:
+    """Yield ``(key, function(*args))`` for every task, in the order they finish, on the chosen backend.
+
+    Parameters
+    ----------
+    function : callable
+        A module-level function (workers import it by name).
+    tasks : dict
+        Key -> the arguments of one call.
+    jobs : int
+        Local worker processes; 1 runs in this process.
+    scheduler : str, optional
+        The address of a running Dask scheduler (``tcp://SCHEDULER:8786``).
+    dask_workers : int, optional
+        Start a local Dask cluster of that many processes instead.
+
+    Examples
+    --------
+    >>> sorted(completed(pow, {"a": (2, 3), "b": (3, 2)}))
+    [('a', 8), ('b', 9)]
+    """
+    if scheduler or dask_workers:
+        # Imported here: dask is an optional extra, and a heavy import the other backends never need.
+        from dask.distributed import Client, LocalCluster, as_completed
+
+        cluster = None if scheduler else LocalCluster(n_workers=dask_workers, threads_per_worker=1,
+                                                      processes=True, dashboard_address=None)
+        client = Client(scheduler or cluster)
+        try:
+            futures = {client.submit(function, *args, pure=False): key for key, args in tasks.items()}
+            for future in as_completed(futures):
+                yield futures[future], future.result()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    elif jobs <= 1:
+        for key, args in tasks.items():
+            yield key, function(*args)
+    else:
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        pool = ProcessPoolExecutor(max_workers=jobs)
+        try:
+            futures = {pool.submit(function, *args): key for key, args in tasks.items()}
+            for future in as_completed(futures):
+                yield futures[future], future.result()
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)

@@ -1,0 +1,221 @@
+"""Running the intersection study, in two stages that workers take in chunks.
+
+1. **cells**: the compiled kernel tessellates every orbit representative and
+   keeps, per configuration, its tetrahedra count, the circumcenter tests and
+   each other cell as (node mask, code masked to the digits its points depend
+   on): equal pairs are the same element at the same place.
+2. **elements**: each distinct non-tetrahedral element is classified once, with
+   its splits under every criterion (the exact Python path).
+
+Each finished chunk can be checkpointed, so an interrupted run resumes; the
+statistics (:mod:`.statistics`) then count every configuration through the orbit
+sizes.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from dataclasses import asdict, dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ...catalogue import option_types, split_options
+from ...core.configuration import Configuration
+from ...core.delaunay import delaunay_cells
+from ...core.element_types import classify
+from ...core.geometry import Frame
+from ...core.polyhedron import polyhedron
+from ...core.split import SPLIT_CRITERIA
+from ...core.symmetry import key_code
+from ...files.yamlio import atomic_write
+from ..summary import TypeInfo
+from .backends import completed
+from .family import all_configurations, orbits
+from .statistics import statistics
+
+__all__ = ["CHUNK", "ELEMENT_CHUNK", "ElementEntry", "element_entries", "run_intersection", "tessellate_chunk"]
+
+CHUNK = 5000
+ELEMENT_CHUNK = 500
+# Bumped when a checkpoint's content changes, so --resume never reads an older layout.
+CHECKPOINT_FORMAT = 2
+
+
+@dataclass(frozen=True)
+class ElementEntry:
+    """A distinct element of the study: its type id and, per split criterion, its options
+    (sorted piece-type tuples, the element itself first, in the order the criteria prefer them)."""
+
+    type: str
+    options: dict[str, tuple[tuple[str, ...], ...]]
+
+    @classmethod
+    def from_json(cls, data: dict) -> ElementEntry:
+        return cls(data["type"], {c: tuple(map(tuple, o)) for c, o in data["options"].items()})
+
+
+@lru_cache(maxsize=None)
+def _cube_tables():
+    # The compiled kernel (numba) is imported only where bulk work needs it: the
+    # command line starts without it.
+    from ...core import compiled
+
+    return compiled.cube_tables()
+
+
+def tessellate_chunk(codes: np.ndarray) -> dict[str, np.ndarray]:
+    """Stage 1 on base-16 codes: per configuration ``tets``, ``closed``, ``open``, ``polys``;
+    per other cell ``poly_mask`` and ``poly_code`` (see :func:`cospherical.core.compiled.cube_batch`)."""
+    from ...core import compiled
+
+    codes = np.ascontiguousarray(codes, dtype=np.int64)
+    n = len(codes)
+    tets, polys = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    closed, open_ = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
+    # A cell has at least four of the at most 27 points, so 27 other cells per configuration is ample.
+    poly_mask, poly_code = np.empty(27 * n, dtype=np.int64), np.empty(27 * n, dtype=np.int64)
+    written = compiled.cube_batch(codes, *_cube_tables(), tets, closed, open_, polys, poly_mask, poly_code)
+    if written < 0:
+        raise RuntimeError(f"configuration {codes[-1 - written]:012x}: beyond the compiled walk's buffers")
+    return {"tets": tets, "closed": closed, "open": open_, "polys": polys,
+            "poly_mask": poly_mask[:written], "poly_code": poly_code[:written]}
+
+
+def element_entries(elements: list[tuple[int, int]]) -> tuple[list[ElementEntry], dict[str, TypeInfo]]:
+    """Stage 2: per (node mask, code of a configuration holding it), the element's
+    :class:`ElementEntry`; and every type met (pieces included), described."""
+    squared = (1, 1, 1)
+    entries, types = [], {}
+    for node_mask, code in elements:
+        nodes = Configuration.from_code(key_code(code)).nodes()
+        points = tuple((n, nodes[n]) for n in sorted(nodes) if node_mask >> n & 1)
+        frame = Frame.build(dict(points), squared)
+        (cell,) = delaunay_cells(frame)  # the points are co-spherical: one cell
+        poly = polyhedron(frame, cell)
+        etype = classify(poly)[0]
+        types.setdefault(etype.id, TypeInfo.of(etype))
+        options = {}
+        for criterion in SPLIT_CRITERIA:
+            found = split_options(points, squared, poly, criterion)
+            for piece in (piece for option in found for piece in option):
+                types.setdefault(piece.type.id, TypeInfo.of(piece.type))
+            options[criterion] = tuple(dict.fromkeys(option_types(o) for o in found))
+        entries.append(ElementEntry(etype.id, options))
+    return entries, types
+
+
+def _element_chunk_json(part) -> str:
+    entries, types = part
+    return json.dumps([[asdict(e) for e in entries], {k: asdict(t) for k, t in types.items()}], sort_keys=True)
+
+
+def _element_chunk_from_json(text: str):
+    entries, types = json.loads(text)
+    return [ElementEntry.from_json(e) for e in entries], {k: TypeInfo(**t) for k, t in types.items()}
+
+
+def _npz_bytes(arrays: dict) -> bytes:
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    return buffer.getvalue()
+
+
+def _tetrahedron():
+    """The entry of the tetrahedron (every 4-point cell has this one type; no split)."""
+    corners = (0, 1, 3, 4)  # of the cube with no Steiner point (code 0)
+    return element_entries([(sum(1 << n for n in corners), 0)])
+
+
+def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, checkpoints=None,
+                     progress=None, chunk: int = CHUNK, scheduler: str | None = None,
+                     dask_workers: int | None = None, brute_force: bool = False) -> dict:
+    """The intersection study's summary, all criteria, in the shape of the bisection study's.
+
+    Parameters
+    ----------
+    resolution, order : int, str
+        Steiner points at multiples of 1/resolution, levels inserted in this order
+        (:data:`~.family.INSERTION_ORDERS`).
+    jobs : int
+        Local worker processes.
+    checkpoints : path, optional
+        A folder keeping each finished chunk; chunks found there are not computed
+        again, so an interrupted run resumes.
+    progress : callable, optional
+        ``progress(stage, n)`` as work finishes: ``cells`` in configurations,
+        ``elements`` in distinct elements.
+    scheduler, dask_workers : optional
+        Run the chunks on Dask (a scheduler address, or a local cluster of that
+        many processes) instead of ``jobs`` local processes.
+    brute_force : bool
+        Tessellate every configuration, not one per orbit (a check).
+
+    Returns
+    -------
+    dict
+        The summary (``study``, ``box``, ``resolution``, ``insertion_order``,
+        ``configurations``, ``orbits``, ``fvm_adequate``, ``fvm_adequate_open``,
+        ``criteria``).
+    """
+    if brute_force:
+        reps = all_configurations(resolution, order)
+        sizes, configurations = np.ones(len(reps), dtype=np.int64), len(reps)
+    else:
+        reps, sizes, configurations = orbits(resolution, order)
+    folder = Path(checkpoints) if checkpoints else None
+    tag = f"v{CHECKPOINT_FORMAT}-r{resolution}-{order}-c{chunk}{'-brute' if brute_force else ''}"
+    if folder:
+        folder.mkdir(parents=True, exist_ok=True)
+    backend = dict(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
+    report = progress or (lambda stage, n: None)
+
+    # Stage 1: cells.
+    starts = range(0, len(reps), chunk)
+    stage1: dict[int, dict] = {}
+    for i, start in enumerate(starts):
+        path = folder / f"{tag}-cells-{i:05d}.npz" if folder else None
+        if path and path.exists():
+            with np.load(path) as data:
+                stage1[i] = {name: data[name] for name in data.files}
+            report("cells", int(sizes[start:start + chunk].sum()))
+    todo = {i: (reps[start:start + chunk],) for i, start in enumerate(starts) if i not in stage1}
+    for i, part in completed(tessellate_chunk, todo, **backend):
+        stage1[i] = part
+        if folder:
+            atomic_write(folder / f"{tag}-cells-{i:05d}.npz", _npz_bytes(part))
+        report("cells", int(sizes[i * chunk:(i + 1) * chunk].sum()))
+    cells = {name: np.concatenate([stage1[i][name] for i in range(len(starts))]) if starts else np.zeros(0, np.int64)
+             for name in ("tets", "closed", "open", "polys", "poly_mask", "poly_code")}
+
+    # Stage 2: every distinct non-tetrahedral element, once.
+    pairs = np.stack([cells["poly_mask"], cells["poly_code"]], axis=1)
+    distinct, first, element_of = np.unique(pairs, axis=0, return_index=True, return_inverse=True)
+    element_of = element_of.reshape(-1)
+    owner = np.repeat(reps, cells["polys"])[first]  # a configuration holding each element
+    work = [(int(mask), int(code)) for (mask, _), code in zip(distinct.tolist(), owner.tolist())]
+    element_starts = range(0, len(work), ELEMENT_CHUNK)
+    stage2: dict[int, tuple] = {}
+    for i in range(len(element_starts)):
+        path = folder / f"{tag}-elements-{i:05d}.json" if folder else None
+        if path and path.exists():
+            stage2[i] = _element_chunk_from_json(path.read_text())
+            report("elements", len(stage2[i][0]))
+    todo = {i: (work[start:start + ELEMENT_CHUNK],) for i, start in enumerate(element_starts) if i not in stage2}
+    for i, part in completed(element_entries, todo, **backend):
+        stage2[i] = part
+        if folder:
+            atomic_write(folder / f"{tag}-elements-{i:05d}.json", _element_chunk_json(part))
+        report("elements", len(part[0]))
+    entries, types = _tetrahedron()
+    for i in range(len(element_starts)):
+        entries.extend(stage2[i][0])
+        types.update(stage2[i][1])
+    return {
+        "study": "intersection", "box": ["1", "1", "1"], "face_points": "octree",
+        "resolution": resolution, "insertion_order": order,
+        "configurations": configurations, "orbits": len(reps),
+        **statistics(sizes, cells, element_of + 1, entries, types),
+    }
