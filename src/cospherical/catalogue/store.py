@@ -34,7 +34,13 @@ def catalogue_path() -> Path:
 
 @lru_cache(maxsize=None)
 def shipped_catalogue() -> dict:
-    """The shipped catalogue, read and validated once per process (empty if there is none)."""
+    """The shipped catalogue, read and validated once per process (empty if there is none).
+
+    Examples
+    --------
+    >>> shipped_catalogue()["schema_version"]
+    1
+    """
     path = catalogue_path()
     if not path.exists():
         return {"schema_version": SCHEMA_VERSION, "version": "none", "types": []}
@@ -86,7 +92,31 @@ def type_names(types: Iterable[ElementType]) -> dict[str, tuple[str, list[str]]]
 
 
 def load_catalogue(path: str | Path) -> dict:
-    """Read and validate a catalogue file."""
+    """Read a catalogue file and validate it against its JSON Schema.
+
+    Parameters
+    ----------
+    path : str or Path
+        A catalogue YAML file, such as ``catalogue/catalogue.yaml``.
+
+    Returns
+    -------
+    dict
+        ``schema_version``, ``version``, ``criteria`` (kept type ids per criterion)
+        and ``types`` (one entry per element type: id, name, code, faces, splits...).
+
+    Raises
+    ------
+    FormatError
+        The file cannot be read, is not YAML, or does not fit the schema; the
+        message names the file and the place.
+
+    Examples
+    --------
+    >>> catalogue = load_catalogue(catalogue_path())
+    >>> next(t["name"] for t in catalogue["types"] if t["vertices"] == 4)
+    'tetrahedron'
+    """
     data = load_yaml(path)
     validate(data, "catalogue", path)
     return data

@@ -10,6 +10,7 @@ import sys
 import threading
 
 from ..errors import CosphericalError, UsageError
+from ..version import __version__
 
 __all__ = ["main"]
 
@@ -29,8 +30,6 @@ def build_parser() -> argparse.ArgumentParser:
         prog="cospherical",
         description="Delaunay tessellations of 1-irregular cuboids with co-spherical elements.",
     )
-    from ..version import __version__
-
     parser.add_argument("--version", action="version", version=f"cospherical {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for name in SUBCOMMANDS:

@@ -9,8 +9,9 @@ from ..catalogue import shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..errors import UsageError
 from ..files.yamlio import atomic_write
-from ..formats.patterns import pattern_name, write_patterns
+from ..formats.patterns import pattern_name, write_pattern_table, write_patterns
 from ..outputs.report import text_report
+from ..paper import paper_comparison, paper_study_key
 from ..studies.bisection import bisection_codes, run_study
 from ..studies.intersection import INSERTION_ORDERS, run_intersection, set_patterns
 from ..studies.summary import study_summary
@@ -76,8 +77,6 @@ def _report(summary: dict, args, study=None) -> int:
     """The summary on stdout, as JSON or text, with the paper beside it if asked."""
     if args.format == "json":
         if args.compare_paper:
-            from ..paper import paper_comparison, paper_study_key
-
             key, _ = paper_study_key(summary)
             summary["paper"] = paper_comparison(summary, key) if key else None
         emit(summary, "json")
@@ -118,13 +117,11 @@ def _intersection(args) -> int:
         stem = f"intersection-r{args.resolution}-{args.order}"
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
         atomic_write(args.out / f"{stem}.yaml", dump(summary, "yaml"))
-        from ..outputs.latex import render_tables
+        from ..outputs.latex import render_tables  # jinja2: loaded only when tables are written
 
         render_tables([summary], shipped_catalogue(), args.out / "latex",
                       f"Intersection study at 1/{args.resolution}, insertion order {args.order}")
         if args.patterns:
-            from ..formats.patterns import write_pattern_table
-
             with progress_bar(summary["orbits"], "pattern table") as advance:
                 write_pattern_table(summary, args.out / f"{stem}-patterns.yaml", shipped_catalogue()["version"],
                                     jobs=max(1, args.jobs), progress=advance, scheduler=args.scheduler,

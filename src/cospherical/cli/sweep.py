@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from ..core.exact import parse_rational
 from ..errors import InputError
 from ..files.yamlio import atomic_write
 from ..outputs.figures import heatmap_png, heatmap_tex, steps_png, steps_tex
@@ -64,8 +65,6 @@ def _ray(args) -> int:
     parts = args.range.split(":")
     if len(parts) != 2:
         raise InputError(f"range {args.range!r}: write R_MIN:R_MAX, for example 1:4")
-    from ..core.exact import parse_rational
-
     r_lo, r_hi = (parse_rational(p, "ray range") for p in parts)
     if not 0 < r_lo <= r_hi:
         raise InputError(f"range {args.range!r}: need 0 < R_MIN <= R_MAX")

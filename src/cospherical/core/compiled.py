@@ -24,6 +24,8 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
+from .configuration import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
+
 __all__ = ["cube_batch", "fits", "orbit_keys", "walk"]
 
 MAX_POINTS = 62
@@ -312,8 +314,6 @@ def buffers(points: int):
 @lru_cache(maxsize=None)  # built once per process, shared by every chunk
 def cube_tables():
     """Point tables of the cube in 16ths: corner coordinates, edge start corners and axes, faces' edge pairs."""
-    from .configuration import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
-
     corners = np.array(CORNERS, dtype=np.int64) * 16
     starts = np.array([min((CORNERS[i] for i in EDGES[k])) for k in range(12)], dtype=np.int64) * 16
     axes = np.array([edge_axis(k) for k in range(12)], dtype=np.int64)

@@ -16,8 +16,17 @@ from typing import Sequence
 
 import numpy as np
 
-from .configuration import (BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis, parse_point_suffix,
-                            point_suffix)
+from .configuration import (
+    BODY_NODE,
+    CORNERS,
+    EDGES,
+    FACES,
+    Box,
+    Configuration,
+    edge_axis,
+    parse_point_suffix,
+    point_suffix,
+)
 from .polyhedron import Polyhedron
 
 __all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "orbit_keys", "orbit_point_keys",

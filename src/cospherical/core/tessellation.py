@@ -55,6 +55,22 @@ class Tessellation:
 def tessellate(configuration: Configuration) -> Tessellation:
     """The Delaunay tessellation of a configuration, its elements the largest co-spherical sets.
 
+    Every cell is the convex hull of all points on one empty sphere, decided in
+    integer arithmetic; each element is classified by the canonical code of its
+    labelled face graph.
+
+    Parameters
+    ----------
+    configuration : Configuration
+        The box, its Steiner points, and its face and body points.
+
+    Returns
+    -------
+    Tessellation
+        The nodes (unit-box coordinates, exact), the elements sorted by node ids,
+        and the FVM tests; :meth:`Tessellation.circumcenter` gives an element's
+        circumcenter in box coordinates.
+
     Examples
     --------
     >>> from cospherical import Configuration

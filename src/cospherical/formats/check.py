@@ -15,6 +15,8 @@ from fractions import Fraction
 from ..core.configuration import Box, Configuration
 from ..core.geometry import Frame, six_volume
 from ..errors import FormatError, InputError
+from ..files.yamlio import validate
+from .diff import document_kind
 from .patterns import entry_elements
 
 __all__ = ["check_catalogue", "check_patterns"]
@@ -108,9 +110,6 @@ def _check_tiling(frame: Frame, elements, types, where: str) -> None:
 
 def validated(data, name: str) -> tuple[str, dict]:
     """The document's kind (``catalogue`` or ``patterns``), after schema validation."""
-    from ..files.yamlio import validate
-    from .diff import document_kind
-
     kind = document_kind(data, name)
     validate(data, kind, name)
     return kind, data

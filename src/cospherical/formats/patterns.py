@@ -134,7 +134,26 @@ def entry_elements(entry: dict, criterion: str) -> list[dict] | None:
 
 
 def load(path: str | Path) -> PatternTable:
-    """Read a pattern table, validated against the JSON Schema; a bad file raises :class:`FormatError`."""
+    """Read a pattern table and validate it (JSON Schema, criterion references).
+
+    Parameters
+    ----------
+    path : str or Path
+        A pattern table, such as ``patterns/bisection-1x1x1.yaml``.
+
+    Returns
+    -------
+    PatternTable
+        ``header`` and, through :meth:`PatternTable.elements`, each configuration's
+        elements per criterion.
+
+    Raises
+    ------
+    FormatError
+        The file cannot be read or does not have the format; the message names the place.
+
+    See the README ("Pattern tables for a mesh generator") for an example, run by the tests.
+    """
     return table_from_data(load_yaml(path), str(path))
 
 

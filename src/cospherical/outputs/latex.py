@@ -19,6 +19,7 @@ from ..core.element_types import face_summary
 from ..errors import InputError
 from ..files.data import data_path
 from ..files.yamlio import atomic_open, atomic_write
+from ..formats.patterns import pattern_name
 from ..paper import comparison_notes, paper_comparison, paper_notes, paper_studies, paper_study_key
 from ..version import __version__
 
@@ -159,8 +160,6 @@ def _type_rows(summaries: list[dict], catalogue: dict) -> list[dict]:
 
 
 def _stem(summary: dict) -> str:
-    from ..formats.patterns import pattern_name
-
     if summary["study"] == "intersection":
         return f"intersection-r{summary['resolution']}-{summary['insertion_order']}"
     return pattern_name(summary["study"], summary["box"], summary["face_points"])

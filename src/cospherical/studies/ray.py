@@ -26,6 +26,7 @@ from ..core.geometry import Frame
 from ..core.symmetry import box_symmetries, orbit_representatives
 from ..core.tessellation import tessellate
 from ..errors import InputError
+from .bisection import bisection_codes
 
 __all__ = ["Ray", "code_pieces", "ray_profile"]
 
@@ -177,8 +178,6 @@ class Step:
 
 def ray_profile(ray: Ray, r_lo: Fraction, r_hi: Fraction, progress=None) -> list[Step]:
     """The bisection study along the ray for r in [r_lo, r_hi], exactly, as steps in u = r^2."""
-    from .bisection import bisection_codes
-
     u_lo, u_hi = r_lo * r_lo, r_hi * r_hi
     codes = bisection_codes()
     # symmetries common to every box of the ray (those of a generic member)
