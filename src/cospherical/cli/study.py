@@ -1,4 +1,4 @@
-"""``cospherical study bisection|intersection``: every configuration of a family, with statistics."""
+"""``cospherical study bisection|leaves|intersection``: every configuration of a family, with statistics."""
 
 from __future__ import annotations
 
@@ -14,7 +14,8 @@ from ..outputs.report import text_report
 from ..paper import paper_comparison, paper_study_key
 from ..studies.bisection import bisection_codes, run_study
 from ..studies.intersection import INSERTION_ORDERS, run_intersection, set_patterns
-from ..studies.summary import study_summary
+from ..studies.leaves import leaf_codes, run_leaves
+from ..studies.summary import compared_with, study_summary
 from .output import dump, emit
 from .progress import progress_bar, stage_bars
 
@@ -26,9 +27,11 @@ def add_parser(commands) -> None:
         description="Tessellate every configuration of a family (one per symmetry orbit) and report "
         "the frequency of every element type.",
     )
-    parser.add_argument("family", choices=["bisection", "intersection"],
-                        help="bisection: a midpoint or nothing on each of the 12 edges; intersection: the paper's "
-                        "section 5, points at multiples of 1/RESOLUTION placed by the midpoint scheme, on the cube")
+    parser.add_argument("family", choices=["bisection", "leaves", "intersection"],
+                        help="bisection: a midpoint or nothing on each of the 12 edges; leaves: the same edges with "
+                        "every admissible set of face points and no body point, as at octree leaves (beside the "
+                        "bisection study); intersection: the paper's section 5, points at multiples of 1/RESOLUTION "
+                        "placed by the midpoint scheme, on the cube")
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), default=["1", "1", "1"],
                         help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2) (default: the cube)")
     parser.add_argument("--resolution", type=int, default=16, help="intersection: positions at multiples of 1/R (2, 4, 8, 16)")
@@ -63,11 +66,20 @@ def run(args) -> int:
         return _intersection(args)
     box = Box.parse(args.box)
     codes = bisection_codes()
-    with progress_bar(len(codes), "bisection") as advance:
-        study = run_study("bisection", box, codes, args.face_points, progress=advance)
-    summary = study_summary(study)
+    if args.family == "leaves":
+        if args.face_points != "octree" or args.compare_paper:
+            raise UsageError("cospherical study: error: the leaf study gives its face points in its codes and sets "
+                             "the octree-policy bisection study beside it: no --face-points, no --compare-paper")
+        with progress_bar(len(leaf_codes()) + len(codes), "leaves") as advance:
+            study = run_leaves(box, progress=advance)
+            bisection = run_study("bisection", box, codes, "octree", progress=advance)
+        summary = compared_with(study_summary(study), study_summary(bisection))
+    else:
+        with progress_bar(len(codes), "bisection") as advance:
+            study = run_study("bisection", box, codes, args.face_points, progress=advance)
+        summary = study_summary(study)
     if args.out:
-        stem = pattern_name("bisection", box.texts, args.face_points)
+        stem = pattern_name(study.name, box.texts, study.face_points)
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
         write_patterns(study, args.out / f"{stem}.yaml", shipped_catalogue()["version"])
     return _report(summary, args, study)

@@ -34,13 +34,18 @@ __all__ = ["PatternTable", "SCHEMA_VERSION", "configuration_lines", "element_lin
            "table_from_data", "write_pattern_table", "write_patterns"]
 
 SCHEMA_VERSION = 1
-SCHEMES = {"bisection": "midpoints: every Steiner point at t = 1/2"}
+SCHEMES = {
+    "bisection": "midpoints: every Steiner point at t = 1/2",
+    "leaves": "octree leaves: midpoints at t = 1/2, the centre of every face whose neighbour is refined "
+    "(any set of faces with four split edges), never a body point; keys are whole-point-set codes",
+}
 
 
 def pattern_name(study: str, box_texts, face_points: str = "octree") -> str:
     """File stem for a study's outputs, e.g. ``bisection-1x1.4142x1.4142``."""
     box = "x".join(re.sub(r"[^0-9a-z./]+", "", text.replace("/", "_")) for text in box_texts)
-    return f"{study}-{box}" + ("" if face_points == "octree" else f"-{face_points}")
+    # explicit points are named by the codes inside the table, not by its file name
+    return f"{study}-{box}" + ("" if face_points in ("octree", "explicit") else f"-{face_points}")
 
 
 def patterns_text(study: Study, catalogue_version: str) -> str:

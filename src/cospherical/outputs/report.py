@@ -6,7 +6,7 @@ from ..catalogue import element_options, type_name
 from ..paper import comparison_notes, paper_class, paper_comparison, paper_notes, paper_studies, paper_study_key
 from ..studies.bisection import Study
 
-__all__ = ["comparison_lines", "paper_set_gaps", "text_report"]
+__all__ = ["comparison_lines", "paper_set_gaps", "study_comparison_lines", "text_report"]
 
 
 def paper_set_gaps(study: Study, key: str, criterion: str) -> list[dict]:
@@ -60,10 +60,39 @@ def text_report(summary: dict, compare_paper: bool = False, study: Study | None 
                 for split in used:
                     pieces = " + ".join(names.get(p, p) for p in split["pieces"])
                     lines.append(f"    {names.get(type_id, type_id)} -> {pieces}  ({split['configurations']})")
+    if "compared_with" in summary:
+        lines.append("")
+        lines.extend(study_comparison_lines(summary))
     if compare_paper:
         lines.append("")
         lines.extend(comparison_lines(summary, study))
     return "\n".join(lines) + "\n"
+
+
+def study_comparison_lines(summary: dict) -> list[str]:
+    """The summary's ``compared_with`` study beside it: the figures, then every type's count."""
+    other = summary["compared_with"]
+    ours, theirs = summary["study"], f"{other['study']} ({other['face_points']})"
+    width = max(len(ours), len(theirs), 8)
+    names = {i: t["name"] for data in (*summary["criteria"].values(), *other["criteria"].values())
+             for i, t in data["types"].items()}
+    lines = [f"Beside the {other['study']} study with the {other['face_points']} point policy, same box:",
+             f"  {'':<56} {ours:>{width}} {theirs:>{width}}"]
+
+    def row(label, mine, them):
+        lines.append(f"  {label[:56]:<56} {mine:>{width}} {them:>{width}}")
+
+    for key, label in (("configurations", "configurations"), ("orbits", "symmetry orbits"),
+                       ("fvm_adequate", "FVM adequate (closed box)"), ("fvm_adequate_open", "FVM adequate (open box)")):
+        row(label, summary[key], other[key])
+    for criterion, data in summary["criteria"].items():
+        them = other["criteria"].get(criterion, {"total": "-", "types_count": "-", "types": {}})
+        row(f"{criterion}: elements", data["total"], them["total"])
+        row(f"{criterion}: element types", data["types_count"], them["types_count"])
+        for type_id in [*data["types"], *(i for i in them["types"] if i not in data["types"])]:
+            mine = data["types"].get(type_id, {}).get("count", 0)
+            row(f"  {type_id:<14} {names[type_id]}", mine, them["types"].get(type_id, {}).get("count", 0))
+    return lines
 
 
 def comparison_lines(summary: dict, study: Study | None = None) -> list[str]:

@@ -19,7 +19,7 @@ from ..core.element_types import ElementType
 from ..paper import paper_class
 from .bisection import Study
 
-__all__ = ["TypeInfo", "frequency_table", "study_summary"]
+__all__ = ["TypeInfo", "compared_with", "frequency_table", "study_summary"]
 
 
 @dataclass(frozen=True)
@@ -103,3 +103,29 @@ def study_summary(study: Study, names: Mapping[str, tuple[str, list[str]]] | Non
         "fvm_adequate_open": study.fvm_adequate_open,
         "criteria": criteria,
     }
+
+
+def compared_with(summary: dict, other: dict) -> dict:
+    """``summary`` with an entry ``compared_with``: another study's figures, to set beside ours.
+
+    The other study's configurations, orbits, FVM counts and, per criterion, its
+    total, number of types and per-type counts (with names); the leaf study is
+    compared so with the octree-policy bisection study of the same box.
+
+    Examples
+    --------
+    >>> ours = {"study": "leaves", "configurations": 2, "criteria": {}}
+    >>> other = {"study": "bisection", "face_points": "octree", "configurations": 1, "orbits": 1,
+    ...          "fvm_adequate": 1, "fvm_adequate_open": 0,
+    ...          "criteria": {"optimal": {"total": 4, "types_count": 1,
+    ...                                   "types": {"v4f4-8f0284": {"name": "tetrahedron", "count": 4}}}}}
+    >>> compared_with(ours, other)["compared_with"]["criteria"]["optimal"]["types"]
+    {'v4f4-8f0284': {'name': 'tetrahedron', 'count': 4}}
+    """
+    keys = ("study", "face_points", "configurations", "orbits", "fvm_adequate", "fvm_adequate_open")
+    criteria = {
+        criterion: {"total": data["total"], "types_count": data["types_count"],
+                    "types": {i: {"name": t["name"], "count": t["count"]} for i, t in data["types"].items()}}
+        for criterion, data in other["criteria"].items()
+    }
+    return {**summary, "compared_with": {**{key: other[key] for key in keys}, "criteria": criteria}}
