@@ -11,7 +11,7 @@ elements still not covered, always branching on the one with fewest options.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Sequence
 
@@ -120,7 +120,8 @@ def split_tessellation(tess: Tessellation, kept: frozenset[str], criterion: str,
         elements.extend(fitting[0])
         used.append((element, fitting[0]))
     elements.sort(key=lambda e: e.polyhedron.nodes)
-    return Tessellation(tess.configuration, tess.nodes, tuple(elements)), used
+    # replace, not a new Tessellation: a shape's tessellation keeps its own FVM test
+    return replace(tess, elements=tuple(elements)), used
 
 
 def option_types(option: Sequence[Element]) -> tuple[str, ...]:

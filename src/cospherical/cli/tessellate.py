@@ -7,8 +7,10 @@ from pathlib import Path
 
 from ..catalogue import CRITERIA, apply_catalogue_criterion
 from ..core.configuration import POINT_POLICIES, Configuration
+from ..core.shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape, tessellate_shape
 from ..core.tessellation import tessellate
-from ..errors import InputError
+from ..errors import FormatError, InputError, UsageError
+from ..files.yamlio import load_yaml
 from ..formats.tessellation import tessellation_data
 from .output import FORMATS, emit
 
@@ -23,16 +25,24 @@ def _steiner(text: str) -> tuple[str, str]:
 def add_parser(commands) -> None:
     parser = commands.add_parser(
         "tessellate",
-        help="tessellate one 1-irregular cuboid",
-        description="Tessellate one 1-irregular cuboid: Delaunay cells = largest co-spherical elements.",
+        help="tessellate one 1-irregular cuboid, prism, pyramid or tetrahedron",
+        description="Tessellate one 1-irregular element: Delaunay cells = largest co-spherical elements.",
     )
+    element = parser.add_mutually_exclusive_group()
+    element.add_argument("--element", choices=ELEMENTS, default="cuboid",
+                         help="the base element in the box (default cuboid): prism (half the box), pyramid (on the "
+                         "bottom face, apex at the centre) or tetrahedron (at the corner); see the README's node numbering")
+    element.add_argument("--shape", type=Path, metavar="FILE",
+                         help="any convex base element: a YAML file with corners (unit coordinates, exact: 0, 1/2), "
+                         "edges and faces (corner numbers), checked exactly")
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), required=True,
                         help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2)")
     points = parser.add_mutually_exclusive_group()
     points.add_argument("--steiner", nargs="+", type=_steiner, default=[], metavar="K:T",
-                        help="Steiner point on edge K (0..11) at parameter T in (0,1), e.g. 0:1/2")
-    points.add_argument("--code", help="12 hexadecimal digits, digit k = 16*t on edge k (0 = no point), optionally "
-                        "followed by the point suffix +f<faces>[b]: the faces carrying a point, e.g. 888888888888+f04")
+                        help="Steiner point on edge K (0..11 for a cuboid) at parameter T in (0,1), e.g. 0:1/2")
+    points.add_argument("--code", help="one hexadecimal digit per edge (12 for a cuboid, 9 prism, 8 pyramid, "
+                        "6 tetrahedron), digit k = 16*t on edge k (0 = no point); a cuboid's code may end with the point "
+                        "suffix +f<faces>[b]: the faces carrying a point, e.g. 888888888888+f04")
     face_points = parser.add_mutually_exclusive_group()
     face_points.add_argument("--face-points", choices=POINT_POLICIES,
                              help="octree (default): add face and body points of refined neighbours; none: edges only")
@@ -48,18 +58,44 @@ def add_parser(commands) -> None:
     parser.set_defaults(run=run)
 
 
-def run(args) -> int:
+def _steiner_map(pairs) -> dict[str, str]:
+    steiner = {}
+    for edge, t in pairs:
+        if edge.strip() in steiner:
+            raise InputError(f"edge {edge}: given twice")
+        steiner[edge.strip()] = t
+    return steiner
+
+
+def _shape_file(path: Path, box) -> Shape:
+    data = load_yaml(path)
+    if not isinstance(data, dict) or any(not isinstance(data.get(key), list) for key in ("corners", "edges", "faces")):
+        raise FormatError(f"{path}: needs the lists corners, edges and faces")
+    try:
+        return Shape.from_vertices(data["corners"], data["edges"], data["faces"], box, str(data.get("name", "element")))
+    except InputError as error:
+        raise FormatError(f"{path}: {error}") from None
+
+
+def _configuration(args):
+    """The configuration the arguments name, and the function that tessellates it."""
     policy = args.face_points or "octree"  # no default in the parser: --faces excludes it
+    if args.element != "cuboid" or args.shape:
+        if args.faces is not None or args.body:
+            raise UsageError("cospherical tessellate: error: --faces and --body are for cuboids; another element "
+                             "puts a point on every quadrilateral face whose edges allow one (--face-points)")
+        shape = _shape_file(args.shape, args.box) if args.shape else standard_shape(args.element, args.box)
+        if args.code is not None:
+            return ShapeConfiguration.from_code(shape, args.code, policy), tessellate_shape
+        return ShapeConfiguration.from_steiner(shape, _steiner_map(args.steiner), policy), tessellate_shape
     if args.code is not None:
-        configuration = Configuration.from_code(args.code, args.box, policy, args.faces, args.body)
-    else:
-        steiner = {}
-        for edge, t in args.steiner:
-            if edge.strip() in steiner:
-                raise InputError(f"edge {edge}: given twice")
-            steiner[edge.strip()] = t
-        configuration = Configuration.from_steiner(args.box, steiner, policy, args.faces, args.body)
-    tess = tessellate(configuration)
+        return Configuration.from_code(args.code, args.box, policy, args.faces, args.body), tessellate
+    return Configuration.from_steiner(args.box, _steiner_map(args.steiner), policy, args.faces, args.body), tessellate
+
+
+def run(args) -> int:
+    configuration, tessellator = _configuration(args)
+    tess = tessellator(configuration)
     if args.criterion != "optimal":
         tess = apply_catalogue_criterion(tess, args.criterion)
     if args.vtu:

@@ -29,7 +29,7 @@ from .configuration import (
 )
 from .polyhedron import Polyhedron
 
-__all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "orbit_keys", "orbit_point_keys",
+__all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys", "orbit_point_keys",
            "orbit_representatives"]
 
 
@@ -90,22 +90,7 @@ class Symmetry:
 
     def polyhedron(self, poly: Polyhedron) -> Polyhedron:
         """The image of a polyhedron, faces normalised as the Delaunay stage writes them."""
-        nodes = self.node_map
-        faces = []
-        for face in poly.faces:
-            image = [nodes[v] for v in face]
-            if not self.proper:  # a reflection turns counter-clockwise into clockwise
-                image.reverse()
-            start = image.index(min(image))
-            faces.append(tuple(image[start:] + image[:start]))
-        order = sorted(range(len(faces)), key=lambda i: faces[i])
-        return Polyhedron(
-            nodes=tuple(sorted(nodes[v] for v in poly.nodes)),
-            faces=tuple(faces[i] for i in order),
-            face_kinds=tuple(poly.face_kinds[i] for i in order),
-            unit_volume=poly.unit_volume,
-            center=self.point(poly.center),
-        )
+        return map_polyhedron(poly, self.node_map, self.proper, self.point)
 
     def inverse(self) -> "Symmetry":
         perm = [0, 0, 0]
@@ -114,6 +99,27 @@ class Symmetry:
             perm[a] = i
             flips[a] = self.flips[i]
         return Symmetry(tuple(perm), tuple(flips))
+
+
+def map_polyhedron(poly: Polyhedron, nodes, proper: bool, point) -> Polyhedron:
+    """The image of a polyhedron under an isometry given by its node map (``nodes[v]``), whether
+    it keeps orientation, and its action on unit coordinates; faces normalised as the Delaunay
+    stage writes them (shared by the box's symmetries and those of other shapes)."""
+    faces = []
+    for face in poly.faces:
+        image = [nodes[v] for v in face]
+        if not proper:  # a reflection turns counter-clockwise into clockwise
+            image.reverse()
+        start = image.index(min(image))
+        faces.append(tuple(image[start:] + image[:start]))
+    order = sorted(range(len(faces)), key=lambda i: faces[i])
+    return Polyhedron(
+        nodes=tuple(sorted(nodes[v] for v in poly.nodes)),
+        faces=tuple(faces[i] for i in order),
+        face_kinds=tuple(poly.face_kinds[i] for i in order),
+        unit_volume=poly.unit_volume,
+        center=point(poly.center),
+    )
 
 
 # The orbit kernel takes a configuration's face and body points as a mask: bit f for

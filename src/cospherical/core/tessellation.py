@@ -11,7 +11,7 @@ from .element_types import ElementType, classify
 from .geometry import Frame
 from .polyhedron import Polyhedron, polyhedron
 
-__all__ = ["Element", "Tessellation", "tessellate"]
+__all__ = ["Element", "Tessellation", "tessellate", "tessellation_elements"]
 
 
 @dataclass(frozen=True)
@@ -81,10 +81,16 @@ def tessellate(configuration: Configuration) -> Tessellation:
     True
     """
     nodes = configuration.nodes()
-    frame = Frame.build(nodes, configuration.box.squared)
+    return Tessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared))
+
+
+def tessellation_elements(nodes, squared) -> tuple[Element, ...]:
+    """The classified Delaunay elements of points ``{node id: unit coordinates}`` in a box
+    with these squared lengths: the one pipeline of every base element (cuboid or other shape)."""
+    frame = Frame.build(nodes, squared)
     elements = []
     for cell in delaunay_cells(frame):
         poly = polyhedron(frame, cell)
         etype, order, mirrored = classify(poly)
         elements.append(Element(etype, order, poly, mirrored))
-    return Tessellation(configuration, nodes, tuple(elements))
+    return tuple(elements)

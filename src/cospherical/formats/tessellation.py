@@ -21,7 +21,9 @@ def tessellation_data(tess: Tessellation) -> dict:
     """
     cfg = tess.configuration
     real = cfg.real_nodes()
+    shape = getattr(cfg, "shape", None)
     return {
+        **({"element": shape.name} if shape is not None else {}),
         "box": list(cfg.box.texts),
         "code": cfg.code,
         "face_points": cfg.face_points,

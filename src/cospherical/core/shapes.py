@@ -1,0 +1,582 @@
+"""1-irregular convex base elements other than the cuboid: prisms, pyramids, tetrahedra, any convex polyhedron.
+
+The paper's conclusion says its algorithm tessellates "any 1-irregular convex
+configuration" unchanged; this module is that generalisation.  A :class:`Shape`
+is a convex polyhedron given by exact corners in *unit* coordinates (s, t, u),
+scaled by a box A x B x C (the real point is (s*A, t*B, u*C)), its edges and its
+faces.  Because the map from unit to real coordinates is a positive diagonal
+scaling, convexity, planarity and orientation are decided on the unit
+coordinates, and everything metric goes through the box's squared lengths, as
+for cuboids (:mod:`cospherical.core.geometry`): the whole pipeline stays exact
+for ``sqrt(2)`` boxes too.
+
+Node numbering: the corners in the order given (VTK order for the standard
+shapes), then one node per edge (edge k carries node ``len(corners) + k``), then
+one node per quadrilateral face, in face order.  A Steiner point on edge k sits
+at parameter t in (0, 1) from the edge's *lower end* (its lexicographically
+smallest corner in unit coordinates; for the axis-parallel edges of a cuboid
+this is the lower-coordinate end).  A quadrilateral face carries a point when
+its four edges are split with opposite edges at the same parameter (measured in
+the same direction); the point is where the two cut lines cross.  Triangles and
+the interior carry nothing: a refined neighbour puts nothing there.
+
+Examples
+--------
+>>> prism = standard_shape("prism")
+>>> len(prism.corners), len(prism.edges), prism.quad_faces
+(6, 9, (2, 3, 4))
+>>> tess = tessellate_shape(ShapeConfiguration.from_code(prism, "888888888"))
+>>> sorted(e.type.name for e in tess.elements), tess.fvm_adequate
+(['cuboid', 'cuboid', 'triangular prism', 'triangular prism', 'triangular prism', 'triangular prism'], True)
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from fractions import Fraction
+from functools import cached_property
+from itertools import combinations
+from typing import Iterable, Mapping, Sequence
+
+from ..errors import InputError
+from .configuration import Box
+from .exact import parse_rational
+from .polyhedron import Polyhedron
+from .symmetry import map_polyhedron
+from .tessellation import Tessellation, tessellation_elements
+
+__all__ = ["ELEMENTS", "STANDARD_SHAPES", "Shape", "ShapeConfiguration", "ShapeSymmetry", "ShapeTessellation",
+           "mask_codes", "shape_orbit_representatives", "standard_shape", "tessellate_shape"]
+
+Point = tuple[Fraction, Fraction, Fraction]
+
+_H = Fraction(1, 2)
+# The standard shapes, corners in VTK order (wedge, pyramid, tetra), edges in the
+# order of the VTK quadratic cells, faces as VTK lists them (oriented on building).
+STANDARD_SHAPES: dict[str, tuple[tuple, tuple, tuple]] = {
+    "prism": (
+        ((0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (0, 1, 1)),
+        ((0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 3), (0, 3), (1, 4), (2, 5)),
+        ((0, 1, 2), (3, 4, 5), (0, 1, 4, 3), (1, 2, 5, 4), (2, 0, 3, 5)),
+    ),
+    "pyramid": (
+        ((0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (_H, _H, _H)),
+        ((0, 1), (1, 2), (2, 3), (3, 0), (0, 4), (1, 4), (2, 4), (3, 4)),
+        ((0, 1, 2, 3), (0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)),
+    ),
+    "tetrahedron": (
+        ((0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)),
+        ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)),
+        ((0, 1, 2), (0, 1, 3), (1, 2, 3), (2, 0, 3)),
+    ),
+}
+ELEMENTS = ("cuboid", *STANDARD_SHAPES)
+
+
+def _sub(p, q):
+    return tuple(a - b for a, b in zip(p, q))
+
+
+def _cross(p, q):
+    return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
+
+
+def _dot(p, q):
+    return sum(a * b for a, b in zip(p, q))
+
+
+def _point(value, where: str) -> Point:
+    if isinstance(value, str) or not hasattr(value, "__len__") or len(value) != 3:
+        raise InputError(f"{where} {value!r}: needs three coordinates")
+    return tuple(parse_rational(x, where) for x in value)
+
+
+def _index(value, count: int, where: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < count:
+        raise InputError(f"{where}: {value!r} is not a corner number 0..{count - 1}")
+    return value
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A convex base element: exact corners, edges and faces, scaled by a box.
+
+    Build it with :meth:`from_vertices` (which checks everything exactly) or
+    :func:`standard_shape`.  ``faces`` are corner cycles, counter-clockwise seen
+    from outside; ``planes`` their outward planes ``normal . x <= offset`` in unit
+    coordinates; ``quad_faces`` the faces with four corners, whose points are the
+    nodes after the edge nodes.
+    """
+
+    name: str
+    box: Box
+    corners: tuple[Point, ...]
+    edges: tuple[tuple[int, int], ...]
+    faces: tuple[tuple[int, ...], ...]
+    planes: tuple[tuple[tuple[Fraction, ...], Fraction], ...] = field(repr=False)
+
+    @classmethod
+    def from_vertices(cls, vertices: Sequence, edges: Sequence, faces: Sequence,
+                      box: Box | Iterable = ("1", "1", "1"), name: str = "element") -> "Shape":
+        """A convex polyhedron from its vertices (unit coordinates), edges and faces, checked exactly.
+
+        The faces may be given in either orientation; they are turned
+        counter-clockwise seen from outside.  Refused with an
+        :class:`~cospherical.errors.InputError` naming the problem: repeated
+        corners, a face that is not a plane convex polygon, a corner outside a
+        face's half-space (not convex) or in its plane without being one of its
+        corners (not a vertex), edges that are not the faces' sides, a surface
+        that is not closed.
+
+        Examples
+        --------
+        >>> shape = Shape.from_vertices([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)],
+        ...                             [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)],
+        ...                             [(0, 1, 2), (0, 1, 3), (1, 2, 3), (2, 0, 3)])
+        >>> shape.faces[0], shape.unit_volume
+        ((0, 2, 1), Fraction(1, 6))
+        >>> Shape.from_vertices([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)], [], [])
+        Traceback (most recent call last):
+        ...
+        cospherical.errors.InputError: element: the corners are coplanar: no solid
+        """
+        box = box if isinstance(box, Box) else Box.parse(box)
+        corners = tuple(_point(v, f"corner {i}") for i, v in enumerate(vertices))
+        n = len(corners)
+        if n < 4:
+            raise InputError(f"{name}: needs at least 4 corners, got {n}")
+        for i, j in combinations(range(n), 2):
+            if corners[i] == corners[j]:
+                raise InputError(f"{name}: corners {i} and {j} are the same point")
+        if all(_dot(_cross(_sub(corners[1], corners[0]), _sub(corners[j], corners[0])), _sub(corners[k], corners[0])) == 0
+               for j in range(2, n) for k in range(j + 1, n)):
+            raise InputError(f"{name}: the corners are coplanar: no solid")
+        cycles = []
+        for f, face in enumerate(faces):
+            if isinstance(face, str) or not hasattr(face, "__len__") or len(face) < 3:
+                raise InputError(f"{name}: face {f} {face!r}: needs at least three corners")
+            cycle = tuple(_index(v, n, f"{name}: face {f}") for v in face)
+            if len(set(cycle)) != len(cycle):
+                raise InputError(f"{name}: face {f} {list(cycle)}: a corner appears twice")
+            cycles.append(cycle)
+        oriented, planes = [], []
+        for f, cycle in enumerate(cycles):
+            cycle, plane = _oriented_face(corners, cycle, f, name)
+            oriented.append(cycle)
+            planes.append(plane)
+        sides = {}
+        for f, cycle in enumerate(oriented):
+            for a, b in zip(cycle, cycle[1:] + cycle[:1]):
+                sides.setdefault(frozenset((a, b)), []).append(f)
+        bad = next((sorted(e) for e, fs in sides.items() if len(fs) != 2), None)
+        if bad is not None:
+            raise InputError(f"{name}: edge {bad[0]}-{bad[1]} belongs to {len(sides[frozenset(bad)])} faces: "
+                             "the faces do not close the surface")
+        missing = [i for i in range(n) if not any(i in c for c in oriented)]
+        if missing:
+            raise InputError(f"{name}: corner {missing[0]} is on no face")
+        pairs = []
+        for k, edge in enumerate(edges):
+            if isinstance(edge, str) or not hasattr(edge, "__len__") or len(edge) != 2:
+                raise InputError(f"{name}: edge {k} {edge!r}: needs two corners")
+            pair = tuple(_index(v, n, f"{name}: edge {k}") for v in edge)
+            if frozenset(pair) not in sides:
+                raise InputError(f"{name}: edge {k} {list(pair)} is not a side of any face")
+            pairs.append(pair)
+        if len({frozenset(p) for p in pairs}) != len(pairs):
+            raise InputError(f"{name}: an edge is given twice")
+        if len(pairs) != len(sides):
+            unlisted = sorted(sorted(e) for e in sides if e not in {frozenset(p) for p in pairs})[0]
+            raise InputError(f"{name}: the side {unlisted[0]}-{unlisted[1]} of a face is not among the edges")
+        if n - len(pairs) + len(oriented) != 2:
+            raise InputError(f"{name}: V - E + F = {n - len(pairs) + len(oriented)}, not 2: not one closed convex surface")
+        return cls(name, box, corners, tuple(pairs), tuple(oriented), tuple(planes))
+
+    @cached_property
+    def quad_faces(self) -> tuple[int, ...]:
+        """The faces with four corners: face ``quad_faces[q]`` carries node ``len(corners) + len(edges) + q``."""
+        return tuple(f for f, face in enumerate(self.faces) if len(face) == 4)
+
+    @cached_property
+    def unit_volume(self) -> Fraction:
+        """The volume as a fraction of the box's."""
+        origin = self.corners[0]
+        total = Fraction(0)
+        for face in self.faces:
+            a = _sub(self.corners[face[0]], origin)
+            for b, c in zip(face[1:-1], face[2:]):
+                total += _dot(a, _cross(_sub(self.corners[b], origin), _sub(self.corners[c], origin)))
+        return total / 6
+
+    def edge_start(self, k: int) -> int:
+        """The corner from which edge k's parameter is measured: its lexicographically smallest."""
+        return min(self.edges[k], key=lambda i: self.corners[i])
+
+    def edge_point(self, k: int, t: Fraction) -> Point:
+        start = self.edge_start(k)
+        end = self.edges[k][0] if self.edges[k][1] == start else self.edges[k][1]
+        p, q = self.corners[start], self.corners[end]
+        return tuple(a + t * (b - a) for a, b in zip(p, q))
+
+    def edge_index(self, i: int, j: int) -> int:
+        return self._edge_index[frozenset((i, j))]
+
+    @cached_property
+    def _edge_index(self) -> dict[frozenset[int], int]:
+        return {frozenset(e): k for k, e in enumerate(self.edges)}
+
+    def contains(self, point: Sequence[Fraction], closed: bool = True) -> bool:
+        """Whether a point (unit coordinates) lies in the closed (or open) element, exactly."""
+        if closed:
+            return all(_dot(normal, point) <= offset for normal, offset in self.planes)
+        return all(_dot(normal, point) < offset for normal, offset in self.planes)
+
+    @cached_property
+    def symmetries(self) -> tuple["ShapeSymmetry", ...]:
+        """The isometries of the scaled shape, identity first (see :class:`ShapeSymmetry`)."""
+        return _symmetries(self)
+
+
+def _oriented_face(corners, cycle, f, name):
+    """The cycle counter-clockwise seen from outside and the outward plane, after the checks."""
+    pts = [corners[i] for i in cycle]
+    m = len(cycle)
+    normal = (0, 0, 0)
+    for i in range(m):  # Newell's normal: exact, and nonzero for any convex polygon
+        p, q = pts[i], pts[(i + 1) % m]
+        normal = (normal[0] + (p[1] - q[1]) * (p[2] + q[2]), normal[1] + (p[2] - q[2]) * (p[0] + q[0]),
+                  normal[2] + (p[0] - q[0]) * (p[1] + q[1]))
+    if normal == (0, 0, 0):  # a self-crossing order can cancel Newell's sum: any corner triple then
+        normal = next((n for a, b, c in combinations(pts, 3) if (n := _cross(_sub(b, a), _sub(c, a))) != (0, 0, 0)),
+                      normal)
+    if normal == (0, 0, 0):
+        raise InputError(f"{name}: face {f} {list(cycle)}: its corners are on one line")
+    offset = _dot(normal, pts[0])
+    if any(_dot(normal, p) != offset for p in pts):
+        raise InputError(f"{name}: face {f} {list(cycle)}: its corners are not on one plane")
+    for i in range(m):
+        # Convex in the given order: every other corner strictly on the inner side of each side.
+        p, q = pts[i], pts[(i + 1) % m]
+        inward = _cross(normal, _sub(q, p))
+        if any(_dot(inward, _sub(r, p)) <= 0 for j, r in enumerate(pts) if j not in (i, (i + 1) % m)):
+            raise InputError(f"{name}: face {f} {list(cycle)}: not a convex polygon in this order "
+                             "(or three corners on a line)")
+    above = below = False
+    for i, p in enumerate(corners):
+        if i in cycle:
+            continue
+        side = _dot(normal, p) - offset
+        if side == 0:
+            raise InputError(f"{name}: corner {i} lies in the plane of face {f} {list(cycle)} without being one "
+                             "of its corners")
+        above, below = above or side > 0, below or side < 0
+    if above and below:
+        raise InputError(f"{name}: not convex: corners lie on both sides of face {f} {list(cycle)}")
+    if above:  # the normal points inwards: turn the face round
+        cycle = (cycle[0], *reversed(cycle[1:]))
+        normal, offset = tuple(-x for x in normal), -offset
+    return cycle, (tuple(Fraction(x) for x in normal), Fraction(offset))
+
+
+def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
+    """One of the issue's standard shapes in a box A x B x C.
+
+    ``prism``: the right triangular prism (0,0,0) (A,0,0) (0,B,0) (0,0,C) (A,0,C) (0,B,C),
+    half a box; ``pyramid``: the square pyramid on the box's bottom face with its
+    apex at the box centre, a sixth of a box; ``tetrahedron``: the corner
+    tetrahedron (0,0,0) (A,0,0) (0,B,0) (0,0,C).
+
+    >>> standard_shape("pyramid").unit_volume
+    Fraction(1, 6)
+    >>> standard_shape("cube")
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.InputError: element 'cube': choose one of cuboid, prism, pyramid, tetrahedron
+    """
+    if name not in STANDARD_SHAPES:
+        raise InputError(f"element {name!r}: choose one of {', '.join(ELEMENTS)}")
+    corners, edges, faces = STANDARD_SHAPES[name]
+    return Shape.from_vertices(corners, edges, faces, box, name)
+
+
+_CODE = re.compile(r"^[0-9a-fA-F]+$")
+
+
+@dataclass(frozen=True)
+class ShapeConfiguration:
+    """A 1-irregular element of a :class:`Shape`: at most one Steiner point per edge.
+
+    ``steiner[k]`` is the parameter of the point on edge k from its lower end,
+    or ``None``.  Face points follow the ``octree`` policy (the paper's: every
+    quadrilateral face whose four edges are split, opposite ones at the same
+    parameter) or ``none``.
+
+    >>> cfg = ShapeConfiguration.from_code(standard_shape("pyramid"), "88880000")
+    >>> sorted(cfg.nodes())[-1], cfg.point_faces
+    (13, frozenset({0}))
+    """
+
+    shape: Shape
+    steiner: tuple[Fraction | None, ...]
+    face_points: str = "octree"
+
+    def __post_init__(self) -> None:
+        if len(self.steiner) != len(self.shape.edges):
+            raise InputError(f"steiner: needs {len(self.shape.edges)} entries, got {len(self.steiner)}")
+        if self.face_points not in ("octree", "none"):
+            raise InputError(f"face-point policy {self.face_points!r}: choose one of octree, none")
+
+    @classmethod
+    def from_code(cls, shape: Shape, code: str, face_points: str = "octree") -> "ShapeConfiguration":
+        """From one hexadecimal digit per edge (digit n: a point at t = n/16; ``0``: none)."""
+        count = len(shape.edges)
+        if not isinstance(code, str) or len(code) != count or not _CODE.match(code):
+            raise InputError(f"configuration code {code!r}: the {shape.name} needs exactly {count} hexadecimal "
+                             "digits, one per edge")
+        return cls(shape, tuple(Fraction(int(ch, 16), 16) if ch != "0" else None for ch in code), face_points)
+
+    @classmethod
+    def from_steiner(cls, shape: Shape, steiner: Mapping | None = None,
+                     face_points: str = "octree") -> "ShapeConfiguration":
+        """From ``{edge: t}``, t a string, int or Fraction strictly between 0 and 1."""
+        params: list[Fraction | None] = [None] * len(shape.edges)
+        for edge, value in (steiner or {}).items():
+            text = str(edge).strip()
+            if isinstance(edge, bool) or not (text.isascii() and text.isdigit()) or int(text) >= len(params):
+                raise InputError(f"edge {edge!r}: not an edge number 0..{len(params) - 1} of the {shape.name}")
+            t = parse_rational(value, f"Steiner parameter on edge {text}")
+            if not 0 < t < 1:
+                raise InputError(f"Steiner parameter on edge {text} is {value!r}: must lie strictly between 0 and 1")
+            params[int(text)] = t
+        return cls(shape, tuple(params), face_points)
+
+    @property
+    def box(self) -> Box:
+        return self.shape.box
+
+    @property
+    def code(self) -> str | None:
+        """One hexadecimal digit per edge; ``None`` when some t is not a multiple of 1/16."""
+        if any(t is not None and (t * 16).denominator != 1 for t in self.steiner):
+            return None
+        return "".join("0" if t is None else "%x" % int(t * 16) for t in self.steiner)
+
+    @property
+    def point_set_code(self) -> str | None:
+        return self.code
+
+    @property
+    def has_body_point(self) -> bool:
+        return False
+
+    @cached_property
+    def point_faces(self) -> frozenset[int]:
+        """The quadrilateral faces carrying a point (face numbers of the shape)."""
+        if self.face_points == "none":
+            return frozenset()
+        return frozenset(f for f in self.shape.quad_faces if self._face_parameters(f) is not None)
+
+    def _face_parameters(self, f: int):
+        # Along the face cycle (c0, c1, c2, c3): sides c0->c1 and c3->c2 are
+        # opposite, as are c0->c3 and c1->c2; each needs the same parameter.
+        c = self.shape.faces[f]
+        params = []
+        for a, b in ((c[0], c[1]), (c[3], c[2]), (c[0], c[3]), (c[1], c[2])):
+            k = self.shape.edge_index(a, b)
+            t = self.steiner[k]
+            if t is None:
+                return None
+            params.append(t if self.shape.edge_start(k) == a else 1 - t)
+        if params[0] != params[1] or params[2] != params[3]:
+            return None
+        return params[0], params[2]
+
+    def _face_point(self, f: int) -> Point:
+        c = [self.shape.corners[i] for i in self.shape.faces[f]]
+        t, s = self._face_parameters(f)
+        p = [a + t * (b - a) for a, b in zip(c[0], c[1])]
+        q = [a + t * (b - a) for a, b in zip(c[3], c[2])]
+        r = [a + s * (b - a) for a, b in zip(c[0], c[3])]
+        u = [a + s * (b - a) for a, b in zip(c[1], c[2])]
+        # p + x (q - p) = r + y (u - r): two of the three coordinate equations have
+        # a nonzero determinant, because the cut lines of a convex face cross.
+        d1, d2, e = _sub(q, p), _sub(u, r), _sub(r, p)
+        for i, j in combinations(range(3), 2):
+            det = d1[i] * -d2[j] + d2[i] * d1[j]
+            if det:
+                x = (e[i] * -d2[j] + d2[i] * e[j]) / det
+                return tuple(a + x * b for a, b in zip(p, d1))
+        raise AssertionError("the cut lines of a convex face cross")  # pragma: no cover
+
+    def nodes(self) -> dict[int, Point]:
+        """Node id -> exact unit coordinates: corners, edge points, face points."""
+        shape = self.shape
+        nodes = dict(enumerate(shape.corners))
+        for k, t in enumerate(self.steiner):
+            if t is not None:
+                nodes[len(shape.corners) + k] = shape.edge_point(k, t)
+        first = len(shape.corners) + len(shape.edges)
+        for q, f in enumerate(shape.quad_faces):
+            if f in self.point_faces:
+                nodes[first + q] = self._face_point(f)
+        return nodes
+
+    def real_nodes(self) -> dict[int, tuple[float, float, float]]:
+        scale = self.box.to_float()
+        return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}
+
+
+@dataclass(frozen=True)
+class ShapeTessellation(Tessellation):
+    """A tessellation of a shape; the FVM tests ask for circumcenters in the base element, not the box."""
+
+    @property
+    def fvm_adequate(self) -> bool:
+        """Every element's circumcenter lies in the closed base element."""
+        return all(self.configuration.shape.contains(e.polyhedron.center) for e in self.elements)
+
+    @property
+    def fvm_adequate_open(self) -> bool:
+        """Every element's circumcenter lies strictly inside the base element."""
+        return all(self.configuration.shape.contains(e.polyhedron.center, closed=False) for e in self.elements)
+
+
+def tessellate_shape(configuration: ShapeConfiguration) -> ShapeTessellation:
+    """The Delaunay tessellation of a 1-irregular element, its elements the largest co-spherical sets.
+
+    >>> tess = tessellate_shape(ShapeConfiguration.from_code(standard_shape("tetrahedron"), "800000"))
+    >>> [e.type.name for e in tess.elements], sum(e.polyhedron.unit_volume for e in tess.elements)
+    (['tetrahedron', 'tetrahedron'], Fraction(1, 6))
+    """
+    nodes = configuration.nodes()
+    return ShapeTessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared))
+
+
+def mask_codes(edges: int) -> list[str]:
+    """The bisection codes of an element with ``edges`` edges: a midpoint (``8``) or nothing on each.
+
+    >>> mask_codes(2)
+    ['00', '80', '08', '88']
+    """
+    return ["".join("8" if mask >> k & 1 else "0" for k in range(edges)) for mask in range(1 << edges)]
+
+
+@dataclass(frozen=True)
+class ShapeSymmetry:
+    """An isometry of a shape: a permutation of its corners, acting on nodes, codes and points.
+
+    ``corner_map[i]`` is the image of corner i; ``linear`` and ``shift`` the
+    affine map of unit coordinates (rational: it maps rational corners to
+    rational corners); ``proper`` whether it keeps orientation.
+    """
+
+    shape: Shape = field(repr=False, compare=False)
+    corner_map: tuple[int, ...]
+    linear: tuple[tuple[Fraction, ...], ...] = field(repr=False)
+    shift: tuple[Fraction, ...] = field(repr=False)
+
+    @property
+    def proper(self) -> bool:
+        m = self.linear
+        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) > 0
+
+    def point(self, p):
+        return tuple(sum(a * x for a, x in zip(row, p)) + b for row, b in zip(self.linear, self.shift))
+
+    @cached_property
+    def edge_map(self) -> tuple[tuple[int, bool], ...]:
+        """For edge k: (image edge, whether t becomes 1 - t)."""
+        shape, image = self.shape, self.corner_map
+        result = []
+        for k, (i, j) in enumerate(shape.edges):
+            target = shape.edge_index(image[i], image[j])
+            result.append((target, image[shape.edge_start(k)] != shape.edge_start(target)))
+        return tuple(result)
+
+    @cached_property
+    def node_map(self) -> dict[int, int]:
+        shape = self.shape
+        nc, ne = len(shape.corners), len(shape.edges)
+        nodes = dict(enumerate(self.corner_map))
+        nodes.update({nc + k: nc + target for k, (target, _) in enumerate(self.edge_map)})
+        face_of = {frozenset(shape.faces[f]): q for q, f in enumerate(shape.quad_faces)}
+        for q, f in enumerate(shape.quad_faces):
+            nodes[nc + ne + q] = nc + ne + face_of[frozenset(self.corner_map[i] for i in shape.faces[f])]
+        return nodes
+
+    def code(self, code: str) -> str:
+        """The image of a configuration code (digit n becomes 16 - n on a reversed edge)."""
+        digits = ["0"] * len(code)
+        for (target, reverse), digit in zip(self.edge_map, code):
+            digits[target] = "%x" % ((16 - int(digit, 16)) % 16) if reverse else digit
+        return "".join(digits)
+
+    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
+        return map_polyhedron(poly, self.node_map, self.proper, self.point)
+
+    def inverse(self) -> "ShapeSymmetry":
+        return next(s for s in self.shape.symmetries
+                    if all(s.corner_map[self.corner_map[i]] == i for i in range(len(self.corner_map))))
+
+
+def _affine(sources: Sequence[Point], targets: Sequence[Point]):
+    """The affine map of unit coordinates taking four affinely independent points to four others."""
+    # Solve M (s_i - s_0) = (t_i - t_0) for i = 1..3 by Cramer's rule, row by row.
+    u = [_sub(s, sources[0]) for s in sources[1:]]
+    v = [_sub(t, targets[0]) for t in targets[1:]]
+    det = _dot(u[0], _cross(u[1], u[2]))
+    inverse_t = [_cross(u[1], u[2]), _cross(u[2], u[0]), _cross(u[0], u[1])]  # rows of det * U^-T ... columns
+    linear = tuple(tuple(sum(v[i][row] * inverse_t[i][col] for i in range(3)) / det for col in range(3))
+                   for row in range(3))
+    shift = tuple(t - sum(a * x for a, x in zip(r, sources[0])) for r, t in zip(linear, targets[0]))
+    return linear, shift
+
+
+def _symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
+    corners, weights = shape.corners, shape.box.squared
+
+    def distance(i, j):
+        return sum(w * (a - b) ** 2 for w, a, b in zip(weights, corners[i], corners[j]))
+
+    n = len(corners)
+    found = []
+
+    def extend(images: list[int]) -> None:
+        # Backtracking: a permutation keeping every squared distance is an isometry
+        # of the corners, hence of their convex hull.
+        i = len(images)
+        if i == n:
+            found.append(tuple(images))
+            return
+        for j in range(n):
+            if j not in images and all(distance(i, k) == distance(j, images[k]) for k in range(i)):
+                extend(images + [j])
+
+    extend([])
+    basis = next(b for b in combinations(range(n), 4)
+                 if _dot(_sub(corners[b[1]], corners[b[0]]),
+                         _cross(_sub(corners[b[2]], corners[b[0]]), _sub(corners[b[3]], corners[b[0]]))) != 0)
+    result = []
+    for images in sorted(found, key=lambda p: p != tuple(range(n))):
+        linear, shift = _affine([corners[i] for i in basis], [corners[images[i]] for i in basis])
+        result.append(ShapeSymmetry(shape, images, linear, shift))
+    return tuple(result)
+
+
+def shape_orbit_representatives(codes: Sequence[str], symmetries: Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
+    """For each code, its orbit's representative (the smallest image code, as a base-16
+    number) and the index of a symmetry taking the code to it.
+
+    >>> shape = standard_shape("tetrahedron")
+    >>> shape_orbit_representatives(["800000", "008000", "080000"], shape.symmetries)[0]
+    ['000800', '000800', '000008']
+    """
+    reps, index = [], []
+    for code in codes:
+        images = [sym.code(code) for sym in symmetries]
+        best = min(range(len(images)), key=lambda i: (int(images[i], 16), i))
+        reps.append(images[best])
+        index.append(best)
+    return reps, index

@@ -1,0 +1,180 @@
+"""Other base elements (prism, pyramid, tetrahedron, any convex polyhedron): exact tessellations,
+checked against Qhull's merged regions and by invariants on random Steiner positions."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from collections import Counter, defaultdict
+from fractions import Fraction
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from oracle import qhull_regions
+from strategies import LENGTHS, PARAMETERS
+from test_delaunay_oracle import check_canonical_codes
+
+from cospherical import InputError, Shape, ShapeConfiguration, standard_shape, tessellate_shape
+from cospherical.core.geometry import Frame
+from cospherical.core.shapes import STANDARD_SHAPES, mask_codes, shape_orbit_representatives
+
+SHAPES = sorted(STANDARD_SHAPES)
+BOXES = {"cube": ("1", "1", "1"), "aspect4": ("1", "2", "4"), "sqrt2-exact": ("1", "sqrt(2)", "sqrt(2)")}
+
+
+@pytest.mark.parametrize("name", SHAPES)
+def test_every_bisection_configuration_matches_qhull(name):
+    """Every edge mask with midpoints (512, 256, 64 configurations) on the cube against
+    ``qdelaunay Qz Fv``, and same canonical code <=> isomorphic face graphs."""
+    shape = standard_shape(name)
+    samples: dict[str, list] = defaultdict(list)
+    for code in mask_codes(len(shape.edges)):
+        cfg = ShapeConfiguration.from_code(shape, code)
+        tess = tessellate_shape(cfg)
+        assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes()), code
+        for e in tess.elements:
+            if len(samples[e.type.code]) < 3:
+                samples[e.type.code].append((e.polyhedron.faces, e.polyhedron.face_kinds))
+    check_canonical_codes(samples)
+
+
+@pytest.mark.parametrize("box", ["aspect4", "sqrt2-exact"])
+def test_other_boxes_match_qhull(box):
+    for name in SHAPES:
+        shape = standard_shape(name, BOXES[box])
+        for code in mask_codes(len(shape.edges))[::7]:
+            cfg = ShapeConfiguration.from_code(shape, code)
+            assert {frozenset(e.nodes) for e in tessellate_shape(cfg).elements} == qhull_regions(cfg.real_nodes())
+
+
+@st.composite
+def shape_configurations(draw):
+    shape = standard_shape(draw(st.sampled_from(SHAPES)), [draw(LENGTHS) for _ in range(3)])
+    steiner = {k: draw(PARAMETERS) for k in range(len(shape.edges)) if draw(st.booleans())}
+    if draw(st.booleans()):  # equal parameters where faces can carry points
+        t = draw(PARAMETERS)
+        steiner = {k: t for k in range(len(shape.edges)) if draw(st.booleans()) or k in steiner}
+    return ShapeConfiguration.from_steiner(shape, steiner, draw(st.sampled_from(["octree", "none"])))
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(shape_configurations())
+def test_invariants_on_random_steiner_positions(cfg):
+    """Volumes add up to the element's exactly, elements meet face to face (an inner face in two
+    elements, a boundary face in one, on the element's boundary), and every sphere is empty."""
+    shape = cfg.shape
+    tess = tessellate_shape(cfg)
+    assert sum(e.polyhedron.unit_volume for e in tess.elements) == shape.unit_volume
+    nodes = tess.nodes
+    frame = Frame.build(nodes, cfg.box.squared)
+    index = {n: i for i, n in enumerate(frame.ids)}
+    faces = Counter(frozenset(f) for e in tess.elements for f in e.polyhedron.faces)
+    for face, count in faces.items():
+        on_boundary = any(all(sum(a * x for a, x in zip(normal, nodes[v])) == offset for v in face)
+                          for normal, offset in shape.planes)
+        assert count == (1 if on_boundary else 2), sorted(face)
+    for e in tess.elements:
+        a, b, c, d = (index[v] for v in e.nodes[:4])
+        members = [index[v] for v in e.nodes]
+        sphere = next(s for s in (frame.sphere(*q) for q in _quadruples(members)) if s is not None)
+        sides = [sphere.side(p) for p in frame.lifted]
+        assert min(sides) == 0 and all(sides[m] == 0 for m in members)
+        assert sum(1 for s in sides if s == 0) == len(members)  # the cell is every point on its sphere
+
+
+def _quadruples(members):
+    from itertools import combinations
+
+    return combinations(members, 4)
+
+
+def test_fvm_is_the_base_element():
+    # The tetrahedron with every midpoint: the middle octahedron's center (1/4, 1/4, 1/4)... lies
+    # inside; a long thin box moves circumcenters out of the element but not out of the box.
+    tess = tessellate_shape(ShapeConfiguration.from_code(standard_shape("tetrahedron", ("1", "1", "8")), "888888"))
+    centers = [e.polyhedron.center for e in tess.elements]
+    assert all(all(0 <= x <= 1 for x in c) for c in centers)
+    assert not tess.fvm_adequate
+
+
+def test_symmetry_groups_and_orbits():
+    sizes = {name: len(standard_shape(name).symmetries) for name in SHAPES}
+    assert sizes == {"prism": 4, "pyramid": 8, "tetrahedron": 6}
+    assert len(standard_shape("tetrahedron", ("1", "2", "4")).symmetries) == 1
+    assert len(standard_shape("pyramid", ("1", "1", "2")).symmetries) == 8
+    for name in SHAPES:
+        shape = standard_shape(name)
+        codes = mask_codes(len(shape.edges))
+        reps, index = shape_orbit_representatives(codes, shape.symmetries)
+        for code, rep, i in zip(codes, reps, index):
+            sym = shape.symmetries[i]
+            assert sym.code(code) == rep
+            assert sym.inverse().code(rep) == code
+            # the image tessellation is the tessellation of the image
+            ours = tessellate_shape(ShapeConfiguration.from_code(shape, code))
+            theirs = tessellate_shape(ShapeConfiguration.from_code(shape, rep))
+            assert sorted(sym.polyhedron(e.polyhedron).faces for e in ours.elements) == \
+                sorted(e.polyhedron.faces for e in theirs.elements)
+
+
+SQUARE = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+PYRAMID_EDGES = [(0, 1), (1, 2), (2, 3), (3, 0), (0, 4), (1, 4), (2, 4), (3, 4)]
+PYRAMID_FACES = [(0, 1, 2, 3), (0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)]
+
+
+@pytest.mark.parametrize("vertices, edges, faces, message", [
+    (SQUARE + [(0, 0, 0)], PYRAMID_EDGES, PYRAMID_FACES, "corners 0 and 4 are the same point"),
+    (SQUARE + [(1, 1, 0)], PYRAMID_EDGES, PYRAMID_FACES, "same point"),
+    (SQUARE + [(2, 2, 0)], PYRAMID_EDGES, PYRAMID_FACES, "coplanar"),
+    (SQUARE + [("1/2", "1/2", "1/2")], PYRAMID_EDGES, [(0, 1, 3, 2), *PYRAMID_FACES[1:]], "not a convex polygon"),
+    ([(0, 0, 0), (1, 0, 0), (1, 1, "1/2"), (0, 1, 0), ("1/2", "1/2", 1)], PYRAMID_EDGES, PYRAMID_FACES,
+     "not on one plane"),
+    (SQUARE + [("1/2", "1/2", 1), ("1/2", "1/2", "1/4")], PYRAMID_EDGES, PYRAMID_FACES, "corner 5 is on no face"),
+    (SQUARE + [("1/2", "1/2", 1)], PYRAMID_EDGES[:-1], PYRAMID_FACES, "is not among the edges"),
+    (SQUARE + [("1/2", "1/2", 1)], PYRAMID_EDGES + [(0, 2)], PYRAMID_FACES, "not a side of any face"),
+    (SQUARE + [("1/2", "1/2", 1)], PYRAMID_EDGES, PYRAMID_FACES[:-1], "do not close the surface"),
+    ([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), ("1/6", "1/6", "1/6")],  # a tetrahedron with a dent
+     [(0, 1), (0, 2), (0, 3), (1, 2), (2, 3), (3, 1), (1, 4), (2, 4), (3, 4)],
+     [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 4), (2, 3, 4), (3, 1, 4)], "not convex"),
+    (SQUARE + [("1/2", "1/2", 1), ("1/2", 0, 0)], PYRAMID_EDGES, PYRAMID_FACES, "corner 5 lies in the plane"),
+    (SQUARE + [(0.5, 0.5, 1)], PYRAMID_EDGES, PYRAMID_FACES, "not a float"),
+])
+def test_bad_vertices_are_refused(vertices, edges, faces, message):
+    with pytest.raises(InputError, match=message):
+        Shape.from_vertices(vertices, edges, faces)
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "cospherical", *args], capture_output=True, text=True)
+
+
+def test_cli_element_and_shape_file(tmp_path):
+    import json
+
+    result = _cli("tessellate", "--element", "pyramid", "--box", "1", "1", "1", "--code", "88880000")
+    data = json.loads(result.stdout)
+    assert data["element"] == "pyramid" and data["faces"] == [0] and "13" in data["nodes"]
+    assert [e["name"] for e in data["elements"]] == ["rectangular pyramid"] * 4
+    bad = tmp_path / "bowtie.yaml"
+    bad.write_text("corners: [[0,0,0],[1,0,0],[1,1,0],[0,1,0],['1/2','1/2',1]]\n"
+                   "edges: [[0,1],[1,2],[2,3],[3,0],[0,4],[1,4],[2,4],[3,4]]\n"
+                   "faces: [[0,1,3,2],[0,1,4],[1,2,4],[2,3,4],[3,0,4]]\n")
+    for args in (["--shape", str(bad)], ["--element", "prism", "--code", "88888888"],
+                 ["--element", "tetrahedron", "--steiner", "6:1/2"], ["--element", "prism", "--faces", "0"]):
+        result = _cli("tessellate", "--box", "1", "1", "1", *args)
+        assert result.returncode == 2 and result.stdout == "" and len(result.stderr.strip().splitlines()) == 1, args
+
+
+def test_general_quadrilateral_face_point():
+    # A trapezoid face: the face point is where the two cut lines cross, not the corners' mean.
+    corners = [(0, 0, 0), (4, 0, 0), (3, 2, 0), (1, 2, 0), (0, 0, 1), (4, 0, 1), (3, 2, 1), (1, 2, 1)]
+    edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
+    faces = [(0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    shape = Shape.from_vertices([[Fraction(x, 4) for x in p] for p in corners], edges, faces)
+    cfg = ShapeConfiguration.from_steiner(shape, {0: "1/2", 1: "1/2", 2: "1/2", 3: "1/2"})
+    assert cfg.point_faces == {0}
+    assert cfg.nodes()[20 + 0] == (Fraction(1, 2), Fraction(1, 4), 0)
+    tess = tessellate_shape(cfg)
+    assert sum(e.polyhedron.unit_volume for e in tess.elements) == shape.unit_volume
+    assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes())
