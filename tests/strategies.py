@@ -30,7 +30,13 @@ def configurations(draw, dyadic: bool = False) -> Configuration:
             for k in axis_edges:
                 if k in steiner:
                     steiner[k] = t
-    return Configuration.from_steiner(box, steiner, draw(st.sampled_from(["octree", "none"])))
+    policy = draw(st.sampled_from(["octree", "none", "explicit"]))
+    if policy != "explicit":
+        return Configuration.from_steiner(box, steiner, policy)
+    # Face points as data, as at an octree leaf: any subset of the faces that may carry one.
+    admissible = sorted(Configuration.from_steiner(box, steiner).admissible_faces)
+    faces = draw(st.sets(st.sampled_from(admissible))) if admissible else set()
+    return Configuration.from_steiner(box, steiner, faces=faces, body=len(faces) == 6 and draw(st.booleans()))
 
 
 def random_configuration(rng) -> Configuration:

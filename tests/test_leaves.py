@@ -11,12 +11,12 @@ from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from cospherical import Box, Configuration, InputError, tessellate
 from cospherical.catalogue import catalogue_path, shipped_catalogue
 from cospherical.cli import main
 from cospherical.core.symmetry import box_symmetries, orbit_representatives
+from cospherical.files.yamlio import dump_yaml, load_yaml
 from cospherical.formats.patterns import load, pattern_name, write_patterns
 from cospherical.studies.bisection import bisection_codes, run_study
 from cospherical.studies.leaves import leaf_codes
@@ -144,23 +144,13 @@ def test_a_policy_and_its_explicit_point_set_tessellate_identically(cfg):
     assert cells(tessellate(explicit)) == cells(tessellate(cfg))
 
 
-@st.composite
-def explicit_configurations(draw):
-    """Configurations at 1/16 positions with any admissible set of face points."""
-    cfg = draw(configurations(dyadic=True))
-    admissible = sorted(cfg.admissible_faces)
-    faces = draw(st.sets(st.sampled_from(admissible))) if admissible else set()
-    body = len(faces) == 6 and draw(st.booleans())
-    return Configuration.from_steiner(cfg.box, {k: t for k, t in enumerate(cfg.steiner) if t is not None},
-                                      faces=faces, body=body)
-
-
 @settings(max_examples=200, deadline=None)
-@given(explicit_configurations())
+@given(configurations(dyadic=True))
 def test_whole_point_set_codes_round_trip(cfg):
     code = cfg.point_set_code
     again = Configuration.from_code(code, cfg.box)
-    assert again == cfg and again.point_set_code == code
+    assert again == cfg.explicit() and again.point_set_code == code and again.nodes() == cfg.nodes()
+    assert Configuration.from_code(cfg.code, cfg.box, cfg.face_points) == cfg
 
 
 # --- the Qhull oracle on face subsets at general positions -------------------------------------------
@@ -267,6 +257,26 @@ def test_leaf_tables_pass_check_and_look_up_by_whole_point_set_code(tmp_path):
              **({"mirror": True} if e.mirrored else {})}
             for e in tess.elements
         ], code
+
+
+@pytest.mark.parametrize(
+    "key, needle",
+    [
+        ("800000000000+f0", "configurations/800000000000+f0: face 0"),  # edges 4, 8, 9 are not split
+        ("888800000000+f44", "configurations"),  # not a whole-point-set code: the schema refuses it
+        ("888800000000+f4b", "configurations/888800000000+f4b: body point"),
+    ],
+)
+def test_leaf_tables_with_bad_codes_fail_check_in_one_line(tmp_path, capsys, key, needle):
+    path = tmp_path / "leaves.yaml"
+    write_patterns(run_study("leaves", Box.parse(CUBE), ["888800000000+f4", "000000000000+f"], "explicit"), path,
+                   shipped_catalogue()["version"])
+    data = load_yaml(path)
+    data["configurations"][key] = data["configurations"].pop("888800000000+f4")
+    dump_yaml(data, path)
+    assert main(["check", str(path)]) == 2
+    out, err = capsys.readouterr()
+    assert len(err.strip().splitlines()) == 1 and needle in err, err
 
 
 # --- the command line ------------------------------------------------------------------------------
