@@ -16,7 +16,7 @@ __all__ = ["main"]
 
 # One module per subcommand, imported inside main() so that an interrupt while
 # the heavy libraries load is handled like any other.
-SUBCOMMANDS = ("tessellate", "study", "reproduce", "render", "diff", "check", "sweep")
+SUBCOMMANDS = ("tessellate", "study", "reproduce", "render", "diff", "check", "sweep", "mesh")
 
 
 class _Parser(argparse.ArgumentParser):

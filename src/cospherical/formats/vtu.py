@@ -17,7 +17,7 @@ import numpy as np
 
 from ..core.tessellation import Tessellation
 
-__all__ = ["to_meshio", "write_vtu"]
+__all__ = ["to_meshio", "write_meshio", "write_vtu"]
 
 
 def to_meshio(tess: Tessellation):
@@ -42,6 +42,11 @@ def to_meshio(tess: Tessellation):
 
 def write_vtu(tess: Tessellation, path: str | Path) -> None:
     """Write the tessellation to ``path`` atomically (temporary file, then rename)."""
+    write_meshio(to_meshio(tess), path)
+
+
+def write_meshio(converted, path: str | Path) -> None:
+    """Write a :class:`meshio.Mesh` as VTU atomically: meshio wants a file name, so a temporary one, then rename."""
     import meshio
 
     path = Path(path)
@@ -49,7 +54,10 @@ def write_vtu(tess: Tessellation, path: str | Path) -> None:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".vtu", dir=path.parent)
     os.close(fd)
     try:
-        meshio.write(tmp, to_meshio(tess), file_format="vtu")
+        meshio.write(tmp, converted, file_format="vtu")
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600; give the file ordinary permissions
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

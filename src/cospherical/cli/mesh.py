@@ -1,0 +1,132 @@
+"""``cospherical mesh``: mesh a 1-irregular octree from a pattern table, check the mesh exactly, count what occurs."""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+from ..catalogue import CRITERIA
+from ..core.configuration import Box
+from ..errors import InputError
+from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
+from ..studies.mesh.assembly import assemble
+from ..studies.mesh.octree import BALANCES, MAX_LEVEL, build_octree, leaves_octree, parse_shape
+from ..studies.mesh.report import mesh_report
+from .progress import progress_bar
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser(
+        "mesh",
+        help="mesh a 1-irregular octree from a pattern table and check the mesh exactly",
+        description="Mesh a 1-irregular octree: each leaf's true configuration, its elements from the pattern table "
+                    "(or tessellated), global vertices; exact checks (volume, conformity, circumcenters, global "
+                    "Delaunay) and the frequencies of types and configurations in the mesh.",
+    )
+    parser.add_argument("--domain", nargs=3, metavar=("A", "B", "C"), required=True,
+                        help="the root cell's lengths, exact: 1, 1.4142, 3/2, sqrt(2)")
+    tree = parser.add_mutually_exclusive_group(required=True)
+    tree.add_argument("--refine", action="append", metavar="SHAPE",
+                      help="split cells whose closed box meets SHAPE, down to --levels: sphere:X,Y,Z,R (its surface), "
+                      "plane:NX,NY,NZ,D, point:X,Y,Z or box:X0,Y0,Z0,X1,Y1,Z1, in domain units (repeatable)")
+    tree.add_argument("--leaves", type=Path, metavar="FILE",
+                      help="the leaves as a list of 'level i j k' (text, one per line) or JSON "
+                      '{"leaves": [[level, i, j, k], ...]}; checked to tile the domain and be 1-irregular')
+    parser.add_argument("--levels", metavar="L", help=f"refine down to level L (0..{MAX_LEVEL}); with --refine")
+    parser.add_argument("--balance", choices=BALANCES, default="vertex",
+                        help="2:1 balance across faces, edges and corners (vertex, default) or faces and edges "
+                        "(edge); face alone is refused: it is not 1-irregular")
+    parser.add_argument("--patterns", type=Path, metavar="FILE",
+                        help="pattern table of the domain's box (configurations it lacks are tessellated); "
+                        "without it every configuration is tessellated")
+    parser.add_argument("--criterion", choices=CRITERIA, default="optimal", help="which elements of the table")
+    parser.add_argument("--out", type=Path, metavar="DIR", help="write mesh.vtu, report.json and mesh.png here")
+    parser.add_argument("--format", choices=("text", "json"), default="text",
+                        help="text (default): the main figures; json: the whole report on stdout")
+    parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check")
+    parser.add_argument("--no-uniform", action="store_true",
+                        help="skip the uniform-weight bisection study beside the frequencies")
+    parser.set_defaults(run=run)
+
+
+def _levels(text: str | None) -> int:
+    if text is None:
+        raise InputError("--refine needs --levels L")
+    value = text.strip()
+    if not (value.isascii() and value.isdigit()) or int(value) > MAX_LEVEL:
+        raise InputError(f"--levels {text!r}: must be an integer from 0 to {MAX_LEVEL}")
+    return int(value)
+
+
+SUMMARY_KEYS = ("leaves", "vertices", "elements", "types", "volume_ok", "nonconforming_faces",
+                "circumcenters_outside_leaf", "leaves_not_fvm_adequate", "delaunay_violations",
+                "configurations", "tessellated_on_the_fly", "paper_final_share")
+
+
+def _text(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if value is None:
+        return "not checked"
+    return f"{value:,}" if isinstance(value, int) else str(value)
+
+
+def run(args) -> int:
+    box = Box.parse(args.domain)
+    clock = time.perf_counter()
+    if args.leaves is not None:
+        if args.levels is not None:
+            raise InputError("--levels goes with --refine, not with --leaves")
+        levels, positions = read_leaves(args.leaves)
+        tree = leaves_octree(box, levels, positions, where=str(args.leaves))
+        described = {"source": "leaves", "file": args.leaves.name, "depth": tree.depth}
+    else:
+        shapes = [parse_shape(text) for text in args.refine]
+        levels = _levels(args.levels)
+        tree = build_octree(box, levels, shapes, args.balance)
+        described = {"source": "refine", "levels": levels, "refine": [s.text for s in shapes],
+                     "balance": args.balance, "depth": tree.depth}
+    lookup = None
+    if args.patterns is not None:
+        from ..formats.patterns import load
+
+        lookup = table_lookup(load(args.patterns), args.criterion, box, str(args.patterns))
+    timings = {"tree": time.perf_counter() - clock}
+    clock = time.perf_counter()
+    with progress_bar(len(tree), "assembling leaves") as advance:
+        mesh = assemble(tree, lookup, progress=advance if len(tree) > 50_000 else None)
+    timings["assembly"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    stages = []
+
+    def stage(name: str) -> None:
+        nonlocal clock
+        if stages:
+            timings[stages[-1]] = time.perf_counter() - clock
+        stages.append(name)
+        clock = time.perf_counter()
+        if len(tree) > 50_000 and sys.stderr.isatty():
+            print(f"cospherical mesh: {name} ...", file=sys.stderr)
+
+    report = mesh_report(mesh, described, args.patterns.name if args.patterns else None, args.criterion,
+                         uniform=not args.no_uniform, delaunay=not args.no_delaunay, stage=stage)
+    stage("outputs")
+    if args.out is not None:
+        from ..formats.mesh import write_vtu
+        from ..outputs.mesh_picture import cut_png
+
+        write_report(report, args.out / "report.json")
+        write_vtu(mesh, args.out / "mesh.vtu")
+        shapes = ", ".join(described.get("refine", [])) or described.get("file", "")
+        cut_png(mesh, args.out / "mesh.png",
+                title=f"{' x '.join(box.texts)}: {shapes}; {report['leaves']:,} leaves, {report['elements']:,} "
+                      f"elements, {report['types']} types (cut at half height)")
+    timings["outputs"] = time.perf_counter() - clock
+    if args.format == "json":
+        sys.stdout.write(report_json(report))
+    else:
+        sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in SUMMARY_KEYS))
+    if sys.stderr.isatty():
+        print("cospherical mesh: seconds " + ", ".join(f"{k} {v:.2f}" for k, v in timings.items()), file=sys.stderr)
+    return 0

@@ -1,0 +1,87 @@
+"""A picture of a meshed octree: a cut through the mesh, each element's section coloured by its type."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..studies.mesh.assembly import Mesh
+from .latex import save_png
+
+__all__ = ["cut_png", "cut_polygons"]
+
+
+def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[str]]:
+    """The sections of the elements by the plane z = ``at`` (fraction of the domain height), in real x, y.
+
+    The plane is moved by a third of the finest grid step off ``at`` so that no face
+    lies in it (a section is then always a proper polygon).  Returns the polygons and
+    each one's element type id.
+    """
+    grid = mesh.grid
+    z0 = round(at * grid) + 1 / 3
+    scale = np.array(mesh.box.to_float()) / grid
+    polygons, types = [], []
+    for _, pattern, leaves in mesh.groups():
+        slots = mesh.slots[leaves]
+        for element in pattern.elements:
+            nodes = list(element.nodes)
+            pts = mesh.vertices[slots[:, nodes]].astype(float)  # (leaves, nodes, 3)
+            z = pts[:, :, 2]
+            crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
+            if not len(crossing):
+                continue
+            index = {n: i for i, n in enumerate(nodes)}
+            edges = {tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in element.faces for i in range(len(c))}
+            a = np.array([index[p] for p, _ in edges])
+            b = np.array([index[q] for _, q in edges])
+            for leaf_points in pts[crossing]:
+                za, zb = leaf_points[a, 2], leaf_points[b, 2]
+                cut = (za - z0) * (zb - z0) < 0
+                t = (z0 - za[cut]) / (zb[cut] - za[cut])
+                xy = leaf_points[a[cut], :2] + t[:, None] * (leaf_points[b[cut], :2] - leaf_points[a[cut], :2])
+                centre = xy.mean(axis=0)
+                xy = xy[np.argsort(np.arctan2(xy[:, 1] - centre[1], xy[:, 0] - centre[0]))]
+                polygons.append(xy * scale[:2])
+                types.append(element.type_id)
+    return polygons, types
+
+
+def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: int = 10) -> None:
+    """Write the cut through the mesh at z = ``at`` as PNG, elements coloured by type (legend: the commonest)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import Patch
+
+    polygons, types = cut_polygons(mesh, at)
+    counts: dict[str, int] = {}
+    for t in types:
+        counts[t] = counts.get(t, 0) + 1
+    order = sorted(counts, key=lambda t: (-counts[t], t))
+    palette = plt.get_cmap("tab20").colors
+    colour = {t: palette[i % len(palette)] for i, t in enumerate(order)}
+    a, b, _ = mesh.box.to_float()
+    fig, ax = plt.subplots(figsize=(10, 6.5 * min(2.0, max(0.6, b / a))))
+    fig.subplots_adjust(left=0.07, right=0.66, top=0.92, bottom=0.08)  # room for the legend on the right
+    ax.add_collection(PolyCollection(polygons, facecolors=[colour[t] for t in types], edgecolors="black",
+                                     linewidths=0.15))
+    ax.set_xlim(0, a)
+    ax.set_ylim(0, b)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_title(title or f"cut at z = {at:g} of the domain height", fontsize=8, wrap=True)
+
+    def label(t: str) -> str:
+        info = mesh.types.get(t, {})
+        return f"{info.get('name', t)} ({counts[t]})"
+
+    shown = order[:legend]
+    ax.legend(handles=[Patch(facecolor=colour[t], edgecolor="black", label=label(t)) for t in shown],
+              loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, title="element type (sections)",
+              title_fontsize=7)
+    save_png(fig, path, dpi=130)

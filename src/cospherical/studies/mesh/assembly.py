@@ -1,0 +1,308 @@
+"""Assemble a global mesh from an octree: each leaf's true configuration, its elements, global vertices.
+
+A leaf's points are the mesh vertices on its closed box.  In a 1-irregular tree
+they sit on the leaf's 27 half-spacing slots (the nodes 0-26 of the shared
+numbering): a corner always, an edge midpoint where a smaller leaf touches that
+edge, a face centre where the face neighbour is refined, and never the body
+centre (a leaf is not split).  So the vertex set is the set of all leaf corners,
+on the integer grid of spacing half the finest leaf, and a leaf's configuration
+is which of its slots are vertices: exact integer identity, no search by distance.
+
+Each distinct configuration is looked up (or tessellated) once and measured once,
+exactly, from the element node lists alone: faces are the convex hull of an
+element's nodes, volumes and circumspheres integer determinants in the
+configuration's frame (:class:`cospherical.core.geometry.Frame`).  The checks then
+work on whole arrays of leaves that share a configuration.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from fractions import Fraction
+from itertools import combinations
+from typing import Callable, Iterable
+
+import numpy as np
+
+from ...catalogue import shipped_catalogue
+from ...core.configuration import CORNERS, EDGES, FACES, Box, Configuration
+from ...core.delaunay import hull_faces
+from ...core.element_types import ElementType
+from ...core.geometry import Frame, Sphere, six_volume
+from ...core.tessellation import tessellate
+from ...errors import InputError
+from ...paper import paper_class
+from .octree import Octree
+
+__all__ = ["LocalElement", "LocalPattern", "Mesh", "NODE_OFFSETS", "assemble", "local_pattern"]
+
+# Twice the unit coordinates of the 27 nodes (corners, edge midpoints, face centres, body).
+NODE_OFFSETS = np.array(
+    [[2 * x for x in c] for c in CORNERS]
+    + [[CORNERS[p][a] + CORNERS[q][a] for a in range(3)] for p, q in EDGES]
+    + [[sum(CORNERS[n][a] for n in face) // 2 for a in range(3)] for face in FACES]
+    + [[1, 1, 1]], dtype=np.int64)
+PAPER_FINAL = ("Cuboid", "Triangular Prism", "Quadrilateral Pyramid", "Tetrahedron", "Tetrahedron Complement",
+               "Deformed Prism", "Deformed Tetrahedron Complement")
+
+# lookup(configuration) -> the table's elements (dicts with ``type`` and ``nodes``), or None when it lacks them
+Lookup = Callable[[Configuration], "list[dict] | None"]
+
+
+@dataclass(frozen=True)
+class LocalElement:
+    """One element of a configuration, measured exactly from its node list.
+
+    ``faces``: node-id cycles counter-clockwise seen from outside (the hull of the
+    nodes); ``unit_volume``: its share of the leaf; ``sphere``: the circumsphere in the
+    configuration's frame, or ``None`` when the nodes are not all on one sphere;
+    ``center``: its centre in unit coordinates of the leaf.
+    """
+
+    type_id: str
+    nodes: tuple[int, ...]
+    faces: tuple[tuple[int, ...], ...]
+    unit_volume: Fraction
+    sphere: Sphere | None
+    center: tuple[Fraction, Fraction, Fraction] | None
+
+    @property
+    def center_in_leaf(self) -> bool:
+        return self.center is not None and all(0 <= x <= 1 for x in self.center)
+
+
+@dataclass(frozen=True)
+class LocalPattern:
+    """The elements of one configuration, with the frame they were measured in."""
+
+    code: str
+    configuration: Configuration
+    elements: tuple[LocalElement, ...]
+    scale: int
+    weights: tuple[int, int, int]
+    on_the_fly: bool
+
+    @property
+    def fvm_adequate(self) -> bool:
+        """Every circumcenter in the closed leaf, decided exactly."""
+        return all(e.center_in_leaf for e in self.elements)
+
+
+def local_pattern(configuration: Configuration, elements: Iterable[tuple[str, Iterable[int]]],
+                  on_the_fly: bool = False) -> LocalPattern:
+    """Measure a configuration's elements (type id, node ids) exactly, trusting nothing but the node lists.
+
+    Examples
+    --------
+    >>> pattern = local_pattern(Configuration.from_code("000000000000", faces=[]),
+    ...                         [("v8f6-c3cb81", range(8))])
+    >>> pattern.elements[0].unit_volume, pattern.elements[0].center, len(pattern.elements[0].faces)
+    (Fraction(1, 1), (Fraction(1, 2), Fraction(1, 2), Fraction(1, 2)), 6)
+    """
+    nodes = configuration.nodes()
+    frame = Frame.build(nodes, configuration.box.squared)
+    index = {node: i for i, node in enumerate(frame.ids)}
+    measured = []
+    for type_id, element_nodes in elements:
+        element_nodes = tuple(int(n) for n in element_nodes)
+        missing = [n for n in element_nodes if n not in index]
+        if missing:
+            raise InputError(f"pattern table: configuration {configuration.code}: an element ({type_id}) uses "
+                             f"node {missing[0]}, which the leaf does not have")
+        members = [index[n] for n in element_nodes]
+        try:
+            cycles = [cycle for cycle, _ in hull_faces(frame, members)]
+        except ValueError:  # flat: no hull, no volume; the volume check reports it
+            cycles = []
+        volume = Fraction(six_volume(frame.coords, cycles), 6 * frame.scale ** 3) if cycles else Fraction(0)
+        sphere = next((s for s in (frame.sphere(*q) for q in combinations(members, 4)) if s is not None), None)
+        if sphere is not None and any(sphere.side(frame.lifted[m]) != 0 for m in members):
+            sphere = None  # not co-spherical: not a Delaunay element
+        measured.append(LocalElement(
+            type_id, element_nodes, tuple(tuple(frame.ids[i] for i in c) for c in cycles), volume, sphere,
+            frame.center(sphere) if sphere is not None else None))
+    return LocalPattern(configuration.point_set_code or "", configuration, tuple(measured), frame.scale,
+                        frame.weights, on_the_fly)
+
+
+@dataclass
+class Mesh:
+    """A global mesh assembled from an octree, as arrays.
+
+    Vertices are integer points of the grid of spacing half the finest leaf
+    (``grid`` intervals per domain side): ``vertices`` (n x 3).  Leaf ``i`` has
+    configuration ``patterns[leaf_pattern[i]]`` and its node ``s`` (0..26) at vertex
+    ``slots[i, s]`` (-1: no point there).  Elements are listed leaf by leaf, in each
+    leaf in its pattern's order: element ``e`` is element ``element_local[e]`` of
+    leaf ``element_leaf[e]``; ``element_offsets[i]`` is the first element of leaf ``i``.
+    """
+
+    tree: Octree
+    grid: int
+    vertices: np.ndarray
+    slots: np.ndarray
+    leaf_pattern: np.ndarray
+    patterns: list[LocalPattern]
+    element_offsets: np.ndarray
+    element_leaf: np.ndarray
+    element_local: np.ndarray
+    types: dict[str, dict] = field(default_factory=dict)
+
+    @property
+    def box(self) -> Box:
+        return self.tree.box
+
+    def __len__(self) -> int:
+        return len(self.element_leaf)
+
+    def leaf_size(self) -> np.ndarray:
+        """Leaf edge lengths in grid units."""
+        return (self.grid >> self.tree.levels.astype(np.int64)).astype(np.int64)
+
+    def groups(self):
+        """Yield ``(pattern index, pattern, leaf indices)`` for every configuration that occurs, in order."""
+        order = np.argsort(self.leaf_pattern, kind="stable")
+        counts = np.bincount(self.leaf_pattern, minlength=len(self.patterns))
+        start = 0
+        for p, count in enumerate(counts.tolist()):
+            yield p, self.patterns[p], order[start:start + count]
+            start += count
+
+    def connectivity(self) -> tuple[np.ndarray, np.ndarray]:
+        """Global vertex ids of every element: (elements x widest) int32 padded with -1, and the sizes."""
+        width = max((len(e.nodes) for p in self.patterns for e in p.elements), default=0)
+        conn = np.full((len(self), width), -1, dtype=np.int32)
+        sizes = np.zeros(len(self), dtype=np.int8)
+        for _, pattern, leaves in self.groups():
+            first = self.element_offsets[leaves]
+            for j, element in enumerate(pattern.elements):
+                conn[first + j, :len(element.nodes)] = self.slots[np.ix_(leaves, element.nodes)]
+                sizes[first + j] = len(element.nodes)
+        return conn, sizes
+
+    def element_types(self) -> tuple[list[str], np.ndarray]:
+        """The type ids met (sorted) and each element's index into them."""
+        ids = sorted({e.type_id for p in self.patterns for e in p.elements})
+        position = {t: i for i, t in enumerate(ids)}
+        codes = np.zeros(len(self), dtype=np.int32)
+        for _, pattern, leaves in self.groups():
+            first = self.element_offsets[leaves]
+            for j, element in enumerate(pattern.elements):
+                codes[first + j] = position[element.type_id]
+        return ids, codes
+
+    def element_fvm(self) -> np.ndarray:
+        """Per element: its circumcenter lies in its closed leaf (exact, per configuration)."""
+        flags = np.zeros(len(self), dtype=bool)
+        for _, pattern, leaves in self.groups():
+            first = self.element_offsets[leaves]
+            for j, element in enumerate(pattern.elements):
+                flags[first + j] = element.center_in_leaf
+        return flags
+
+
+def _type_info(type_id: str, etype: ElementType | None) -> dict:
+    """Name, paper class, VTK cell and size of a type: from the shipped catalogue, else from the type itself."""
+    for entry in shipped_catalogue()["types"]:
+        if entry["id"] == type_id:
+            return {"name": entry["name"], "paper_class": (entry.get("aliases") or [None])[0],
+                    "vtk": entry.get("vtk"), "vertices": entry["vertices"], "faces": entry["faces"]}
+    if etype is not None:
+        cls = paper_class(etype)
+        return {"name": etype.name, "paper_class": cls["name"] if cls else None, "vtk": etype.vtk,
+                "vertices": etype.vertices, "faces": etype.faces}
+    return {"name": type_id, "paper_class": None, "vtk": None, "vertices": None, "faces": None}
+
+
+def leaf_code(edges: int, faces: int) -> str:
+    """The whole-point-set code of a leaf from its edge and face bit masks.
+
+    >>> leaf_code(0b1, 0), leaf_code(0xfff, 0b010001)
+    ('800000000000+f', '888888888888+f04')
+    """
+    digits = "".join("8" if edges >> k & 1 else "0" for k in range(12))
+    return digits + "+f" + "".join(str(f) for f in range(6) if faces >> f & 1)
+
+
+def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int], None] | None = None,
+             cache: dict | None = None) -> Mesh:
+    """Mesh an octree: configurations from the vertex set, elements from ``lookup`` (else tessellated).
+
+    ``lookup(configuration)`` returns the pattern table's elements of that point set
+    (dicts with ``type`` and ``nodes``) or ``None`` when the table lacks it; a
+    configuration without table elements is tessellated on the fly (and marked so).
+    ``cache`` (code -> :class:`LocalPattern`) may be shared between runs.
+    ``progress(n)`` is told as leaves are assembled.
+
+    Examples
+    --------
+    >>> from cospherical.studies.mesh.octree import build_octree, parse_shape
+    >>> mesh = assemble(build_octree(Box.parse([1, 1, 1]), 1, [parse_shape("point:0.5,0.5,0.5")]))
+    >>> len(mesh.tree), len(mesh.vertices), len(mesh)
+    (8, 27, 8)
+    """
+    cache = {} if cache is None else cache
+    levels = tree.levels.astype(np.int64)
+    grid = 1 << (tree.depth + 1)
+    size = grid >> levels  # leaf edge in grid units (even)
+    origin = tree.positions.astype(np.int64) * size[:, None]
+    half = size // 2
+    n = np.int64(grid + 1)
+
+    def keys_at(part: slice, nodes: slice) -> np.ndarray:
+        # per axis, (leaves x nodes): far cheaper than one (leaves x nodes x 3) array
+        x, y, z = (origin[part, a, None] + NODE_OFFSETS[None, nodes, a] * half[part, None] for a in range(3))
+        return (x * n + y) * n + z
+
+    vertex_keys = np.sort(keys_at(slice(None), slice(0, 8)), axis=None)
+    # sort and keep firsts: numpy's hash-based unique is much slower on int64 keys
+    vertex_keys = vertex_keys[np.r_[True, vertex_keys[1:] != vertex_keys[:-1]]]
+    vertices = np.stack([vertex_keys // (n * n), (vertex_keys // n) % n, vertex_keys % n], axis=1)
+    slots = np.empty((len(tree), 27), dtype=np.int32)
+    chunk = 1 << 18
+    for start in range(0, len(tree), chunk):  # bounded temporaries on large trees
+        part = slice(start, start + chunk)
+        keys = keys_at(part, slice(None))
+        where = np.minimum(np.searchsorted(vertex_keys, keys), len(vertex_keys) - 1)
+        slots[part] = np.where(vertex_keys[where] == keys, where, -1)
+        if progress:
+            progress(min(chunk, len(tree) - start) // 2)
+    if (slots[:, 26] >= 0).any():
+        i = int(np.flatnonzero(slots[:, 26] >= 0)[0])
+        raise InputError(f"leaf {i}: a vertex at its centre: the leaves do not form an octree")
+    present = slots >= 0
+    edges = (present[:, 8:20].astype(np.int64) << np.arange(12)).sum(axis=1)
+    faces = (present[:, 20:26].astype(np.int64) << np.arange(6)).sum(axis=1)
+    value = edges | faces << 12  # < 2**18: count instead of sorting
+    seen = np.bincount(value, minlength=1 << 18) > 0
+    distinct = np.flatnonzero(seen)
+    leaf_pattern = (np.cumsum(seen) - 1)[value]
+    patterns, types = [], {}
+    for value in distinct.tolist():
+        code = leaf_code(value & 0xFFF, value >> 12)
+        if code not in cache:
+            cache[code] = _pattern(Configuration.from_code(code, tree.box), lookup, types)
+        patterns.append(cache[code])
+    for pattern in patterns:
+        for element in pattern.elements:
+            if element.type_id not in types:
+                types[element.type_id] = _type_info(element.type_id, None)
+    counts = np.array([len(p.elements) for p in patterns], dtype=np.int64)[leaf_pattern]
+    offsets = np.zeros(len(tree) + 1, dtype=np.int64)
+    np.cumsum(counts, out=offsets[1:])
+    element_leaf = np.repeat(np.arange(len(tree), dtype=np.int32), counts)
+    element_local = (np.arange(offsets[-1], dtype=np.int64) - offsets[:-1][element_leaf]).astype(np.int16)
+    if progress:
+        progress(len(tree) - len(tree) // 2)
+    return Mesh(tree, grid, vertices, slots, leaf_pattern.astype(np.int32).reshape(-1), patterns, offsets,
+                element_leaf, element_local, types)
+
+
+def _pattern(configuration: Configuration, lookup: Lookup | None, types: dict) -> LocalPattern:
+    elements = lookup(configuration) if lookup is not None else None
+    if elements is not None:
+        return local_pattern(configuration, [(e["type"], e["nodes"]) for e in elements])
+    tess = tessellate(configuration)
+    for element in tess.elements:
+        types.setdefault(element.type.id, _type_info(element.type.id, element.type))
+    return local_pattern(configuration, [(e.type.id, e.nodes) for e in tess.elements], on_the_fly=True)

@@ -1,0 +1,215 @@
+"""Exact checks of a whole mesh: volume, conformity, circumcenters in their leaf, global Delaunay.
+
+Per-leaf properties (a configuration's volume, its circumcenters) are decided once
+per distinct configuration, exactly, and counted over the leaves that have it.
+Whole-mesh properties are decided on the global vertex ids (conformity) and on the
+global vertex set (Delaunay): a leaf's sphere can hold a vertex of a smaller
+neighbour, so no per-leaf test can replace them.
+
+Global Delaunay, exactly: a k-d tree on the vertices' float coordinates proposes,
+for every element, the vertices within its circumradius times (1 + 1e-9); the
+element's own nodes are expected there.  Where the tree finds anything else, each
+such vertex is decided with the integer in-sphere test of the element's
+configuration frame (the same predicate as the tessellation's), so every
+violation and every tie is decided exactly; the float slack only widens the net.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+
+from .assembly import Mesh
+
+__all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume"]
+
+
+def check_volume(mesh: Mesh) -> dict:
+    """Volumes sum to the domain's, exactly (integers and rationals), every element of positive volume.
+
+    Returns ``volume_ok``, ``volume`` (the sum as a fraction of the domain, exact text)
+    and ``flat_elements`` (elements of volume <= 0).
+
+    Examples
+    --------
+    >>> from cospherical.core.configuration import Box
+    >>> from cospherical.studies.mesh.octree import build_octree
+    >>> from cospherical.studies.mesh.assembly import assemble
+    >>> check_volume(assemble(build_octree(Box.parse([1, 2, 4]), 0, [])))
+    {'volume_ok': True, 'volume': '1', 'flat_elements': 0}
+    """
+    depth = mesh.tree.depth
+    total = Fraction(0)
+    flat = 0
+    for _, pattern, leaves in mesh.groups():
+        per_level = np.bincount(mesh.tree.levels[leaves].astype(np.int64), minlength=depth + 1)
+        weight = sum(int(count) * 8 ** (depth - level) for level, count in enumerate(per_level.tolist()))
+        total += sum((e.unit_volume for e in pattern.elements), Fraction(0)) * weight
+        flat += sum(e.unit_volume <= 0 for e in pattern.elements) * len(leaves)
+    share = total / 8 ** depth
+    return {"volume_ok": share == 1 and flat == 0, "volume": str(share), "flat_elements": int(flat)}
+
+
+def _faces(mesh: Mesh) -> dict[int, list[np.ndarray]]:
+    """Every element face as a row of global vertex ids, by face size."""
+    by_size: dict[int, list[np.ndarray]] = {}
+    for _, pattern, leaves in mesh.groups():
+        local: dict[int, list[tuple[int, ...]]] = {}
+        for element in pattern.elements:
+            for cycle in element.faces:
+                local.setdefault(len(cycle), []).append(cycle)
+        slots = mesh.slots[leaves]
+        for size, cycles in local.items():
+            by_size.setdefault(size, []).append(slots[:, np.array(cycles)].reshape(-1, size))
+    return by_size
+
+
+def check_conformity(mesh: Mesh, examples: int = 5) -> dict:
+    """Every interior face shared by exactly two elements, same vertices, opposite orientation; the rest on the boundary.
+
+    A face is its cycle of global vertex ids, turned to start at its smallest id
+    and read in the direction whose second id is the smaller; the direction it had
+    is its orientation.  A face met once must lie in one plane of the domain's
+    boundary; a face met twice must be met once in each orientation; anything else
+    (a hanging face, a T-junction, an overlap) counts as nonconforming.
+
+    Returns ``nonconforming_faces`` (face occurrences), ``interior_faces`` (pairs),
+    ``boundary_faces`` and up to ``examples`` nonconforming faces (vertex
+    coordinates as fractions of the domain).
+    """
+    grid = mesh.grid
+    bad_total, interior, boundary = 0, 0, 0
+    shown: list[list[list[float]]] = []
+    for size, parts in sorted(_faces(mesh).items()):
+        faces = np.concatenate(parts).astype(np.int64)
+        del parts
+        start = np.argmin(faces, axis=1)
+        turned = np.take_along_axis(faces, (start[:, None] + np.arange(size)[None]) % size, axis=1)
+        flipped = turned[:, 1] > turned[:, -1]
+        turned[flipped, 1:] = turned[flipped, :0:-1]
+        order = np.lexsort(turned.T[::-1])
+        turned, flipped = turned[order], flipped[order]
+        new = np.r_[True, np.any(turned[1:] != turned[:-1], axis=1)]
+        starts = np.flatnonzero(new)
+        counts = np.diff(np.r_[starts, len(turned)])
+        ok = np.zeros(len(turned), dtype=bool)
+        pairs = starts[counts == 2]
+        good_pairs = pairs[flipped[pairs] != flipped[pairs + 1]]
+        ok[good_pairs] = ok[good_pairs + 1] = True
+        interior += len(good_pairs)
+        single = starts[counts == 1]
+        points = mesh.vertices[turned[single]]  # (n, size, 3)
+        on_boundary = np.zeros(len(single), dtype=bool)
+        for axis in range(3):
+            for side in (0, grid):
+                on_boundary |= np.all(points[:, :, axis] == side, axis=1)
+        ok[single[on_boundary]] = True
+        boundary += int(on_boundary.sum())
+        bad = np.flatnonzero(~ok)
+        bad_total += len(bad)
+        for row in bad[:max(0, examples - len(shown))]:
+            shown.append((mesh.vertices[turned[row]] / grid).tolist())
+    return {"nonconforming_faces": int(bad_total), "interior_faces": int(interior), "boundary_faces": int(boundary),
+            "nonconforming_examples": shown}
+
+
+def check_circumcenters(mesh: Mesh) -> dict:
+    """Circumcenters in their own closed leaf, decided exactly per configuration, counted over the leaves.
+
+    Returns ``circumcenters_outside_leaf`` (elements), ``leaves_not_fvm_adequate``
+    (leaves with at least one) and ``elements_not_cospherical`` (elements whose nodes
+    are not on one sphere: not Delaunay elements at all).
+    """
+    outside = leaves_bad = not_spherical = 0
+    for _, pattern, leaves in mesh.groups():
+        outside += sum(not e.center_in_leaf for e in pattern.elements) * len(leaves)
+        not_spherical += sum(e.sphere is None for e in pattern.elements) * len(leaves)
+        if not pattern.fvm_adequate:
+            leaves_bad += len(leaves)
+    return {"circumcenters_outside_leaf": int(outside), "leaves_not_fvm_adequate": int(leaves_bad),
+            "elements_not_cospherical": int(not_spherical)}
+
+
+def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
+    """No mesh vertex strictly inside any element's circumsphere, decided exactly.
+
+    Returns ``delaunay_violations`` (elements whose sphere strictly holds a vertex),
+    ``delaunay_violating_pairs`` (element, vertex), ``delaunay_violating_leaves``,
+    ``delaunay_ties`` (a vertex of another element on an element's sphere: it could
+    merge with a neighbour), ``delaunay_exact_tests`` (pairs decided with integers) and
+    ``_leaves`` (the violating leaves' indices, an array, for the caller).
+    """
+    from scipy.spatial import cKDTree
+
+    grid = mesh.grid
+    scale = np.array(mesh.box.to_float()) / grid
+    points = mesh.vertices * scale
+    tree = cKDTree(points)
+    levels = mesh.tree.levels.astype(np.int64)
+    size = grid >> levels
+    origin = mesh.tree.positions.astype(np.int64) * size[:, None]
+    rows_pattern, rows_local, rows_leaf, centres, radii, n_nodes = [], [], [], [], [], []
+    for p, pattern, leaves in mesh.groups():
+        for j, element in enumerate(pattern.elements):
+            if element.sphere is None:
+                continue  # reported by check_circumcenters as not co-spherical
+            centre = (origin[leaves] + np.array([float(x) for x in element.center])[None] * size[leaves, None]) * scale
+            first = points[mesh.slots[leaves, element.nodes[0]]]
+            rows_pattern.append(np.full(len(leaves), p, dtype=np.int32))
+            rows_local.append(np.full(len(leaves), j, dtype=np.int16))
+            rows_leaf.append(leaves.astype(np.int64))
+            centres.append(centre)
+            radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
+            n_nodes.append(np.full(len(leaves), len(element.nodes), dtype=np.int64))
+    if not centres:
+        return {"_leaves": np.zeros(0, dtype=np.int64), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
+                "delaunay_ties": 0, "delaunay_exact_tests": 0}
+    rows_pattern, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_pattern, rows_local, rows_leaf))
+    centres, radii, n_nodes = np.concatenate(centres), np.concatenate(radii), np.concatenate(n_nodes)
+    reach = radii * (1 + 1e-9) + 1e-12 * float(np.abs(points).max())
+    counts = np.empty(len(centres), dtype=np.int64)
+    chunk = 1 << 18
+    for start in range(0, len(centres), chunk):
+        part = slice(start, start + chunk)
+        counts[part] = tree.query_ball_point(centres[part], reach[part], return_length=True, workers=workers)
+        if progress:
+            progress(len(centres[part]))
+    # the element's own nodes are on its sphere; anything more (or less) is looked at exactly
+    suspect = np.flatnonzero(counts != n_nodes)
+    pairs_row, pairs_vertex = [], []
+    for start in range(0, len(suspect), chunk):
+        rows = suspect[start:start + chunk]
+        found = tree.query_ball_point(centres[rows], reach[rows], workers=workers)
+        lengths = np.fromiter((len(x) for x in found), dtype=np.int64, count=len(found))
+        pairs_row.append(np.repeat(rows, lengths))
+        pairs_vertex.append(np.fromiter((v for x in found for v in x), dtype=np.int64, count=int(lengths.sum())))
+    pair_row = np.concatenate(pairs_row) if pairs_row else np.zeros(0, dtype=np.int64)
+    pair_vertex = np.concatenate(pairs_vertex) if pairs_vertex else np.zeros(0, dtype=np.int64)
+    # drop each element's own nodes
+    own = np.zeros(len(pair_row), dtype=bool)
+    for p, pattern in enumerate(mesh.patterns):
+        for j, element in enumerate(pattern.elements):
+            mine = np.flatnonzero((rows_pattern[pair_row] == p) & (rows_local[pair_row] == j))
+            if len(mine):
+                nodes = mesh.slots[rows_leaf[pair_row[mine]]][:, list(element.nodes)]
+                own[mine] = (nodes == pair_vertex[mine, None]).any(axis=1)
+    pair_row, pair_vertex = pair_row[~own], pair_vertex[~own]
+    inside = np.zeros(len(pair_row), dtype=bool)
+    ties = 0
+    for i, (row, vertex) in enumerate(zip(pair_row.tolist(), pair_vertex.tolist())):
+        pattern = mesh.patterns[rows_pattern[row]]
+        element = pattern.elements[rows_local[row]]
+        leaf = rows_leaf[row]
+        m = int(size[leaf])
+        x = [pattern.scale * (int(v) - int(o)) for v, o in zip(mesh.vertices[vertex], origin[leaf])]
+        n0, n1, n2, n3 = element.sphere.normal
+        w0, w1, w2 = pattern.weights
+        side = (n0 * x[0] + n1 * x[1] + n2 * x[2]) * m + n3 * (w0 * x[0] ** 2 + w1 * x[1] ** 2 + w2 * x[2] ** 2) \
+            - element.sphere.offset * m * m
+        inside[i] = side < 0
+        ties += side == 0
+    bad_rows = np.unique(pair_row[inside])
+    return {"_leaves": np.unique(rows_leaf[bad_rows]),"delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),
+            "delaunay_violating_leaves": int(len(np.unique(rows_leaf[bad_rows]))), "delaunay_ties": int(ties),
+            "delaunay_exact_tests": int(len(pair_row))}

@@ -1,0 +1,408 @@
+"""A 1-irregular octree over a box domain: refined by shapes and balanced, or brought as a list of leaves.
+
+A cell at level ``l`` is the integer position ``(i, j, k)`` with ``0 <= i, j, k < 2**l``;
+its box in unit coordinates of the domain is ``[i/2**l, (i+1)/2**l] x ...``, the real
+box that times the domain lengths (A, B, C).  Every decision (does a cell meet a
+shape, do the leaves tile the domain, is the tree balanced) is made with integers:
+shape coordinates are exact rationals, squared lengths are rationals, and the
+comparisons are cleared of denominators before they are made (no tolerance).
+
+The tree is held as arrays, level by level, never as Python objects per cell:
+``split[l]`` holds the sorted linear keys ``(i * 2**l + j) * 2**l + k`` of the cells of
+level ``l`` that are split.  A tree is 2:1 balanced exactly when every neighbour
+(same level) of a split cell exists, i.e. its parent is split; that closure, taken
+from the finest level down, is the coarsest balanced tree containing the refinement.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+from itertools import product
+from typing import Sequence
+
+import numpy as np
+
+from ...core.configuration import Box
+from ...core.exact import parse_rational
+from ...errors import InputError
+
+__all__ = ["BALANCES", "MAX_LEVEL", "Octree", "Shape", "build_octree", "leaves_octree", "parse_shape"]
+
+MAX_LEVEL = 16  # keys (2**16)**3 and the half-spacing grid (2**17 + 1)**3 stay inside int64
+BALANCES = ("vertex", "edge", "face")
+SHAPE_FORMS = {
+    "sphere": ("X,Y,Z,R", 4),
+    "plane": ("NX,NY,NZ,D", 4),
+    "point": ("X,Y,Z", 3),
+    "box": ("X0,Y0,Z0,X1,Y1,Z1", 6),
+}
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A refinement shape in domain units, exact: ``kind`` and its rational ``values``.
+
+    Examples
+    --------
+    >>> parse_shape("sphere:0.5,0.5,0.5,0.3")
+    Shape(kind='sphere', values=(Fraction(1, 2), Fraction(1, 2), Fraction(1, 2), Fraction(3, 10)), text='sphere:0.5,0.5,0.5,0.3')
+    """
+
+    kind: str
+    values: tuple[Fraction, ...]
+    text: str
+
+
+def parse_shape(text: str) -> Shape:
+    """Read ``sphere:X,Y,Z,R``, ``plane:NX,NY,NZ,D``, ``point:X,Y,Z`` or ``box:X0,Y0,Z0,X1,Y1,Z1``.
+
+    Numbers are exact rationals (``0.3`` is 3/10, ``1/3``); a bad shape raises
+    :class:`~cospherical.errors.InputError` naming it.
+
+    Examples
+    --------
+    >>> parse_shape("point:0.3,0.61,0.77").values[1]
+    Fraction(61, 100)
+    >>> parse_shape("cone:1,2")
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.InputError: refine shape 'cone:1,2': unknown kind 'cone'; write sphere:X,Y,Z,R, plane:NX,NY,NZ,D, point:X,Y,Z or box:X0,Y0,Z0,X1,Y1,Z1
+    """
+    kind, sep, rest = str(text).partition(":")
+    kind = kind.strip().lower()
+    forms = ", ".join(f"{k}:{form}" for k, (form, _) in SHAPE_FORMS.items())
+    forms = forms.replace(", box", " or box")
+    if not sep or kind not in SHAPE_FORMS:
+        what = f"unknown kind {kind!r}" if sep else "no kind"
+        raise InputError(f"refine shape {text!r}: {what}; write {forms}")
+    form, count = SHAPE_FORMS[kind]
+    parts = [p for p in rest.split(",")]
+    if len(parts) != count:
+        raise InputError(f"refine shape {text!r}: {kind} needs {count} numbers {form}, got {len(parts)}")
+    values = tuple(parse_rational(p.strip(), f"refine shape {text!r}: number") for p in parts)
+    if kind == "sphere" and values[3] <= 0:
+        raise InputError(f"refine shape {text!r}: the radius must be positive")
+    if kind == "plane" and not any(values[:3]):
+        raise InputError(f"refine shape {text!r}: the normal (NX,NY,NZ) must not be zero")
+    if kind == "box" and any(values[a] > values[a + 3] for a in range(3)):
+        raise InputError(f"refine shape {text!r}: needs X0 <= X1, Y0 <= Y1, Z0 <= Z1")
+    return Shape(kind, values, str(text))
+
+
+def _rational_lengths(box: Box, shape: Shape) -> tuple[Fraction, Fraction, Fraction]:
+    lengths = []
+    for length in box.lengths:
+        root = Fraction(math.isqrt(length.squared.numerator), math.isqrt(length.squared.denominator))
+        if root * root != length.squared:
+            # A sphere or plane over a sqrt length compares sums of unlike square roots:
+            # refuse rather than decide with floats.
+            raise InputError(f"refine shape {shape.text!r}: {shape.kind} needs rational domain lengths, "
+                             f"got {length.text}; use point or box shapes, or --leaves")
+        lengths.append(root)
+    return tuple(lengths)
+
+
+def _exact_array(values: Sequence[int], bound: int) -> np.ndarray:
+    """Integers as int64 when products up to ``bound`` fit, else as Python ints (object)."""
+    return np.asarray(values, dtype=np.int64 if bound < 2**62 else object)
+
+
+def _meets(shape: Shape, box: Box, level: int, cells: np.ndarray) -> np.ndarray:
+    """Which cells (n x 3 positions at ``level``) have a closed box meeting the shape, exactly.
+
+    Everything is scaled to integers: a cell spans ``[i*S, (i+1)*S]`` per axis with
+    ``S = M`` on the ``M * 2**level`` grid, where M clears the shape's denominators.
+    """
+    v = shape.values
+    if shape.kind in ("point", "box"):
+        # Compare X with i * len / 2**l per axis: X / len is a rational when len**2 is.
+        lo, hi = (v[:3], v[:3]) if shape.kind == "point" else (v[:3], v[3:])
+        inside = np.ones(len(cells), dtype=bool)
+        for axis, length in enumerate(box.lengths):
+            # cell [i, i+1] * len / 2**l meets [lo, hi] iff i * len <= hi * 2**l and (i+1) * len >= lo * 2**l;
+            # with len = sqrt(q): sign-aware comparison of squares (all of len, i, i+1 are >= 0).
+            i = cells[:, axis]
+            inside &= _le_scaled(i, length.squared, hi[axis] * 2**level)
+            inside &= _ge_scaled(i + 1, length.squared, lo[axis] * 2**level)
+        return inside
+    lengths = _rational_lengths(box, shape)
+    if shape.kind == "sphere":
+        centre, radius = v[:3], v[3]
+        # unit-frame centre c = X / len; distances squared weigh each axis by len**2.
+        unit = [centre[a] / lengths[a] for a in range(3)]
+        den = math.lcm(*(u.denominator for u in unit))
+        grid = den * 2**level  # cell [i, i+1] is [i*den, (i+1)*den] on this grid
+        weights_den = math.lcm(*(length.denominator ** 2 for length in lengths), radius.denominator ** 2)
+        weights = [int(length * length * weights_den) for length in lengths]
+        c = [int(u * grid) for u in unit]
+        r2 = radius * radius * weights_den * grid * grid  # an integer: R**2 on the grid, weighted like the axes
+        assert r2.denominator == 1
+        extent = max(abs(x) for x in c) + grid
+        fit = extent * extent * sum(weights) * 4
+        near = np.zeros(len(cells), dtype=object if fit >= 2**62 else np.int64)
+        far = np.zeros_like(near)
+        for axis in range(3):
+            lo = _exact_array(cells[:, axis], fit) * den
+            hi = lo + den
+            ca = c[axis]
+            # nearest point of [lo, hi] to ca, and the farther end
+            d_near = np.where(ca < lo, lo - ca, np.where(ca > hi, ca - hi, 0))
+            d_far = np.maximum(np.abs(lo - ca), np.abs(hi - ca))
+            near = near + weights[axis] * d_near * d_near
+            far = far + weights[axis] * d_far * d_far
+        r2 = int(r2)
+        return (near <= r2) & (r2 <= far)
+    # plane n . x = D with x = (s*A, t*B, u*C): coefficients n_a * len_a on the unit frame
+    coeff = [v[a] * lengths[a] for a in range(3)]
+    den = math.lcm(*(x.denominator for x in coeff), v[3].denominator)
+    k = [int(x * den) for x in coeff]
+    rhs = v[3] * den * 2**level  # compare sum k_a * i_a with D * den * 2**l
+    assert rhs.denominator == 1
+    fit = (sum(abs(x) for x in k) + 1) * 2 ** (level + 1) + abs(int(rhs))
+    low = np.zeros(len(cells), dtype=object if fit >= 2**62 else np.int64)
+    high = np.zeros_like(low)
+    for axis in range(3):
+        i = _exact_array(cells[:, axis], fit)
+        a, b = k[axis] * i, k[axis] * (i + 1)
+        low = low + np.minimum(a, b)
+        high = high + np.maximum(a, b)
+    rhs = int(rhs)
+    return (low <= rhs) & (rhs <= high)
+
+
+def _le_scaled(i: np.ndarray, squared: Fraction, bound: Fraction) -> np.ndarray:
+    """``i * sqrt(squared) <= bound`` for integers i >= 0, exactly."""
+    if bound < 0:
+        return np.zeros(len(i), dtype=bool)
+    return _compare_squares(i, squared, bound * bound) <= 0
+
+
+def _ge_scaled(i: np.ndarray, squared: Fraction, bound: Fraction) -> np.ndarray:
+    """``i * sqrt(squared) >= bound`` for integers i >= 0, exactly."""
+    if bound <= 0:
+        return np.ones(len(i), dtype=bool)
+    return _compare_squares(i, squared, bound * bound) >= 0
+
+
+def _compare_squares(i: np.ndarray, squared: Fraction, target: Fraction) -> np.ndarray:
+    """Sign of ``i**2 * squared - target`` per entry, with the denominators cleared."""
+    left, right = squared.numerator * target.denominator, target.numerator * squared.denominator
+    i = np.asarray(i, dtype=np.int64)
+    fit = int(i.max(initial=0)) ** 2 * left
+    values = _exact_array(i, max(fit, right))
+    return np.sign(values * values * left - right)
+
+
+# ---------------------------------------------------------------------------
+# Keys and neighbourhoods
+
+
+def keys_of(level: int, cells: np.ndarray) -> np.ndarray:
+    """Linear keys of positions (n x 3) at ``level``."""
+    n = np.int64(1 << level)
+    cells = cells.astype(np.int64)
+    return (cells[:, 0] * n + cells[:, 1]) * n + cells[:, 2]
+
+
+def cells_of(level: int, keys: np.ndarray) -> np.ndarray:
+    """Positions (n x 3) of linear keys at ``level``."""
+    n = np.int64(1 << level)
+    keys = keys.astype(np.int64)
+    return np.stack([keys // (n * n), (keys // n) % n, keys % n], axis=1)
+
+
+def _offsets(balance: str) -> np.ndarray:
+    """Neighbour offsets touching a cell across a face and an edge (``edge``), or also a corner (``vertex``)."""
+    most = 3 if balance == "vertex" else 2
+    return np.array([d for d in product((-1, 0, 1), repeat=3) if sum(map(abs, d)) <= most], dtype=np.int64)
+
+
+def _neighbours(level: int, cells: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Positions of the cells (with the cells themselves) at ``offsets``, inside the domain, unique keys."""
+    n = 1 << level
+    near = (cells[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
+    near = near[np.all((near >= 0) & (near < n), axis=1)]
+    return np.unique(keys_of(level, near))
+
+
+def _children(level: int, keys: np.ndarray) -> np.ndarray:
+    """Keys at ``level + 1`` of the eight children of cells at ``level``."""
+    cells = cells_of(level, keys) * 2
+    kids = (cells[:, None, :] + np.array(list(product((0, 1), repeat=3)))[None]).reshape(-1, 3)
+    return np.sort(keys_of(level + 1, kids))
+
+
+# ---------------------------------------------------------------------------
+# The tree
+
+
+@dataclass(frozen=True)
+class Octree:
+    """Leaves of a 1-irregular octree: ``levels`` (n,) and integer ``positions`` (n x 3), sorted by (level, key).
+
+    ``depth`` is the finest leaf level.  Leaf ``i`` is the box
+    ``positions[i] / 2**levels[i]`` (+ one cell) in unit coordinates of the domain.
+    """
+
+    box: Box
+    levels: np.ndarray
+    positions: np.ndarray
+
+    @property
+    def depth(self) -> int:
+        return int(self.levels.max()) if len(self.levels) else 0
+
+    def __len__(self) -> int:
+        return len(self.levels)
+
+
+def _leaves_from_splits(split: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Leaves of the tree whose split cells per level are ``split`` (level 0 is the root)."""
+    levels, positions = [], []
+    existing = np.zeros(1, dtype=np.int64)  # the root
+    for level in range(len(split) + 1):
+        here = split[level] if level < len(split) else np.zeros(0, dtype=np.int64)
+        leaves = existing[~np.isin(existing, here, assume_unique=True)]
+        levels.append(np.full(len(leaves), level, dtype=np.int8))
+        positions.append(cells_of(level, leaves))
+        if level < len(split):
+            existing = _children(level, here)
+    return np.concatenate(levels), np.concatenate(positions)
+
+
+def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = "vertex",
+                 max_cells: int = 50_000_000) -> Octree:
+    """Refine every cell whose closed box meets a shape down to ``levels``, then 2:1 balance (coarsest).
+
+    ``balance``: ``vertex`` (leaves touching across a face, an edge or a corner
+    differ by at most one level; the default) or ``edge`` (faces and edges only).
+    Face-only balance is refused: it is not 1-irregular (an edge can get two points).
+
+    Examples
+    --------
+    >>> tree = build_octree(Box.parse([1, 1, 1]), 2, [parse_shape("point:0.1,0.1,0.1")])
+    >>> len(tree), sorted(set(tree.levels.tolist()))
+    (15, [1, 2])
+    >>> build_octree(Box.parse([1, 1, 1]), 2, [], balance="face")
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.InputError: --balance face: balance across faces alone is not 1-irregular (an edge can get two Steiner points); use edge or vertex
+    """
+    if balance not in BALANCES:
+        raise InputError(f"--balance {balance}: choose vertex or edge")
+    if balance == "face":
+        raise InputError("--balance face: balance across faces alone is not 1-irregular "
+                         "(an edge can get two Steiner points); use edge or vertex")
+    if isinstance(levels, bool) or not isinstance(levels, int) or not 0 <= levels <= MAX_LEVEL:
+        raise InputError(f"--levels {levels!r}: must be an integer from 0 to {MAX_LEVEL}")
+    split: list[np.ndarray] = []
+    existing = np.zeros(1, dtype=np.int64)
+    for level in range(levels):
+        cells = cells_of(level, existing)
+        hit = np.zeros(len(cells), dtype=bool)
+        for shape in shapes:
+            hit |= _meets(shape, box, level, cells)
+        split.append(existing[hit])
+        existing = _children(level, split[-1])
+        if len(existing) > max_cells:
+            raise InputError(f"--levels {levels}: level {level + 1} already has {len(existing):,} cells "
+                             f"(limit {max_cells:,}); use fewer levels or a smaller shape")
+    offsets = _offsets(balance)
+    for level in range(levels - 1, 0, -1):
+        # every neighbour of a split cell must exist: its parent must be split
+        need = _neighbours(level, cells_of(level, split[level]), offsets)
+        parents = np.unique(keys_of(level - 1, cells_of(level, need) // 2))
+        split[level - 1] = np.union1d(split[level - 1], parents)
+    levels_, positions = _leaves_from_splits(split)
+    return Octree(box, levels_, positions)
+
+
+# ---------------------------------------------------------------------------
+# A tree brought as a list of leaves
+
+
+def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[int]], where: str = "leaves") -> Octree:
+    """Check a list of leaves (level, i, j, k) and order it as an :class:`Octree`.
+
+    The leaves must tile the domain (no overlap, no gap) and be 1-irregular (leaves
+    touching across a face or an edge differ by at most one level); otherwise
+    :class:`~cospherical.errors.InputError` names a bad leaf by its index in the list.
+
+    Examples
+    --------
+    >>> tree = leaves_octree(Box.parse([1, 1, 1]), [0], [[0, 0, 0]])
+    >>> len(tree), tree.depth
+    (1, 0)
+    >>> leaves_octree(Box.parse([1, 1, 1]), [1] * 7, [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0],
+    ...                                               [0, 0, 1], [1, 0, 1], [0, 1, 1]])
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.InputError: leaves: no leaf covers the cell at level 1, position 1 1 1
+    """
+    levels = np.asarray(levels, dtype=np.int64).reshape(-1)
+    positions = np.asarray(positions, dtype=np.int64).reshape(-1, 3)
+    if len(levels) == 0:
+        raise InputError(f"{where}: no leaves")
+    if len(levels) != len(positions):
+        raise InputError(f"{where}: {len(levels)} levels but {len(positions)} positions")
+    bad = np.flatnonzero((levels < 0) | (levels > MAX_LEVEL))
+    if len(bad):
+        raise InputError(f"{where}: leaf {bad[0]}: level {levels[bad[0]]} is not in 0..{MAX_LEVEL}")
+    bad = np.flatnonzero(np.any((positions < 0) | (positions >= (1 << levels)[:, None]), axis=1))
+    if len(bad):
+        i = bad[0]
+        raise InputError(f"{where}: leaf {i}: position {' '.join(map(str, positions[i]))} is outside the domain "
+                         f"at level {levels[i]} (0..{(1 << levels[i]) - 1})")
+    depth = int(levels.max())
+    keys = {level: keys_of(level, positions[levels == level]) for level in range(depth + 1)}
+    index = {level: np.flatnonzero(levels == level) for level in range(depth + 1)}
+    for level in range(depth + 1):
+        order = np.argsort(keys[level], kind="stable")
+        k = keys[level][order]
+        same = np.flatnonzero(k[1:] == k[:-1])
+        if len(same):
+            a, b = sorted(index[level][order[same[0]:same[0] + 2]])
+            raise InputError(f"{where}: leaf {b} repeats leaf {a} (level {level}, position "
+                             f"{' '.join(map(str, positions[a]))})")
+    # split[l]: the cells of level l that are ancestors of a leaf; a leaf must not be one
+    split = []
+    for level in range(depth):
+        deeper = [keys_of(level, cells_of(d, keys[d]) >> (d - level)) for d in range(level + 1, depth + 1)]
+        split.append(np.unique(np.concatenate(deeper)) if deeper else np.zeros(0, dtype=np.int64))
+        clash = np.isin(keys[level], split[level])
+        if clash.any():
+            i = index[level][np.flatnonzero(clash)[0]]
+            raise InputError(f"{where}: leaf {i} (level {level}, position {' '.join(map(str, positions[i]))}) "
+                             "overlaps smaller leaves inside it")
+    # no gap: every child of a split cell exists (is a leaf or split)
+    existing = np.zeros(1, dtype=np.int64)
+    for level in range(depth + 1):
+        here = np.union1d(keys[level], split[level] if level < depth else np.zeros(0, dtype=np.int64))
+        missing = existing[~np.isin(existing, here)]
+        if len(missing):
+            cell = cells_of(level, missing[:1])[0]
+            raise InputError(f"{where}: no leaf covers the cell at level {level}, position "
+                             f"{' '.join(map(str, cell))}")
+        if level < depth:
+            existing = _children(level, split[level])
+    # 1-irregular: every face or edge neighbour of a split cell exists
+    offsets = _offsets("edge")
+    for level in range(1, depth):
+        need = _neighbours(level, cells_of(level, split[level]), offsets)
+        parents = keys_of(level - 1, cells_of(level, need) // 2)
+        lacking = np.flatnonzero(~np.isin(parents, split[level - 1]))
+        if len(lacking):
+            cell = cells_of(level, need[lacking[:1]])[0]
+            # the leaf holding that cell is coarser than its parent: find it by its ancestors
+            for coarse in range(level - 1, -1, -1):
+                key = keys_of(coarse, (cell >> (level - coarse))[None])[0]
+                hit = np.flatnonzero(keys[coarse] == key)
+                if len(hit):
+                    i = index[coarse][hit[0]]
+                    raise InputError(f"{where}: leaf {i} (level {coarse}, position "
+                                     f"{' '.join(map(str, positions[i]))}) touches leaves of level {level + 1} "
+                                     "across a face or an edge: not 1-irregular (2:1 balance)")
+    levels_, positions_ = _leaves_from_splits(split)
+    return Octree(box, levels_, positions_)

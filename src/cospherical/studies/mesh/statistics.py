@@ -1,0 +1,104 @@
+"""What really occurs in a mesh: element types and configurations weighted by how often they occur.
+
+The paper's study weighs every bisection configuration the same ("but this is for
+sure not true ... a complete study should consider also this case").  Here each
+type and configuration is counted over the leaves of a real octree, beside the
+uniform-weight bisection study of the same box (octree point policy, the paper's
+system), and the share of elements the paper's seven final elements cover.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+
+import numpy as np
+
+from ...core.configuration import Box, Configuration
+from ..bisection import bisection_codes, run_study
+from .assembly import PAPER_FINAL, Mesh, _type_info
+
+__all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "uniform_study"]
+
+BISECTION_CONFIGURATIONS = 4096
+
+
+def uniform_study(box: Box) -> dict:
+    """Element counts per type of the uniform-weight bisection study of ``box`` (octree policy, optimal)."""
+    study = run_study("bisection", box, bisection_codes(), "octree", criteria=("optimal",))
+    counts = {tc.type.id: tc.count for tc in study.type_counts("optimal")}
+    info = {tc.type.id: _type_info(tc.type.id, tc.type) for tc in study.type_counts("optimal")}
+    return {"counts": counts, "types": info, "elements": study.total("optimal")}
+
+
+def _share(part: int, whole: int) -> float:
+    return round(part / whole, 6) if whole else 0.0
+
+
+def in_bisection_family(configuration: Configuration) -> bool:
+    """Whether a leaf's point set is one the paper's bisection study has (octree policy of its edge code).
+
+    >>> in_bisection_family(Configuration.from_code("888888888888+f"))
+    False
+    >>> in_bisection_family(Configuration.from_code("800000000000+f"))
+    True
+    """
+    digits = configuration.point_set_code.split("+")[0]
+    return Configuration.from_code(digits, configuration.box).point_set_code == configuration.point_set_code
+
+
+def mesh_statistics(mesh: Mesh, uniform: dict | None = None) -> dict:
+    """Per element type and per configuration, how often it occurs in the mesh, beside the uniform study.
+
+    Returns ``type_frequencies`` (by decreasing count), ``configuration_frequencies``
+    (by decreasing leaf count), ``paper_final_share`` (elements whose paper class is
+    one of the paper's seven final elements) and, with ``uniform``, its figures.
+    """
+    type_counts: Counter = Counter()
+    configurations = []
+    total_leaves = len(mesh.tree)
+    for _, pattern, leaves in mesh.groups():
+        for element in pattern.elements:
+            type_counts[element.type_id] += len(leaves)
+        configurations.append({
+            "code": pattern.code,
+            "leaves": int(len(leaves)),
+            "share": _share(len(leaves), total_leaves),
+            "uniform_share": (_share(1, BISECTION_CONFIGURATIONS) if in_bisection_family(pattern.configuration)
+                              else None),
+            "elements_per_leaf": len(pattern.elements),
+            "fvm_adequate": pattern.fvm_adequate,
+            "tessellated_on_the_fly": pattern.on_the_fly,
+        })
+    configurations.sort(key=lambda c: (-c["leaves"], c["code"]))
+    total = sum(type_counts.values())
+    uniform_counts = uniform["counts"] if uniform else {}
+    uniform_total = uniform["elements"] if uniform else 0
+    info = dict(uniform["types"]) if uniform else {}
+    info.update(mesh.types)
+    rows = []
+    for type_id in sorted(set(type_counts) | set(uniform_counts), key=lambda t: (-type_counts[t], t)):
+        entry = info.get(type_id) or _type_info(type_id, None)
+        rows.append({
+            "id": type_id, "name": entry["name"], "paper_class": entry["paper_class"], "vtk": entry["vtk"],
+            "count": int(type_counts[type_id]), "share": _share(type_counts[type_id], total),
+            "uniform_count": int(uniform_counts.get(type_id, 0)) if uniform else None,
+            "uniform_share": _share(uniform_counts.get(type_id, 0), uniform_total) if uniform else None,
+        })
+    final = sum(r["count"] for r in rows if r["paper_class"] in PAPER_FINAL)
+    result = {
+        "paper_final_share": _share(final, total),
+        "leaves_in_bisection_family": int(sum(c["leaves"] for c in configurations if c["uniform_share"] is not None)),
+        "type_frequencies": rows,
+        "configuration_frequencies": configurations,
+    }
+    if uniform:
+        uniform_final = sum(r["uniform_count"] for r in rows if r["paper_class"] in PAPER_FINAL)
+        result["uniform"] = {"study": "bisection", "face_points": "octree", "configurations": BISECTION_CONFIGURATIONS,
+                             "elements": int(uniform_total), "paper_final_share": _share(uniform_final, uniform_total)}
+    return result
+
+
+def level_counts(mesh: Mesh) -> dict[str, int]:
+    """Leaves per level (levels that occur)."""
+    counts = np.bincount(mesh.tree.levels.astype(np.int64))
+    return {str(level): int(n) for level, n in enumerate(counts.tolist()) if n}

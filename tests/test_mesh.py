@@ -1,0 +1,217 @@
+"""cospherical mesh: octrees, assembly from pattern tables, the exact whole-mesh checks, outputs and refusals."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from cospherical.cli import main
+from cospherical.core.configuration import Box, Configuration
+from cospherical.core.tessellation import tessellate
+from cospherical.files.yamlio import atomic_write, yaml_text
+from cospherical.formats.mesh import read_leaves, table_lookup, to_meshio, write_vtu
+from cospherical.formats.patterns import configuration_lines, load
+from cospherical.studies.mesh.assembly import assemble
+from cospherical.studies.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
+from cospherical.studies.mesh.octree import build_octree, leaves_octree, parse_shape
+
+CUBE = Box.parse(["1", "1", "1"])
+BRICK = Box.parse(["1", "2", "4"])
+
+# One octant of the root refined: 7 leaves of level 1 and 8 of level 2.
+OCTANT = [(1, i, j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1) if (i, j, k) != (0, 0, 0)] + \
+         [(2, i, j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1)]
+
+
+def octant_tree(box=CUBE):
+    return leaves_octree(box, [leaf[0] for leaf in OCTANT], [leaf[1:] for leaf in OCTANT])
+
+
+def checks(mesh) -> dict:
+    found = {**check_volume(mesh), **check_conformity(mesh), **check_circumcenters(mesh), **check_delaunay(mesh)}
+    found.pop("_leaves")
+    return found
+
+
+def small_table(path, box, codes):
+    """A pattern table of some bare (octree-policy) codes, in the shipped tables' format."""
+    header = {"schema_version": 1, "generator": "test", "catalogue_version": "test", "study": "bisection",
+              "box": list(box.texts), "face_points": "octree", "scheme": "test", "criteria": ["optimal"]}
+    lines = [yaml_text(header).rstrip("\n"), "configurations:"]
+    for code in sorted(codes):
+        tess = tessellate(Configuration.from_code(code, box))
+        lines.extend(configuration_lines(code, tess.fvm_adequate, {"optimal": tess}))
+    atomic_write(path, "\n".join(lines) + "\n")
+    return load(path)
+
+
+def bare_codes(mesh) -> set[str]:
+    return {p.code.split("+")[0] for p in mesh.patterns}
+
+
+def test_one_leaf():
+    mesh = assemble(build_octree(CUBE, 0, []))
+    assert (len(mesh.tree), len(mesh.vertices), len(mesh)) == (1, 8, 1)
+    assert mesh.patterns[0].code == "000000000000+f"
+    found = checks(mesh)
+    assert found["volume_ok"] and found["nonconforming_faces"] == 0 and found["boundary_faces"] == 6
+    assert found["delaunay_violations"] == 0 and found["leaves_not_fvm_adequate"] == 0
+
+
+def test_one_refined_octant_by_hand():
+    mesh = assemble(octant_tree())
+    # 27 points of the level-1 grid, and the octant's own 27 points of which its 8 corners are shared
+    assert (len(mesh.tree), len(mesh.vertices)) == (15, 46)
+    codes = sorted(p.code for p in mesh.patterns)
+    # the three face neighbours see a face point and four edge points, the three edge neighbours one edge point,
+    # the corner neighbour and the small leaves nothing
+    assert "000000000000+f" in codes and len(codes) == 1 + 3 + 3
+    face_leaf = [p for p in mesh.patterns if "+f" in p.code and p.code.endswith(tuple("012345"))]
+    assert len(face_leaf) == 3 and all(p.code.count("8") == 4 for p in face_leaf)
+    found = checks(mesh)
+    assert found["volume_ok"] and found["volume"] == "1"
+    assert found["nonconforming_faces"] == 0 and found["delaunay_violations"] == 0
+    # the same tree by refinement: a point, a small box, a small sphere inside the first octant
+    for shape in ("point:0.25,0.25,0.25", "box:0.1,0.1,0.1,0.2,0.2,0.2", "sphere:0.2,0.2,0.2,0.1"):
+        again = build_octree(CUBE, 2, [parse_shape(shape)])
+        assert sorted(zip(again.levels.tolist(), map(tuple, again.positions.tolist()))) == \
+            sorted((leaf[0], leaf[1:]) for leaf in OCTANT), shape
+
+
+def test_table_equals_tessellating_every_leaf(tmp_path):
+    tree = build_octree(BRICK, 3, [parse_shape("sphere:0.5,1,2,0.6")])
+    fly = assemble(tree)
+    table = small_table(tmp_path / "t.yaml", BRICK, bare_codes(fly))
+    mesh = assemble(tree, table_lookup(table, "optimal", BRICK))
+    assert not any(p.on_the_fly for p in mesh.patterns) and all(p.on_the_fly for p in fly.patterns)
+    assert np.array_equal(mesh.connectivity()[0], fly.connectivity()[0])
+    assert mesh.element_types()[0] == fly.element_types()[0]
+    assert np.array_equal(mesh.element_types()[1], fly.element_types()[1])
+    assert checks(mesh) == checks(fly)
+
+
+def test_missing_configurations_are_tessellated_and_counted(tmp_path):
+    tree = octant_tree()
+    fly = assemble(tree)
+    codes = sorted(bare_codes(fly))
+    table = small_table(tmp_path / "t.yaml", CUBE, codes[:2])
+    mesh = assemble(tree, table_lookup(table, "optimal", CUBE))
+    assert sum(p.on_the_fly for p in mesh.patterns) == len(fly.patterns) - 2
+
+
+class Broken:
+    """A pattern table with one configuration's elements edited."""
+
+    def __init__(self, edit):
+        self.edit = edit
+
+    def __call__(self, configuration):
+        tess = tessellate(configuration)
+        elements = [{"type": e.type.id, "nodes": list(e.nodes)} for e in tess.elements]
+        return self.edit(elements) if len(elements) > 1 else elements
+
+
+@pytest.mark.parametrize("edit, volume", [
+    (lambda elements: elements[:-1], "less"),             # an element missing: a hole
+    (lambda elements: elements + elements[:1], "more"),  # an element twice: an overlap
+])
+def test_checks_catch_a_broken_table(edit, volume):
+    mesh = assemble(octant_tree(), Broken(edit))
+    found = checks(mesh)
+    assert not found["volume_ok"]
+    share = eval(found["volume"].replace("/", "/ "))  # noqa: S307 (a fraction written by us)
+    assert (share < 1) if volume == "less" else (share > 1)
+    assert found["nonconforming_faces"] > 0 and found["nonconforming_examples"]
+
+
+def test_global_delaunay_equals_brute_force_on_a_brick():
+    """The 1x2x4 octree is not globally Delaunay; the exact check agrees with brute force over all vertices."""
+    mesh = assemble(build_octree(BRICK, 4, [parse_shape("sphere:0.5,1,2,0.6")]))
+    found = check_delaunay(mesh)
+    conn, sizes = mesh.connectivity()
+    points = mesh.vertices * (np.array(BRICK.to_float()) / mesh.grid)
+    pairs = elements = 0
+    for e in range(len(mesh)):
+        nodes = conn[e, :sizes[e]]
+        x = points[nodes]
+        centre = np.linalg.lstsq(2 * (x[1:] - x[0]), (x[1:] ** 2).sum(1) - (x[0] ** 2).sum(), rcond=None)[0]
+        d2 = ((points - centre) ** 2).sum(1)
+        d2[nodes] = np.inf
+        inside = int((d2 < ((x[0] - centre) ** 2).sum() * (1 - 1e-9)).sum())
+        pairs, elements = pairs + inside, elements + (inside > 0)
+    assert (found["delaunay_violating_pairs"], found["delaunay_violations"]) == (pairs, elements)
+    assert found["delaunay_violations"] > 0
+    assert check_circumcenters(mesh)["leaves_not_fvm_adequate"] > 0
+
+
+def test_vtu_reads_back(tmp_path):
+    import meshio
+
+    mesh = assemble(octant_tree())
+    write_vtu(mesh, tmp_path / "mesh.vtu")
+    back = meshio.read(tmp_path / "mesh.vtu")
+    assert len(back.points) == len(mesh.vertices)
+    assert sum(len(block.data) for block in back.cells) == len(mesh)
+    leaves = np.concatenate(back.cell_data["leaf"])
+    assert sorted(leaves.tolist()) == sorted(mesh.element_leaf.tolist())
+    standard = assemble(build_octree(CUBE, 0, []))  # one cuboid: a VTK hexahedron
+    assert to_meshio(standard).cells[0].type == "hexahedron"
+
+
+def test_cli_report_and_outputs(tmp_path, capsys):
+    leaves = tmp_path / "leaves.json"
+    leaves.write_text(json.dumps({"leaves": [list(leaf) for leaf in OCTANT]}))
+    assert main(["mesh", "--domain", "1", "1", "1", "--leaves", str(leaves), "--out", str(tmp_path / "out"),
+                 "--format", "json", "--no-uniform"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    for key in ("leaves", "vertices", "elements", "types", "volume_ok", "nonconforming_faces",
+                "leaves_not_fvm_adequate", "delaunay_violations", "configurations", "tessellated_on_the_fly"):
+        assert key in report
+    assert (report["leaves"], report["vertices"], report["configurations"], report["tessellated_on_the_fly"]) == \
+        (15, 46, 7, 7)
+    assert json.loads((tmp_path / "out" / "report.json").read_text()) == report
+    assert (tmp_path / "out" / "mesh.png").stat().st_size > 1000
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["mesh.png", "mesh.vtu", "report.json"]
+
+
+def test_text_leaf_list(tmp_path):
+    path = tmp_path / "leaves.txt"
+    path.write_text("# octant\n" + "\n".join(" ".join(map(str, leaf)) for leaf in OCTANT) + "\n")
+    levels, positions = read_leaves(path)
+    assert len(levels) == 15 and positions.shape == (15, 3)
+
+
+UNBALANCED = [(1, i, j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1) if (i, j, k) != (0, 0, 0)] + \
+             [(2, i, j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1) if (i, j, k) != (1, 1, 1)] + \
+             [(3, 2 + i, 2 + j, 2 + k) for i in (0, 1) for j in (0, 1) for k in (0, 1)]
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--levels", "3", "--refine", "cone:1,2"], "unknown kind 'cone'"),
+    (["--levels", "3", "--refine", "sphere:0.5,0.5,0.5"], "sphere needs 4 numbers"),
+    (["--levels", "3", "--refine", "sphere:0.5,0.5,0.5,-1"], "radius must be positive"),
+    (["--levels", "3", "--refine", "box:1,0,0,0,1,1"], "X0 <= X1"),
+    (["--levels", "3", "--refine", "point:a,0,0"], "point:a,0,0"),
+    (["--levels", "17", "--refine", "point:0,0,0"], "--levels '17'"),
+    (["--levels", "x", "--refine", "point:0,0,0"], "--levels 'x'"),
+    (["--refine", "point:0,0,0"], "needs --levels"),
+    (["--levels", "2", "--refine", "point:0,0,0", "--balance", "face"], "not 1-irregular"),
+    (["--leaves", "{tmp}/overlap.txt"], "leaf 1 repeats leaf 0"),
+    (["--leaves", "{tmp}/gap.txt"], "no leaf covers the cell at level 1, position 1 1 1"),
+    (["--leaves", "{tmp}/unbalanced.txt"], "leaf 0 (level 1, position 0 0 1) touches leaves of level 3"),
+    (["--leaves", "{tmp}/outside.txt"], "leaf 0: position 2 0 0 is outside the domain"),
+    (["--leaves", "{tmp}/garbage.txt"], "line 2: 'one two' is not 'level i j k'"),
+    (["--leaves", "{tmp}/missing.txt"], "cannot read"),
+])
+def test_bad_input_is_refused_with_one_line(tmp_path, capsys, argv, needle):
+    (tmp_path / "overlap.txt").write_text("0 0 0 0\n0 0 0 0\n")
+    (tmp_path / "gap.txt").write_text("\n".join(" ".join(map(str, leaf)) for leaf in OCTANT[:6] + OCTANT[7:]))
+    (tmp_path / "unbalanced.txt").write_text("\n".join(" ".join(map(str, leaf)) for leaf in UNBALANCED))
+    (tmp_path / "outside.txt").write_text("1 2 0 0\n")
+    (tmp_path / "garbage.txt").write_text("0 0 0 0\none two\n")
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    assert main(["mesh", "--domain", "1", "1", "1", *argv]) == 2
+    err = capsys.readouterr().err
+    assert needle in err and err.count("\n") == 1, err
