@@ -287,7 +287,7 @@ def test_tessellate_with_faces_on_the_command_line():
     assert by_flag.returncode == 0, by_flag.stderr
     data = json.loads(by_flag.stdout)
     assert data["code"] == "888888888888+f04" and data["face_points"] == "explicit"
-    assert data["faces"] == [0, 4] and data["body_point"] is False
+    assert data["faces"] == [0, 4] and data["body_point"] is False and data["point_set_code"] == data["code"]
     assert set(data["nodes"]) == {str(i) for i in range(20)} | {"20", "24"}
     by_code = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888+f04")
     assert by_code.stdout == by_flag.stdout
@@ -301,6 +301,7 @@ def test_no_faces_given_explicitly_is_policy_none():
     none = json.loads(cospherical("tessellate", "--box", "1", "2", "4", "--code", "888888888888",
                                   "--face-points", "none").stdout)
     assert explicit["code"] == "888888888888+f" and none["code"] == "888888888888"
+    assert explicit["point_set_code"] == none["point_set_code"] == "888888888888+f"
     assert explicit["elements"] == none["elements"] and explicit["nodes"] == none["nodes"]
 
 

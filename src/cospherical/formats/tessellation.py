@@ -26,6 +26,7 @@ def tessellation_data(tess: Tessellation) -> dict:
         **({"element": shape.name} if shape is not None else {}),
         "box": list(cfg.box.texts),
         "code": cfg.code,
+        "point_set_code": cfg.point_set_code,  # the key of this point set in any pattern table
         "face_points": cfg.face_points,
         "faces": sorted(cfg.point_faces),
         "body_point": cfg.has_body_point,
