@@ -178,3 +178,87 @@ def test_general_quadrilateral_face_point():
     tess = tessellate_shape(cfg)
     assert sum(e.polyhedron.unit_volume for e in tess.elements) == shape.unit_volume
     assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes())
+
+
+# ---------------------------------------------------------------------------
+# The bisection studies of the three shapes
+
+ROOT = __import__("pathlib").Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="module")
+def shape_studies():
+    from cospherical.studies.bisection import bisection_codes, run_study
+
+    return {name: run_study("bisection", standard_shape(name).box, bisection_codes(name), element=name)
+            for name in SHAPES}
+
+
+@pytest.mark.parametrize("name", SHAPES)
+def test_study_counts_equal_direct_counts(shape_studies, name):
+    """Orbit statistics (one tessellation per orbit, weighted by orbit sizes) equal tessellating
+    every configuration, and every member's mapped tessellation is its direct one."""
+    study = shape_studies[name]
+    shape = standard_shape(name)
+    counts, fvm, fvm_open = Counter(), 0, 0
+    for code in study.codes:
+        cfg = ShapeConfiguration.from_code(shape, code)
+        tess = tessellate_shape(cfg)
+        counts.update(e.type.id for e in tess.elements)
+        fvm += tess.fvm_adequate
+        fvm_open += tess.fvm_adequate_open
+        # The FVM verdicts against float circumcenters and a tolerance (the unit box: no scaling).
+        margin = min(_float_margin(shape, [cfg.real_nodes()[v] for v in e.nodes]) for e in tess.elements)
+        assert (tess.fvm_adequate, tess.fvm_adequate_open) == (margin > -1e-9, margin > 1e-9), code
+        mapped = study.tessellation(code)
+        assert [(e.type.id, e.nodes, e.mirrored) for e in mapped.elements] == \
+            [(e.type.id, e.nodes, e.mirrored) for e in tess.elements], code
+    assert {t.type.id: t.count for t in study.type_counts()} == dict(counts)
+    assert (study.fvm_adequate, study.fvm_adequate_open) == (fvm, fvm_open)
+    assert study.configurations == 1 << len(shape.edges)
+
+
+def _float_margin(shape, points) -> float:
+    """The least distance of the points' circumcenter inside the shape's face planes (negative: outside)."""
+    import numpy as np
+
+    p = np.array(points)
+    center = np.linalg.lstsq(2 * (p[1:] - p[0]), (p[1:] ** 2).sum(1) - (p[0] ** 2).sum(), rcond=None)[0]
+    margins = []
+    for normal, offset in shape.planes:
+        n = np.array([float(x) for x in normal])
+        margins.append((float(offset) - n @ center) / np.linalg.norm(n))
+    return min(margins)
+
+
+@pytest.mark.parametrize("name", SHAPES)
+def test_committed_shape_tables_pass_check(name):
+    from cospherical import load_catalogue
+    from cospherical.catalogue import catalogue_path
+    from cospherical.formats.check import check_patterns
+    from cospherical.formats.patterns import load
+
+    table = load(ROOT / "patterns" / f"bisection-{name}-1x1x1.yaml")
+    shape = standard_shape(name)
+    assert table.header["element"] == name and len(table.configurations) == 1 << len(shape.edges)
+    check_patterns(table, load_catalogue(catalogue_path()), name)  # known types, node counts, tiling
+    for code in list(table.configurations)[::5]:
+        tess = tessellate_shape(ShapeConfiguration.from_code(shape, code))
+        assert table.elements(code) == [
+            {"type": e.type.id, "nodes": list(e.nodes), "circumcenter": list(tess.circumcenter(e)),
+             **({"mirror": True} if e.mirrored else {})} for e in tess.elements]
+        assert table.configurations[code]["fvm_adequate"] == tess.fvm_adequate
+
+
+def test_study_cli_element(tmp_path):
+    import json
+
+    result = _cli("study", "bisection", "--element", "tetrahedron", "--format", "json", "--out", str(tmp_path))
+    data = json.loads(result.stdout)
+    assert data["element"] == "tetrahedron" and data["configurations"] == 64
+    assert data["criteria"]["optimal"]["total"] == sum(t["count"] for t in data["criteria"]["optimal"]["types"].values())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bisection-tetrahedron-1x1x1.json",
+                                                          "bisection-tetrahedron-1x1x1.yaml"]
+    assert _cli("check", str(tmp_path / "bisection-tetrahedron-1x1x1.yaml")).returncode == 0
+    result = _cli("study", "leaves", "--element", "prism")
+    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..catalogue import shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
+from ..core.shapes import ELEMENTS
 from ..errors import FormatError, UsageError
 from ..files.yamlio import load_yaml
 from ..formats.catalogue_file import build_catalogue
@@ -29,6 +30,8 @@ def add_parser(commands) -> None:
     source.add_argument("--summary", nargs="+", type=Path, metavar="FILE",
                         help="study summaries written by 'cospherical study --out' or 'reproduce'")
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), help="box of the study (with --study)")
+    parser.add_argument("--element", choices=ELEMENTS, default="cuboid",
+                        help="base element of the study (with --study; default cuboid)")
     parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree")
     parser.add_argument("--out", type=Path, required=True, metavar="DIR")
     parser.add_argument("--pdf", action="store_true", help="compile document.tex with pdflatex into DIR")
@@ -48,16 +51,17 @@ def run(args) -> int:
     if args.study:
         if not args.box:
             raise UsageError("cospherical render: error: --study needs --box A B C")
-        codes = bisection_codes()
+        codes = bisection_codes(args.element)
         with progress_bar(len(codes), args.study) as advance:
-            study = run_study(args.study, Box.parse(args.box), codes, args.face_points, progress=advance)
+            study = run_study(args.study, Box.parse(args.box), codes, args.face_points, progress=advance,
+                              element=args.element)
         catalogue = build_catalogue([study])
         names = {t["id"]: (t["name"], t["aliases"]) for t in catalogue["types"]}
         summaries = [study_summary(study, names)]
     else:
         summaries = [_load_summary(path) for path in args.summary]
         catalogue = shipped_catalogue()
-    written = render_tables(summaries, catalogue, args.out, "Delaunay tessellations of 1-irregular cuboids")
+    written = render_tables(summaries, catalogue, args.out, "Delaunay tessellations of 1-irregular elements")
     print(f"wrote {len(written)} files in {args.out}")
     if args.pdf:
         print(f"wrote {compile_pdf(args.out)}")

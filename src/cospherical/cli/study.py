@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ..catalogue import shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
+from ..core.shapes import ELEMENTS
 from ..errors import UsageError
 from ..files.yamlio import atomic_write
 from ..formats.patterns import pattern_name, write_pattern_table, write_patterns
@@ -32,6 +33,9 @@ def add_parser(commands) -> None:
                         "every admissible set of face points and no body point, as at octree leaves (beside the "
                         "bisection study); intersection: the paper's section 5, points at multiples of 1/RESOLUTION "
                         "placed by the midpoint scheme, on the cube")
+    parser.add_argument("--element", choices=ELEMENTS, default="cuboid",
+                        help="bisection: the base element in the box (default cuboid): prism, pyramid or tetrahedron "
+                        "(512, 256, 64 configurations)")
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), default=["1", "1", "1"],
                         help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2) (default: the cube)")
     parser.add_argument("--resolution", type=int, default=16, help="intersection: positions at multiples of 1/R (2, 4, 8, 16)")
@@ -62,10 +66,13 @@ def add_parser(commands) -> None:
 
 
 def run(args) -> int:
+    if args.element != "cuboid" and args.family != "bisection":
+        raise UsageError(f"cospherical study: error: --element {args.element}: the {args.family} study is of cuboids; "
+                         "other base elements have the bisection study")
     if args.family == "intersection":
         return _intersection(args)
     box = Box.parse(args.box)
-    codes = bisection_codes()
+    codes = bisection_codes(args.element)
     if args.family == "leaves":
         if args.face_points != "octree" or args.compare_paper:
             raise UsageError("cospherical study: error: the leaf study gives its face points in its codes and sets "
@@ -76,10 +83,10 @@ def run(args) -> int:
         summary = compared_with(study_summary(study), study_summary(bisection))
     else:
         with progress_bar(len(codes), "bisection") as advance:
-            study = run_study("bisection", box, codes, args.face_points, progress=advance)
+            study = run_study("bisection", box, codes, args.face_points, progress=advance, element=args.element)
         summary = study_summary(study)
     if args.out:
-        stem = pattern_name(study.name, box.texts, study.face_points)
+        stem = pattern_name(study.name, box.texts, study.face_points, study.element)
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
         write_patterns(study, args.out / f"{stem}.yaml", shipped_catalogue()["version"])
     return _report(summary, args, study)

@@ -469,6 +469,12 @@ class ShapeSymmetry:
     ``corner_map[i]`` is the image of corner i; ``linear`` and ``shift`` the
     affine map of unit coordinates (rational: it maps rational corners to
     rational corners); ``proper`` whether it keeps orientation.
+
+    Examples
+    --------
+    >>> swap = standard_shape("prism").symmetries[1]  # x <-> y: corners 1 and 2, 4 and 5
+    >>> swap.corner_map, swap.proper, swap.code("800000000")
+    ((0, 2, 1, 3, 5, 4), False, '008000000')
     """
 
     shape: Shape = field(repr=False, compare=False)

@@ -23,7 +23,8 @@ def _chiral(element) -> bool:
 
 
 def _study_label(study) -> str:
-    return f"{study.name} {'x'.join(study.box.texts)} {study.face_points}"
+    element = "" if study.element == "cuboid" else f" {study.element}"
+    return f"{study.name}{element} {'x'.join(study.box.texts)} {study.face_points}"
 
 
 def build_catalogue(studies) -> dict:
@@ -85,6 +86,7 @@ def build_catalogue(studies) -> dict:
                 "reference_faces": [{"nodes": nodes, "kind": kind} for nodes, kind in faces],
                 "example": {
                     "configuration": tess.configuration.code,
+                    **({"element": study.element} if study.element != "cuboid" else {}),
                     "box": list(study.box.texts),
                     "face_points": study.face_points,
                     "nodes": list(element.nodes),

@@ -2,9 +2,9 @@
 
 A pattern table's elements are checked against the catalogue (known type ids,
 one node per vertex) and against geometry: every configuration's elements,
-with the nodes its code and the table's box and point policy give, must tile
-the box (exact volumes adding up to the box, every face shared by two
-elements or lying on the box's boundary).
+with the nodes its code and the table's base element, box and point policy
+give, must tile the base element (exact volumes adding up to its volume, every
+face shared by two elements or lying on its boundary).
 """
 
 from __future__ import annotations
@@ -12,10 +12,11 @@ from __future__ import annotations
 from collections import Counter
 from fractions import Fraction
 
-from ..core.configuration import Box, Configuration
+from ..core.configuration import Box
 from ..core.geometry import Frame, six_volume
 from ..errors import FormatError, InputError
 from ..files.yamlio import validate
+from ..studies.bisection import element_family
 from .diff import document_kind
 from .patterns import entry_elements
 
@@ -56,9 +57,10 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
         box = Box.parse(header["box"])
     except InputError as error:
         raise FormatError(f"{name}: box: {error}") from None
+    family = element_family(header.get("element", "cuboid"), box, header["face_points"])
     for code, entry in table.configurations.items():
         try:
-            cfg = Configuration.from_code(code, box, header["face_points"])
+            cfg = family.configuration(code)
         except InputError as error:
             raise FormatError(f"{name}: configurations/{code}: {error}") from None
         nodes = cfg.nodes()
@@ -79,10 +81,11 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
                     if len(element["nodes"]) != t["vertices"]:
                         raise FormatError(f"{where}/{k}: {len(element['nodes'])} nodes for a type with {t['vertices']} vertices")
             if frame is not None:
-                _check_tiling(frame, elements, types, where)
+                _check_tiling(frame, elements, types, where, getattr(cfg, "shape", None))
 
 
-def _check_tiling(frame: Frame, elements, types, where: str) -> None:
+def _check_tiling(frame: Frame, elements, types, where: str, shape=None) -> None:
+    """The elements fill the box (or the ``shape``) exactly and meet face to face."""
     index = {node: i for i, node in enumerate(frame.ids)}
     coords = frame.coords
     total = 0
@@ -97,13 +100,20 @@ def _check_tiling(frame: Frame, elements, types, where: str) -> None:
             raise FormatError(f"{where}/{k}: the nodes do not make a proper element of type {element['type']}")
         total += six
         faces.update(frozenset(frame.ids[v] for v in cycle) for cycle in cycles)
-    if Fraction(total, 6 * frame.scale**3) != 1:
-        raise FormatError(f"{where}: the elements do not fill the box (volume {Fraction(total, 6 * frame.scale**3)} of 1)")
+    volume = Fraction(total, 6 * frame.scale**3)
+    if volume != (1 if shape is None else shape.unit_volume):
+        raise FormatError(f"{where}: the elements do not fill the {'box' if shape is None else shape.name} "
+                          f"(volume {volume} of {1 if shape is None else shape.unit_volume})")
+    # A shape's face planes, in the frame's integer coordinates (x = coords / scale).
+    planes = [] if shape is None else [(normal, offset * frame.scale) for normal, offset in shape.planes]
     for face, count in faces.items():
-        on_boundary = any(
-            len({coords[index[v]][axis] for v in face}) == 1 and coords[index[next(iter(face))]][axis] in (0, frame.scale)
-            for axis in range(3)
-        )
+        points = [coords[index[v]] for v in face]
+        if shape is None:
+            on_boundary = any(len({p[axis] for p in points}) == 1 and points[0][axis] in (0, frame.scale)
+                              for axis in range(3))
+        else:
+            on_boundary = any(all(sum(a * x for a, x in zip(normal, p)) == offset for p in points)
+                              for normal, offset in planes)
         if count != (1 if on_boundary else 2):
             raise FormatError(f"{where}: face {sorted(face)} belongs to {count} elements: they do not meet face to face")
 

@@ -41,11 +41,13 @@ SCHEMES = {
 }
 
 
-def pattern_name(study: str, box_texts, face_points: str = "octree") -> str:
-    """File stem for a study's outputs, e.g. ``bisection-1x1.4142x1.4142``."""
+def pattern_name(study: str, box_texts, face_points: str = "octree", element: str = "cuboid") -> str:
+    """File stem for a study's outputs, e.g. ``bisection-1x1.4142x1.4142``; another base element
+    than the cuboid is named after the study: ``bisection-prism-1x1x1``."""
     box = "x".join(re.sub(r"[^0-9a-z./]+", "", text.replace("/", "_")) for text in box_texts)
     # explicit points are named by the codes inside the table, not by its file name
-    return f"{study}-{box}" + ("" if face_points in ("octree", "explicit") else f"-{face_points}")
+    return f"{study}-{'' if element == 'cuboid' else element + '-'}{box}" + (
+        "" if face_points in ("octree", "explicit") else f"-{face_points}")
 
 
 def patterns_text(study: Study, catalogue_version: str) -> str:
@@ -55,6 +57,7 @@ def patterns_text(study: Study, catalogue_version: str) -> str:
         "generator": f"cospherical {__version__}",
         "catalogue_version": catalogue_version,
         "study": study.name,
+        **({"element": study.element} if study.element != "cuboid" else {}),
         "box": list(study.box.texts),
         "face_points": study.face_points,
         "scheme": SCHEMES.get(study.name, study.name),

@@ -162,7 +162,7 @@ def _type_rows(summaries: list[dict], catalogue: dict) -> list[dict]:
 def _stem(summary: dict) -> str:
     if summary["study"] == "intersection":
         return f"intersection-r{summary['resolution']}-{summary['insertion_order']}"
-    return pattern_name(summary["study"], summary["box"], summary["face_points"])
+    return pattern_name(summary["study"], summary["box"], summary["face_points"], summary.get("element", "cuboid"))
 
 
 def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str) -> list[Path]:
@@ -183,7 +183,7 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str)
     for summary in summaries:
         stem = _stem(summary)
         key, _ = paper_study_key(summary)
-        box = " x ".join(summary["box"])
+        box = " x ".join(summary["box"]) + (f" ({summary['element']})" if "element" in summary else "")
         files = []
         for criterion, data in summary["criteria"].items():
             rows = [{"name": t["name"], "paper_class": t["paper_class"], "count": t["count"], "share": t["share"],
@@ -210,7 +210,8 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str)
                          "files": files})
     sections.insert(1, {"title": "Finite-volume circumcenter test",
                         "files": [write("fvm.tex", "fvm.tex.j2", rows=fvm_rows,
-                                        caption="Configurations whose element circumcenters all lie in the box")]})
+                                        caption="Configurations whose element circumcenters all lie in the box "
+                                        "(in the base element for a prism, pyramid or tetrahedron)")]})
     write("document.tex", "document.tex.j2", title=title, version=__version__, sections=sections)
     return written
 

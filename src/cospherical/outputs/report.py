@@ -39,7 +39,8 @@ def _mark(paper, ours) -> str:
 def text_report(summary: dict, compare_paper: bool = False, study: Study | None = None) -> str:
     """A plain-text report: the frequency table and, if asked, the paper beside it."""
     lines = [
-        f"{summary['study']} study, box {' x '.join(summary['box'])}, face points {summary['face_points']}: "
+        f"{summary['study']} study{' of the ' + summary['element'] if 'element' in summary else ''}, "
+        f"box {' x '.join(summary['box'])}, face points {summary['face_points']}: "
         f"{summary['configurations']} configurations ({summary['orbits']} orbits)",
         f"FVM adequate: {summary['fvm_adequate']} (closed box), {summary['fvm_adequate_open']} (open box)",
     ]

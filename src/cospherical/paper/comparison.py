@@ -33,8 +33,8 @@ def paper_study_key(summary: dict) -> tuple[str | None, list[str]]:
     """
     if summary["study"] == "intersection":
         return "intersection_cube", ["classes", "insertion_order"]
-    if summary["study"] != "bisection":
-        return None, []
+    if summary["study"] != "bisection" or summary.get("element", "cuboid") != "cuboid":
+        return None, []  # the paper studied cuboids only
     notes = ["classes"]
     if summary["face_points"] != "octree":
         notes.append("none_policy")

@@ -1,7 +1,8 @@
 """Studies: tessellate every configuration of a family, one per symmetry orbit.
 
 A study tessellates only one member (the smallest code) of each orbit of the
-box's symmetry group.  Statistics count every configuration through the orbit
+base element's symmetry group (the box's for a cuboid; for a prism, pyramid or
+tetrahedron the isometries of that shape, :mod:`cospherical.core.shapes`).  Statistics count every configuration through the orbit
 sizes, since a symmetry maps element types and circumcenter tests to
 themselves.  A member's own tessellation is the representative's mapped
 through the symmetry and re-classified, so that its node orders are exactly
@@ -11,23 +12,60 @@ what a direct call gives.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
-from typing import Callable, Sequence
+from dataclasses import dataclass, replace
+from functools import lru_cache
+from typing import Callable, NamedTuple, Sequence
 
 from ..catalogue import CRITERIA, Choice, choose
-from ..core.configuration import Box, Configuration
+from ..core.configuration import EDGES, Box, Configuration
 from ..core.element_types import ElementType, classify
+from ..core.shapes import ShapeConfiguration, mask_codes, shape_orbit_representatives, standard_shape, tessellate_shape
 from ..core.symmetry import Symmetry, box_symmetries, orbit_representatives
 from ..core.tessellation import Element, Tessellation, tessellate
 
-__all__ = ["Study", "TypeCount", "bisection_codes", "map_tessellation", "run_study"]
+__all__ = ["Family", "Study", "TypeCount", "bisection_codes", "element_family", "map_tessellation", "run_study"]
 
 Progress = Callable[[int], None]
 
 
-def bisection_codes() -> list[str]:
-    """The 4096 bisection configuration codes: a midpoint (``8``) or nothing on each edge."""
-    return ["".join("8" if mask >> k & 1 else "0" for k in range(12)) for mask in range(4096)]
+def bisection_codes(element: str = "cuboid") -> list[str]:
+    """The bisection configuration codes of a base element: a midpoint (``8``) or nothing on each
+    edge (4096 for the cuboid; 512, 256 and 64 for the prism, pyramid and tetrahedron).
+
+    >>> len(bisection_codes()), bisection_codes("tetrahedron")[:3]
+    (4096, ['000000', '800000', '080000'])
+    """
+    return mask_codes(len(EDGES) if element == "cuboid" else len(standard_shape(element).edges))
+
+
+class Family(NamedTuple):
+    """What a study needs of its base element: configurations from codes, the symmetries, the
+    orbit representatives of codes under them, and the tessellation."""
+
+    configuration: Callable[[str], object]
+    symmetries: tuple
+    representatives: Callable
+    tessellate: Callable
+
+
+@lru_cache(maxsize=None)  # a study maps every member through it
+def element_family(element: str, box: Box, face_points: str = "octree") -> Family:
+    """The :class:`Family` of a base element (``cuboid``, ``prism``, ``pyramid``, ``tetrahedron``) in a box.
+
+    Examples
+    --------
+    >>> family = element_family("prism", Box.parse(["1", "1", "1"]))
+    >>> len(family.symmetries), family.configuration("888888888").point_faces
+    (4, frozenset({2, 3, 4}))
+    >>> len(element_family("cuboid", Box.parse(["1", "2", "4"])).symmetries)
+    8
+    """
+    if element == "cuboid":
+        return Family(lambda code: Configuration.from_code(code, box, face_points), box_symmetries(box),
+                      orbit_representatives, tessellate)
+    shape = standard_shape(element, box)
+    return Family(lambda code: ShapeConfiguration.from_code(shape, code, face_points), shape.symmetries,
+                  shape_orbit_representatives, tessellate_shape)
 
 
 def map_tessellation(tess: Tessellation, sym: Symmetry, target: Configuration) -> Tessellation:
@@ -38,7 +76,8 @@ def map_tessellation(tess: Tessellation, sym: Symmetry, target: Configuration) -
         etype, order, mirrored = classify(poly)
         elements.append(Element(etype, order, poly, mirrored))
     elements.sort(key=lambda e: e.polyhedron.nodes)
-    return Tessellation(target, target.nodes(), tuple(elements))
+    # replace keeps the tessellation's class: a shape's keeps its own FVM test
+    return replace(tess, configuration=target, nodes=target.nodes(), elements=tuple(elements))
 
 
 @dataclass(frozen=True)
@@ -58,6 +97,7 @@ class Study:
     codes: tuple[str, ...]
     representative: dict[str, tuple[str, Symmetry]]  # code -> (orbit representative, symmetry to it)
     choices: dict[str, Choice]  # criterion -> kept types and the representatives' tessellations
+    element: str = "cuboid"  # the base element: cuboid, prism, pyramid or tetrahedron
 
     @property
     def criteria(self) -> tuple[str, ...]:
@@ -89,7 +129,7 @@ class Study:
         rep, sym = self.representative[code]
         if rep == code:
             return tess
-        target = Configuration.from_code(code, self.box, self.face_points)
+        target = element_family(self.element, self.box, self.face_points).configuration(code)
         return map_tessellation(tess, sym.inverse(), target)
 
     def _count(self, predicate: Callable[[Tessellation], bool]) -> int:
@@ -133,22 +173,31 @@ def run_study(
     face_points: str = "octree",
     progress: Progress | None = None,
     criteria: Sequence[str] = CRITERIA,
+    element: str = "cuboid",
 ) -> Study:
-    """Tessellate every configuration code, one per orbit of the box's symmetries.
+    """Tessellate every configuration code of a base element, one per orbit of its symmetries.
 
     ``progress(n)`` is called as orbits are done, with the number of
     configurations they account for.  Each criterion (``optimal``,
     ``internal_faces``, ``internal_edges_and_faces``) gets its kept types and
     split tessellations.
+
+    Examples
+    --------
+    >>> study = run_study("bisection", Box.parse(["1", "1", "1"]), bisection_codes("tetrahedron"),
+    ...                   element="tetrahedron")
+    >>> study.configurations, study.orbits, study.total(), study.fvm_adequate
+    (64, 20, 206, 7)
     """
-    symmetries = box_symmetries(box)
-    reps, sym_index = orbit_representatives(codes, symmetries)
+    family = element_family(element, box, face_points)
+    symmetries = family.symmetries
+    reps, sym_index = family.representatives(codes, symmetries)
     representative = {code: (rep, symmetries[i]) for code, rep, i in zip(codes, reps, sym_index)}
     sizes = Counter(reps)
     tessellations = {}
     for rep in sorted(sizes):
-        tessellations[rep] = tessellate(Configuration.from_code(rep, box, face_points))
+        tessellations[rep] = family.tessellate(family.configuration(rep))
         if progress:
             progress(sizes[rep])
     choices = {criterion: choose(tessellations, sizes, criterion) for criterion in criteria}
-    return Study(name, box, face_points, tuple(codes), representative, choices)
+    return Study(name, box, face_points, tuple(codes), representative, choices, element)

@@ -95,6 +95,7 @@ def study_summary(study: Study, names: Mapping[str, tuple[str, list[str]]] | Non
         criteria[criterion] = frequency_table(counts, configurations, types, splits)
     return {
         "study": study.name,
+        **({"element": study.element} if study.element != "cuboid" else {}),
         "box": list(study.box.texts),
         "face_points": study.face_points,
         "configurations": study.configurations,
