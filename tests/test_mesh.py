@@ -215,3 +215,13 @@ def test_bad_input_is_refused_with_one_line(tmp_path, capsys, argv, needle):
     assert main(["mesh", "--domain", "1", "1", "1", *argv]) == 2
     err = capsys.readouterr().err
     assert needle in err and err.count("\n") == 1, err
+
+
+def test_split_criteria_keep_the_mesh_whole():
+    """Splits add internal faces and edges only: the split mesh still fills the domain and conforms."""
+    tree = build_octree(CUBE, 4, [parse_shape("sphere:0.5,0.5,0.5,0.3")])
+    optimal = assemble(tree)
+    split = assemble(tree, criterion="internal_edges_and_faces")
+    assert len(split) > len(optimal)
+    found = checks(split)
+    assert found["volume_ok"] and found["nonconforming_faces"] == 0 and found["delaunay_violations"] == 0

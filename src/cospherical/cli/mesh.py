@@ -13,7 +13,7 @@ from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
 from ..studies.mesh.assembly import assemble
 from ..studies.mesh.octree import BALANCES, MAX_LEVEL, build_octree, leaves_octree, parse_shape
 from ..studies.mesh.report import mesh_report
-from .progress import progress_bar
+from .progress import stage_bars
 
 
 def add_parser(commands) -> None:
@@ -87,30 +87,35 @@ def run(args) -> int:
         tree = build_octree(box, levels, shapes, args.balance)
         described = {"source": "refine", "levels": levels, "refine": [s.text for s in shapes],
                      "balance": args.balance, "depth": tree.depth}
+    timings = {"tree": time.perf_counter() - clock}
+    clock = time.perf_counter()
     lookup = None
     if args.patterns is not None:
         from ..formats.patterns import load
 
         lookup = table_lookup(load(args.patterns), args.criterion, box, str(args.patterns))
-    timings = {"tree": time.perf_counter() - clock}
-    clock = time.perf_counter()
-    with progress_bar(len(tree), "assembling leaves") as advance:
-        mesh = assemble(tree, lookup, progress=advance if len(tree) > 50_000 else None)
-    timings["assembly"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    stages = []
-
-    def stage(name: str) -> None:
-        nonlocal clock
-        if stages:
-            timings[stages[-1]] = time.perf_counter() - clock
-        stages.append(name)
+        timings["table"] = time.perf_counter() - clock
         clock = time.perf_counter()
-        if len(tree) > 50_000 and sys.stderr.isatty():
-            print(f"cospherical mesh: {name} ...", file=sys.stderr)
+    large = len(tree) > 50_000  # bars on large trees only (and only on a terminal: tqdm's disable=None)
+    bars = {"assembly": (len(tree), "assembling", "leaf"), "delaunay": (None, "Delaunay check", "element")}
+    with stage_bars(bars) as advance:
+        mesh = assemble(tree, lookup, progress=(lambda n: advance("assembly", n)) if large else None,
+                        criterion=args.criterion)
+        timings["assembly"] = time.perf_counter() - clock
+        clock = time.perf_counter()
+        bars["delaunay"] = (len(mesh), "Delaunay check", "element")  # read when its bar opens
+        stages = []
 
-    report = mesh_report(mesh, described, args.patterns.name if args.patterns else None, args.criterion,
-                         uniform=not args.no_uniform, delaunay=not args.no_delaunay, stage=stage)
+        def stage(name: str) -> None:
+            nonlocal clock
+            if stages:
+                timings[stages[-1]] = time.perf_counter() - clock
+            stages.append(name)
+            clock = time.perf_counter()
+
+        report = mesh_report(mesh, described, args.patterns.name if args.patterns else None, args.criterion,
+                             uniform=not args.no_uniform, delaunay=not args.no_delaunay, stage=stage,
+                             progress=(lambda n: advance("delaunay", n)) if large else None)
     stage("outputs")
     if args.out is not None:
         from ..formats.mesh import write_vtu

@@ -24,7 +24,7 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from ...catalogue import shipped_catalogue
+from ...catalogue import apply_catalogue_criterion, shipped_catalogue
 from ...core.configuration import CORNERS, EDGES, FACES, Box, Configuration
 from ...core.delaunay import hull_faces
 from ...core.element_types import ElementType
@@ -147,6 +147,7 @@ class Mesh:
     element_leaf: np.ndarray
     element_local: np.ndarray
     types: dict[str, dict] = field(default_factory=dict)
+    _groups: list | None = field(default=None, repr=False, compare=False)
 
     @property
     def box(self) -> Box:
@@ -161,12 +162,13 @@ class Mesh:
 
     def groups(self):
         """Yield ``(pattern index, pattern, leaf indices)`` for every configuration that occurs, in order."""
-        order = np.argsort(self.leaf_pattern, kind="stable")
-        counts = np.bincount(self.leaf_pattern, minlength=len(self.patterns))
-        start = 0
-        for p, count in enumerate(counts.tolist()):
-            yield p, self.patterns[p], order[start:start + count]
-            start += count
+        if self._groups is None:  # every check walks the groups: sort the leaves once
+            order = np.argsort(self.leaf_pattern, kind="stable")
+            counts = np.bincount(self.leaf_pattern, minlength=len(self.patterns))
+            starts = np.r_[0, np.cumsum(counts)]
+            self._groups = [order[starts[p]:starts[p + 1]] for p in range(len(self.patterns))]
+        for p, leaves in enumerate(self._groups):
+            yield p, self.patterns[p], leaves
 
     def connectivity(self) -> tuple[np.ndarray, np.ndarray]:
         """Global vertex ids of every element: (elements x widest) int32 padded with -1, and the sizes."""
@@ -225,13 +227,14 @@ def leaf_code(edges: int, faces: int) -> str:
 
 
 def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int], None] | None = None,
-             cache: dict | None = None) -> Mesh:
+             cache: dict | None = None, criterion: str = "optimal") -> Mesh:
     """Mesh an octree: configurations from the vertex set, elements from ``lookup`` (else tessellated).
 
     ``lookup(configuration)`` returns the pattern table's elements of that point set
     (dicts with ``type`` and ``nodes``) or ``None`` when the table lacks it; a
-    configuration without table elements is tessellated on the fly (and marked so).
-    ``cache`` (code -> :class:`LocalPattern`) may be shared between runs.
+    configuration without table elements is tessellated on the fly (and marked so), its
+    elements split by the catalogue's kept types when ``criterion`` is not ``optimal``.
+    ``cache`` ((code, criterion) -> :class:`LocalPattern`) may be shared between runs.
     ``progress(n)`` is told as leaves are assembled.
 
     Examples
@@ -280,9 +283,9 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     patterns, types = [], {}
     for value in distinct.tolist():
         code = leaf_code(value & 0xFFF, value >> 12)
-        if code not in cache:
-            cache[code] = _pattern(Configuration.from_code(code, tree.box), lookup, types)
-        patterns.append(cache[code])
+        if (code, criterion) not in cache:
+            cache[code, criterion] = _pattern(Configuration.from_code(code, tree.box), lookup, types, criterion)
+        patterns.append(cache[code, criterion])
     for pattern in patterns:
         for element in pattern.elements:
             if element.type_id not in types:
@@ -298,11 +301,11 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
                 element_leaf, element_local, types)
 
 
-def _pattern(configuration: Configuration, lookup: Lookup | None, types: dict) -> LocalPattern:
+def _pattern(configuration: Configuration, lookup: Lookup | None, types: dict, criterion: str) -> LocalPattern:
     elements = lookup(configuration) if lookup is not None else None
     if elements is not None:
         return local_pattern(configuration, [(e["type"], e["nodes"]) for e in elements])
-    tess = tessellate(configuration)
+    tess = apply_catalogue_criterion(tessellate(configuration), criterion)
     for element in tess.elements:
         types.setdefault(element.type.id, _type_info(element.type.id, element.type))
     return local_pattern(configuration, [(e.type.id, e.nodes) for e in tess.elements], on_the_fly=True)

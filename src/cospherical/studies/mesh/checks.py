@@ -186,14 +186,16 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         pairs_vertex.append(np.fromiter((v for x in found for v in x), dtype=np.int64, count=int(lengths.sum())))
     pair_row = np.concatenate(pairs_row) if pairs_row else np.zeros(0, dtype=np.int64)
     pair_vertex = np.concatenate(pairs_vertex) if pairs_vertex else np.zeros(0, dtype=np.int64)
-    # drop each element's own nodes
-    own = np.zeros(len(pair_row), dtype=bool)
+    # drop each element's own nodes: a (pattern, element) -> local node table, padded with slot 26 (never a vertex)
+    width = max(len(e.nodes) for p in mesh.patterns for e in p.elements)
+    widest = max(len(p.elements) for p in mesh.patterns)
+    local = np.full((len(mesh.patterns), widest, width), 26, dtype=np.int64)
     for p, pattern in enumerate(mesh.patterns):
         for j, element in enumerate(pattern.elements):
-            mine = np.flatnonzero((rows_pattern[pair_row] == p) & (rows_local[pair_row] == j))
-            if len(mine):
-                nodes = mesh.slots[rows_leaf[pair_row[mine]]][:, list(element.nodes)]
-                own[mine] = (nodes == pair_vertex[mine, None]).any(axis=1)
+            local[p, j, :len(element.nodes)] = element.nodes
+    leaf_of_pair = rows_leaf[pair_row]
+    nodes = mesh.slots[leaf_of_pair[:, None], local[rows_pattern[pair_row], rows_local[pair_row]]]
+    own = (nodes == pair_vertex[:, None]).any(axis=1)
     pair_row, pair_vertex = pair_row[~own], pair_vertex[~own]
     inside = np.zeros(len(pair_row), dtype=bool)
     ties = 0

@@ -15,14 +15,16 @@ __all__ = ["mesh_report"]
 
 
 def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal", uniform: bool = True,
-                delaunay: bool = True, stage: Callable[[str], None] | None = None) -> dict:
+                delaunay: bool = True, stage: Callable[[str], None] | None = None,
+                progress: Callable[[int], None] | None = None) -> dict:
     """Run every check on ``mesh`` and gather the report (the keys of ``schemas/mesh-report.schema.json``).
 
     ``tree`` describes where the octree came from; ``patterns`` names the table read
     (``None``: every configuration tessellated); ``uniform`` adds the uniform-weight
     bisection study of the box beside the mesh's frequencies; ``delaunay=False``
     skips the global Delaunay check (``delaunay_violations`` is then ``null``);
-    ``stage(name)`` is told as each check starts.
+    ``stage(name)`` is told as each check starts, ``progress(n)`` as the Delaunay check
+    goes through the elements.
     """
     def start(name: str) -> None:
         if stage:
@@ -49,7 +51,7 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     report.update(check_circumcenters(mesh))
     if delaunay:
         start("delaunay")
-        found = check_delaunay(mesh)
+        found = check_delaunay(mesh, progress=progress)
         bad_leaves = found.pop("_leaves")
         report.update(found)
         # the issue's point: a leaf can be fvm_adequate on its own and still not globally Delaunay

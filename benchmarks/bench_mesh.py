@@ -1,0 +1,74 @@
+"""Mesh a sphere octree of about a million leaves from a pattern table, with every exact check, timed.
+
+    python benchmarks/bench_mesh.py [--levels 9] [--radius 0.3] [--patterns patterns/leaves-1x1x1.yaml]
+    python benchmarks/bench_mesh.py --domain 1 2 4 --levels 8 --radius 0.6 --patterns patterns/leaves-1x2x4.yaml
+
+The sphere is centred in the domain.
+Stages, each timed on its own: loading the table; building the octree (refinement
+and vertex balance); assembly (each leaf's configuration from the vertex set,
+elements from the table, global vertex ids; the distinct configurations are looked
+up and measured once each, shown separately as "configurations"); the volume,
+conformity and circumcenter checks; the exact global Delaunay check; the
+frequency statistics (without the uniform study).  Peak memory is the process's
+maximum resident set size.  Targets (issue 14): assembly >= 100,000 leaves/s,
+volume + conformity + circumcenters < 2 min, Delaunay < 5 min, peak < 4 GB.
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import time
+
+from cospherical import load_patterns
+from cospherical.core.configuration import Box
+from cospherical.formats.mesh import table_lookup
+from cospherical.studies.mesh.assembly import assemble
+from cospherical.studies.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
+from cospherical.studies.mesh.octree import build_octree, parse_shape
+from cospherical.studies.mesh.statistics import mesh_statistics
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--domain", nargs=3, default=["1", "1", "1"])
+    parser.add_argument("--levels", type=int, default=9)
+    parser.add_argument("--radius", default="0.3")
+    parser.add_argument("--patterns", default="patterns/leaves-1x1x1.yaml")
+    args = parser.parse_args()
+    box = Box.parse(args.domain)
+    centre = ",".join(str(float(length) / 2) for length in box.lengths)
+    clock = {}
+
+    def stage(name, function):
+        start, cpu = time.perf_counter(), time.process_time()
+        value = function()
+        clock[name] = (time.perf_counter() - start, time.process_time() - cpu)
+        return value
+
+    table = stage("load table", lambda: load_patterns(args.patterns))
+    lookup = table_lookup(table, "optimal", box, args.patterns)
+    tree = stage("octree", lambda: build_octree(box, args.levels, [parse_shape(f"sphere:{centre},{args.radius}")]))
+    cache: dict = {}
+    stage("configurations (first assembly)", lambda: assemble(tree, lookup, cache=cache))
+    mesh = stage("assembly", lambda: assemble(tree, lookup, cache=cache))
+    volume = stage("volume", lambda: check_volume(mesh))
+    conformity = stage("conformity", lambda: check_conformity(mesh))
+    centres = stage("circumcenters", lambda: check_circumcenters(mesh))
+    delaunay = stage("delaunay", lambda: check_delaunay(mesh))
+    stage("statistics", lambda: mesh_statistics(mesh))
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
+    print(f"leaves {len(tree):,}  vertices {len(mesh.vertices):,}  elements {len(mesh):,}  "
+          f"configurations {len(mesh.patterns)}  on the fly {sum(p.on_the_fly for p in mesh.patterns)}")
+    for name, (wall, cpu) in clock.items():
+        print(f"{name:34s} {wall:8.2f} s wall {cpu:8.2f} s cpu")
+    wall = clock["assembly"][0]
+    print(f"assembly rate {len(tree) / wall:,.0f} leaves/s (wall)")
+    checks = sum(clock[k][0] for k in ("volume", "conformity", "circumcenters"))
+    print(f"volume + conformity + circumcenters {checks:.1f} s; delaunay {clock['delaunay'][0]:.1f} s; "
+          f"peak {peak:.2f} GB")
+    print({**volume, **conformity, **centres, **{k: v for k, v in delaunay.items() if k != "_leaves"}})
+
+
+if __name__ == "__main__":
+    main()
