@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..catalogue import CRITERIA
 from ..core.configuration import Box
+from ..core.exact import parse_rational
 from ..errors import InputError
 from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
 from ..studies.mesh.assembly import assemble
@@ -44,6 +45,8 @@ def add_parser(commands) -> None:
     parser.add_argument("--out", type=Path, metavar="DIR", help="write mesh.vtu, report.json and mesh.png here")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="text (default): the main figures; json: the whole report on stdout")
+    parser.add_argument("--cut", metavar="Z", help="height of the picture's cut as a fraction of the domain height "
+                        "(default: through the first shape's centre, else 1/2)")
     parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check")
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
@@ -64,6 +67,22 @@ SUMMARY_KEYS = ("leaves", "vertices", "elements", "types", "volume_ok", "nonconf
                 "configurations", "tessellated_on_the_fly", "paper_final_share")
 
 
+def _cut(args, box: Box) -> float:
+    """Where the picture cuts: ``--cut``, else through the first shape's centre, else half height."""
+    if args.cut is not None:
+        value = parse_rational(args.cut, "--cut")
+        if not 0 <= value <= 1:
+            raise InputError(f"--cut {args.cut}: must be a fraction of the domain height, 0..1")
+        return float(value)
+    if args.refine:
+        shape = parse_shape(args.refine[0])
+        if shape.kind in ("sphere", "point"):
+            return min(1.0, max(0.0, float(shape.values[2]) / float(box.c)))
+        if shape.kind == "box":
+            return min(1.0, max(0.0, float(shape.values[2] + shape.values[5]) / 2 / float(box.c)))
+    return 0.5
+
+
 def _text(value) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -74,6 +93,7 @@ def _text(value) -> str:
 
 def run(args) -> int:
     box = Box.parse(args.domain)
+    at = _cut(args, box)  # before the work: a bad --cut is refused at once
     clock = time.perf_counter()
     if args.leaves is not None:
         if args.levels is not None:
@@ -124,9 +144,9 @@ def run(args) -> int:
         write_report(report, args.out / "report.json")
         write_vtu(mesh, args.out / "mesh.vtu")
         shapes = ", ".join(described.get("refine", [])) or described.get("file", "")
-        cut_png(mesh, args.out / "mesh.png",
+        cut_png(mesh, args.out / "mesh.png", at=at,
                 title=f"{' x '.join(box.texts)}: {shapes}; {report['leaves']:,} leaves, {report['elements']:,} "
-                      f"elements, {report['types']} types (cut at half height)")
+                      f"elements, {report['types']} types (cut at z = {at * float(box.c):.4g})")
     timings["outputs"] = time.perf_counter() - clock
     if args.format == "json":
         sys.stdout.write(report_json(report))

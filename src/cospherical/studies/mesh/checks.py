@@ -34,7 +34,7 @@ def check_volume(mesh: Mesh) -> dict:
     Examples
     --------
     >>> from cospherical.core.configuration import Box
-    >>> from cospherical.studies.mesh.octree import build_octree
+    >>> from cospherical.studies.mesh.octree import build_octree, parse_shape
     >>> from cospherical.studies.mesh.assembly import assemble
     >>> check_volume(assemble(build_octree(Box.parse([1, 2, 4]), 0, [])))
     {'volume_ok': True, 'volume': '1', 'flat_elements': 0}
@@ -77,6 +77,15 @@ def check_conformity(mesh: Mesh, examples: int = 5) -> dict:
     Returns ``nonconforming_faces`` (face occurrences), ``interior_faces`` (pairs),
     ``boundary_faces`` and up to ``examples`` nonconforming faces (vertex
     coordinates as fractions of the domain).
+
+    Examples
+    --------
+    >>> from cospherical.core.configuration import Box
+    >>> from cospherical.studies.mesh.octree import build_octree, parse_shape
+    >>> from cospherical.studies.mesh.assembly import assemble
+    >>> found = check_conformity(assemble(build_octree(Box.parse([1, 1, 1]), 1, [parse_shape("point:0.5,0.5,0.5")])))
+    >>> found["nonconforming_faces"], found["interior_faces"], found["boundary_faces"]
+    (0, 12, 24)
     """
     grid = mesh.grid
     bad_total, interior, boundary = 0, 0, 0

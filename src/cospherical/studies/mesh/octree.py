@@ -112,8 +112,9 @@ def _exact_array(values: Sequence[int], bound: int) -> np.ndarray:
 def _meets(shape: Shape, box: Box, level: int, cells: np.ndarray) -> np.ndarray:
     """Which cells (n x 3 positions at ``level``) have a closed box meeting the shape, exactly.
 
-    Everything is scaled to integers: a cell spans ``[i*S, (i+1)*S]`` per axis with
-    ``S = M`` on the ``M * 2**level`` grid, where M clears the shape's denominators.
+    Everything is scaled to integers: on a grid of ``M * 2**level`` steps per side, where M
+    clears the shape's denominators, a cell spans ``[i*M, (i+1)*M]`` per axis.  Arrays are
+    int64 where a bound shows the products fit, else Python integers.
     """
     v = shape.values
     if shape.kind in ("point", "box"):
@@ -140,7 +141,7 @@ def _meets(shape: Shape, box: Box, level: int, cells: np.ndarray) -> np.ndarray:
         r2 = radius * radius * weights_den * grid * grid  # an integer: R**2 on the grid, weighted like the axes
         assert r2.denominator == 1
         extent = max(abs(x) for x in c) + grid
-        fit = extent * extent * sum(weights) * 4
+        fit = max(extent * extent * sum(weights) * 4, int(r2))
         near = np.zeros(len(cells), dtype=object if fit >= 2**62 else np.int64)
         far = np.zeros_like(near)
         for axis in range(3):

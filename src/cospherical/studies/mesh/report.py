@@ -25,6 +25,16 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     skips the global Delaunay check (``delaunay_violations`` is then ``null``);
     ``stage(name)`` is told as each check starts, ``progress(n)`` as the Delaunay check
     goes through the elements.
+
+    Examples
+    --------
+    >>> from cospherical.core.configuration import Box
+    >>> from cospherical.studies.mesh.assembly import assemble
+    >>> from cospherical.studies.mesh.octree import build_octree, parse_shape
+    >>> tree = build_octree(Box.parse([1, 1, 1]), 2, [parse_shape("point:0.1,0.1,0.1")])
+    >>> report = mesh_report(assemble(tree), {"source": "refine"}, None, uniform=False)
+    >>> [report[k] for k in ("leaves", "elements", "volume_ok", "nonconforming_faces", "delaunay_violations")]
+    [15, 48, True, 0, 0]
     """
     def start(name: str) -> None:
         if stage:
