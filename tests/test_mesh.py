@@ -226,3 +226,18 @@ def test_split_criteria_keep_the_mesh_whole():
     assert len(split) > len(optimal)
     found = checks(split)
     assert found["volume_ok"] and found["nonconforming_faces"] == 0 and found["delaunay_violations"] == 0
+
+
+@pytest.mark.parametrize("balance", ["edge", "vertex"])
+def test_both_balances_give_whole_meshes(balance):
+    """Edge balance lets leaves touching only at a corner differ by two levels: still 1-irregular, still whole."""
+    tree = build_octree(CUBE, 5, [parse_shape("point:0.3,0.61,0.77"), parse_shape("plane:1,1,1,1.2")], balance)
+    found = checks(assemble(tree))
+    assert found["volume_ok"] and found["nonconforming_faces"] == 0 and found["delaunay_violations"] == 0
+    again = leaves_octree(CUBE, tree.levels, tree.positions)  # the leaf-list check accepts it
+    assert np.array_equal(again.positions, tree.positions)
+
+
+def test_vertex_balance_is_never_coarser_than_edge_balance():
+    shapes = [parse_shape("point:0.3,0.61,0.77")]
+    assert len(build_octree(CUBE, 6, shapes, "vertex")) >= len(build_octree(CUBE, 6, shapes, "edge"))
