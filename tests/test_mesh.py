@@ -12,7 +12,7 @@ from cospherical.core.configuration import Box, Configuration
 from cospherical.core.tessellation import tessellate
 from cospherical.files.yamlio import atomic_write, yaml_text
 from cospherical.formats.mesh import read_leaves, table_lookup, to_meshio, write_vtu
-from cospherical.formats.patterns import configuration_lines, load
+from cospherical.formats.patterns import configuration_line, load
 from cospherical.studies.mesh.assembly import assemble
 from cospherical.studies.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
 from cospherical.studies.mesh.octree import build_octree, leaves_octree, parse_shape
@@ -42,7 +42,7 @@ def small_table(path, box, codes):
     lines = [yaml_text(header).rstrip("\n"), "configurations:"]
     for code in sorted(codes):
         tess = tessellate(Configuration.from_code(code, box))
-        lines.extend(configuration_lines(code, tess.fvm_adequate, {"optimal": tess}))
+        lines.append(configuration_line(code, tess.fvm_adequate, {"optimal": tess}).rstrip("\n"))
     atomic_write(path, "\n".join(lines) + "\n")
     return load(path)
 

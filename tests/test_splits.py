@@ -179,3 +179,25 @@ def test_paper_table_r2_row_by_row(studies):
     table = paper_comparison(study_summary(studies["C"]), "bisection_C", "internal_faces")
     assert all(row["paper"] == row["ours"] for row in table["rows"]), table["rows"]
     assert table["total"] == {"paper": 43231, "ours": 43231}
+
+
+def test_internal_face_splits_are_the_internal_edge_splits_without_inner_edges(studies):
+    # split_options filters the internal-edge search for the internal-face criterion:
+    # the filter must give exactly what the criterion's own search gives.
+    from cospherical.core.geometry import Frame
+    from cospherical.core.split import subdivisions
+
+    seen = set()
+    for study in studies.values():
+        for tess in study.tessellations.values():
+            for element in tess.elements:
+                points = {n: tess.nodes[n] for n in element.polyhedron.nodes}
+                key = (tuple(sorted(points.items())), tess.configuration.box.squared)
+                if key in seen:
+                    continue
+                seen.add(key)
+                own = subdivisions(Frame.build(points, tess.configuration.box.squared), element.polyhedron,
+                                   "internal_faces")
+                filtered = element_options(tess, element, "internal_faces")
+                assert sorted(tuple(p.nodes for p in split) for split in own) == sorted(
+                    tuple(p.polyhedron.nodes for p in option) for option in filtered)

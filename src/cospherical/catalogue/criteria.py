@@ -22,7 +22,7 @@ from ..core.tessellation import Element, Tessellation
 from .store import shipped_catalogue
 
 __all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "choose", "choose_kept",
-           "element_options", "minimal_kept_sets", "option_types", "split_options", "split_tessellation"]
+           "element_options", "minimal_kept_sets", "option_types", "split_options", "split_positions", "split_tessellation"]
 
 
 def element_options(tess: Tessellation, element: Element, criterion: str) -> tuple[tuple[Element, ...], ...]:
@@ -36,6 +36,14 @@ def element_options(tess: Tessellation, element: Element, criterion: str) -> tup
 def split_options(points, squared, poly, criterion) -> tuple[tuple[Element, ...], ...]:
     """Every split of the polyhedron ``poly`` with ``points`` ((node, unit coordinates) pairs)
     under a criterion, the element itself first, pieces classified."""
+    if criterion == "internal_faces":
+        # The internal-face splits are exactly the internal-edge splits whose pieces
+        # have only the element's own edges (the two criteria differ in nothing
+        # else): filter the other search's result, already sorted, instead of
+        # searching twice (a third of a bisection study's time).
+        edges = set(poly.edges)
+        return tuple(option for option in split_options(points, squared, poly, "internal_edges_and_faces")
+                     if all(edge in edges for piece in option for edge in piece.polyhedron.edges))
     frame = Frame.build(dict(points), squared)
     options = []
     for split in subdivisions(frame, poly, criterion):
@@ -180,10 +188,15 @@ def choose(tessellations: dict[str, Tessellation], sizes: dict[str, int], criter
     for rep, tess in tessellations.items():
         split[rep], used = split_tessellation(tess, kept, criterion)
         for element, pieces in used:
-            position = {node: i for i, node in enumerate(element.nodes)}
-            pieces_at = tuple(sorted((p.type.id, tuple(position[n] for n in p.nodes)) for p in pieces))
-            splits.setdefault(element.type.id, Counter())[pieces_at] += sizes[rep]
+            splits.setdefault(element.type.id, Counter())[split_positions(element, pieces)] += sizes[rep]
     return Choice(criterion, kept, split, splits)
+
+
+def split_positions(element: Element, pieces) -> tuple[tuple[str, tuple[int, ...]], ...]:
+    """A split as the catalogue records it: (piece type, piece nodes as positions in the element's
+    reference order), sorted."""
+    position = {node: i for i, node in enumerate(element.nodes)}
+    return tuple(sorted((p.type.id, tuple(position[n] for n in p.nodes)) for p in pieces))
 
 
 def apply_catalogue_criterion(tess: Tessellation, criterion: str) -> Tessellation:

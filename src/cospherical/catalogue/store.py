@@ -18,10 +18,11 @@ from typing import Iterable
 
 from ..core.element_types import ElementType, systematic_name
 from ..files.data import data_path
-from ..files.yamlio import load_yaml, validate
+from ..files.flowyaml import decode_entry, split_section
+from ..files.yamlio import parse_yaml, read_text, validate
 from ..paper import paper_class
 
-__all__ = ["SCHEMA_VERSION", "catalogue_path", "known_name", "load_catalogue", "shipped_catalogue", "type_name",
+__all__ = ["SCHEMA_VERSION", "catalogue_from_text", "catalogue_path", "known_name", "load_catalogue", "shipped_catalogue", "type_name",
            "type_names"]
 
 SCHEMA_VERSION = 1
@@ -117,6 +118,25 @@ def load_catalogue(path: str | Path) -> dict:
     >>> next(t["name"] for t in catalogue["types"] if t["vertices"] == 4)
     'tetrahedron'
     """
-    data = load_yaml(path)
-    validate(data, "catalogue", path)
+    return catalogue_from_text(read_text(path), str(path))
+
+
+def catalogue_from_text(text: str, name: str) -> dict:
+    """A catalogue's text as validated data; a bad catalogue raises :class:`FormatError`.
+
+    A catalogue as this package writes it (one type per line, JSON flow style)
+    has its types decoded as JSON and only its header parsed as YAML; any other
+    YAML spelling is read by the YAML parser.
+    """
+    split = split_section(text, "types")
+    data = None
+    if split is not None and isinstance(split[1], list):
+        data = parse_yaml(split[0], name)
+        if isinstance(data, dict) and "types" not in data and "configurations" not in data:
+            data["types"] = [decode_entry(item, f"{name}: types/{i}") for i, item in enumerate(split[1])]
+        else:
+            data = None
+    if data is None:
+        data = parse_yaml(text, name)
+    validate(data, "catalogue", name)
     return data

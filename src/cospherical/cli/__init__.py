@@ -25,14 +25,20 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(f"{self.prog}: error: {message}")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The whole command's parser; ``only``: with that one subcommand alone.
+
+    A subcommand module imports what its ``run`` needs; importing all seven to
+    parse one command line would load everything (numpy, jinja2, ...) for a
+    command that takes milliseconds.
+    """
     parser = _Parser(
         prog="cospherical",
         description="Delaunay tessellations of 1-irregular cuboids with co-spherical elements.",
     )
     parser.add_argument("--version", action="version", version=f"cospherical {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for name in SUBCOMMANDS:
+    for name in SUBCOMMANDS if only is None else (only,):
         importlib.import_module(f"{__name__}.{name}").add_parser(commands)
     return parser
 
@@ -47,7 +53,9 @@ def main(argv: list[str] | None = None) -> int:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminated)
     try:
-        args = build_parser().parse_args(argv)
+        words = sys.argv[1:] if argv is None else argv
+        command = next((word for word in words if not word.startswith("-")), None)
+        args = build_parser(command if command in SUBCOMMANDS else None).parse_args(argv)
         return args.run(args)
     except UsageError as error:  # the message already names the command
         print(error, file=sys.stderr)

@@ -5,9 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..catalogue import catalogue_path, load_catalogue
-from ..files.yamlio import load_yaml
-from ..formats.check import check_catalogue, check_patterns, validated
-from ..formats.patterns import table_from_data
+from ..files.yamlio import read_text
+from ..formats.check import check_catalogue, check_patterns, read_document
 
 
 def add_parser(commands) -> None:
@@ -28,16 +27,15 @@ def add_parser(commands) -> None:
 def run(args) -> int:
     catalogue = None
     for path in args.files:
-        kind, data = validated(load_yaml(path), str(path))
+        kind, document = read_document(read_text(path), str(path))
         if kind == "catalogue":
-            check_catalogue(data, str(path))
-            print(f"{path}: ok, catalogue of {len(data['types'])} element types")
+            check_catalogue(document, str(path))
+            print(f"{path}: ok, catalogue of {len(document['types'])} element types")
             continue
         if catalogue is None:
             catalogue_file = args.catalogue or catalogue_path()
             catalogue = load_catalogue(catalogue_file)
             check_catalogue(catalogue, str(catalogue_file))
-        table = table_from_data(data, str(path))
-        check_patterns(table, catalogue, str(path), tiling=not args.no_tiling)
-        print(f"{path}: ok, pattern table of {len(table.configurations)} configurations")
+        check_patterns(document, catalogue, str(path), tiling=not args.no_tiling)
+        print(f"{path}: ok, pattern table of {len(document.configurations)} configurations")
     return 0

@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 from ..errors import FormatError, UsageError
-from ..files.yamlio import load_yaml, parse_yaml
-from ..formats.check import validated
+from ..files.yamlio import read_text
+from ..formats.check import document_data, read_document
 from ..formats.diff import diff_documents, has_changes, text_report
 from .output import dump
 
@@ -40,7 +40,7 @@ def _from_git(rev: str, path: Path):
     if result.returncode != 0:
         message = (result.stderr.strip().splitlines() or ["git show failed"])[-1]
         raise FormatError(f"{path.name} at {rev}: {message}")
-    return parse_yaml(result.stdout, f"{path.name}@{rev}")
+    return result.stdout
 
 
 def run(args) -> int:
@@ -55,11 +55,11 @@ def run(args) -> int:
         if len(args.files) != 2:
             raise UsageError("cospherical diff: error: give OLD NEW (or --rev REV FILE)")
         old_name, new_name = args.files
-        old = load_yaml(old_name)
+        old = read_text(old_name)
         new_path = Path(new_name)
-    new = load_yaml(new_path)
-    validated(old, old_name)
-    validated(new, new_name)
+    new = read_text(new_path)
+    old = document_data(read_document(old, old_name)[1])
+    new = document_data(read_document(new, new_name)[1])
     report = diff_documents(old, new, old_name, new_name)
     if args.format == "text":
         sys.stdout.write(text_report(report, old_name, new_name))

@@ -5,8 +5,6 @@ from __future__ import annotations
 import json
 import sys
 
-import yaml
-
 FORMATS = ("json", "yaml")
 
 
@@ -24,6 +22,8 @@ def to_json(data, indent: int = 0) -> str:
 
 def dump(data, fmt: str) -> str:
     if fmt == "yaml":
+        import yaml  # here: most commands write JSON, and start faster without it
+
         return yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=120)
     return to_json(data) + "\n"
 

@@ -2,14 +2,22 @@
 
 from __future__ import annotations
 
+import sys
 from contextlib import contextmanager
 
-from tqdm import tqdm
+
+def _quiet(*args) -> None:
+    pass
 
 
 @contextmanager
 def progress_bar(total: int, label: str):
     """Yield ``advance(n)``; the bar shows configurations done out of ``total``."""
+    if not sys.stderr.isatty():  # tqdm would draw nothing; not importing it saves start-up time
+        yield _quiet
+        return
+    from tqdm import tqdm
+
     with tqdm(total=total, desc=label, unit="cfg", disable=None, leave=False) as bar:
         yield bar.update
 
@@ -17,10 +25,12 @@ def progress_bar(total: int, label: str):
 @contextmanager
 def stage_bars(stages: dict[str, tuple[int | None, str, str]]):
     """Yield ``advance(stage, n)``; one bar per stage (total or None, label, unit), opened when it starts."""
-    bars: dict[str, tqdm] = {}
+    bars: dict = {}
 
     def advance(stage: str, n: int) -> None:
         if stage not in bars:
+            from tqdm import tqdm
+
             total, label, unit = stages[stage]
             bars[stage] = tqdm(total=total, desc=label, unit=unit, disable=None, leave=False)
         bars[stage].update(n)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..core.configuration import POINT_POLICIES, Box
 from ..files.yamlio import atomic_write
-from ..formats.catalogue_file import build_catalogue, write_catalogue
+from ..formats.catalogue_file import build_catalogue, intersection_examples, write_catalogue
 from ..formats.patterns import pattern_name, write_patterns
 from ..outputs.latex import element_png, render_tables
 from ..outputs.report import comparison_lines, text_report
@@ -52,7 +52,7 @@ def run(args) -> int:
         leaves = [run_leaves(Box.parse(box), progress=advance) for box in LEAF_BOXES]
         shapes = [run_study("bisection", Box.parse(SHAPE_BOX), bisection_codes(element), progress=advance,
                             element=element) for element in SHAPE_ELEMENTS]
-    catalogue = build_catalogue(studies + leaves + shapes)
+    catalogue = build_catalogue(studies + leaves + shapes, intersection_examples())
     names = {t["id"]: (t["name"], t["aliases"]) for t in catalogue["types"]}
     write_catalogue(catalogue, root / "catalogue" / "catalogue.yaml")
 

@@ -52,14 +52,19 @@ class _Element:
         for face in self.faces:
             normal = cross(sub(coords[face[1]], coords[face[0]]), sub(coords[face[2]], coords[face[0]]))
             self.planes.append((normal, dot(normal, coords[face[0]])))
+        # The element's points on each face plane: a hull face lies on a boundary
+        # plane exactly when its points are among them (a set test instead of a
+        # dot product per point and plane, for every face the search meets).
+        self.on_plane = [frozenset(m for m in self.members if dot(normal, coords[m]) == offset)
+                         for normal, offset in self.planes]
         self.edges = {frozenset((f[i], f[(i + 1) % len(f)])) for f in self.faces for i in range(len(f))}
         self.six_volume = six_volume(coords, self.faces)
         self._pieces: dict[frozenset[int], tuple | None] = {}
 
     def _on_boundary_plane(self, cycle) -> int | None:
-        points = [self.frame.coords[v] for v in cycle]
-        for f, ((nx, ny, nz), offset) in enumerate(self.planes):
-            if all(nx * x + ny * y + nz * z == offset for x, y, z in points):
+        points = set(cycle)
+        for f, on_plane in enumerate(self.on_plane):
+            if points <= on_plane:
                 return f
         return None
 

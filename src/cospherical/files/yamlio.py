@@ -88,12 +88,16 @@ def yaml_float(x: float) -> str:
 
 def load_yaml(path: str | Path):
     """Read a YAML file with safe loading; a missing, unreadable or malformed file raises FormatError."""
+    return parse_yaml(read_text(path), str(path))
+
+
+def read_text(path: str | Path) -> str:
+    """A file's text (UTF-8); a missing or unreadable file raises FormatError."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
         raise FormatError(f"{path}: cannot read: {getattr(error, 'strerror', None) or error}") from None
-    return parse_yaml(text, str(path))
 
 
 def parse_yaml(text: str, name: str):

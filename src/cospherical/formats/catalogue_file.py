@@ -6,14 +6,23 @@ import hashlib
 import json
 from pathlib import Path
 
-from ..catalogue import SCHEMA_VERSION, type_names
+from ..catalogue import SCHEMA_VERSION, option_types, split_options, split_positions, type_names
 from ..core.canonical import canonical_form
-from ..core.element_types import ElementType
+from ..core.configuration import Configuration
+from ..core.delaunay import delaunay_cells
+from ..core.element_types import ElementType, classify
+from ..core.geometry import Frame
+from ..core.polyhedron import polyhedron
 from ..core.split import SPLIT_CRITERIA
-from ..files.yamlio import dump_yaml
+from ..core.tessellation import Element
+from ..errors import FormatError
+from ..files.data import data_path
+from ..files.flowyaml import decode_entry, split_section
+from ..files.flowyaml import sequence_line
+from ..files.yamlio import atomic_write, read_text, yaml_text
 from ..version import __version__
 
-__all__ = ["build_catalogue", "write_catalogue"]
+__all__ = ["build_catalogue", "intersection_examples", "write_catalogue"]
 
 
 def _chiral(element) -> bool:
@@ -27,8 +36,51 @@ def _study_label(study) -> str:
     return f"{study.name}{element} {'x'.join(study.box.texts)} {study.face_points}"
 
 
-def build_catalogue(studies) -> dict:
-    """The catalogue of every element type met in the studies, as YAML-ready data."""
+def intersection_examples(path: str | Path | None = None) -> list[dict]:
+    """The examples of the intersection studies' types (``scripts/intersection_examples.py`` writes them),
+    each rebuilt as an element: dicts with ``configuration``, ``element``, ``studies`` and ``splits``
+    (per criterion, the splits the studies used, as (piece type, positions in the element's
+    reference order) tuples).
+
+    A type is rebuilt from its configuration code (the cube, octree points) and node ids: the
+    points are co-spherical, so their Delaunay subdivision is the element itself.  A file whose
+    example no longer gives its type (the classification changed) raises :class:`FormatError`.
+    """
+    path = Path(path) if path else data_path("intersection-examples.yaml")
+    if not path.exists():
+        return []
+    split = split_section(read_text(path), "types")
+    if split is None or not isinstance(split[1], list):
+        raise FormatError(f"{path}: not a list of examples, one per line")
+    found = []
+    for i, text in enumerate(split[1]):
+        example = decode_entry(text, f"{path}: types/{i}")
+        configuration = Configuration.from_code(example["configuration"])
+        nodes = configuration.nodes()
+        points = {n: nodes[n] for n in example["nodes"]}
+        frame = Frame.build(points, configuration.box.squared)
+        (cell,) = delaunay_cells(frame)
+        poly = polyhedron(frame, cell)
+        etype, order, mirrored = classify(poly)
+        element = Element(etype, order, poly, mirrored)
+        if element.type.id != example["type"]:
+            raise FormatError(f"{path}: types/{i}: the example gives type {element.type.id}, not {example['type']}: "
+                              "run scripts/intersection_examples.py again")
+        splits = {}
+        for criterion, used in example["splits"].items():
+            options = split_options(tuple(sorted(points.items())), configuration.box.squared, poly, criterion)
+            splits[criterion] = {split_positions(element, option) for option in options
+                                 if sorted(option_types(option)) in used}
+        found.append({"configuration": configuration, "element": element, "studies": example["studies"],
+                      "splits": splits})
+    return found
+
+
+def build_catalogue(studies, extra: list[dict] = ()) -> dict:
+    """The catalogue of every element type met in the studies, as YAML-ready data.
+
+    ``extra``: examples of further types (:func:`intersection_examples`), after the studies'.
+    """
     examples: dict[str, tuple] = {}
     appears: dict[str, list[str]] = {}
     types: dict[str, ElementType] = {}
@@ -44,9 +96,15 @@ def build_catalogue(studies) -> dict:
                 for element in reps[rep].elements:
                     t = element.type
                     types[t.id] = t
-                    examples.setdefault(t.id, (study, reps[rep], element))
+                    examples.setdefault(t.id, (study.box.texts, study.face_points, reps[rep].configuration, element,
+                                              study.element))
                     if label not in appears.setdefault(t.id, []):
                         appears[t.id].append(label)
+    for example in extra:
+        element = example["element"]
+        types.setdefault(element.type.id, element.type)
+        examples.setdefault(element.type.id, (("1", "1", "1"), "octree", example["configuration"], element, "cuboid"))
+        appears.setdefault(element.type.id, []).extend(example["studies"])
     names = type_names(types.values())
     splits: dict[str, dict[str, set]] = {}
     kept: dict[str, set[str]] = {}
@@ -57,12 +115,15 @@ def build_catalogue(studies) -> dict:
             kept.setdefault(criterion, set()).update(choice.kept)
             for type_id, used in choice.splits.items():
                 splits.setdefault(type_id, {}).setdefault(criterion, set()).update(used)
+    for example in extra:
+        for criterion, used in example["splits"].items():
+            splits.setdefault(example["element"].type.id, {}).setdefault(criterion, set()).update(used)
     entries = []
     for type_id in sorted(types, key=lambda i: (types[i].vertices, types[i].faces, i)):
         t = types[type_id]
-        study, tess, element = examples[type_id]
+        box_texts, face_points, configuration, element, shape = examples[type_id]
         position = {v: i for i, v in enumerate(element.nodes)}
-        real = tess.configuration.real_nodes()
+        real = configuration.real_nodes()
         # Faces of the type's direct form, counter-clockwise seen from outside: an
         # example that is the mirror image gives them the other way round.
         faces = sorted(
@@ -85,10 +146,10 @@ def build_catalogue(studies) -> dict:
                 "chiral": t.vtk is None and _chiral(element),
                 "reference_faces": [{"nodes": nodes, "kind": kind} for nodes, kind in faces],
                 "example": {
-                    "configuration": tess.configuration.code,
-                    **({"element": study.element} if study.element != "cuboid" else {}),
-                    "box": list(study.box.texts),
-                    "face_points": study.face_points,
+                    "configuration": configuration.code,
+                    **({"element": shape} if shape != "cuboid" else {}),
+                    "box": list(box_texts),
+                    "face_points": face_points,
                     "nodes": list(element.nodes),
                     "coordinates": [list(real[v]) for v in element.nodes],
                 },
@@ -113,4 +174,11 @@ def build_catalogue(studies) -> dict:
 
 
 def write_catalogue(catalogue: dict, path: str | Path) -> None:
-    dump_yaml(catalogue, path)
+    """Write the catalogue as YAML, one element type per line (JSON flow style).
+
+    One line per type keeps the file YAML and its diffs per type, and lets
+    :func:`cospherical.catalogue.load_catalogue` read it with a JSON parser:
+    every command that names a type reads the catalogue at start-up.
+    """
+    header = {k: v for k, v in catalogue.items() if k != "types"}
+    atomic_write(path, yaml_text(header) + "types:\n" + "".join(sequence_line(t) for t in catalogue["types"]))

@@ -12,15 +12,17 @@ from __future__ import annotations
 from collections import Counter
 from fractions import Fraction
 
+from ..catalogue import catalogue_from_text
 from ..core.configuration import Box
 from ..core.geometry import Frame, six_volume
 from ..errors import FormatError, InputError
-from ..files.yamlio import validate
+from ..files.flowyaml import split_section
+from ..files.yamlio import parse_yaml, validate
 from ..studies.bisection import element_family
 from .diff import document_kind
-from .patterns import entry_elements
+from .patterns import entry_elements, table_from_data, table_from_text
 
-__all__ = ["check_catalogue", "check_patterns"]
+__all__ = ["check_catalogue", "check_patterns", "document_data", "read_document", "validated"]
 
 
 def check_catalogue(data: dict, name: str) -> None:
@@ -58,16 +60,26 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
     except InputError as error:
         raise FormatError(f"{name}: box: {error}") from None
     family = element_family(header.get("element", "cuboid"), box, header["face_points"])
+    # The same element (type, nodes, node positions) recurs in many configurations
+    # and criteria of a table: its volume and faces are computed once.
+    geometry: dict[tuple, tuple | None] = {}
     for code, entry in table.configurations.items():
         try:
             cfg = family.configuration(code)
         except InputError as error:
             raise FormatError(f"{name}: configurations/{code}: {error}") from None
         nodes = cfg.nodes()
-        frame = Frame.build(nodes, box.squared) if tiling and types else None
+        # Positions as integer pairs: they key the geometry cache, and hashing
+        # Fractions would be most of the check's time.
+        positions = {n: tuple((x.numerator, x.denominator) for x in point) for n, point in nodes.items()}
+        shape = getattr(cfg, "shape", None)
+        checked = []
         for criterion in header["criteria"]:
             where = f"{name}: configurations/{code}/{criterion}"
             elements = entry_elements(entry, criterion)
+            if any(elements is other for other in checked):  # a reference to an earlier criterion's elements
+                continue
+            checked.append(elements)
             for k, element in enumerate(elements):
                 missing = [n for n in element["nodes"] if n not in nodes]
                 if missing:
@@ -80,42 +92,84 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
                         raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
                     if len(element["nodes"]) != t["vertices"]:
                         raise FormatError(f"{where}/{k}: {len(element['nodes'])} nodes for a type with {t['vertices']} vertices")
-            if frame is not None:
-                _check_tiling(frame, elements, types, where, getattr(cfg, "shape", None))
+            if tiling and types:
+                _check_tiling(nodes, positions, box.squared, elements, types, geometry, where, shape)
 
 
-def _check_tiling(frame: Frame, elements, types, where: str, shape=None) -> None:
+def _element_geometry(element: dict, points: tuple, squared, types, shape=None) -> tuple | None:
+    """(unit volume, faces as (node set, on the boundary of the box or ``shape``)) of an element,
+    or ``None`` if its nodes do not make a proper element of its type."""
+    frame = Frame.build(dict(enumerate(points)), squared)  # frame index = position in the element's node list
+    cycles = [face["nodes"] for face in types[element["type"]]["reference_faces"]]
+    six = six_volume(frame.coords, cycles)
+    if element.get("mirror"):  # the mirror image: its reference faces run the other way round
+        six = -six
+    if six <= 0:
+        return None
+    nodes, coords, scale = element["nodes"], frame.coords, frame.scale
+    # The box's or the shape's face planes, in the frame's integer coordinates (x = coords / scale).
+    planes = [] if shape is None else [(normal, offset * scale) for normal, offset in shape.planes]
+    faces = []
+    for cycle in cycles:
+        if shape is None:
+            on_boundary = any(all(coords[p][axis] == coords[cycle[0]][axis] for p in cycle)
+                              and coords[cycle[0]][axis] in (0, scale) for axis in range(3))
+        else:
+            on_boundary = any(all(sum(a * x for a, x in zip(normal, coords[p])) == offset for p in cycle)
+                              for normal, offset in planes)
+        faces.append((frozenset(nodes[p] for p in cycle), on_boundary))
+    return Fraction(six, 6 * scale**3), tuple(faces)
+
+
+def _check_tiling(nodes: dict, positions: dict, squared, elements, types, geometry: dict, where: str,
+                  shape=None) -> None:
     """The elements fill the box (or the ``shape``) exactly and meet face to face."""
-    index = {node: i for i, node in enumerate(frame.ids)}
-    coords = frame.coords
-    total = 0
+    total = Fraction(0)
     faces: Counter = Counter()
     for k, element in enumerate(elements):
-        nodes = element["nodes"]
-        cycles = [[index[nodes[p]] for p in face["nodes"]] for face in types[element["type"]]["reference_faces"]]
-        six = six_volume(coords, cycles)
-        if element.get("mirror"):  # the mirror image: its reference faces run the other way round
-            six = -six
-        if six <= 0:
+        key = (element["type"], tuple(element["nodes"]), bool(element.get("mirror")),
+               tuple(positions[n] for n in element["nodes"]))
+        found = geometry.get(key, False)
+        if found is False:
+            points = tuple(nodes[n] for n in element["nodes"])
+            found = geometry[key] = _element_geometry(element, points, squared, types, shape)
+        if found is None:
             raise FormatError(f"{where}/{k}: the nodes do not make a proper element of type {element['type']}")
-        total += six
-        faces.update(frozenset(frame.ids[v] for v in cycle) for cycle in cycles)
-    volume = Fraction(total, 6 * frame.scale**3)
-    if volume != (1 if shape is None else shape.unit_volume):
+        volume, element_faces = found
+        total += volume
+        faces.update(element_faces)
+    if total != (1 if shape is None else shape.unit_volume):
         raise FormatError(f"{where}: the elements do not fill the {'box' if shape is None else shape.name} "
-                          f"(volume {volume} of {1 if shape is None else shape.unit_volume})")
-    # A shape's face planes, in the frame's integer coordinates (x = coords / scale).
-    planes = [] if shape is None else [(normal, offset * frame.scale) for normal, offset in shape.planes]
-    for face, count in faces.items():
-        points = [coords[index[v]] for v in face]
-        if shape is None:
-            on_boundary = any(len({p[axis] for p in points}) == 1 and points[0][axis] in (0, frame.scale)
-                              for axis in range(3))
-        else:
-            on_boundary = any(all(sum(a * x for a, x in zip(normal, p)) == offset for p in points)
-                              for normal, offset in planes)
+                          f"(volume {total} of {1 if shape is None else shape.unit_volume})")
+    for (face, on_boundary), count in faces.items():
         if count != (1 if on_boundary else 2):
             raise FormatError(f"{where}: face {sorted(face)} belongs to {count} elements: they do not meet face to face")
+
+
+def read_document(text: str, name: str):
+    """A catalogue's or pattern table's text: ``("catalogue", data)`` or ``("patterns", PatternTable)``, validated.
+
+    Files as this package writes them take the fast path of each reader (one
+    JSON entry per line, see :mod:`cospherical.files.flowyaml`); anything else is
+    parsed as YAML.  A pattern table's entries are validated as they are read.
+    """
+    section = split_section(text, "configurations")
+    if section is not None and isinstance(section[1], dict):
+        table = table_from_text(text, name)
+        document_kind({**table.header, "configurations": {}}, name)
+        return "patterns", table
+    section = split_section(text, "types")
+    if section is not None and isinstance(section[1], list):
+        return "catalogue", catalogue_from_text(text, name)
+    kind, data = validated(parse_yaml(text, name), name)
+    return kind, (data if kind == "catalogue" else table_from_data(data, name))
+
+
+def document_data(document) -> dict:
+    """A read document as one mapping (a pattern table's header with its configurations), as diff compares them."""
+    if isinstance(document, dict):
+        return document
+    return {**document.header, "configurations": document.configurations}
 
 
 def validated(data, name: str) -> tuple[str, dict]:

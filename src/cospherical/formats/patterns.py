@@ -18,20 +18,23 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Mapping
+from collections.abc import Mapping
+from typing import Callable
 
 from ..catalogue import split_tessellation
 from ..core.configuration import Configuration
 from ..core.symmetry import key_code
 from ..core.tessellation import Tessellation, tessellate
 from ..errors import FormatError
-from ..files.yamlio import atomic_open, atomic_write, load_yaml, validate, yaml_float, yaml_text
+from ..files.flowyaml import decode_entry, mapping_line, split_section
+from ..files.yamlio import atomic_open, atomic_write, parse_yaml, read_text, validate, yaml_text
 from ..studies.bisection import Study
 from ..studies.intersection import completed, orbits
 from ..version import __version__
 
-__all__ = ["PatternTable", "SCHEMA_VERSION", "configuration_lines", "element_lines", "entry_elements", "load", "pattern_chunk", "pattern_name", "patterns_text",
-           "table_from_data", "write_pattern_table", "write_patterns"]
+__all__ = ["Entries", "PatternTable", "SCHEMA_VERSION", "configuration_line", "element_entries", "entry_elements", "load",
+           "pattern_chunk", "pattern_name", "patterns_text", "table_from_data", "table_from_text", "write_pattern_table",
+           "write_patterns"]
 
 SCHEMA_VERSION = 1
 SCHEMES = {
@@ -63,62 +66,128 @@ def patterns_text(study: Study, catalogue_version: str) -> str:
         "scheme": SCHEMES.get(study.name, study.name),
         "criteria": list(study.criteria),
     }
-    lines = [yaml_text(header).rstrip("\n"), "configurations:"]
+    lines = [yaml_text(header), "configurations:\n"]
     for code in sorted(study.codes):
         rep, _ = study.representative[code]
-        lines.extend(configuration_lines(
+        lines.append(configuration_line(
             code,
             study.tessellations[rep].fvm_adequate,  # a symmetry keeps circumcenters in the box
             {criterion: study.choices[criterion].tessellations[rep] for criterion in study.criteria},
             lambda tess: study.member_tessellation(code, tess)))
-    return "\n".join(lines) + "\n"
+    return "".join(lines)
 
 
-def configuration_lines(code: str, fvm_adequate: bool, tessellations: Mapping[str, Tessellation],
-                        image: Callable[[Tessellation], Tessellation] = lambda tess: tess) -> list[str]:
-    """The YAML lines of one configuration's entry in a pattern table, every table's.
+def configuration_line(code: str, fvm_adequate: bool, tessellations: Mapping[str, Tessellation],
+                       image: Callable[[Tessellation], Tessellation] = lambda tess: tess) -> str:
+    """One configuration's entry in a pattern table, every table's: one line of YAML (a JSON flow mapping).
 
     ``tessellations``: per criterion, in the table's order.  Where a criterion
     gives the same elements as an earlier one (most configurations need no
     split), the entry names that criterion instead of a copy.  ``image`` maps a
     tessellation to the configuration ``code`` (a study keeps one per orbit).
+    One line per entry is what lets :func:`load` hand each to a JSON parser
+    (:mod:`cospherical.files.flowyaml`).
     """
-    lines = [f"  '{code}':", f"    fvm_adequate: {'true' if fvm_adequate else 'false'}"]
+    entry: dict = {"fvm_adequate": fvm_adequate}
     written: dict[tuple, str] = {}
     for criterion, tess in tessellations.items():
         key = tuple(e.polyhedron.nodes for e in tess.elements)
         if key in written:
-            lines.append(f"    {criterion}: {written[key]}")
+            entry[criterion] = written[key]
             continue
         written[key] = criterion
-        lines.extend(element_lines(criterion, image(tess)))
-    return lines
+        entry[criterion] = element_entries(image(tess))
+    return mapping_line(code, entry)
 
 
-def element_lines(criterion: str, tess) -> list[str]:
-    """The YAML lines of one configuration's elements under a criterion (inside its entry)."""
-    lines = [f"    {criterion}:"]
+def element_entries(tess) -> list[dict]:
+    """A tessellation's elements as pattern-table data: type id, nodes in reference order, circumcenter."""
+    entries = []
     for element in tess.elements:
-        nodes = ", ".join(map(str, element.nodes))
-        center = ", ".join(yaml_float(x) for x in tess.circumcenter(element))
-        mirror = ", mirror: true" if element.mirrored else ""
-        lines.append(f"    - {{type: {element.type.id}, nodes: [{nodes}], circumcenter: [{center}]{mirror}}}")
-    return lines
+        entry = {"type": element.type.id, "nodes": list(element.nodes),
+                 "circumcenter": [float(x) for x in tess.circumcenter(element)]}
+        if element.mirrored:
+            entry["mirror"] = True
+        entries.append(entry)
+    return entries
 
 
 def write_patterns(study: Study, path: str | Path, catalogue_version: str) -> None:
     atomic_write(path, patterns_text(study, catalogue_version))
 
 
+class Entries(Mapping):
+    """A table's configurations, code -> entry, each decoded and validated when first asked for.
+
+    A mesher looks up a few configurations of a table of thousands (millions at
+    R = 16): decoding all of them up front is what made loading slow.  Iterating
+    visits every entry, so ``check`` still validates the whole table.
+    """
+
+    def __init__(self, texts: dict[str, str], header: dict, name: str):
+        self._texts = texts
+        self._header = header
+        self._name = name
+        self._decoded: dict[str, dict] = {}
+
+    def __getitem__(self, code: str) -> dict:
+        entry = self._decoded.get(code)
+        if entry is None:
+            entry = decode_entry(self._texts[code], f"{self._name}: configurations/{code}")
+            _check_entries({**self._header, "configurations": {code: entry}}, self._name)
+            self._decoded[code] = entry
+        return entry
+
+    def items(self, chunk: int = 4096):
+        """Every (code, entry) in file order, decoded and validated a chunk at a time.
+
+        One schema validation per chunk costs a quarter of one per entry; entries
+        not looked up before are not kept, so a table of millions of
+        configurations is checked in bounded memory.
+        """
+        codes = list(self._texts)
+        for start in range(0, len(codes), chunk):
+            batch = {}
+            for code in codes[start:start + chunk]:
+                entry = self._decoded.get(code)
+                batch[code] = entry if entry is not None else decode_entry(
+                    self._texts[code], f"{self._name}: configurations/{code}")
+            _check_entries({**self._header, "configurations": batch}, self._name)
+            yield from batch.items()
+
+    def values(self):
+        return (entry for _, entry in self.items())
+
+    def __contains__(self, code) -> bool:
+        return code in self._texts
+
+    def __iter__(self):
+        return iter(self._texts)
+
+    def __len__(self) -> int:
+        return len(self._texts)
+
+
 @dataclass(frozen=True)
 class PatternTable:
-    """A loaded, validated pattern table."""
+    """A loaded pattern table: its header and its configurations, validated against the JSON Schema."""
 
     header: dict
-    configurations: dict[str, dict]
+    configurations: Mapping[str, dict]
 
     def elements(self, code: str, criterion: str = "optimal") -> list[dict]:
-        """The elements of one configuration: dicts with ``type``, ``nodes``, ``circumcenter``."""
+        """The elements of one configuration: dicts with ``type``, ``nodes``, ``circumcenter``.
+
+        Examples
+        --------
+        >>> text = ("schema_version: 1\\ngenerator: g\\ncatalogue_version: c\\nstudy: s\\nbox: ['1', '1', '1']\\n"
+        ...         "face_points: octree\\nscheme: s\\ncriteria: [optimal]\\nconfigurations:\\n"
+        ...         + mapping_line("000000000000", {"fvm_adequate": True, "optimal": [
+        ...             {"type": "v8f6-c3cb81", "nodes": [0, 1, 2, 3, 4, 5, 6, 7], "circumcenter": [0.5, 0.5, 0.5]}]}))
+        >>> table = table_from_text(text, "demo.yaml")
+        >>> table.elements("000000000000")[0]["nodes"]
+        [0, 1, 2, 3, 4, 5, 6, 7]
+        """
         if code not in self.configurations:
             raise KeyError(f"configuration {code!r} is not in this table")
         if criterion not in self.header["criteria"]:
@@ -160,13 +229,37 @@ def load(path: str | Path) -> PatternTable:
     FormatError
         The file cannot be read or does not have the format; the message names the place.
 
+    A table as this package writes it (one line per configuration) is indexed
+    line by line and each entry decoded, as JSON, and validated when it is first
+    used; any other YAML spelling of a table is read whole by the YAML parser.
     See the README ("Pattern tables for a mesh generator") for an example, run by the tests.
     """
-    return table_from_data(load_yaml(path), str(path))
+    return table_from_text(read_text(path), str(path))
+
+
+def table_from_text(text: str, name: str) -> PatternTable:
+    """:func:`load` on the file's text."""
+    split = split_section(text, "configurations")
+    if split is None:
+        return table_from_data(parse_yaml(text, name), name)
+    header_text, texts = split
+    header = parse_yaml(header_text, name)
+    if not isinstance(header, dict) or not isinstance(texts, dict):
+        return table_from_data(parse_yaml(text, name), name)
+    _check_entries({**header, "configurations": {}}, name)
+    return PatternTable(header, Entries(texts, header, name))
 
 
 def table_from_data(data, name: str) -> PatternTable:
     """A :class:`PatternTable` from parsed YAML, validated (schema, criteria references)."""
+    _check_entries(data, name)
+    header = {k: v for k, v in data.items() if k != "configurations"}
+    return PatternTable(header, data["configurations"])
+
+
+def _check_entries(data, name: str) -> None:
+    # The schema, then what it cannot say: every criterion present, references
+    # only to earlier criteria.
     validate(data, "patterns", name)
     criteria = data["criteria"]
     for code, entry in data["configurations"].items():
@@ -177,8 +270,6 @@ def table_from_data(data, name: str) -> PatternTable:
             if isinstance(same, str) and same not in criteria[:i]:
                 raise FormatError(f"{name}: configuration {code}: {criterion} refers to {same!r}, "
                                   "which is not an earlier criterion of the table")
-    header = {k: v for k, v in data.items() if k != "configurations"}
-    return PatternTable(header, data["configurations"])
 
 
 # ---------------------------------------------------------------------------
@@ -196,6 +287,10 @@ SYMMETRY_CONVENTION = (
 
 def pattern_chunk(codes: list[int], kept: dict[str, list[str]]) -> str:
     """Pattern-table entries (YAML text) of some representatives, every criterion of ``kept``."""
+    # Bulk work: load the compiled walk, which tessellate() then takes (the
+    # Python walk costs several ms per 1/16 configuration, the kernel ~10 us).
+    from ..core import compiled  # noqa: F401
+
     lines = []
     for code in codes:
         text = key_code(code)
@@ -203,8 +298,8 @@ def pattern_chunk(codes: list[int], kept: dict[str, list[str]]) -> str:
         tessellations = {"optimal": tess}
         for criterion, types in kept.items():
             tessellations[criterion] = split_tessellation(tess, frozenset(types), criterion)[0]
-        lines.extend(configuration_lines(text, tess.fvm_adequate, tessellations))
-    return "\n".join(lines) + "\n" if lines else ""
+        lines.append(configuration_line(text, tess.fvm_adequate, tessellations))
+    return "".join(lines)
 
 
 def write_pattern_table(summary: dict, path, catalogue_version: str, jobs: int = 1, progress=None,

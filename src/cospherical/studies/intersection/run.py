@@ -36,7 +36,8 @@ from .backends import completed
 from .family import all_configurations, orbits
 from .statistics import statistics
 
-__all__ = ["CHUNK", "ELEMENT_CHUNK", "ElementEntry", "element_entries", "run_intersection", "tessellate_chunk"]
+__all__ = ["CHUNK", "ELEMENT_CHUNK", "ElementEntry", "element_entries", "example_elements", "run_intersection",
+           "tessellate_chunk"]
 
 CHUNK = 5000
 ELEMENT_CHUNK = 500
@@ -131,7 +132,8 @@ def _tetrahedron():
 
 def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, checkpoints=None,
                      progress=None, chunk: int = CHUNK, scheduler: str | None = None,
-                     dask_workers: int | None = None, brute_force: bool = False) -> dict:
+                     dask_workers: int | None = None, brute_force: bool = False,
+                     examples: dict | None = None) -> dict:
     """The intersection study's summary, all criteria, in the shape of the bisection study's.
 
     Parameters
@@ -152,6 +154,11 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
         many processes) instead of ``jobs`` local processes.
     brute_force : bool
         Tessellate every configuration, not one per orbit (a check).
+    examples : dict, optional
+        Filled with an example of every type met: type id -> ``(node mask, code)``
+        of an element of that type, or ``(node mask, code, criterion)`` of an
+        element one of whose splits under that criterion has a piece of that type
+        (see :func:`example_elements`).
 
     Returns
     -------
@@ -213,9 +220,38 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     for i in range(len(element_starts)):
         entries.extend(stage2[i][0])
         types.update(stage2[i][1])
+    if examples is not None:
+        tetrahedron = (sum(1 << n for n in (0, 1, 3, 4)), 0)  # as _tetrahedron() makes it
+        for (mask, code), entry in zip([tetrahedron, *work], entries):
+            examples.setdefault(entry.type, (mask, code))
+            for criterion, options in entry.options.items():
+                for piece in (piece for option in options for piece in option):
+                    examples.setdefault(piece, (mask, code, criterion))
     return {
         "study": "intersection", "box": ["1", "1", "1"], "face_points": "octree",
         "resolution": resolution, "insertion_order": order,
         "configurations": configurations, "orbits": len(reps),
         **statistics(sizes, cells, element_of + 1, entries, types),
     }
+
+
+def example_elements(examples: dict) -> dict[str, tuple[str, tuple[int, ...]]]:
+    """The examples :func:`run_intersection` collects as type id -> (configuration code, node ids).
+
+    A piece type's example is a piece of its parent element's splits with that type.
+    """
+    squared = (1, 1, 1)
+    found = {}
+    for type_id, example in examples.items():
+        mask, code = example[:2]
+        nodes = Configuration.from_code(key_code(code)).nodes()
+        points = tuple((n, nodes[n]) for n in sorted(nodes) if mask >> n & 1)
+        if len(example) == 2:
+            found[type_id] = (key_code(code), tuple(n for n, _ in points))
+            continue
+        frame = Frame.build(dict(points), squared)
+        (cell,) = delaunay_cells(frame)
+        options = split_options(points, squared, polyhedron(frame, cell), example[2])
+        piece = next(p for option in options for p in option if p.type.id == type_id)
+        found[type_id] = (key_code(code), piece.polyhedron.nodes)
+    return found
