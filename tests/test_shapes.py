@@ -262,3 +262,15 @@ def test_study_cli_element(tmp_path):
     assert _cli("check", str(tmp_path / "bisection-tetrahedron-1x1x1.yaml")).returncode == 0
     result = _cli("study", "leaves", "--element", "prism")
     assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
+
+
+def test_committed_shape_latex_compiles(tmp_path):
+    import shutil
+
+    for path in (ROOT / "results" / "latex-shapes").iterdir():
+        shutil.copy(path, tmp_path)
+    result = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "document.tex"], cwd=tmp_path,
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout[-2000:]
+    text = subprocess.run(["pdftotext", str(tmp_path / "document.pdf"), "-"], capture_output=True, text=True).stdout
+    assert all(f"1 x 1 x 1 ({name})" in text for name in SHAPES)
