@@ -256,7 +256,8 @@ def test_study_cli_element(tmp_path):
     result = _cli("study", "bisection", "--element", "tetrahedron", "--format", "json", "--out", str(tmp_path))
     data = json.loads(result.stdout)
     assert data["element"] == "tetrahedron" and data["configurations"] == 64
-    assert data["criteria"]["optimal"]["total"] == sum(t["count"] for t in data["criteria"]["optimal"]["types"].values())
+    optimal = data["criteria"]["optimal"]
+    assert optimal["total"] == sum(t["count"] for t in optimal["types"].values())
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bisection-tetrahedron-1x1x1.json",
                                                           "bisection-tetrahedron-1x1x1.yaml"]
     assert _cli("check", str(tmp_path / "bisection-tetrahedron-1x1x1.yaml")).returncode == 0

@@ -42,6 +42,7 @@ from typing import Iterable, Mapping, Sequence
 from ..errors import InputError
 from .configuration import Box
 from .exact import parse_rational
+from .geometry import six_volume
 from .polyhedron import Polyhedron
 from .symmetry import map_polyhedron
 from .tessellation import Tessellation, tessellation_elements
@@ -84,6 +85,11 @@ def _cross(p, q):
 
 def _dot(p, q):
     return sum(a * b for a, b in zip(p, q))
+
+
+def _volume6(p, q, r, s):
+    """Six times the signed volume of the tetrahedron pqrs (zero: the four are coplanar)."""
+    return _dot(_sub(q, p), _cross(_sub(r, p), _sub(s, p)))
 
 
 def _point(value, where: str) -> Point:
@@ -149,7 +155,7 @@ class Shape:
         for i, j in combinations(range(n), 2):
             if corners[i] == corners[j]:
                 raise InputError(f"{name}: corners {i} and {j} are the same point")
-        if all(_dot(_cross(_sub(corners[1], corners[0]), _sub(corners[j], corners[0])), _sub(corners[k], corners[0])) == 0
+        if all(_volume6(corners[0], corners[1], corners[j], corners[k]) == 0
                for j in range(2, n) for k in range(j + 1, n)):
             raise InputError(f"{name}: the corners are coplanar: no solid")
         cycles = []
@@ -190,7 +196,8 @@ class Shape:
             unlisted = sorted(sorted(e) for e in sides if e not in {frozenset(p) for p in pairs})[0]
             raise InputError(f"{name}: the side {unlisted[0]}-{unlisted[1]} of a face is not among the edges")
         if n - len(pairs) + len(oriented) != 2:
-            raise InputError(f"{name}: V - E + F = {n - len(pairs) + len(oriented)}, not 2: not one closed convex surface")
+            raise InputError(f"{name}: V - E + F = {n - len(pairs) + len(oriented)}, not 2: "
+                             "not one closed convex surface")
         return cls(name, box, corners, tuple(pairs), tuple(oriented), tuple(planes))
 
     @cached_property
@@ -201,13 +208,7 @@ class Shape:
     @cached_property
     def unit_volume(self) -> Fraction:
         """The volume as a fraction of the box's."""
-        origin = self.corners[0]
-        total = Fraction(0)
-        for face in self.faces:
-            a = _sub(self.corners[face[0]], origin)
-            for b, c in zip(face[1:-1], face[2:]):
-                total += _dot(a, _cross(_sub(self.corners[b], origin), _sub(self.corners[c], origin)))
-        return total / 6
+        return Fraction(six_volume(self.corners, self.faces)) / 6
 
     def edge_start(self, k: int) -> int:
         """The corner from which edge k's parameter is measured: its lexicographically smallest."""
@@ -533,7 +534,8 @@ def _affine(sources: Sequence[Point], targets: Sequence[Point]):
     u = [_sub(s, sources[0]) for s in sources[1:]]
     v = [_sub(t, targets[0]) for t in targets[1:]]
     det = _dot(u[0], _cross(u[1], u[2]))
-    inverse_t = [_cross(u[1], u[2]), _cross(u[2], u[0]), _cross(u[0], u[1])]  # rows of det * U^-T ... columns
+    # With U the matrix of columns u[i], the rows of det * U^-1 are these cross products.
+    inverse_t = [_cross(u[1], u[2]), _cross(u[2], u[0]), _cross(u[0], u[1])]
     linear = tuple(tuple(sum(v[i][row] * inverse_t[i][col] for i in range(3)) / det for col in range(3))
                    for row in range(3))
     shift = tuple(t - sum(a * x for a, x in zip(r, sources[0])) for r, t in zip(linear, targets[0]))
@@ -561,9 +563,7 @@ def _symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
                 extend(images + [j])
 
     extend([])
-    basis = next(b for b in combinations(range(n), 4)
-                 if _dot(_sub(corners[b[1]], corners[b[0]]),
-                         _cross(_sub(corners[b[2]], corners[b[0]]), _sub(corners[b[3]], corners[b[0]]))) != 0)
+    basis = next(b for b in combinations(range(n), 4) if _volume6(*(corners[i] for i in b)) != 0)
     result = []
     for images in sorted(found, key=lambda p: p != tuple(range(n))):
         linear, shift = _affine([corners[i] for i in basis], [corners[images[i]] for i in basis])
@@ -571,7 +571,8 @@ def _symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
     return tuple(result)
 
 
-def shape_orbit_representatives(codes: Sequence[str], symmetries: Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
+def shape_orbit_representatives(codes: Sequence[str],
+                                symmetries: Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
     """For each code, its orbit's representative (the smallest image code, as a base-16
     number) and the index of a symmetry taking the code to it.
 
