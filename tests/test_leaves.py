@@ -19,7 +19,7 @@ from cospherical.core.symmetry import box_symmetries, orbit_representatives
 from cospherical.files.yamlio import dump_yaml, load_yaml
 from cospherical.formats.patterns import load, pattern_name, write_patterns
 from cospherical.studies.bisection import bisection_codes, run_study
-from cospherical.studies.leaves import leaf_codes
+from cospherical.studies.leaves import leaf_codes, run_leaves
 from oracle import qhull_regions
 from strategies import configurations
 
@@ -200,7 +200,7 @@ def test_every_leaf_configuration_matches_qhull(box):
     of an octree- or none-policy bisection configuration (no face point, or exactly the
     admissible ones short of all six) is checked by test_delaunay_oracle for both boxes:
     here only that the point sets coincide."""
-    study = run_study("leaves", Box.parse(box), leaf_codes(), "explicit", criteria=("optimal",))
+    study = run_leaves(Box.parse(box), criteria=("optimal",))
     new = 0
     for code in study.codes:
         cfg = Configuration.from_code(code, box)

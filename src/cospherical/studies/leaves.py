@@ -18,7 +18,9 @@ its reports set the octree-policy bisection study of the same box beside it
 from __future__ import annotations
 
 from itertools import combinations
+from typing import Sequence
 
+from ..catalogue import CRITERIA
 from ..core.configuration import FACE_EDGES, Box
 from .bisection import Progress, Study, bisection_codes, run_study
 
@@ -46,13 +48,27 @@ def leaf_codes() -> list[str]:
     return codes
 
 
-def run_leaves(box: Box, progress: Progress | None = None) -> Study:
+def run_leaves(box: Box, progress: Progress | None = None, criteria: Sequence[str] = CRITERIA) -> Study:
     """The leaf study of a box: every configuration of :func:`leaf_codes`, one per symmetry orbit.
+
+    Parameters
+    ----------
+    box : Box
+        The cuboid.
+    progress : callable, optional
+        Called with the number of configurations each finished orbit accounts for.
+    criteria : sequence of str
+        The criteria to apply (all three by default; ``("optimal",)`` skips the split search).
+
+    Returns
+    -------
+    Study
+        Named ``leaves``, face points ``explicit``; its codes are whole-point-set codes.
 
     Examples
     --------
-    >>> study = run_leaves(Box.parse(["1", "2", "4"]))
-    >>> study.configurations, study.orbits, study.face_points, study.fvm_adequate
-    (6210, 1012, 'explicit', 1720)
+    >>> study = run_leaves(Box.parse(["1", "2", "4"]), criteria=("optimal",))
+    >>> study.configurations, study.orbits, study.face_points, study.fvm_adequate, study.fvm_adequate_open
+    (6210, 1012, 'explicit', 1720, 268)
     """
-    return run_study("leaves", box, leaf_codes(), "explicit", progress=progress)
+    return run_study("leaves", box, leaf_codes(), "explicit", progress=progress, criteria=criteria)
