@@ -36,13 +36,19 @@ def _mark(paper, ours) -> str:
     return "" if paper == ours else "  <- differs"
 
 
+def _region(summary: dict) -> str:
+    """Where the FVM test wants the circumcenters: the box, or another base element itself."""
+    return summary.get("element", "box")
+
+
 def text_report(summary: dict, compare_paper: bool = False, study: Study | None = None) -> str:
     """A plain-text report: the frequency table and, if asked, the paper beside it."""
     lines = [
         f"{summary['study']} study{' of the ' + summary['element'] if 'element' in summary else ''}, "
         f"box {' x '.join(summary['box'])}, face points {summary['face_points']}: "
         f"{summary['configurations']} configurations ({summary['orbits']} orbits)",
-        f"FVM adequate: {summary['fvm_adequate']} (closed box), {summary['fvm_adequate_open']} (open box)",
+        f"FVM adequate: {summary['fvm_adequate']} (closed {_region(summary)}), "
+        f"{summary['fvm_adequate_open']} (open {_region(summary)})",
     ]
     names = {i: t["name"] for data in summary["criteria"].values() for i, t in data["types"].items()}
     for criterion, data in summary["criteria"].items():
