@@ -119,6 +119,8 @@ def main() -> None:
     parser.add_argument("--order", default="edge")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--sample", type=int, default=300, help="configurations timed for the estimates (b), (c)")
+    parser.add_argument("--resolution", type=int, default=16, choices=(2, 4, 8, 16),
+                        help="positions at multiples of 1/R (default 16, the paper's; smaller for a quick check)")
     args = parser.parse_args()
     if not shutil.which("qdelaunay"):
         raise SystemExit("qdelaunay not found: install qhull-bin (scripts/setup.sh does)")
@@ -129,11 +131,11 @@ def main() -> None:
 
     with PeakMemory() as memory:
         start = time.perf_counter()
-        summary = run_intersection(16, args.order, jobs=args.jobs)
+        summary = run_intersection(args.resolution, args.order, jobs=args.jobs)
         wall = time.perf_counter() - start
     configurations = summary["configurations"]
 
-    digits = intersection_codes(16, args.order)
+    digits = intersection_codes(args.resolution, args.order)
     rng = random.Random(2026)
     sample = codes_of(digits[sorted(rng.sample(range(len(digits)), args.sample))])
     start = time.perf_counter()
@@ -151,7 +153,7 @@ def main() -> None:
     fast, slow = median_call(single, True), median_call(single, False)
 
     optimal = summary["criteria"]["optimal"]
-    print(f"intersection study at 1/16, insertion order {args.order}, {args.jobs} processes")
+    print(f"intersection study at 1/{args.resolution}, insertion order {args.order}, {args.jobs} processes")
     print(f"  configurations {configurations:,}, orbits {summary['orbits']:,}, elements {optimal['total']:,}, "
           f"types {optimal['types_count']}")
     print(f"  (a) whole study, all three criteria       {wall:8.1f} s   {configurations / wall:,.0f} configurations/s"

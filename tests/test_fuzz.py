@@ -1,12 +1,13 @@
 """Fuzzing the readers and the command line: no input may fail with anything but the clean error.
 
-Counts (max_examples): codes 2500, lengths 2500, Steiner maps 1500, YAML documents 2000,
-command lines 2000: more than 10,000 generated inputs per run.
+Counts (max_examples): codes 2500, lengths 2500, Steiner maps 1500, number grammar 2000,
+Steiner lists 1000, YAML documents 2000, command lines 2000: more than 13,000 generated inputs per run.
 """
 
 from __future__ import annotations
 
 import io
+import re
 from contextlib import redirect_stderr, redirect_stdout
 
 import yaml
@@ -15,10 +16,18 @@ from hypothesis import strategies as st
 
 from cospherical import Configuration, InputError, Length
 from cospherical.cli import main
+from cospherical.core.exact import parse_rational
 from cospherical.errors import FormatError
 from cospherical.files.yamlio import parse_yaml
 from cospherical.formats.check import check_catalogue, check_patterns, validated
 from cospherical.formats.patterns import table_from_data
+
+
+# The number grammar, written again here as the oracle: ASCII digits only, an optional sign, an
+# integer or decimal with an optional exponent, or a fraction; at most 40 digits above and below.
+ORACLE = re.compile(r"[+-]?([0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?|[0-9]+/[0-9]+)")
+# characters that look like digits, signs or spaces to a person but are not ASCII
+LOOKALIKES = "\u0661\u0662\u0663\u06f1\u0967\uff10\uff11\uff12\u00b2\u2212\u00a0\u2009\uff0f\u2044_"
 
 
 def fuzz(n: int):
@@ -116,3 +125,43 @@ def test_command_lines(argv):
     if status == 2:
         assert len(err.getvalue().strip().splitlines()) == 1, (argv, err.getvalue())
         assert "Traceback" not in err.getvalue()
+
+
+@fuzz(2000)
+@given(st.one_of(st.text(alphabet="0123456789+-./eE " + LOOKALIKES, max_size=14),
+                 st.from_regex(r"\A[+-]?[0-9]{1,45}(\.[0-9]{1,45})?([eE][+-]?[0-9]{1,3})?\Z"),
+                 st.from_regex(r"\A[0-9]{1,45}/[0-9]{1,45}\Z")))
+def test_number_grammar(text):
+    """parse_rational accepts exactly the ASCII grammar with bounded digits, and reads it exactly."""
+    from fractions import Fraction
+
+    cleaned = text.strip(" ")
+    try:
+        value = parse_rational(text)
+    except InputError as error:
+        assert str(error).startswith("number ")
+        if ORACLE.fullmatch(cleaned) and "e" not in cleaned.lower() and not cleaned.endswith("/0") \
+                and not re.fullmatch(r"[+-]?0+/0+|.*/0+", cleaned):
+            exact = Fraction(cleaned)
+            assert abs(exact.numerator) >= 10**40 or exact.denominator >= 10**40, (text, error)
+    else:
+        assert ORACLE.fullmatch(cleaned), text
+        assert value == Fraction(cleaned)
+        assert abs(value.numerator) < 10**40 and value.denominator < 10**40
+
+
+EDGE_SPELLINGS = st.sampled_from(["0", "00", "000", " 0", "1", "01", "11", "011", "3", "+3", "\uff13", "\u0663", "12"])
+
+
+@fuzz(1000)
+@given(st.lists(st.tuples(EDGE_SPELLINGS, st.sampled_from(["1/2", "1/3", "3/4"])), max_size=4))
+def test_steiner_lists_refuse_an_edge_given_twice(pairs):
+    """Duplicates are found by value ('0' and '00' are one edge); only ASCII edge numbers 0..11."""
+    valid = [e.strip() for e, _ in pairs if e.strip().isascii() and e.strip().isdigit() and int(e) <= 11]
+    try:
+        cfg = Configuration.from_steiner(("1", "1", "1"), pairs)
+    except InputError:
+        assert len(valid) < len(pairs) or len({int(e) for e in valid}) < len(valid)
+    else:
+        assert len(valid) == len(pairs) and len({int(e) for e in valid}) == len(valid)
+        assert sum(t is not None for t in cfg.steiner) == len(pairs)

@@ -62,8 +62,8 @@ def test_good_files_pass_the_deep_check(tmp_path, small_table):
         (lambda d: d["configurations"]["800000000000"]["optimal"].pop(), "do not fill the box"),
         (lambda d: d["configurations"]["880000000000"]["optimal"][0].update(
             nodes=list(reversed(d["configurations"]["880000000000"]["optimal"][0]["nodes"]))), "configurations/880000000000"),
-        (lambda d: d["configurations"]["800000000000"]["optimal"].append(
-            d["configurations"]["800000000000"]["optimal"][0]), "do not fill the box"),
+        (lambda d: d["configurations"]["800000000000"]["optimal"].append(  # a copy: a shared object is a YAML alias
+            copy.deepcopy(d["configurations"]["800000000000"]["optimal"][0])), "do not fill the box"),
         (lambda d: d["configurations"]["000000000000"].update(internal_faces="internal_edges_and_faces"), "internal_faces"),
         (lambda d: d.update(box=["1", "0", "4"]), "box"),
         (lambda d: d.update(schema_version=2), "schema_version"),

@@ -37,6 +37,10 @@ def test_full_document_compiles_and_page_one_is_not_blank(tmp_path):
     assert 0.005 < ink < 0.5, f"page 1 looks blank or black: {ink:.4f} of the pixels are dark"
     text = subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True).stdout
     assert "Generic #10" in text and "37,259" in text and "Element types" in text
+    log = (tmp_path / "document.log").read_text(errors="replace")
+    assert "Overfull \\hbox" not in log, "a table is wider than the text block"
+    captions = [line for tex in tmp_path.glob("*.tex") for line in tex.read_text().splitlines() if "\\caption" in line]
+    assert captions and not [c for c in captions if "\\_" in c], "captions show internal ids"
 
 
 def test_rendered_tex_is_byte_identical_across_runs(tmp_path):

@@ -194,7 +194,8 @@ def small_table(small_table_path):
     "edit, needle",
     [
         (lambda d: d.update(schema_version=7), "schema_version"),
-        (lambda d: d["configurations"].update({"xyz": d["configurations"]["000000000000"]}), "configurations"),
+        (lambda d: d["configurations"].update({"xyz": copy.deepcopy(d["configurations"]["000000000000"])}),
+         "configurations"),  # a copy: a shared object is written as a YAML alias, refused as such
         (lambda d: d["configurations"]["800000000000"]["optimal"][0].update(nodes=[1, 2]), "nodes"),
         (lambda d: d["configurations"]["800000000000"]["optimal"][0].pop("type"), "type"),
         (lambda d: d.pop("box"), "box"),
@@ -209,10 +210,27 @@ def test_broken_pattern_tables_are_refused(tmp_path, small_table, edit, needle):
         load(path)
 
 
-def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path):
-    result = subprocess.run([sys.executable, "-m", "cospherical", "reproduce", "--root", str(tmp_path)],
-                            capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr
+def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypatch, capsys):
+    # From nothing, in one run, whatever state the catalogue is in: here the catalogue the
+    # package would read is corrupt, and the root holds stale, half-written and corrupt outputs.
+    import cospherical.catalogue.store as store
+    from cospherical.cli import main
+
+    corrupt = tmp_path / "corrupt-catalogue.yaml"
+    corrupt.write_text("types: [unclosed\n")
+    monkeypatch.setattr(store, "catalogue_path", lambda: corrupt)
+    store._read_shipped.cache_clear()
+    root = tmp_path / "root"
+    (root / "catalogue").mkdir(parents=True)
+    (root / "catalogue" / "catalogue.yaml").write_text("types: [unclosed\n")
+    (root / "results").mkdir()
+    (root / "results" / "summary.md").write_text("stale")
+    (root / "results" / ".summary.md.abcd1234.tmp").write_text("left by a killed run")
+    try:
+        assert main(["reproduce", "--root", str(root)]) == 0, capsys.readouterr().err
+    finally:
+        store._read_shipped.cache_clear()
+    tmp_path = root
     for folder in ("catalogue", "patterns", "results"):
         # results/sweep/, results/intersection/ and results/mesh/ come from other commands (README), not from reproduce
         committed = sorted(p.relative_to(ROOT) for p in (ROOT / folder).rglob("*") if p.is_file()

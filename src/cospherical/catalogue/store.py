@@ -22,7 +22,8 @@ from ..files.flowyaml import decode_entry, split_section
 from ..files.yamlio import parse_yaml, read_text, validate
 from ..paper import paper_class
 
-__all__ = ["SCHEMA_VERSION", "catalogue_from_text", "catalogue_path", "known_name", "load_catalogue", "shipped_catalogue", "type_name",
+__all__ = ["SCHEMA_VERSION", "catalogue_from_text", "catalogue_path", "known_name", "load_catalogue", "shipped_catalogue",
+           "type_name", "use_catalogue",
            "type_names"]
 
 SCHEMA_VERSION = 1
@@ -33,7 +34,9 @@ def catalogue_path() -> Path:
     return data_path("catalogue.yaml")
 
 
-@lru_cache(maxsize=None)
+_in_use: list[dict] = []  # set by use_catalogue(): the catalogue this process works with instead of the file
+
+
 def shipped_catalogue() -> dict:
     """The shipped catalogue, read and validated once per process (empty if there is none).
 
@@ -42,10 +45,26 @@ def shipped_catalogue() -> dict:
     >>> shipped_catalogue()["schema_version"]
     1
     """
+    return _in_use[0] if _in_use else _read_shipped()
+
+
+@lru_cache(maxsize=None)
+def _read_shipped() -> dict:
     path = catalogue_path()
     if not path.exists():
         return {"schema_version": SCHEMA_VERSION, "version": "none", "types": []}
     return load_catalogue(path)
+
+
+def use_catalogue(catalogue: dict | None) -> None:
+    """Work with ``catalogue`` (names, kept sets) instead of the shipped file; ``None``: the file again.
+
+    ``reproduce`` regenerates the catalogue from nothing: it starts from an empty
+    one, whatever state the file is in (missing, stale, corrupt), and then names
+    everything by the catalogue it has just built, so one run gives the final bytes.
+    """
+    _in_use[:] = [catalogue] if catalogue is not None else []
+    _known_names.cache_clear()
 
 
 @lru_cache(maxsize=None)

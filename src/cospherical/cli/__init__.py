@@ -49,14 +49,30 @@ def _terminated(signum, frame):
     raise SystemExit(128 + signum)
 
 
+_interrupted = threading.Event()
+
+
+def _interrupt(signum, frame):
+    # Remembered as well as raised: a KeyboardInterrupt raised inside a callback
+    # from compiled code can be swallowed there, and the run must not then end with 0.
+    _interrupted.set()
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminated)
+        signal.signal(signal.SIGINT, _interrupt)
+    _interrupted.clear()
     try:
         words = sys.argv[1:] if argv is None else argv
         command = next((word for word in words if not word.startswith("-")), None)
         args = build_parser(command if command in SUBCOMMANDS else None).parse_args(argv)
-        return args.run(args)
+        status = args.run(args)
+        sys.stdout.flush()  # a full disk or /dev/full shows here, as one line, not at exit
+        if _interrupted.is_set():
+            raise KeyboardInterrupt
+        return status
     except UsageError as error:  # the message already names the command
         print(error, file=sys.stderr)
         return 2
@@ -69,12 +85,31 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:
         # The reader (``| head``) has gone: stop quietly; keep Python from
         # complaining again when it flushes stdout at exit.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        _silence_stdout()
         return 141
+    except OSError as error:  # the system refused: a full disk, a missing device, too many files, ...
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"cospherical: error: {where}{error.strerror or error}", file=sys.stderr)
+        _silence_stdout()
+        return 2
+    except Exception:
+        if _interrupted.is_set():  # an interrupt that a library turned into its own error (numpy: ImportError)
+            print("cospherical: interrupted", file=sys.stderr)
+            return 130
+        raise
     except SystemExit as exit:
         if exit.code == 128 + signal.SIGTERM:
             print("cospherical: terminated", file=sys.stderr)
         raise
+
+
+def _silence_stdout() -> None:
+    # Whatever is still buffered for stdout is dropped: Python would report the
+    # same failure again when it flushes at exit.
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover

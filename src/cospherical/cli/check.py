@@ -17,7 +17,9 @@ def add_parser(commands) -> None:
         "tables (schema, known types, node counts, and that every configuration's elements tile the box). "
         "Exit status 0 when every file is valid, 2 at the first problem.",
     )
-    parser.add_argument("files", nargs="+", type=Path, metavar="FILE")
+    parser.add_argument("files", nargs="+", type=Path, metavar="FILE",
+                        help="catalogues and pattern tables, checked in order (about 10-20 s per 4096-configuration "
+                        "pattern table: every configuration is recomputed)")
     parser.add_argument("--catalogue", type=Path, metavar="FILE",
                         help="catalogue that pattern tables refer to (default: the shipped one)")
     parser.add_argument("--no-tiling", action="store_true", help="skip the geometric tiling check (faster)")

@@ -26,14 +26,18 @@ def add_parser(commands) -> None:
     )
     parser.add_argument("files", nargs="+", metavar="FILE", help="OLD NEW, or with --rev just the file")
     parser.add_argument("--rev", metavar="REV", help="read OLD from git at this revision (e.g. HEAD~3)")
-    parser.add_argument("--format", choices=("text", "json", "yaml"), default="text")
+    parser.add_argument("--format", choices=("text", "json", "yaml"), default="text",
+                        help="text (default): a readable report; json or yaml: the same report as data")
     parser.set_defaults(run=run)
 
 
 def _from_git(rev: str, path: Path):
+    # A revision is data, never an option: refuse a leading '-' and end git's options before it.
+    if not rev or rev.startswith("-") or any(ch.isspace() or ch == ":" or not ch.isprintable() for ch in rev):
+        raise UsageError(f"cospherical diff: error: --rev {rev!r}: not a git revision")
     path = path.resolve()
     try:
-        result = subprocess.run(["git", "show", f"{rev}:./{path.name}"], cwd=path.parent,
+        result = subprocess.run(["git", "show", "--end-of-options", f"{rev}:./{path.name}"], cwd=path.parent,
                                 capture_output=True, text=True)
     except OSError as error:
         raise FormatError(f"git: {error.strerror}") from None

@@ -6,6 +6,7 @@ import json
 import sys
 
 FORMATS = ("json", "yaml")
+FACE_POINTS_HELP = "octree (default): add face and body points of refined neighbours; none: corners and edge points only"
 
 
 def to_json(data, indent: int = 0) -> str:

@@ -7,12 +7,13 @@ from pathlib import Path
 from ..catalogue import shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
-from ..errors import FormatError, UsageError
-from ..files.yamlio import load_yaml
+from ..errors import FormatError, InputError, UsageError
+from ..files.yamlio import load_yaml, validate
 from ..formats.catalogue_file import build_catalogue
 from ..outputs.latex import compile_pdf, render_tables
 from ..studies.bisection import bisection_codes, run_study
 from ..studies.summary import study_summary
+from .output import FACE_POINTS_HELP
 from .progress import progress_bar
 
 SUMMARY_KEYS = ("study", "box", "face_points", "configurations", "fvm_adequate", "fvm_adequate_open", "criteria")
@@ -32,17 +33,27 @@ def add_parser(commands) -> None:
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), help="box of the study (with --study)")
     parser.add_argument("--element", choices=ELEMENTS, default="cuboid",
                         help="base element of the study (with --study; default cuboid)")
-    parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree")
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR")
+    parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree",
+                        help="with --study: " + FACE_POINTS_HELP)
+    parser.add_argument("--out", type=Path, required=True, metavar="DIR",
+                        help="folder for the .tex files (created; tables of an earlier render there are replaced)")
     parser.add_argument("--pdf", action="store_true", help="compile document.tex with pdflatex into DIR")
     parser.set_defaults(run=run)
 
 
 def _load_summary(path: Path) -> dict:
+    """A summary file, validated: every name in it is one of the known ones, every count a number."""
     data = load_yaml(path)  # JSON is YAML
-    if not isinstance(data, dict) or any(key not in data for key in SUMMARY_KEYS):
-        missing = [k for k in SUMMARY_KEYS if not isinstance(data, dict) or k not in data]
+    if isinstance(data, dict) and any(key not in data for key in SUMMARY_KEYS):
+        missing = [k for k in SUMMARY_KEYS if k not in data]
         raise FormatError(f"{path}: not a study summary (missing {', '.join(missing)})")
+    validate(data, "summary", path)
+    try:
+        Box.parse(data["box"])
+    except InputError as error:
+        raise FormatError(f"{path}: box: {error}") from None
+    if data["study"] == "intersection" and ("resolution" not in data or "insertion_order" not in data):
+        raise FormatError(f"{path}: an intersection study summary needs resolution and insertion_order")
     return data
 
 

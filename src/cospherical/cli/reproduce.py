@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..catalogue import SCHEMA_VERSION, use_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..files.yamlio import atomic_write
 from ..formats.catalogue_file import build_catalogue, intersection_examples, write_catalogue
@@ -40,7 +41,16 @@ def add_parser(commands) -> None:
 
 
 def run(args) -> int:
-    root: Path = args.root
+    # From nothing: whatever state catalogue/ is in (missing, stale, corrupt), it is neither read
+    # nor trusted; everything is named by the catalogue this run builds.
+    use_catalogue({"schema_version": SCHEMA_VERSION, "version": "none", "types": []})
+    try:
+        return _reproduce(args.root)
+    finally:
+        use_catalogue(None)
+
+
+def _reproduce(root: Path) -> int:
     codes = bisection_codes()
     runs = [(box, policy) for box in PAPER_BOXES for policy in POINT_POLICIES]
     studies = []
@@ -54,6 +64,7 @@ def run(args) -> int:
                             element=element) for element in SHAPE_ELEMENTS]
     catalogue = build_catalogue(studies + leaves + shapes, intersection_examples())
     names = {t["id"]: (t["name"], t["aliases"]) for t in catalogue["types"]}
+    use_catalogue(catalogue)
     write_catalogue(catalogue, root / "catalogue" / "catalogue.yaml")
 
     report = ["# Results: the paper's bisection studies, reproduced", "",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from ..catalogue import shipped_catalogue
@@ -17,7 +18,7 @@ from ..studies.bisection import bisection_codes, run_study
 from ..studies.intersection import INSERTION_ORDERS, run_intersection, set_patterns
 from ..studies.leaves import leaf_codes, run_leaves
 from ..studies.summary import compared_with, study_summary
-from .output import dump, emit
+from .output import FACE_POINTS_HELP, dump, emit
 from .progress import progress_bar, stage_bars
 
 
@@ -38,31 +39,44 @@ def add_parser(commands) -> None:
                         "(512, 256, 64 configurations)")
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), default=["1", "1", "1"],
                         help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2) (default: the cube)")
-    parser.add_argument("--resolution", type=int, default=16, help="intersection: positions at multiples of 1/R (2, 4, 8, 16)")
-    parser.add_argument("--order", choices=INSERTION_ORDERS, default="edge",
+    parser.add_argument("--resolution", type=int, help="intersection: positions at multiples of 1/R (2, 4, 8, 16; "
+                        "default 16)")
+    parser.add_argument("--order", choices=INSERTION_ORDERS,
                         help="intersection: the order in which the midpoint scheme inserts the levels (default edge)")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="intersection: worker processes")
-    parser.add_argument("--chunk-size", type=int, default=5000, metavar="N",
+    parser.add_argument("--jobs", type=int, metavar="N",
+                        help="intersection: worker processes (default: all cores, here %d)" % (os.cpu_count() or 1))
+    parser.add_argument("--chunk-size", type=int, metavar="N",
                         help="intersection: orbits per work unit and checkpoint (default 5000)")
     parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                         help="intersection: run the work units on this Dask scheduler's workers")
+    parser.add_argument("--scheduler-timeout", type=float, metavar="SECONDS",
+                        help="intersection: give up connecting to --scheduler after this long (default 30)")
     parser.add_argument("--dask-workers", type=int, metavar="N",
                         help="intersection: run the work units on a local Dask cluster of N processes")
     parser.add_argument("--no-orbits", action="store_true",
                         help="intersection: tessellate every configuration, not one per symmetry orbit (a check; "
                         "the statistics must not change)")
     parser.add_argument("--resume", action="store_true",
-                        help="intersection: keep finished chunks in DIR/checkpoints and reuse them (needs --out)")
+                        help="intersection: keep finished chunks in DIR/checkpoints and reuse them (needs --out; "
+                        "the bisection study takes seconds and has no checkpoints)")
     parser.add_argument("--patterns", action="store_true",
                         help="intersection: also write the pattern table of the orbit representatives into DIR "
                         "(large: one tessellation per orbit in Python, about 1 ms each)")
-    parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree")
+    parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree", help=FACE_POINTS_HELP)
     parser.add_argument("--out", type=Path, metavar="DIR",
                         help="also write the summary (JSON) and the pattern table (YAML) into DIR")
-    parser.add_argument("--format", choices=("text", "json"), default="text")
+    parser.add_argument("--format", choices=("text", "json"), default="text",
+                        help="text (default): the frequency table; json: the summary as data")
     parser.add_argument("--compare-paper", action="store_true",
                         help="print the paper's figures beside ours, each difference marked and explained")
     parser.set_defaults(run=run)
+
+
+# Options of the intersection study only: given to the bisection study they are refused, not ignored.
+INTERSECTION_ONLY = ("resolution", "order", "jobs", "chunk_size", "scheduler", "scheduler_timeout", "dask_workers",
+                     "no_orbits", "resume", "patterns")
+INTERSECTION_DEFAULTS = {"resolution": 16, "order": "edge", "jobs": os.cpu_count() or 1, "chunk_size": 5000,
+                         "scheduler_timeout": 30.0}
 
 
 def run(args) -> int:
@@ -70,7 +84,14 @@ def run(args) -> int:
         raise UsageError(f"cospherical study: error: --element {args.element}: the {args.family} study is of cuboids; "
                          "other base elements have the bisection study")
     if args.family == "intersection":
+        for name, value in INTERSECTION_DEFAULTS.items():
+            if getattr(args, name) is None:
+                setattr(args, name, value)
         return _intersection(args)
+    given = [name for name in INTERSECTION_ONLY if getattr(args, name) not in (None, False)]  # bisection, leaves
+    if given:
+        option = "--" + given[0].replace("_", "-")
+        raise UsageError(f"cospherical study: error: {option} is an option of the intersection study only")
     box = Box.parse(args.box)
     codes = bisection_codes(args.element)
     if args.family == "leaves":
@@ -124,6 +145,14 @@ def _intersection(args) -> int:
         if find_spec("distributed") is None:
             raise UsageError("cospherical study: error: the Dask backend needs dask.distributed: "
                              "pip install 'cospherical[dask]'")
+    if args.scheduler:
+        if not re.fullmatch(r"(tcp|tls|ucx)://[A-Za-z0-9._\[\]:-]+", args.scheduler):
+            raise UsageError(f"cospherical study: error: --scheduler {args.scheduler!r}: give tcp://HOST:PORT")
+        if not args.scheduler_timeout > 0:
+            raise UsageError(f"cospherical study: error: --scheduler-timeout {args.scheduler_timeout}: must be > 0")
+        import dask
+
+        dask.config.set({"distributed.comm.timeouts.connect": f"{args.scheduler_timeout}s"})
     checkpoints = args.out / "checkpoints" if args.out else None
     total = len(set_patterns(args.resolution, args.order)) ** 3  # one pattern per set of parallel edges
     with stage_bars({"cells": (total, f"intersection 1/{args.resolution}: cells", "cfg"),

@@ -30,7 +30,8 @@ def add_parser(commands) -> None:
     parser.add_argument("--range", default="1:4", metavar="R_MIN:R_MAX", help="range of r along the ray (default 1:4)")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="processes for the grid (default: all cores)")
     parser.add_argument("--out", type=Path, metavar="DIR", help="also write JSON, PNG and pgfplots figures into DIR")
-    parser.add_argument("--format", choices=("text", "json"), default="text")
+    parser.add_argument("--format", choices=("text", "json"), default="text",
+                        help="text (default): a table; json: the counts as data")
     parser.set_defaults(run=run)
 
 

@@ -12,7 +12,7 @@ from ..core.tessellation import tessellate
 from ..errors import FormatError, InputError, UsageError
 from ..files.yamlio import load_yaml
 from ..formats.tessellation import tessellation_data
-from .output import FORMATS, emit
+from .output import FACE_POINTS_HELP, FORMATS, emit
 
 
 def _steiner(text: str) -> tuple[str, str]:
@@ -22,11 +22,26 @@ def _steiner(text: str) -> tuple[str, str]:
     return edge, t
 
 
+NUMBERING = """\
+node numbering (box A x B x C):
+  corners 0-7 (VTK hexahedron order): 0 (0,0,0), 1 (A,0,0), 2 (A,B,0), 3 (0,B,0),
+                                      4 (0,0,C), 5 (A,0,C), 6 (A,B,C), 7 (0,B,C)
+  edge k joins (0,1) (1,2) (2,3) (3,0) (4,5) (5,6) (6,7) (7,4) (0,4) (1,5) (2,6) (3,7)
+    for k = 0..11; its Steiner point is node 8+k, at parameter T from the lower-coordinate end
+  face points 20-25 on faces (0,1,5,4) (1,2,6,5) (2,3,7,6) (3,0,4,7) (0,1,2,3) (4,5,6,7);
+    body point 26
+  circumcenters are in box coordinates (as tess.circumcenter() in Python;
+    element.polyhedron.center is the exact value in unit coordinates, [0,1]^3)
+"""
+
+
 def add_parser(commands) -> None:
     parser = commands.add_parser(
         "tessellate",
         help="tessellate one 1-irregular cuboid, prism, pyramid or tetrahedron",
         description="Tessellate one 1-irregular element: Delaunay cells = largest co-spherical elements.",
+        epilog=NUMBERING,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     element = parser.add_mutually_exclusive_group()
     element.add_argument("--element", choices=ELEMENTS, default="cuboid",
@@ -45,7 +60,7 @@ def add_parser(commands) -> None:
                         "suffix +f<faces>[b]: the faces carrying a point, e.g. 888888888888+f04")
     face_points = parser.add_mutually_exclusive_group()
     face_points.add_argument("--face-points", choices=POINT_POLICIES,
-                             help="octree (default): add face and body points of refined neighbours; none: edges only")
+                             help=FACE_POINTS_HELP)
     face_points.add_argument("--faces", nargs="*", metavar="F",
                              help="the faces (0..5) carrying a centre point, given explicitly (no F: none), as at "
                              "an octree leaf whose face neighbours across F are refined")
@@ -53,18 +68,9 @@ def add_parser(commands) -> None:
     parser.add_argument("--criterion", choices=CRITERIA, default="optimal",
                         help="optimal (default): largest co-spherical elements; internal_faces / "
                         "internal_edges_and_faces: split the types the catalogue does not keep for that criterion")
-    parser.add_argument("--format", choices=FORMATS, default="json")
+    parser.add_argument("--format", choices=FORMATS, default="json", help="json (default) or yaml, on stdout")
     parser.add_argument("--vtu", type=Path, metavar="FILE", help="also write the tessellation as a VTU mesh (ParaView)")
     parser.set_defaults(run=run)
-
-
-def _steiner_map(pairs) -> dict[str, str]:
-    steiner = {}
-    for edge, t in pairs:
-        if edge.strip() in steiner:
-            raise InputError(f"edge {edge}: given twice")
-        steiner[edge.strip()] = t
-    return steiner
 
 
 def _shape_file(path: Path, box) -> Shape:
@@ -87,10 +93,10 @@ def _configuration(args):
         shape = _shape_file(args.shape, args.box) if args.shape else standard_shape(args.element, args.box)
         if args.code is not None:
             return ShapeConfiguration.from_code(shape, args.code, policy), tessellate_shape
-        return ShapeConfiguration.from_steiner(shape, _steiner_map(args.steiner), policy), tessellate_shape
+        return ShapeConfiguration.from_steiner(shape, args.steiner, policy), tessellate_shape
     if args.code is not None:
         return Configuration.from_code(args.code, args.box, policy, args.faces, args.body), tessellate
-    return Configuration.from_steiner(args.box, _steiner_map(args.steiner), policy, args.faces, args.body), tessellate
+    return Configuration.from_steiner(args.box, args.steiner, policy, args.faces, args.body), tessellate
 
 
 def run(args) -> int:

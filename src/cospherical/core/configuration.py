@@ -101,20 +101,35 @@ class Box:
         return tuple(float(length) for length in self.lengths)
 
 
-def _parse_parameter(edge: int, value) -> Fraction:
-    t = parse_rational(value, f"Steiner parameter on edge {edge}")
-    if not 0 < t < 1:
-        raise InputError(f"Steiner parameter on edge {edge} is {value!r}: must lie strictly between 0 and 1")
-    return t
+def steiner_parameters(steiner: Mapping | Iterable | None, edges: int = 12,
+                       element: str = "cuboid") -> tuple[Fraction | None, ...]:
+    """The Steiner parameter of each of ``edges`` edges from ``{edge: t}`` or ``[(edge, t), ...]``.
 
+    Edge numbers are ASCII digits (or ints), an edge given twice is refused by value
+    (``0`` and ``00`` are one edge, never the last one winning), and every t is an
+    exact number strictly between 0 and 1.
 
-def _parse_edge(edge) -> int:
-    text = str(edge).strip()
-    # isascii: str.isdigit() also accepts digits such as '²' that int() refuses
-    if isinstance(edge, bool) or not isinstance(edge, (int, str)) or not (text.isascii() and text.isdigit()) \
-            or int(text) > 11:
-        raise InputError(f"edge {edge!r}: not an edge number 0..11")
-    return int(text)
+    >>> steiner_parameters([("0", "1/2"), ("00", "1/3")])
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.InputError: edge '00': edge 0 is given twice
+    """
+    params: list[Fraction | None] = [None] * edges
+    for edge, value in (steiner.items() if isinstance(steiner, Mapping) else steiner or ()):
+        text = str(edge).strip(" \t")
+        # isascii: str.isdigit() also accepts digits such as '²' or '٣' that are not ours
+        if isinstance(edge, bool) or not isinstance(edge, (int, str)) or not (text.isascii() and text.isdigit()) \
+                or int(text) >= edges:
+            raise InputError(f"edge {edge!r}: not an edge number 0..{edges - 1}"
+                             + ("" if element == "cuboid" else f" of the {element}"))
+        k = int(text)
+        if params[k] is not None:
+            raise InputError(f"edge {edge!r}: edge {k} is given twice")
+        t = parse_rational(value, f"Steiner parameter on edge {k}")
+        if not 0 < t < 1:
+            raise InputError(f"Steiner parameter on edge {k} is {value!r}: must lie strictly between 0 and 1")
+        params[k] = t
+    return tuple(params)
 
 
 FACE_POINT_SOURCES = (*POINT_POLICIES, "explicit")
@@ -232,22 +247,18 @@ class Configuration:
     def from_steiner(
         cls,
         box: Box | Iterable = ("1", "1", "1"),
-        steiner: Mapping | None = None,
+        steiner: Mapping | Iterable | None = None,
         face_points: str = "octree",
         faces: Iterable | None = None,
         body: bool = False,
     ) -> "Configuration":
-        """Build from ``{edge: t}``; t may be a string, int or Fraction.
+        """Build from ``{edge: t}`` or ``[(edge, t), ...]``; t may be a string, int or Fraction.
 
         ``faces`` (face numbers 0..5) and ``body`` give the face and body points
         explicitly; then ``face_points`` is ignored.
         """
         box = box if isinstance(box, Box) else Box.parse(box)
-        params: list[Fraction | None] = [None] * 12
-        for edge, value in (steiner or {}).items():
-            k = _parse_edge(edge)
-            params[k] = _parse_parameter(k, value)
-        return cls._build(box, tuple(params), face_points, faces, body)
+        return cls._build(box, steiner_parameters(steiner), face_points, faces, body)
 
     @classmethod
     def from_code(

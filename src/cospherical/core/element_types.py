@@ -10,7 +10,7 @@ from functools import lru_cache
 from .canonical import canonical_form
 from .polyhedron import Polyhedron
 
-__all__ = ["ElementType", "classify", "element_type"]
+__all__ = ["ElementType", "classify", "classify_faces", "element_type"]
 
 _POLYGON_ADJECTIVE = {3: "triangular", 4: "quadrilateral", 5: "pentagonal", 6: "hexagonal", 7: "heptagonal", 8: "octagonal"}
 _KIND_PLURAL = {
@@ -168,6 +168,11 @@ def classify(poly: Polyhedron) -> tuple[ElementType, tuple[int, ...], bool]:
     whether it is the mirror image of the type's direct form (never for VTK types,
     whose node order is fixed by orientation)."""
     return _classify(poly.faces, poly.face_kinds)
+
+
+def classify_faces(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]):
+    """:func:`classify` from a polyhedron's face cycles (counter-clockwise from outside) and face kinds."""
+    return _classify(faces, kinds)
 
 
 # A study meets the same cell (same node ids and faces) in many configurations.

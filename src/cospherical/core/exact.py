@@ -15,14 +15,22 @@ from fractions import Fraction
 
 from ..errors import InputError
 
-__all__ = ["Length", "parse_rational", "rational_text"]
+__all__ = ["Length", "MAX_DIGITS", "NUMBER", "bounded", "parse_rational", "rational_text"]
 
 
 _SQRT = re.compile(r"^(?:(?P<factor>[^*]+)\*)?sqrt\((?P<radicand>[^()]+)\)$")
+# The one number grammar (ASCII only): an integer, a decimal, either with an
+# exponent, or a fraction of two integers; an optional sign.  ``re.ASCII`` keeps
+# \d from matching other scripts' digits (Arabic-Indic, fullwidth, ...).
+NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d+)?(?:[eE][+-]?\d+)?|\d+/\d+)", re.ASCII)
+# Bounds that keep every exact computation small: at most MAX_DIGITS digits in
+# the numerator and in the denominator (1e-40 and 10^40 are fine; 1e400 is not).
+MAX_DIGITS = 40
+_MAX_TEXT = 100
 
 
 def parse_rational(text: str | int | Fraction, what: str = "number") -> Fraction:
-    """Parse an integer, decimal or fraction exactly.
+    """Parse an integer, decimal or fraction exactly (the ASCII grammar :data:`NUMBER`, bounded size).
 
     Examples
     --------
@@ -30,18 +38,39 @@ def parse_rational(text: str | int | Fraction, what: str = "number") -> Fraction
     Fraction(7071, 5000)
     >>> parse_rational("3/2")
     Fraction(3, 2)
+    >>> parse_rational("\u0663/\u0662")
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.InputError: number '٣/٢': not an integer, decimal or fraction (ASCII digits)
     """
     if isinstance(text, (int, Fraction)) and not isinstance(text, bool):
-        return Fraction(text)
+        return bounded(Fraction(text), what, text)
     if isinstance(text, float):
         raise InputError(f"{what} {text!r}: give an exact value (a string such as '0.5' or '1/3'), not a float")
     if not isinstance(text, str):
         raise InputError(f"{what} {text!r}: not a number")
-    cleaned = text.strip().replace(" ", "")
+    cleaned = text.strip(" \t")
+    if len(cleaned) > _MAX_TEXT:
+        raise InputError(f"{what} {text[:20]!r}...: too long ({len(cleaned)} characters; at most {_MAX_TEXT})")
+    if not NUMBER.fullmatch(cleaned):
+        raise InputError(f"{what} {text!r}: not an integer, decimal or fraction (ASCII digits)")
+    mantissa, _, exponent = cleaned.lower().partition("e")
+    if exponent and abs(int(exponent)) > MAX_DIGITS + _MAX_TEXT:  # before computing 10**exponent
+        raise InputError(f"{what} {text!r}: too large or too small (at most {MAX_DIGITS} digits)")
     try:
         value = Fraction(cleaned)
-    except (ValueError, ZeroDivisionError):
-        raise InputError(f"{what} {text!r}: not an integer, decimal or fraction") from None
+    except ZeroDivisionError:
+        raise InputError(f"{what} {text!r}: division by zero") from None
+    return bounded(value, what, text)
+
+
+def bounded(value: Fraction, what: str, text) -> Fraction:
+    """``value``, when its numerator and denominator have at most :data:`MAX_DIGITS` digits each."""
+    limit = 10**MAX_DIGITS
+    if abs(value.numerator) >= limit or value.denominator >= limit:
+        shown = text if len(str(text)) <= 30 else f"{str(text)[:20]}..."
+        raise InputError(f"{what} {shown!r}: too large or too precise (at most {MAX_DIGITS} digits in the "
+                         "numerator and in the denominator)")
     return value
 
 
@@ -102,7 +131,7 @@ class Length:
         if isinstance(text, Length):
             return text
         if isinstance(text, str):
-            cleaned = text.strip().replace(" ", "").lower()
+            cleaned = text.strip(" \t").replace(" ", "").lower()
             match = _SQRT.match(cleaned)
             if match:
                 radicand = parse_rational(match["radicand"], what)

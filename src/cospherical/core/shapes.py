@@ -40,7 +40,7 @@ from itertools import combinations
 from typing import Iterable, Mapping, Sequence
 
 from ..errors import InputError
-from .configuration import Box
+from .configuration import Box, steiner_parameters
 from .exact import parse_rational
 from .geometry import six_volume
 from .polyhedron import Polyhedron
@@ -338,19 +338,10 @@ class ShapeConfiguration:
         return cls(shape, tuple(Fraction(int(ch, 16), 16) if ch != "0" else None for ch in code), face_points)
 
     @classmethod
-    def from_steiner(cls, shape: Shape, steiner: Mapping | None = None,
+    def from_steiner(cls, shape: Shape, steiner: Mapping | Iterable | None = None,
                      face_points: str = "octree") -> "ShapeConfiguration":
-        """From ``{edge: t}``, t a string, int or Fraction strictly between 0 and 1."""
-        params: list[Fraction | None] = [None] * len(shape.edges)
-        for edge, value in (steiner or {}).items():
-            text = str(edge).strip()
-            if isinstance(edge, bool) or not (text.isascii() and text.isdigit()) or int(text) >= len(params):
-                raise InputError(f"edge {edge!r}: not an edge number 0..{len(params) - 1} of the {shape.name}")
-            t = parse_rational(value, f"Steiner parameter on edge {text}")
-            if not 0 < t < 1:
-                raise InputError(f"Steiner parameter on edge {text} is {value!r}: must lie strictly between 0 and 1")
-            params[int(text)] = t
-        return cls(shape, tuple(params), face_points)
+        """From ``{edge: t}`` or ``[(edge, t), ...]``, t a string, int or Fraction strictly between 0 and 1."""
+        return cls(shape, steiner_parameters(steiner, len(shape.edges), shape.name), face_points)
 
     @property
     def box(self) -> Box:

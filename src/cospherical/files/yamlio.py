@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
+import re
+import stat
 import tempfile
 from contextlib import contextmanager
 from functools import lru_cache
@@ -11,16 +14,26 @@ from pathlib import Path
 
 import yaml
 
-from ..errors import FormatError
+from ..errors import FormatError, InputError
 from .data import data_path
 
-__all__ = ["FormatError", "atomic_write", "dump_yaml", "load_yaml", "parse_yaml", "validate", "yaml_float"]
+__all__ = ["FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_yaml", "parse_yaml", "validate", "yaml_float"]
 
 _Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 
 
 class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
-    """Safe loading that refuses a mapping with a repeated key (YAML would keep the last)."""
+    """Safe loading that refuses a mapping with a repeated key (YAML would keep the last).
+
+    Timestamps are not resolved: a date stays a string (an impossible date such as
+    2001-13-14 would otherwise raise from deep inside the loader), and the schemas
+    say which strings are allowed.
+    """
+
+    yaml_implicit_resolvers = {
+        first: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:timestamp"]
+        for first, resolvers in getattr(yaml, "CSafeLoader", yaml.SafeLoader).yaml_implicit_resolvers.items()
+    }
 
     def construct_mapping(self, node, deep=False):
         seen = set()
@@ -37,24 +50,101 @@ class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
         return super().construct_mapping(node, deep)
 
 
-@contextmanager
-def atomic_open(path: str | Path, binary: bool = False):
-    """A file to write, in place at ``path`` only when the block ends without an error.
+# Reading: our files are at most a few MB (a pattern table at R = 4 is 69 MB); a
+# larger file, or one nested deeper than any we write, is refused before parsing
+# (deep nesting overflows the C parser's stack).
+MAX_INPUT_BYTES = 512 * 2**20
+MAX_DEPTH = 64
+MAX_INDENT = 256
 
-    It is a temporary file in the same folder, renamed at the end: never a
-    half-written file, and no temporary file left behind.
+
+def _output_error(path: Path, error: OSError) -> InputError:
+    return InputError(f"{path}: cannot write: {error.strerror or error}")
+
+
+def _refuse_special(path: Path) -> None:
+    """An existing output must be a regular file: never replace a device, a FIFO, a symlink or a folder."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return
+    except OSError as error:
+        raise _output_error(path, error) from None
+    if not stat.S_ISREG(mode):
+        kind = "a symbolic link" if stat.S_ISLNK(mode) else "a folder" if stat.S_ISDIR(mode) else "a special file"
+        raise InputError(f"{path}: exists and is {kind}, not a regular file: not replacing it")
+
+
+def _remove_stale_temporaries(path: Path) -> None:
+    """Remove ``.NAME.XXXXXXXX.tmp`` files of earlier runs that were killed (SIGKILL, power loss).
+
+    A live writer holds an exclusive lock on its temporary file, so a file whose
+    lock can be taken belongs to a dead process: removing it never disturbs a
+    concurrent run.
+    """
+    prefix = f".{path.name}."
+    try:
+        candidates = [p for p in path.parent.iterdir() if p.name.startswith(prefix) and p.name.endswith(".tmp")
+                      and re.fullmatch(r"[a-z0-9_]{8}", p.name[len(prefix):-4])]
+    except OSError:
+        return
+    for candidate in candidates:
+        try:
+            fd = os.open(candidate, os.O_RDONLY | os.O_NOFOLLOW)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            candidate.unlink(missing_ok=True)
+        except OSError:
+            pass  # locked: a live writer
+        finally:
+            os.close(fd)
+
+
+@contextmanager
+def atomic_path(path: str | Path):
+    """A temporary path to write, renamed to ``path`` only when the block ends without an error.
+
+    The temporary file is in the same folder, so the rename is atomic: never a
+    half-written file, and no temporary file left behind (one left by a killed
+    run is removed by the next).  An existing ``path`` that is not a regular file
+    is refused; an unwritable place raises :class:`InputError` with one line.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    _refuse_special(path)
     try:
-        with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding="utf-8", newline="\n")) as handle:
-            yield handle
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file ordinary permissions
-        os.replace(tmp, path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        _remove_stale_temporaries(path)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as error:
+        raise _output_error(path, error) from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)  # held until the rename: marks the file as live
+        try:
+            yield Path(tmp)
+            _refuse_special(path)
+            os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file ordinary permissions
+            os.replace(tmp, path)
+        except OSError as error:
+            raise _output_error(path, error) from None
+        finally:
+            os.close(fd)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+@contextmanager
+def atomic_open(path: str | Path, binary: bool = False):
+    """A file to write, in place at ``path`` only when the block ends without an error (see :func:`atomic_path`)."""
+    with atomic_path(path) as tmp:
+        try:
+            handle = open(tmp, "wb") if binary else open(tmp, "w", encoding="utf-8", newline="\n")
+        except OSError as error:
+            raise _output_error(Path(path), error) from None
+        with handle:
+            yield handle
 
 
 def atomic_write(path: str | Path, text: str | bytes) -> None:
@@ -91,23 +181,88 @@ def load_yaml(path: str | Path):
     return parse_yaml(read_text(path), str(path))
 
 
-def read_text(path: str | Path) -> str:
-    """A file's text (UTF-8); a missing or unreadable file raises FormatError."""
+def read_text(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> str:
+    """The UTF-8 text of an input file: only a regular file (never a device or a FIFO), at most
+    ``max_bytes`` of it; anything else raises FormatError with one line."""
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8")
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)  # a FIFO must not block the open
+        try:
+            info = os.fstat(fd)
+            if not stat.S_ISREG(info.st_mode):
+                kind = "a folder" if stat.S_ISDIR(info.st_mode) else "a special file"
+                raise FormatError(f"{path}: cannot read: {kind}, not a regular file")
+            if info.st_size > max_bytes:
+                raise FormatError(f"{path}: cannot read: too large ({info.st_size} bytes; at most {max_bytes})")
+            with os.fdopen(os.dup(fd), "rb") as handle:
+                data = handle.read(max_bytes + 1)
+        finally:
+            os.close(fd)
+        if len(data) > max_bytes:
+            raise FormatError(f"{path}: cannot read: too large (more than {max_bytes} bytes)")
+        return data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as error:
         raise FormatError(f"{path}: cannot read: {getattr(error, 'strerror', None) or error}") from None
 
 
+def check_nesting(text: str, name: str) -> None:
+    """Refuse nesting deeper than any file we write, before the parser recurses into it."""
+    import numpy as np
+
+    data = np.frombuffer(text.encode("utf-8"), dtype=np.uint8)
+    # Flow collections: brackets, counted also inside quoted strings (ours hold none, so this only over-counts).
+    steps = np.isin(data, (ord("["), ord("{"))).astype(np.int64) - np.isin(data, (ord("]"), ord("}")))
+    flow = int(np.cumsum(steps).max()) if len(steps) else 0
+    # Block collections: indentation and leading "- " / "? " indicators.
+    block = max((len(m) for m in re.findall(r"^[ ?\-]+", text, re.M)), default=0)
+    if flow > MAX_DEPTH or block > MAX_INDENT:
+        raise FormatError(f"{name}: nested too deeply (more than {MAX_DEPTH} levels)")
+
+
+def _refuse_aliases(data, name: str) -> None:
+    """Refuse YAML aliases: the tool never writes them, and they make small files expand without bound.
+
+    An alias makes two places hold the same list or mapping object; a walk that
+    meets one container twice has found one.
+    """
+    seen: set[int] = set()
+    stack = [data]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, (dict, list)):
+            if id(item) in seen:
+                raise FormatError(f"{name}: a YAML alias (*name): not allowed in cospherical files")
+            seen.add(id(item))
+            stack.extend(item.values() if isinstance(item, dict) else item)
+
+
+def _unique_pairs(pairs):
+    keys = [key for key, _ in pairs]
+    if len(set(keys)) != len(keys):
+        raise ValueError("repeated key")
+    return dict(pairs)
+
+
 def parse_yaml(text: str, name: str):
+    """Parse YAML text safely: no aliases, no deep nesting, no Python tags; errors as one-line FormatError."""
+    check_nesting(text, name)
+    if text.lstrip().startswith("{"):  # JSON (our summaries): read as JSON, where 4e-06 is a number
+        try:
+            return json.loads(text, object_pairs_hook=_unique_pairs)
+        except ValueError:
+            pass  # a YAML flow mapping, or broken: the YAML reader says where
     try:
-        return yaml.load(text, Loader=_Loader)
+        data = yaml.load(text, Loader=_Loader)
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark else ""
         problem = getattr(error, "problem", None) or "not valid YAML"
         raise FormatError(f"{name}:{where}: {problem}") from None
+    except (ValueError, OverflowError, RecursionError) as error:
+        # e.g. an integer of more digits than Python converts (sys.get_int_max_str_digits)
+        raise FormatError(f"{name}: a value cannot be read: {str(error).splitlines()[0][:120]}") from None
+    _refuse_aliases(data, name)
+    return data
 
 
 @lru_cache(maxsize=None)

@@ -14,7 +14,10 @@ from fractions import Fraction
 
 from ..catalogue import catalogue_from_text
 from ..core.configuration import Box
+from ..core.delaunay import hull_faces
+from ..core.element_types import classify_faces
 from ..core.geometry import Frame, six_volume
+from ..core.polyhedron import face_kind
 from ..errors import FormatError, InputError
 from ..files.flowyaml import split_section
 from ..files.yamlio import parse_yaml, validate
@@ -28,10 +31,7 @@ __all__ = ["check_catalogue", "check_patterns", "document_data", "read_document"
 def check_catalogue(data: dict, name: str) -> None:
     """Ids, codes and names unique; faces consistent with V/E/F; splits name known types."""
     ids = Counter(t["id"] for t in data["types"])
-    for field in ("id", "code", "name"):
-        repeated = [k for k, n in Counter(t[field] for t in data["types"]).items() if n > 1]
-        if repeated:
-            raise FormatError(f"{name}: types: {field} {repeated[0]!r} appears more than once")
+    check_unique(data, name)
     for i, t in enumerate(data["types"]):
         where = f"{name}: types/{i} ({t['id']})"
         faces = [f["nodes"] for f in t["reference_faces"]]
@@ -51,6 +51,14 @@ def check_catalogue(data: dict, name: str) -> None:
             raise FormatError(f"{name}: criteria/{criterion}/kept: unknown type {unknown[0]!r}")
 
 
+def check_unique(data: dict, name: str) -> None:
+    """Every type once: the same id, canonical code or name twice makes a catalogue ambiguous."""
+    for field in ("id", "code", "name"):
+        repeated = [k for k, n in Counter(t[field] for t in data["types"]).items() if n > 1]
+        if repeated:
+            raise FormatError(f"{name}: types: {field} {repeated[0]!r} appears more than once")
+
+
 def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True) -> None:
     """Check a loaded :class:`~cospherical.patterns.PatternTable` against the catalogue and geometry."""
     types = {t["id"]: t for t in catalogue["types"]} if catalogue else None
@@ -63,6 +71,7 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
     # The same element (type, nodes, node positions) recurs in many configurations
     # and criteria of a table: its volume and faces are computed once.
     geometry: dict[tuple, tuple | None] = {}
+    recomputed: dict[tuple, tuple | None] = {}
     for code, entry in table.configurations.items():
         try:
             cfg = family.configuration(code)
@@ -94,6 +103,64 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
                         raise FormatError(f"{where}/{k}: {len(element['nodes'])} nodes for a type with {t['vertices']} vertices")
             if tiling and types:
                 _check_tiling(nodes, positions, box.squared, elements, types, geometry, where, shape)
+        if tiling and types:
+            _check_recomputed(cfg, positions, box.squared, entry, header["criteria"], f"{name}: configurations/{code}",
+                              recomputed, family.tessellate)
+
+
+def _check_recomputed(cfg, positions: dict, squared, entry: dict, criteria, where: str, cache: dict,
+                      tessellate) -> None:
+    """Recompute and compare exactly, element by element: the type label and mirror flag (from the
+    convex hull of the element's points), the circumcenter (the stored float must be the float of the
+    exact one), and ``fvm_adequate`` (every circumcenter of the optimal elements in the closed box;
+    in the base element for another element than the cuboid).  Elements recur across a table, so
+    each distinct one (its points) is computed once."""
+    scale = cfg.box.to_float()
+    centers = []
+    for c, criterion in enumerate(criteria):
+        for k, element in enumerate(entry_elements(entry, criterion)):
+            here = f"{where}/{criterion}/{k}"
+            points = tuple(positions[n] for n in element["nodes"])
+            if points not in cache:
+                cache[points] = _recompute(points, squared)
+            if cache[points] is None:
+                raise FormatError(f"{here}: its nodes are not the vertices of a convex element on one sphere")
+            type_id, mirrored, center = cache[points]
+            if element["type"] != type_id:
+                raise FormatError(f"{here}: type {element['type']}, recomputed {type_id}")
+            if bool(element.get("mirror", False)) != mirrored:
+                raise FormatError(f"{here}: mirror is {bool(element.get('mirror', False))}, recomputed {mirrored}")
+            real = [float(x) * s for x, s in zip(center, scale)]
+            if [float(x) for x in element["circumcenter"]] != real:
+                raise FormatError(f"{here}: circumcenter {element['circumcenter']}, recomputed {real}")
+            if c == 0:
+                centers.append(center)
+    if hasattr(cfg, "shape"):  # the FVM test of another base element is in that element
+        adequate = tessellate(cfg).fvm_adequate
+    else:
+        adequate = all(0 <= x <= 1 for center in centers for x in center)
+    if entry["fvm_adequate"] != adequate:
+        raise FormatError(f"{where}: fvm_adequate is {entry['fvm_adequate']}, recomputed {adequate}")
+
+
+def _recompute(points: tuple, squared) -> tuple | None:
+    """(type id, mirrored, exact circumcenter in unit coordinates) of the element with these
+    points, or ``None`` if they are not the vertices of a convex polyhedron on one sphere."""
+    from itertools import combinations
+
+    unit = {i: tuple(Fraction(n, d) for n, d in point) for i, point in enumerate(points)}
+    frame = Frame.build(unit, squared)
+    try:
+        cycles = sorted(cycle for cycle, _ in hull_faces(frame, list(range(len(points)))))
+    except ValueError:
+        return None
+    if {i for cycle in cycles for i in cycle} != set(range(len(points))):
+        return None
+    etype, _, mirrored = classify_faces(tuple(cycles), tuple(face_kind(frame, cycle) for cycle in cycles))
+    sphere = next((s for s in (frame.sphere(*q) for q in combinations(range(len(points)), 4)) if s is not None), None)
+    if sphere is None or any(sphere.side(frame.lifted[i]) != 0 for i in range(len(points))):
+        return None
+    return etype.id, mirrored, frame.center(sphere)
 
 
 def _element_geometry(element: dict, points: tuple, squared, types, shape=None) -> tuple | None:
@@ -160,7 +227,9 @@ def read_document(text: str, name: str):
         return "patterns", table
     section = split_section(text, "types")
     if section is not None and isinstance(section[1], list):
-        return "catalogue", catalogue_from_text(text, name)
+        catalogue = catalogue_from_text(text, name)
+        check_unique(catalogue, name)
+        return "catalogue", catalogue
     kind, data = validated(parse_yaml(text, name), name)
     return kind, (data if kind == "catalogue" else table_from_data(data, name))
 
@@ -173,7 +242,10 @@ def document_data(document) -> dict:
 
 
 def validated(data, name: str) -> tuple[str, dict]:
-    """The document's kind (``catalogue`` or ``patterns``), after schema validation."""
+    """The document's kind (``catalogue`` or ``patterns``), after schema validation (and, for a
+    catalogue, every type once)."""
     kind = document_kind(data, name)
     validate(data, kind, name)
+    if kind == "catalogue":
+        check_unique(data, name)
     return kind, data

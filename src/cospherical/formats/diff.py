@@ -33,11 +33,15 @@ def diff_catalogues(old: dict, new: dict) -> dict:
     new_types = {t["code"]: t for t in new["types"]}
     added = [_brief(new_types[c]) for c in sorted(set(new_types) - set(old_types), key=lambda c: new_types[c]["id"])]
     removed = [_brief(old_types[c]) for c in sorted(set(old_types) - set(new_types), key=lambda c: old_types[c]["id"])]
-    renamed, aliases, splits = [], [], []
+    renamed, aliases, splits, fields = [], [], [], []
     for code in sorted(set(old_types) & set(new_types), key=lambda c: new_types[c]["id"]):
         a, b = old_types[code], new_types[code]
         if a["name"] != b["name"]:
             renamed.append({"id": b["id"], "old": a["name"], "new": b["name"]})
+        # every other field of the type: faces, V/E/F, VTK type, chirality, example, studies, ...
+        other = sorted(k for k in set(a) | set(b) if k not in _REPORTED_APART and a.get(k) != b.get(k))
+        if other:
+            fields.append({"id": b["id"], "name": b["name"], "fields": other})
         if a.get("aliases", []) != b.get("aliases", []):
             aliases.append({"id": b["id"], "name": b["name"], "old": a.get("aliases", []), "new": b.get("aliases", [])})
         for criterion in sorted(set(a.get("splits", {})) | set(b.get("splits", {}))):
@@ -53,8 +57,12 @@ def diff_catalogues(old: dict, new: dict) -> dict:
         if before != after:
             kept.append({"criterion": criterion, "now_kept": sorted(after - before), "no_longer_kept": sorted(before - after)})
     changes = {"header": header, "added": added, "removed": removed, "renamed": renamed,
-               "aliases": aliases, "splits": splits, "kept": kept}
+               "changed": fields, "aliases": aliases, "splits": splits, "kept": kept}
     return {"kind": "catalogue", **{k: v for k, v in changes.items() if v}}
+
+
+# Fields of a type with a report of their own; the canonical code is what matches types.
+_REPORTED_APART = {"code", "name", "aliases", "splits"}
 
 
 def _brief(entry: dict) -> dict:
@@ -80,8 +88,7 @@ def _what_changed(before, after) -> str:
 
 
 def diff_patterns(old: dict, new: dict) -> dict:
-    header = _changed(old, new, ("schema_version", "generator", "catalogue_version", "study", "box",
-                                 "face_points", "scheme", "criteria"))
+    header = _changed(old, new, [k for k in {**old, **new} if k != "configurations"])  # every header field
     old_conf, new_conf = old["configurations"], new["configurations"]
     added = sorted(set(new_conf) - set(old_conf))
     removed = sorted(set(old_conf) - set(new_conf))
@@ -133,6 +140,8 @@ def text_report(report: dict, old_name: str, new_name: str) -> str:
             lines.append(f"- type {entry['id']} {entry['name']} (V/E/F {'/'.join(map(str, entry['vef']))})")
         for entry in report.get("renamed", []):
             lines.append(f"~ renamed {entry['id']}: {entry['old']!r} -> {entry['new']!r}")
+        for entry in report.get("changed", []):
+            lines.append(f"~ changed {entry['id']} {entry['name']}: {', '.join(entry['fields'])}")
         for entry in report.get("aliases", []):
             lines.append(f"~ aliases {entry['id']} {entry['name']}: {entry['old']} -> {entry['new']}")
         for entry in report.get("splits", []):

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..core.configuration import POINT_POLICIES, Box, Configuration
 from ..errors import FormatError, InputError
-from ..files.yamlio import atomic_write, validate
+from ..files.yamlio import atomic_write, check_nesting, read_text, validate
 from ..studies.mesh.assembly import Lookup, Mesh
 from .vtu import write_meshio
 
@@ -48,17 +48,11 @@ def read_leaves(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     ([0], [[0, 0, 0]])
     """
     path = Path(path)
-    try:
-        if path.stat().st_size > MAX_LEAF_FILE:
-            raise FormatError(f"{path}: larger than {MAX_LEAF_FILE // 1024**3} GiB")
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise InputError(f"{path}: cannot read: {error.strerror}") from None
-    except UnicodeDecodeError:
-        raise FormatError(f"{path}: not UTF-8 text") from None
+    text = read_text(path, MAX_LEAF_FILE)
     stripped = text.lstrip()
     rows = []
     if stripped.startswith(("{", "[")):
+        check_nesting(text, str(path))
         try:
             data = json.loads(text)
         except json.JSONDecodeError as error:

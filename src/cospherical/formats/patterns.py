@@ -22,10 +22,11 @@ from collections.abc import Mapping
 from typing import Callable
 
 from ..catalogue import split_tessellation
-from ..core.configuration import Configuration
+from ..core.configuration import POINT_POLICIES, Box, Configuration
+from ..core.shapes import ELEMENTS
 from ..core.symmetry import key_code
 from ..core.tessellation import Tessellation, tessellate
-from ..errors import FormatError
+from ..errors import FormatError, InputError
 from ..files.flowyaml import decode_entry, mapping_line, split_section
 from ..files.yamlio import atomic_open, atomic_write, parse_yaml, read_text, validate, yaml_text
 from ..studies.bisection import Study
@@ -45,9 +46,22 @@ SCHEMES = {
 
 
 def pattern_name(study: str, box_texts, face_points: str = "octree", element: str = "cuboid") -> str:
-    """File stem for a study's outputs, e.g. ``bisection-1x1.4142x1.4142``; another base element
-    than the cuboid is named after the study: ``bisection-prism-1x1x1``."""
-    box = "x".join(re.sub(r"[^0-9a-z./]+", "", text.replace("/", "_")) for text in box_texts)
+    """File stem for a study's outputs, e.g. ``bisection-1x1.4142x1.4142``: a lossless name of the box.
+
+    Another base element than the cuboid is named after the study:
+    ``bisection-prism-1x1x1``.  The box's canonical texts (digits, ``.``, ``/`` and
+    ``sqrt(...)``) are written with ``/`` as ``_`` and ``sqrt(R)`` as ``sqrtR``, so
+    different boxes never share a name (``1/3`` is ``1_3``, ``13`` is ``13``).
+    Names read from a file are checked against the known ones: never a path.
+
+    >>> pattern_name("bisection", ["1/3", "sqrt(2/3)", "2*sqrt(2)"], "none")
+    'bisection-1_3xsqrt2_3xsqrt8-none'
+    """
+    if study not in SCHEMES and study != "intersection" or face_points not in (*POINT_POLICIES, "explicit") \
+            or element not in ELEMENTS:
+        raise InputError(f"study {study!r} of a {element!r} with face points {face_points!r}: not a known study")
+    texts = Box.parse(box_texts).texts
+    box = "x".join(text.replace("/", "_").replace("sqrt(", "sqrt").replace(")", "") for text in texts)
     # explicit points are named by the codes inside the table, not by its file name
     return f"{study}-{'' if element == 'cuboid' else element + '-'}{box}" + (
         "" if face_points in ("octree", "explicit") else f"-{face_points}")

@@ -9,13 +9,13 @@ integer) and ``vertices``.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from ..core.tessellation import Tessellation
+from ..errors import InputError
+from ..files.yamlio import atomic_path
 
 __all__ = ["to_meshio", "write_meshio", "write_vtu"]
 
@@ -41,24 +41,17 @@ def to_meshio(tess: Tessellation):
 
 
 def write_vtu(tess: Tessellation, path: str | Path) -> None:
-    """Write the tessellation to ``path`` atomically (temporary file, then rename)."""
+    """Write the tessellation to ``path`` atomically (see :func:`write_meshio`)."""
     write_meshio(to_meshio(tess), path)
 
 
 def write_meshio(converted, path: str | Path) -> None:
-    """Write a :class:`meshio.Mesh` as VTU atomically: meshio wants a file name, so a temporary one, then rename."""
+    """Write a :class:`meshio.Mesh` as VTU atomically (see :func:`~cospherical.files.yamlio.atomic_path`):
+    meshio wants a file name, so a temporary one, then rename."""
     import meshio
 
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".vtu", dir=path.parent)
-    os.close(fd)
-    try:
-        meshio.write(tmp, converted, file_format="vtu")
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600; give the file ordinary permissions
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as tmp:
+        try:
+            meshio.write(tmp, converted, file_format="vtu")
+        except OSError as error:
+            raise InputError(f"{path}: cannot write: {error.strerror or error}") from None

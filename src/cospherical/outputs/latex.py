@@ -9,6 +9,7 @@ one fixed oblique view, visible edges solid, hidden edges dashed.
 from __future__ import annotations
 
 import math
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -165,12 +166,24 @@ def _stem(summary: dict) -> str:
     return pattern_name(summary["study"], summary["box"], summary["face_points"], summary.get("element", "cuboid"))
 
 
+def _readable(name: str) -> str:
+    """A criterion or paper-study key as words for a caption: ``internal_faces`` -> ``internal faces``,
+    ``bisection_A`` -> ``case A``, ``intersection_cube`` -> ``intersection study``."""
+    if name.startswith("bisection_"):
+        return "case " + name.split("_", 1)[1].replace("_", " ")
+    if name.startswith("intersection_"):
+        return "intersection study"
+    return name.replace("_", " ")
+
+
 def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str) -> list[Path]:
     """Write every table of the studies' summaries, and ``document.tex`` including them all."""
     env = environment()
     written: list[Path] = []
 
     def write(name: str, template: str, **context) -> str:
+        if not _OUR_NAME.fullmatch(name):  # names come from validated summaries; never a path
+            raise InputError(f"{name!r}: not a file name of a rendered table")
         path = out / name
         atomic_write(path, env.get_template(template).render(**context))
         written.append(path)
@@ -190,7 +203,8 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str)
                      "configurations": t["configurations"]} for t in data["types"].values()]
             files.append(write(f"frequencies-{stem}-{criterion}.tex", "frequencies.tex.j2", rows=rows,
                                total=data["total"], types_count=data["types_count"],
-                               caption=f"Element frequencies, box {box}, {summary['face_points']} points, {criterion}"))
+                               caption=f"Element frequencies, box {box}, {summary['face_points']} points, "
+                                       f"{_readable(criterion)}"))
             if key and criterion in paper_studies()[key]:
                 table = paper_comparison(summary, key, criterion)
                 crows = [{"label": r["class"], "paper": "--" if r["paper"] is None else f"{r['paper']:,}",
@@ -201,7 +215,8 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str)
                 notes = [paper_notes()[n] for n in comparison_notes(summary, key, [criterion])]
                 files.append(write(f"comparison-{stem}-{criterion}.tex", "comparison.tex.j2", rows=crows,
                                    total=total, notes=notes,
-                                   caption=f"Beside the paper ({key}), box {box}, {summary['face_points']} points, {criterion}"))
+                                   caption=f"Beside the paper ({_readable(key)}), box {box}, "
+                                           f"{summary['face_points']} points, {_readable(criterion)}"))
         fvm_rows.append({"box": box, "face_points": summary["face_points"],
                          "configurations": summary["configurations"], "closed": summary["fvm_adequate"],
                          "open": summary["fvm_adequate_open"],
@@ -213,7 +228,21 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str)
                                         caption="Configurations whose element circumcenters all lie in the box "
                                         "(in the base element for a prism, pyramid or tetrahedron)")]})
     write("document.tex", "document.tex.j2", title=title, version=__version__, sections=sections)
+    _remove_old_tables(out, written)
     return written
+
+
+# The files render_tables writes; the tables of an earlier render into the same
+# folder (another study's) are removed, nothing else.
+_OUR_NAME = re.compile(r"[0-9a-z][0-9a-z._-]*\.tex")
+_OUR_TABLE = re.compile(r"(frequencies|comparison)-[0-9a-z._-]+\.tex")
+
+
+def _remove_old_tables(out: Path, written: list[Path]) -> None:
+    keep = {path.name for path in written}
+    for path in out.iterdir():
+        if _OUR_TABLE.fullmatch(path.name) and path.name not in keep and path.is_file() and not path.is_symlink():
+            path.unlink()
 
 
 def compile_pdf(out: Path, document: str = "document.tex") -> Path:

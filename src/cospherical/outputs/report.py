@@ -52,13 +52,18 @@ def text_report(summary: dict, compare_paper: bool = False, study: Study | None 
     ]
     names = {i: t["name"] for data in summary["criteria"].values() for i, t in data["types"].items()}
     for criterion, data in summary["criteria"].items():
+        types = data["types"].values()
+        classes = {t["paper_class"] for t in types if t["paper_class"]}
+        outside = sum(1 for t in types if not t["paper_class"])
         lines.append("")
         lines.append(f"{criterion}: {data['total']} elements, {data['types_count']} element types "
-                     f"({data['paper_classes_count']} paper classes)")
-        lines.append(f"  {'id':<14} {'name':<48} {'paper class':<32} {'count':>8} {'share':>7} {'configs':>7}")
+                     f"({len(classes)} of the paper's classes, {outside} types outside them)")
+        # Columns as wide as the longest name: a name is never cut (two rows would read the same).
+        width = max([48] + [len(t["name"]) for t in types])
+        lines.append(f"  {'id':<14} {'name':<{width}} {'paper class':<32} {'count':>8} {'share':>7} {'configs':>7}")
         for type_id, entry in data["types"].items():
             lines.append(
-                f"  {type_id:<14} {entry['name'][:48]:<48} {(entry['paper_class'] or '-')[:32]:<32} "
+                f"  {type_id:<14} {entry['name']:<{width}} {(entry['paper_class'] or '-'):<32} "
                 f"{entry['count']:>8} {100 * entry['share']:>6.2f}% {entry['configurations']:>7}"
             )
         if data.get("splits"):
@@ -114,15 +119,16 @@ def comparison_lines(summary: dict, study: Study | None = None) -> list[str]:
             continue
         table = paper_comparison(summary, key, criterion)
         lines.append(f"  {criterion}:")
-        lines.append(f"    {'paper class / type':<48} {'paper':>8} {'ours':>8}")
+        width = max([48] + [len(row["class"]) for row in table["rows"]])
+        lines.append(f"    {'paper class / type':<{width}} {'paper':>8} {'ours':>8}")
         for row in table["rows"]:
             paper = "-" if row["paper"] is None else row["paper"]
             ours = "-" if row["ours"] is None else row["ours"]
-            lines.append(f"    {row['class'][:48]:<48} {paper:>8} {ours:>8}{_mark(row['paper'], row['ours'])}")
+            lines.append(f"    {row['class']:<{width}} {paper:>8} {ours:>8}{_mark(row['paper'], row['ours'])}")
         total = table["total"]
-        lines.append(f"    {'total':<48} {total['paper']:>8} {total['ours']:>8}{_mark(total['paper'], total['ours'])}")
+        lines.append(f"    {'total':<{width}} {total['paper']:>8} {total['ours']:>8}{_mark(total['paper'], total['ours'])}")
         classes = table["classes"]
-        lines.append(f"    {'element classes':<48} {classes['paper']:>8} {classes['ours']:>8}"
+        lines.append(f"    {'element classes':<{width}} {classes['paper']:>8} {classes['ours']:>8}"
                      f"{_mark(classes['paper'], classes['ours'])}")
         if criterion != "optimal" and study is not None:
             gaps = paper_set_gaps(study, key, criterion)

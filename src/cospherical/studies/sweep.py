@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 from fractions import Fraction
 from typing import Callable, Iterable
 
@@ -10,6 +9,7 @@ from ..core.configuration import Box
 from ..core.exact import parse_rational, rational_text
 from ..errors import InputError
 from .bisection import bisection_codes, run_study
+from .pool import process_pool
 
 __all__ = ["box_statistics", "grid_values", "sweep"]
 
@@ -59,7 +59,7 @@ def sweep(b_values: Iterable[Fraction], c_values: Iterable[Fraction], jobs: int 
             if progress:
                 progress(1)
         return results
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    with process_pool(jobs) as pool:
         results = []
         for stats in pool.map(box_statistics, boxes):
             results.append(stats)

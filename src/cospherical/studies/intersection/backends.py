@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any, Callable, Hashable, Iterator
 
+from ...errors import InputError
+
 __all__ = ["completed"]
 
 
@@ -35,7 +37,11 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
 
         cluster = None if scheduler else LocalCluster(n_workers=dask_workers, threads_per_worker=1,
                                                       processes=True, dashboard_address=None)
-        client = Client(scheduler or cluster)
+        try:  # the connect timeout is dask's distributed.comm.timeouts.connect (--scheduler-timeout)
+            client = Client(scheduler or cluster)
+        except (OSError, TimeoutError, ValueError, TypeError) as error:
+            raise InputError(f"Dask scheduler {scheduler}: cannot connect: "
+                             f"{str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
         try:
             futures = {client.submit(function, *args, pure=False): key for key, args in tasks.items()}
             for future in as_completed(futures):
@@ -48,9 +54,11 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
         for key, args in tasks.items():
             yield key, function(*args)
     else:
-        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from concurrent.futures import as_completed
 
-        pool = ProcessPoolExecutor(max_workers=jobs)
+        from ..pool import process_pool
+
+        pool = process_pool(jobs)
         try:
             futures = {pool.submit(function, *args): key for key, args in tasks.items()}
             for future in as_completed(futures):

@@ -30,6 +30,7 @@ from ...core.geometry import Frame
 from ...core.polyhedron import polyhedron
 from ...core.split import SPLIT_CRITERIA
 from ...core.symmetry import key_code
+from ...errors import FormatError
 from ...files.yamlio import atomic_write
 from ..summary import TypeInfo
 from .backends import completed
@@ -118,6 +119,35 @@ def _element_chunk_from_json(text: str):
     return [ElementEntry.from_json(e) for e in entries], {k: TypeInfo(**t) for k, t in types.items()}
 
 
+def _damaged(path) -> FormatError:
+    return FormatError(f"{path}: damaged checkpoint: remove it (it is computed again) and run again")
+
+
+def _read_cells(path, count: int) -> dict[str, np.ndarray]:
+    """A stage-1 checkpoint, checked: the arrays of ``count`` configurations, or FormatError."""
+    import zipfile
+
+    names = ("tets", "closed", "open", "polys", "poly_mask", "poly_code")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            part = {name: data[name] for name in names}
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+        raise _damaged(path) from None
+    if any(part[name].ndim != 1 or part[name].dtype.kind not in "iub" for name in names) \
+            or any(len(part[name]) != count for name in names[:4]) \
+            or not len(part["poly_mask"]) == len(part["poly_code"]) == int(part["polys"].sum()):
+        raise _damaged(path)
+    return part
+
+
+def _read_elements(path):
+    """A stage-2 checkpoint, checked: ``(entries, types)``, or FormatError."""
+    try:
+        return _element_chunk_from_json(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        raise _damaged(path) from None
+
+
 def _npz_bytes(arrays: dict) -> bytes:
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
@@ -185,8 +215,7 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     for i, start in enumerate(starts):
         path = folder / f"{tag}-cells-{i:05d}.npz" if folder else None
         if path and path.exists():
-            with np.load(path) as data:
-                stage1[i] = {name: data[name] for name in data.files}
+            stage1[i] = _read_cells(path, len(reps[start:start + chunk]))
             report("cells", int(sizes[start:start + chunk].sum()))
     todo = {i: (reps[start:start + chunk],) for i, start in enumerate(starts) if i not in stage1}
     for i, part in completed(tessellate_chunk, todo, **backend):
@@ -208,7 +237,7 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     for i in range(len(element_starts)):
         path = folder / f"{tag}-elements-{i:05d}.json" if folder else None
         if path and path.exists():
-            stage2[i] = _element_chunk_from_json(path.read_text())
+            stage2[i] = _read_elements(path)
             report("elements", len(stage2[i][0]))
     todo = {i: (work[start:start + ELEMENT_CHUNK],) for i, start in enumerate(element_starts) if i not in stage2}
     for i, part in completed(element_entries, todo, **backend):
