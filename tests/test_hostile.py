@@ -624,3 +624,16 @@ def test_tessellate_help_shows_the_numbering(capsys):
 
 def test_setup_installs_python3_venv():
     assert "python3-venv" in (ROOT / "scripts" / "setup.sh").read_text()
+
+
+def test_hostile_entries_of_the_fast_table_format_are_one_line(tmp_path, capsys):
+    # pattern tables are read line by line (one JSON entry per configuration): hostile lines there too
+    lines = (ROOT / "patterns" / "bisection-1x2x4.yaml").read_text().split("\n")
+    start = lines.index("configurations:") + 2
+    for name, value in (("deep", "[" * 30000 + "]" * 30000), ("bigint", "1" + "0" * 5000), ("nan", "NaN")):
+        edited = list(lines)
+        edited[start] = edited[start].split(":", 1)[0] + ': {"fvm_adequate": ' + value + "}"
+        path = tmp_path / f"{name}.yaml"
+        path.write_text("\n".join(edited))
+        refused(capsys, "check", path)
+        refused(capsys, "diff", path, ROOT / "patterns" / "bisection-1x2x4.yaml")

@@ -29,6 +29,8 @@ SMALLER = [
     (re.compile(r"^(cospherical study intersection)(?!.*--resolution)"), r"\1 --resolution 2"),
     (re.compile(r"^(python benchmarks/bench_intersection.py)"), r"\1 --resolution 2 --sample 3"),
     (re.compile(r"^(python benchmarks/bench_tessellate.py)"), r"\1 --samples 5"),
+    (re.compile(r"^(python benchmarks/bench_mesh.py)"), r"\1 --levels 4"),
+    (re.compile(r"^(cospherical mesh .*)--levels \d+"), r"\1--levels 3"),
 ]
 
 
@@ -66,7 +68,9 @@ def scratch(tmp_path_factory):
     subprocess.run(["git", "clone", "-q", str(ROOT), str(folder)], check=True)
     catalogue = (folder / "catalogue" / "catalogue.yaml").read_text()
     (folder / "OLD.yaml").write_text(catalogue)
-    (folder / "NEW.yaml").write_text(catalogue.replace("name: tetrahedron\n", "name: simplex\n", 1))
+    (folder / "NEW.yaml").write_text(catalogue.replace('"name": "tetrahedron"', '"name": "simplex"', 1))
+    (folder / "leaves.txt").write_text("# level i j k: the root cell\n0 0 0 0\n")  # "a tree you bring"
+    (folder / "SRC").symlink_to(folder / "src")  # "an older src/": this one
     return folder
 
 
