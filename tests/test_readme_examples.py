@@ -71,6 +71,10 @@ def scratch(tmp_path_factory):
     (folder / "NEW.yaml").write_text(catalogue.replace('"name": "tetrahedron"', '"name": "simplex"', 1))
     (folder / "leaves.txt").write_text("# level i j k: the root cell\n0 0 0 0\n")  # "a tree you bring"
     (folder / "SRC").symlink_to(folder / "src")  # "an older src/": this one
+    (folder / "my-element.yaml").write_text(  # "any convex element": a square pyramid, 8 edges
+        "corners: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], ['1/2', '1/2', 1]]\n"
+        "edges: [[0, 1], [1, 2], [2, 3], [3, 0], [0, 4], [1, 4], [2, 4], [3, 4]]\n"
+        "faces: [[0, 1, 2, 3], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]\n")
     return folder
 
 
