@@ -434,11 +434,12 @@ def test_damaged_checkpoints_are_one_line(tmp_path, capsys):
 
 
 def test_sigint_during_start_up_is_clean():
-    # From 0.5 s on the command is loading its libraries (numpy, numba, jinja2, ...) inside main();
-    # a signal in the interpreter's own first tenths of a second is Python's to report.
-    for delay in (0.5, 0.8, 1.2):
-        process = subprocess.Popen([sys.executable, "-m", "cospherical", "study", "bisection"],
-                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # A command that runs for seconds (so the signal never comes after the end), interrupted while it
+    # loads its libraries (numpy, numba, ...) and while it starts its work. A signal in the interpreter's
+    # own first tenths of a second, before any of our code runs, is Python's to report.
+    for delay in (0.3, 0.6, 1.0, 2.0):
+        process = subprocess.Popen([sys.executable, "-m", "cospherical", "study", "intersection", "--resolution", "8",
+                                    "--jobs", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         time.sleep(delay)
         process.send_signal(signal.SIGINT)
         _, err = process.communicate(timeout=60)

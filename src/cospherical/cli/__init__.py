@@ -56,7 +56,21 @@ def _interrupt(signum, frame):
     # Remembered as well as raised: a KeyboardInterrupt raised inside a callback
     # from compiled code can be swallowed there, and the run must not then end with 0.
     _interrupted.set()
+    if _in_compiler(frame):
+        # Unwinding through numba's compiler or cache loader crashes the process (SIGSEGV):
+        # deliver the signal again shortly, until it arrives outside.
+        threading.Timer(0.1, os.kill, (os.getpid(), signum)).start()
+        return
     raise KeyboardInterrupt
+
+
+def _in_compiler(frame) -> bool:
+    while frame is not None:
+        name = frame.f_globals.get("__name__", "")
+        if name.startswith(("numba.", "llvmlite.")):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def main(argv: list[str] | None = None) -> int:
