@@ -3,7 +3,7 @@ intersection studies (R = 4, 8, 16, every insertion order, every criterion), for
 
     python scripts/intersection_examples.py [--jobs 2]
 
-The nine studies take about ten minutes on two cores; ``cospherical reproduce`` then
+The nine studies take about 15 minutes on the shared two-core machine; ``cospherical reproduce`` then
 rebuilds each type from its example (a configuration code and node ids: the cube, octree
 points) in well under a second, so the catalogue holds every type of the intersection
 studies without the main job running them.  Each line: the type id, the example, the

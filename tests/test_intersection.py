@@ -142,3 +142,38 @@ def test_rank_and_reverse_are_mirror_families():
     assert reflected == set(set_patterns(16, "reverse"))
     a, b = run_intersection(4, "rank", jobs=2), run_intersection(4, "reverse", jobs=2)
     assert a["criteria"] == b["criteria"] and a["orbits"] == b["orbits"]
+
+
+def test_a_pattern_table_at_resolution_4_passes_check(pool_run, tmp_path):
+    # Every type of the intersection studies is in the shipped catalogue, so `check`
+    # (known types, node counts, exact tiling) passes their tables: here every 40th
+    # orbit representative of the R = 4 table, every criterion.
+    from cospherical.catalogue import shipped_catalogue
+    from cospherical.cli import main
+    from cospherical.files.yamlio import atomic_write, yaml_text
+    from cospherical.formats.patterns import pattern_chunk
+    from cospherical.studies.intersection import orbits
+
+    reps, _, _ = orbits(4)
+    kept = {c: data["kept"] for c, data in pool_run["criteria"].items() if c != "optimal"}
+    header = {"schema_version": 1, "generator": "test", "catalogue_version": shipped_catalogue()["version"],
+              "study": "intersection", "box": ["1", "1", "1"], "face_points": "octree", "scheme": "test",
+              "criteria": ["optimal", *kept]}
+    path = tmp_path / "r4.yaml"
+    atomic_write(path, yaml_text(header) + "configurations:\n" + pattern_chunk(reps[::40].tolist(), kept))
+    assert main(["check", str(path)]) == 0
+
+
+def test_the_catalogue_holds_every_type_of_the_intersection_studies():
+    from pathlib import Path
+
+    from cospherical.catalogue import shipped_catalogue
+    from cospherical.formats.catalogue_file import intersection_examples
+
+    known = {t["id"] for t in shipped_catalogue()["types"]}
+    examples = {e["element"].type.id for e in intersection_examples()}
+    assert examples <= known
+    results = Path(__file__).resolve().parents[1] / "results" / "intersection"
+    for summary in results.glob("*/intersection-r16-*.json"):
+        for criterion, data in json.loads(summary.read_text())["criteria"].items():
+            assert set(data["types"]) <= examples, (summary.name, criterion)
