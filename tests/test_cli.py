@@ -22,7 +22,7 @@ def test_tessellate_json_contract():
     assert len(data["elements"]) == 4
     for element in data["elements"]:
         assert {"type", "name", "nodes", "vertices", "edges", "faces", "circumcenter"} <= set(element)
-        assert element["name"] == "rectangular pyramid" and len(element["nodes"]) == 5
+        assert element["name"] == "Rectangular Pyramid" and len(element["nodes"]) == 5
         assert (element["vertices"], element["edges"], element["faces"]) == (5, 8, 5)
     assert data["fvm_adequate"] is True
 

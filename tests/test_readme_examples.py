@@ -69,7 +69,7 @@ def scratch(tmp_path_factory):
     subprocess.run(["git", "clone", "-q", str(ROOT), str(folder)], check=True)
     catalogue = (folder / "catalogue" / "catalogue.yaml").read_text()
     (folder / "OLD.yaml").write_text(catalogue)
-    (folder / "NEW.yaml").write_text(catalogue.replace('"name": "tetrahedron"', '"name": "simplex"', 1))
+    (folder / "NEW.yaml").write_text(catalogue.replace('"name": "Tetrahedron"', '"name": "simplex"', 1))
     (folder / "leaves.txt").write_text("# level i j k: the root cell\n0 0 0 0\n")  # "a tree you bring"
     (folder / "SRC").symlink_to(folder / "src")  # "an older src/": this one
     (folder / "my-element.yaml").write_text(  # "any convex element": a square pyramid, 8 edges

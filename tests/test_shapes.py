@@ -155,7 +155,7 @@ def test_cli_element_and_shape_file(tmp_path):
     result = _cli("tessellate", "--element", "pyramid", "--box", "1", "1", "1", "--code", "88880000")
     data = json.loads(result.stdout)
     assert data["element"] == "pyramid" and data["faces"] == [0] and "13" in data["nodes"]
-    assert [e["name"] for e in data["elements"]] == ["rectangular pyramid"] * 4
+    assert [e["name"] for e in data["elements"]] == ["Rectangular Pyramid"] * 4
     bad = tmp_path / "bowtie.yaml"
     bad.write_text("corners: [[0,0,0],[1,0,0],[1,1,0],[0,1,0],['1/2','1/2',1]]\n"
                    "edges: [[0,1],[1,2],[2,3],[3,0],[0,4],[1,4],[2,4],[3,4]]\n"

@@ -96,7 +96,7 @@ def test_committed_catalogue_and_patterns_validate(committed_tables):
     check_catalogue(catalogue, "catalogue")
     ids = [t["id"] for t in catalogue["types"]]
     names = {t["name"] for t in catalogue["types"]}
-    assert {"tetrahedron", "cuboid", "rectangular pyramid", "Tetrahedron Complement", "Generic #8"} <= names
+    assert {"Tetrahedron", "Cuboid", "Rectangular Pyramid", "Tetrahedron Complement", "Generic #8"} <= names
     for stem, table in committed_tables.items():
         assert table.header["catalogue_version"] == catalogue["version"]
         assert len(table.configurations) == 4096

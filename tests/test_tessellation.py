@@ -16,18 +16,18 @@ def names(code, box=("1", "1", "1"), policy="octree"):
 def test_plain_box_is_one_cuboid():
     tess = tessellate(Configuration.from_code("000000000000", ("1", "2", "4")))
     (element,) = tess.elements
-    assert element.type.name == "cuboid" and element.nodes == (0, 1, 2, 3, 4, 5, 6, 7)
+    assert element.type.name == "Cuboid" and element.nodes == (0, 1, 2, 3, 4, 5, 6, 7)
     assert element.polyhedron.center == (Fraction(1, 2),) * 3
     assert tess.circumcenter(element) == (0.5, 1.0, 2.0)
 
 
 def test_one_midpoint_gives_four_pyramids():
-    assert names("800000000000") == {"rectangular pyramid": 4}
+    assert names("800000000000") == {"Rectangular Pyramid": 4}
 
 
 def test_all_midpoints_with_octree_points_give_eight_cuboids():
-    assert names("888888888888") == {"cuboid": 8}
-    assert names("888888888888", ("1", "2", "4")) == {"cuboid": 8}
+    assert names("888888888888") == {"Cuboid": 8}
+    assert names("888888888888", ("1", "2", "4")) == {"Cuboid": 8}
 
 
 def test_exact_sqrt2_differs_from_rounded():

@@ -8,7 +8,7 @@ on first use, so ``import cospherical`` stays cheap for the command line.
 >>> from cospherical import Configuration, tessellate
 >>> tess = tessellate(Configuration.from_code("888888888888"))
 >>> len(tess.elements), tess.elements[0].type.name
-(8, 'cuboid')
+(8, 'Cuboid')
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ The catalogue is versioned data (``catalogue/catalogue.yaml``, shipped in the
 wheel as ``cospherical/data/catalogue.yaml``; built from studies by
 :mod:`cospherical.formats.catalogue_file`).  Names follow one rule, applied
 when the catalogue is built: a type's structural name (tetrahedron, pyramids,
-bipyramids, triangular prism, cuboid) if it has one; else its paper class's name
+bipyramids, Triangular Prism, Cuboid) if it has one; else its paper class's name
 when the class is not structural (numbered variants when several types share
 it); else a systematic name.  The paper class is kept as an alias, which is
 what comparisons with the paper use.
@@ -84,7 +84,7 @@ def type_name(etype: ElementType) -> str:
     --------
     >>> from cospherical import Configuration, tessellate
     >>> type_name(tessellate(Configuration.from_code("000000000000")).elements[0].type)
-    'cuboid'
+    'Cuboid'
     """
     return known_name(etype.code) or etype.name
 
@@ -135,7 +135,7 @@ def load_catalogue(path: str | Path) -> dict:
     --------
     >>> catalogue = load_catalogue(catalogue_path())
     >>> next(t["name"] for t in catalogue["types"] if t["vertices"] == 4)
-    'tetrahedron'
+    'Tetrahedron'
     """
     return catalogue_from_text(read_text(path), str(path))
 

@@ -12,7 +12,8 @@ from .polyhedron import Polyhedron
 
 __all__ = ["ElementType", "classify", "classify_faces", "element_type"]
 
-_POLYGON_ADJECTIVE = {3: "triangular", 4: "quadrilateral", 5: "pentagonal", 6: "hexagonal", 7: "heptagonal", 8: "octagonal"}
+# Names are in Title Case, as the paper names its classes ("Quadrilateral Pyramid").
+_POLYGON_ADJECTIVE = {3: "Triangular", 4: "Quadrilateral", 5: "Pentagonal", 6: "Hexagonal", 7: "Heptagonal", 8: "Octagonal"}
 _KIND_PLURAL = {
     "triangle": "triangles",
     "rectangle": "rectangles",
@@ -28,8 +29,8 @@ _KIND_PLURAL = {
 class ElementType:
     """One element type: polyhedra whose labelled face graphs are isomorphic.
 
-    ``name`` is ``structural`` (tetrahedron, n-gonal pyramid or bipyramid,
-    triangular prism, cuboid) when the face structure has one, else a systematic
+    ``name`` is ``structural`` (Tetrahedron, n-gonal Pyramid or Bipyramid,
+    Triangular Prism, Cuboid) when the face structure has one, else a systematic
     name from the face counts.  It depends on the polyhedron alone; the catalogue
     (:func:`cospherical.catalogue.type_name`) adds the names of the types it knows.
     ``face_kinds`` counts faces per kind, e.g. ``(("rectangle", 1), ("triangle", 4))``.
@@ -95,18 +96,18 @@ def _standard(faces, kinds) -> tuple[str | None, str | None]:
     vertices = len({v for f in faces for v in f})
     polygons = [kind for kind in kinds if kind != "triangle"]
     if vertices == 4:
-        return "tetrahedron", "tetra"
+        return "Tetrahedron", "tetra"
     if len(polygons) == 1 and len(faces) == vertices:
         base = next(face for face, kind in zip(faces, kinds) if kind != "triangle")
         if len(base) == 4:
-            return f"{'rectangular' if polygons[0] == 'rectangle' else 'quadrilateral'} pyramid", "pyramid"
-        return f"{_POLYGON_ADJECTIVE.get(len(base), f'{len(base)}-gonal')} pyramid", None
+            return f"{'Rectangular' if polygons[0] == 'rectangle' else 'Quadrilateral'} Pyramid", "pyramid"
+        return f"{_POLYGON_ADJECTIVE.get(len(base), f'{len(base)}-gonal')} Pyramid", None
     if vertices == 6 and counts["triangle"] == 2 and len(faces) == 5:
-        return ("triangular prism" if counts["rectangle"] == 3 else None), "wedge"
+        return ("Triangular Prism" if counts["rectangle"] == 3 else None), "wedge"
     if vertices == 8 and len(faces) == 6 and all(len(face) == 4 for face in faces):
-        return ("cuboid" if counts["rectangle"] == 6 else None), "hexahedron"
+        return ("Cuboid" if counts["rectangle"] == 6 else None), "hexahedron"
     if _is_bipyramid(faces, kinds):
-        return f"{_POLYGON_ADJECTIVE.get(vertices - 2, f'{vertices - 2}-gonal')} bipyramid", None
+        return f"{_POLYGON_ADJECTIVE.get(vertices - 2, f'{vertices - 2}-gonal')} Bipyramid", None
     return None, None
 
 
@@ -121,7 +122,7 @@ def element_type(code: str, faces, kinds) -> ElementType:
 
 
 def systematic_name(vertices: int, face_summary: str) -> str:
-    return f"{vertices}-vertex polyhedron ({face_summary})"
+    return f"{vertices}-Vertex Polyhedron ({face_summary})"
 
 
 def _new_type(code: str, faces, kinds) -> ElementType:

@@ -27,7 +27,7 @@ Examples
 (6, 9, (2, 3, 4))
 >>> tess = tessellate_shape(ShapeConfiguration.from_code(prism, "888888888"))
 >>> sorted(e.type.name for e in tess.elements), tess.fvm_adequate
-(['cuboid', 'cuboid', 'triangular prism', 'triangular prism', 'triangular prism', 'triangular prism'], True)
+(['Cuboid', 'Cuboid', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism'], True)
 """
 
 from __future__ import annotations
@@ -439,7 +439,7 @@ def tessellate_shape(configuration: ShapeConfiguration) -> ShapeTessellation:
 
     >>> tess = tessellate_shape(ShapeConfiguration.from_code(standard_shape("tetrahedron"), "800000"))
     >>> [e.type.name for e in tess.elements], sum(e.polyhedron.unit_volume for e in tess.elements)
-    (['tetrahedron', 'tetrahedron'], Fraction(1, 6))
+    (['Tetrahedron', 'Tetrahedron'], Fraction(1, 6))
     """
     nodes = configuration.nodes()
     return ShapeTessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared))

@@ -76,7 +76,7 @@ def tessellate(configuration: Configuration) -> Tessellation:
     >>> from cospherical import Configuration
     >>> tess = tessellate(Configuration.from_code("800000000000"))
     >>> [e.type.name for e in tess.elements]
-    ['rectangular pyramid', 'rectangular pyramid', 'rectangular pyramid', 'rectangular pyramid']
+    ['Rectangular Pyramid', 'Rectangular Pyramid', 'Rectangular Pyramid', 'Rectangular Pyramid']
     >>> tess.fvm_adequate
     True
     """

@@ -17,7 +17,7 @@ def tessellation_data(tess: Tessellation) -> dict:
     >>> from cospherical import Configuration, tessellate
     >>> data = tessellation_data(tessellate(Configuration.from_code("800000000000", ("1", "2", "4"))))
     >>> data["elements"][0]["name"], data["elements"][0]["circumcenter"]
-    ('rectangular pyramid', [0.25, 1.0, 2.0])
+    ('Rectangular Pyramid', [0.25, 1.0, 2.0])
     """
     cfg = tess.configuration
     real = cfg.real_nodes()
