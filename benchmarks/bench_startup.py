@@ -10,7 +10,9 @@
 (3) ``cospherical.load_patterns("patterns/bisection-1x1x1.yaml")`` and one lookup, in a
     fresh interpreter: wall time from start to the answer, and peak memory (targets:
     0.5 s, 150 MB);
-(4) the same file read whole by PyYAML (C loader), for comparison.
+(4) the same file read whole by PyYAML (C loader), for comparison;
+(5) ``cospherical check catalogue/catalogue.yaml patterns/*.yaml`` as a whole process (the
+    target is 15 s).
 
 Wall times on a shared machine vary; the script prints the median of ``--runs`` runs
 and the machine's load average beside them.  ``--before SRC`` (the ``src`` folder of
@@ -87,6 +89,9 @@ def measure(label: str, env, root: Path, runs: int, qhull: float) -> None:
     seconds = statistics.median(float(s) for s, _ in loads)
     print(f"(3) load_patterns + one lookup, fresh process: median {seconds:.3f} s, "
           f"peak {max(float(m) for _, m in loads):.0f} MB ({table.stat().st_size / 2**20:.1f} MB file)")
+    files = [root / "catalogue" / "catalogue.yaml", *sorted((root / "patterns").glob("*.yaml"))]
+    seconds = wall([*COSPHERICAL, "check", *map(str, files)], env)
+    print(f"(5) check catalogue/catalogue.yaml patterns/*.yaml ({len(files) - 1} tables), whole process: {seconds:.1f} s")
 
 
 def main() -> None:

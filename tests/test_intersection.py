@@ -144,26 +144,6 @@ def test_rank_and_reverse_are_mirror_families():
     assert a["criteria"] == b["criteria"] and a["orbits"] == b["orbits"]
 
 
-def test_a_pattern_table_at_resolution_4_passes_check(pool_run, tmp_path):
-    # Every type of the intersection studies is in the shipped catalogue, so `check`
-    # (known types, node counts, exact tiling) passes their tables: here every 40th
-    # orbit representative of the R = 4 table, every criterion.
-    from cospherical.catalogue import shipped_catalogue
-    from cospherical.cli import main
-    from cospherical.files.yamlio import atomic_write, yaml_text
-    from cospherical.formats.patterns import pattern_chunk
-    from cospherical.studies.intersection import orbits
-
-    reps, _, _ = orbits(4)
-    kept = {c: data["kept"] for c, data in pool_run["criteria"].items() if c != "optimal"}
-    header = {"schema_version": 1, "generator": "test", "catalogue_version": shipped_catalogue()["version"],
-              "study": "intersection", "box": ["1", "1", "1"], "face_points": "octree", "scheme": "test",
-              "criteria": ["optimal", *kept]}
-    path = tmp_path / "r4.yaml"
-    atomic_write(path, yaml_text(header) + "configurations:\n" + pattern_chunk(reps[::40].tolist(), kept))
-    assert main(["check", str(path)]) == 0
-
-
 def test_the_catalogue_holds_every_type_of_the_intersection_studies():
     from pathlib import Path
 
@@ -177,3 +157,64 @@ def test_the_catalogue_holds_every_type_of_the_intersection_studies():
     for summary in results.glob("*/intersection-r16-*.json"):
         for criterion, data in json.loads(summary.read_text())["criteria"].items():
             assert set(data["types"]) <= examples, (summary.name, criterion)
+
+
+@pytest.fixture(scope="module")
+def r4_sample(pool_run, tmp_path_factory):
+    """The R = 4 pattern table of every 10th orbit representative, as YAML and as an indexed store."""
+    from cospherical.catalogue import shipped_catalogue
+    from cospherical.files.flowyaml import mapping_entries
+    from cospherical.files.yamlio import atomic_write, yaml_text
+    from cospherical.formats.patterns import pattern_chunk
+    from cospherical.formats.store import write_store
+    from cospherical.studies.intersection import orbits
+
+    reps, _, _ = orbits(4)
+    kept = {c: data["kept"] for c, data in pool_run["criteria"].items() if c != "optimal"}
+    header = {"schema_version": 1, "generator": "test", "catalogue_version": shipped_catalogue()["version"],
+              "study": "intersection", "box": ["1", "1", "1"], "face_points": "octree", "scheme": "test",
+              "criteria": ["optimal", *kept]}
+    folder = tmp_path_factory.mktemp("r4")
+    text = pattern_chunk(reps[::10].tolist(), kept)
+    atomic_write(folder / "r4.yaml", yaml_text(header) + "configurations:\n" + text)
+    write_store(folder / "r4.sqlite", header, mapping_entries(text))
+    return folder / "r4.yaml", folder / "r4.sqlite"
+
+
+def test_a_pattern_table_at_resolution_4_passes_check(r4_sample):
+    # Every type of the intersection studies is in the shipped catalogue, so `check`
+    # (known types, node counts, exact tiling) passes their tables.
+    from cospherical.cli import main
+
+    assert main(["check", str(r4_sample[0])]) == 0
+
+
+def test_the_indexed_store_answers_exactly_like_the_yaml(r4_sample):
+    from cospherical.cli import main
+    from cospherical.formats.patterns import load
+
+    yaml_table, store = (load(path) for path in r4_sample)
+    assert store.header == yaml_table.header and list(store.configurations) == list(yaml_table.configurations)
+    for code in yaml_table.configurations:
+        for criterion in yaml_table.header["criteria"]:
+            assert store.elements(code, criterion) == yaml_table.elements(code, criterion)
+    with pytest.raises(KeyError):
+        store.elements("fffffffffff0")
+    assert main(["check", str(r4_sample[1])]) == 0  # every type in the catalogue, every configuration tiles
+    assert main(["diff", *map(str, r4_sample)]) == 0
+
+
+@pytest.mark.parametrize("damage", ["truncated", "overwritten", "not a store"])
+def test_a_bad_store_is_refused_with_exit_2(r4_sample, tmp_path, damage):
+    data = bytearray(r4_sample[1].read_bytes())
+    if damage == "truncated":
+        data = data[: len(data) // 2]
+    elif damage == "overwritten":  # every page after the first: the tables' pages are garbage
+        data[4096:] = bytes(range(256)) * ((len(data) - 4096) // 256) + bytes((len(data) - 4096) % 256)
+    else:
+        data = b"SQLite format 3\x00" + b"\x00" * 200
+    path = tmp_path / "bad.sqlite"
+    path.write_bytes(bytes(data))
+    result = subprocess.run([sys.executable, "-m", "cospherical", "check", str(path)], capture_output=True, text=True)
+    assert result.returncode == 2, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and "bad.sqlite" in result.stderr

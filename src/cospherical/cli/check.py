@@ -5,8 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..catalogue import catalogue_path, load_catalogue
-from ..files.yamlio import read_text
-from ..formats.check import check_catalogue, check_patterns, read_document
+from ..formats.check import check_catalogue, check_patterns, read_document_file
 
 
 def add_parser(commands) -> None:
@@ -29,7 +28,7 @@ def add_parser(commands) -> None:
 def run(args) -> int:
     catalogue = None
     for path in args.files:
-        kind, document = read_document(read_text(path), str(path))
+        kind, document = read_document_file(path)
         if kind == "catalogue":
             check_catalogue(document, str(path))
             print(f"{path}: ok, catalogue of {len(document['types'])} element types")

@@ -10,8 +10,7 @@ import sys
 from pathlib import Path
 
 from ..errors import FormatError, UsageError
-from ..files.yamlio import read_text
-from ..formats.check import document_data, read_document
+from ..formats.check import document_data, read_document, read_document_file
 from ..formats.diff import diff_documents, has_changes, text_report
 from .output import dump
 
@@ -54,16 +53,14 @@ def run(args) -> int:
             raise UsageError("cospherical diff: error: with --rev give one FILE (OLD is that file at REV)")
         new_path = Path(args.files[0])
         old_name, new_name = f"{new_path}@{args.rev}", str(new_path)
-        old = _from_git(args.rev, new_path)
+        old = document_data(read_document(_from_git(args.rev, new_path), old_name)[1])
     else:
         if len(args.files) != 2:
             raise UsageError("cospherical diff: error: give OLD NEW (or --rev REV FILE)")
         old_name, new_name = args.files
-        old = read_text(old_name)
+        old = document_data(read_document_file(old_name)[1])
         new_path = Path(new_name)
-    new = read_text(new_path)
-    old = document_data(read_document(old, old_name)[1])
-    new = document_data(read_document(new, new_name)[1])
+    new = document_data(read_document_file(new_path)[1])
     report = diff_documents(old, new, old_name, new_name)
     if args.format == "text":
         sys.stdout.write(text_report(report, old_name, new_name))

@@ -60,8 +60,9 @@ def add_parser(commands) -> None:
                         help="intersection: keep finished chunks in DIR/checkpoints and reuse them (needs --out; "
                         "the bisection study takes seconds and has no checkpoints)")
     parser.add_argument("--patterns", action="store_true",
-                        help="intersection: also write the pattern table of the orbit representatives into DIR "
-                        "(large: one tessellation per orbit in Python, about 1 ms each)")
+                        help="intersection: also write the pattern table of the orbit representatives into DIR, "
+                        "as YAML and as an indexed store (.sqlite) that a mesher queries one configuration at a "
+                        "time (large: one tessellation per orbit in Python, about 1 ms each)")
     parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree", help=FACE_POINTS_HELP)
     parser.add_argument("--out", type=Path, metavar="DIR",
                         help="also write the summary (JSON) and the pattern table (YAML) into DIR")
@@ -173,5 +174,5 @@ def _intersection(args) -> int:
             with progress_bar(summary["orbits"], "pattern table") as advance:
                 write_pattern_table(summary, args.out / f"{stem}-patterns.yaml", shipped_catalogue()["version"],
                                     jobs=max(1, args.jobs), progress=advance, scheduler=args.scheduler,
-                                    dask_workers=args.dask_workers)
+                                    dask_workers=args.dask_workers, store=args.out / f"{stem}-patterns.sqlite")
     return _report(summary, args)

@@ -32,7 +32,7 @@ import re
 from ..errors import FormatError
 from .yamlio import yaml_float
 
-__all__ = ["decode_entry", "flow", "mapping_line", "sequence_line", "split_section"]
+__all__ = ["decode_entry", "flow", "mapping_entries", "mapping_line", "sequence_line", "split_section"]
 
 # A mapping entry: two spaces, a single-quoted key without quotes in it, then a
 # JSON object.  A sequence entry: "- " then a JSON object.
@@ -77,6 +77,15 @@ def mapping_line(key: str, entry: dict) -> str:
 def sequence_line(entry: dict) -> str:
     """One item of a block sequence at indent 0, as a JSON flow mapping (with a newline)."""
     return f"- {flow(entry)}\n"
+
+
+def mapping_entries(text: str):
+    """The (key, JSON text) pairs of consecutive :func:`mapping_line` lines; another line raises FormatError."""
+    for line in text.splitlines():
+        found = _MAPPING_LINE.fullmatch(line)
+        if found is None:
+            raise FormatError(f"not an entry line: {line[:60]!r}")
+        yield found.group(1), found.group(2)
 
 
 def split_section(text: str, key: str) -> tuple[str, dict[str, str] | list[str]] | None:

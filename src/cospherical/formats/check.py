@@ -20,12 +20,14 @@ from ..core.geometry import Frame, six_volume
 from ..core.polyhedron import face_kind
 from ..errors import FormatError, InputError
 from ..files.flowyaml import split_section
-from ..files.yamlio import parse_yaml, validate
+from ..files.yamlio import parse_yaml, read_text, validate
 from ..studies.bisection import element_family
 from .diff import document_kind
-from .patterns import entry_elements, table_from_data, table_from_text
+from .patterns import entry_elements, load, table_from_data, table_from_text
+from .store import is_store
 
-__all__ = ["check_catalogue", "check_patterns", "document_data", "read_document", "validated"]
+__all__ = ["check_catalogue", "check_patterns", "document_data", "read_document", "read_document_file",
+           "validated"]
 
 
 def check_catalogue(data: dict, name: str) -> None:
@@ -232,6 +234,13 @@ def read_document(text: str, name: str):
         return "catalogue", catalogue
     kind, data = validated(parse_yaml(text, name), name)
     return kind, (data if kind == "catalogue" else table_from_data(data, name))
+
+
+def read_document_file(path) -> tuple[str, object]:
+    """:func:`read_document` on a file: a catalogue, a pattern table, or a pattern table's indexed store."""
+    if is_store(path):
+        return "patterns", load(path)
+    return read_document(read_text(path), str(path))
 
 
 def document_data(document) -> dict:

@@ -16,9 +16,9 @@ A mesh generator looks a configuration up like this::
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from collections.abc import Mapping
 from typing import Callable
 
 from ..catalogue import split_tessellation
@@ -27,11 +27,12 @@ from ..core.shapes import ELEMENTS
 from ..core.symmetry import key_code
 from ..core.tessellation import Tessellation, tessellate
 from ..errors import FormatError, InputError
-from ..files.flowyaml import decode_entry, mapping_line, split_section
+from ..files.flowyaml import decode_entry, mapping_entries, mapping_line, split_section
 from ..files.yamlio import atomic_open, atomic_write, parse_yaml, read_text, validate, yaml_text
 from ..studies.bisection import Study
 from ..studies.intersection import completed, orbits
 from ..version import __version__
+from .store import is_store, open_store, write_store
 
 __all__ = ["Entries", "PatternTable", "SCHEMA_VERSION", "configuration_line", "element_entries", "entry_elements", "load",
            "pattern_chunk", "pattern_name", "patterns_text", "table_from_data", "table_from_text", "write_pattern_table",
@@ -138,7 +139,7 @@ class Entries(Mapping):
     visits every entry, so ``check`` still validates the whole table.
     """
 
-    def __init__(self, texts: dict[str, str], header: dict, name: str):
+    def __init__(self, texts: Mapping[str, str], header: dict, name: str):
         self._texts = texts
         self._header = header
         self._name = name
@@ -159,15 +160,18 @@ class Entries(Mapping):
         not looked up before are not kept, so a table of millions of
         configurations is checked in bounded memory.
         """
-        codes = list(self._texts)
-        for start in range(0, len(codes), chunk):
-            batch = {}
-            for code in codes[start:start + chunk]:
-                entry = self._decoded.get(code)
-                batch[code] = entry if entry is not None else decode_entry(
-                    self._texts[code], f"{self._name}: configurations/{code}")
-            _check_entries({**self._header, "configurations": batch}, self._name)
-            yield from batch.items()
+        # An indexed store streams its rows; a dict of lines is read in place.
+        pairs = self._texts.texts() if hasattr(self._texts, "texts") else self._texts.items()
+        batch: dict = {}
+        for code, text in pairs:
+            entry = self._decoded.get(code)
+            batch[code] = entry if entry is not None else decode_entry(text, f"{self._name}: configurations/{code}")
+            if len(batch) == chunk:
+                _check_entries({**self._header, "configurations": batch}, self._name)
+                yield from batch.items()
+                batch = {}
+        _check_entries({**self._header, "configurations": batch}, self._name)
+        yield from batch.items()
 
     def values(self):
         return (entry for _, entry in self.items())
@@ -245,9 +249,15 @@ def load(path: str | Path) -> PatternTable:
 
     A table as this package writes it (one line per configuration) is indexed
     line by line and each entry decoded, as JSON, and validated when it is first
-    used; any other YAML spelling of a table is read whole by the YAML parser.
+    used; any other YAML spelling of a table is read whole by the YAML parser.  An
+    indexed store (:mod:`cospherical.formats.store`, an SQLite file) is opened and
+    queried one configuration at a time.
     See the README ("Pattern tables for a mesh generator") for an example, run by the tests.
     """
+    if is_store(path):
+        header, texts = open_store(path)
+        _check_entries({**header, "configurations": {}}, str(path))
+        return PatternTable(header, Entries(texts, header, str(path)))
     return table_from_text(read_text(path), str(path))
 
 
@@ -317,8 +327,13 @@ def pattern_chunk(codes: list[int], kept: dict[str, list[str]]) -> str:
 
 
 def write_pattern_table(summary: dict, path, catalogue_version: str, jobs: int = 1, progress=None,
-                        chunk: int = 2000, scheduler: str | None = None, dask_workers: int | None = None) -> None:
-    """Write the pattern table of the study's orbit representatives (``summary`` gives the kept sets)."""
+                        chunk: int = 2000, scheduler: str | None = None, dask_workers: int | None = None,
+                        store=None) -> None:
+    """Write the pattern table of the study's orbit representatives (``summary`` gives the kept sets).
+
+    ``store``: also write the indexed store (:mod:`cospherical.formats.store`) there, from the
+    same entries in the same pass.
+    """
     resolution, order = summary["resolution"], summary["insertion_order"]
     reps, _, _ = orbits(resolution, order)
     kept = {c: data["kept"] for c, data in summary["criteria"].items() if c != "optimal"}
@@ -332,11 +347,21 @@ def write_pattern_table(summary: dict, path, catalogue_version: str, jobs: int =
     with atomic_open(path) as handle:
         handle.write(yaml_text(header) + "configurations:\n")
         tasks = {i: (reps[i:i + chunk].tolist(), kept) for i in range(0, len(reps), chunk)}
-        waiting, next_start = {}, 0
-        for start, text in completed(pattern_chunk, tasks, jobs, scheduler, dask_workers):
-            waiting[start] = text
-            while next_start in waiting:  # in code order, whatever order the chunks finish in
-                handle.write(waiting.pop(next_start))
-                if progress:
-                    progress(len(tasks[next_start][0]))
-                next_start += chunk
+
+        def entries():
+            waiting, next_start = {}, 0
+            for start, text in completed(pattern_chunk, tasks, jobs, scheduler, dask_workers):
+                waiting[start] = text
+                while next_start in waiting:  # in code order, whatever order the chunks finish in
+                    text = waiting.pop(next_start)
+                    handle.write(text)
+                    yield from mapping_entries(text)
+                    if progress:
+                        progress(len(tasks[next_start][0]))
+                    next_start += chunk
+
+        if store:
+            write_store(store, header, entries())
+        else:
+            for _ in entries():
+                pass

@@ -1,0 +1,155 @@
+"""Indexed pattern tables: one SQLite file beside the YAML, for tables too big to read whole.
+
+A pattern table at R >= 4 holds hundreds of thousands of configurations (millions at
+R = 16).  Its YAML stays the canonical, diffable form; the store holds the same
+entries, each the same JSON text as its YAML line, keyed by configuration code in an
+indexed table, so a mesher looks one configuration up without reading the rest.  Each
+entry is zlib-compressed on its own with a preset dictionary made of the first
+entries (kept in the store): entries are short and alike, so the dictionary is what
+lets each compress several-fold and still be read alone::
+
+    table = cospherical.load_patterns("intersection-r8-edge-patterns.sqlite")
+    table.elements("0000000000c8")
+
+:func:`cospherical.formats.patterns.load` opens either form; ``check`` and ``diff``
+read both.  A store is written atomically (a temporary file renamed into place) and
+checked when opened: a file that is not a complete SQLite database of this layout
+(truncated, or another file) raises :class:`FormatError`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import os
+import sqlite3
+import zlib
+from collections.abc import Mapping
+from pathlib import Path
+
+from ..errors import FormatError
+from ..files.yamlio import atomic_path
+
+__all__ = ["MAGIC", "StoreEntries", "is_store", "open_store", "write_store"]
+
+MAGIC = b"SQLite format 3\x00"
+LAYOUT = 1  # the store's own layout version, in its meta table
+# zlib level 1: most of the size gain of level 6 at a fifth of its time (the writer is one process).
+LEVEL = 1
+DICTIONARY_ENTRIES = 64
+
+
+def is_store(path: str | Path) -> bool:
+    """Whether the file begins like an SQLite database (else it is read as YAML)."""
+    try:
+        with open(path, "rb") as handle:
+            return handle.read(len(MAGIC)) == MAGIC
+    except OSError:
+        return False
+
+
+def write_store(path: str | Path, header: dict, entries) -> None:
+    """Write a store of ``header`` and ``entries`` ((code, JSON text) pairs, in code order), atomically."""
+    with atomic_path(path) as tmp:
+        Path(tmp).unlink(missing_ok=True)  # sqlite3 creates its own file
+        connection = sqlite3.connect(tmp)
+        try:
+            connection.execute("PRAGMA journal_mode = OFF")
+            connection.execute("PRAGMA synchronous = OFF")
+            connection.execute("CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL)")
+            connection.execute("CREATE TABLE entries (code TEXT PRIMARY KEY, entry BLOB NOT NULL) WITHOUT ROWID")
+            connection.executemany("INSERT INTO meta VALUES (?, ?)",
+                                   [("layout", str(LAYOUT)), ("header", json.dumps(header, sort_keys=True))])
+            entries = iter(entries)
+            first = [pair for _, pair in zip(range(DICTIONARY_ENTRIES), entries)]
+            dictionary = "".join(text for _, text in first).encode("utf-8")[-32768:]  # zlib's window
+            connection.execute("CREATE TABLE dictionary (data BLOB NOT NULL)")
+            connection.execute("INSERT INTO dictionary VALUES (?)", (dictionary,))
+            count = 0
+            batch = []
+            for code, text in itertools.chain(first, entries):
+                packer = zlib.compressobj(LEVEL, zdict=dictionary)
+                batch.append((code, packer.compress(text.encode("utf-8")) + packer.flush()))
+                if len(batch) == 10_000:
+                    connection.executemany("INSERT INTO entries VALUES (?, ?)", batch)
+                    count += len(batch)
+                    batch = []
+            connection.executemany("INSERT INTO entries VALUES (?, ?)", batch)
+            count += len(batch)
+            connection.execute("INSERT INTO meta VALUES ('count', ?)", (str(count),))
+            connection.commit()
+        finally:
+            connection.close()
+
+
+def _complete(path: Path) -> bool:
+    # The database header records its page size (bytes 16-17, 1 meaning 65536) and
+    # page count (bytes 28-31): a truncated file is shorter than their product.
+    with open(path, "rb") as handle:
+        head = handle.read(100)
+    if len(head) < 100 or not head.startswith(MAGIC):
+        return False
+    page_size = int.from_bytes(head[16:18], "big")
+    page_size = 65536 if page_size == 1 else page_size
+    pages = int.from_bytes(head[28:32], "big")
+    return pages > 0 and os.path.getsize(path) >= page_size * pages
+
+
+def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
+    """The header and the entries of a store; a bad or truncated store raises :class:`FormatError`."""
+    path = Path(path)
+    if not _complete(path):
+        raise FormatError(f"{path}: not a complete pattern-table store (truncated, or not an SQLite database)")
+    try:
+        connection = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True, check_same_thread=False)
+        meta = dict(connection.execute("SELECT key, value FROM meta"))
+        if meta.get("layout") != str(LAYOUT):
+            raise FormatError(f"{path}: store layout {meta.get('layout')!r}, expected {LAYOUT}")
+        header = json.loads(meta["header"])
+        count = int(meta["count"])
+        (dictionary,) = connection.execute("SELECT data FROM dictionary").fetchone()
+    except (sqlite3.Error, KeyError, ValueError, TypeError) as error:
+        raise FormatError(f"{path}: not a pattern-table store: {str(error).splitlines()[0][:120]}") from None
+    return header, StoreEntries(connection, count, bytes(dictionary), str(path))
+
+
+class StoreEntries(Mapping):
+    """A store's configurations as code -> raw entry text (JSON), read one at a time by the index."""
+
+    def __init__(self, connection: sqlite3.Connection, count: int, dictionary: bytes, name: str):
+        self._connection = connection
+        self._count = count
+        self._dictionary = dictionary
+        self._name = name
+
+    def _query(self, sql: str, arguments=()):
+        try:
+            return self._connection.execute(sql, arguments)
+        except sqlite3.Error as error:
+            raise FormatError(f"{self._name}: store damaged: {str(error).splitlines()[0][:120]}") from None
+
+    def _text(self, blob) -> str:
+        try:
+            unpacker = zlib.decompressobj(zdict=self._dictionary)
+            return (unpacker.decompress(blob) + unpacker.flush()).decode("utf-8")
+        except (zlib.error, UnicodeDecodeError, TypeError) as error:
+            raise FormatError(f"{self._name}: store damaged: an entry does not decompress ({error})") from None
+
+    def __getitem__(self, code: str) -> str:
+        row = self._query("SELECT entry FROM entries WHERE code = ?", (code,)).fetchone()
+        if row is None:
+            raise KeyError(code)
+        return self._text(row[0])
+
+    def __contains__(self, code) -> bool:
+        return self._query("SELECT 1 FROM entries WHERE code = ?", (code,)).fetchone() is not None
+
+    def __iter__(self):
+        return (code for (code,) in self._query("SELECT code FROM entries ORDER BY code"))
+
+    def __len__(self) -> int:
+        return self._count
+
+    def texts(self):
+        """Every (code, entry text), in code order, streamed."""
+        return ((code, self._text(blob)) for code, blob in self._query("SELECT code, entry FROM entries ORDER BY code"))
