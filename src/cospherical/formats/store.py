@@ -50,8 +50,7 @@ def is_store(path: str | Path) -> bool:
 
 def write_store(path: str | Path, header: dict, entries) -> None:
     """Write a store of ``header`` and ``entries`` ((code, JSON text) pairs, in code order), atomically."""
-    with atomic_path(path) as tmp:
-        Path(tmp).unlink(missing_ok=True)  # sqlite3 creates its own file
+    with atomic_path(path) as tmp:  # an empty file: SQLite makes it a new database
         connection = sqlite3.connect(tmp)
         try:
             connection.execute("PRAGMA journal_mode = OFF")
