@@ -23,6 +23,7 @@ import itertools
 import json
 import os
 import sqlite3
+import stat
 import zlib
 from collections.abc import Mapping
 from pathlib import Path
@@ -40,8 +41,11 @@ DICTIONARY_ENTRIES = 64
 
 
 def is_store(path: str | Path) -> bool:
-    """Whether the file begins like an SQLite database (else it is read as YAML)."""
+    """Whether the file is a regular file beginning like an SQLite database (else it is read as YAML,
+    whose reader refuses what is not a regular file: opening a FIFO here would block)."""
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return False
         with open(path, "rb") as handle:
             return handle.read(len(MAGIC)) == MAGIC
     except OSError:
