@@ -77,3 +77,21 @@ def test_type_ids_are_stable():
     assert type_id("v4:1t2t3t/0t3t2t/0t1t3t/0t2t1t", 4, 4) == "v4f4-8f0284"
     tess = tessellate(Configuration.from_code("000000000000"))
     assert tess.elements[0].type.id.startswith("v8f6-")
+
+
+def test_classification_on_id_ranks_is_the_classification_on_ids():
+    # classify works on the ranks of the node ids and maps the answer back (a cache
+    # shared by cells whose ids come in the same order): the same as on the ids.
+    from cospherical.core.element_types import _classify_ranks, classify
+    from cospherical.studies.bisection import bisection_codes
+
+    seen = set()
+    for box in (("1", "1", "1"), ("1", "2", "3")):
+        for code in bisection_codes()[::7]:
+            for element in tessellate(Configuration.from_code(code, box)).elements:
+                poly = element.polyhedron
+                if (poly.faces, poly.face_kinds) in seen:
+                    continue
+                seen.add((poly.faces, poly.face_kinds))
+                assert classify(poly) == _classify_ranks.__wrapped__(poly.faces, poly.face_kinds)
+    assert len(seen) > 500

@@ -46,10 +46,13 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
     from outside and starting at its smallest index.
     """
     coords = frame.coords
-    found: list[frozenset[int]] = []
+    points = [(m, *coords[m]) for m in members]
+    # Triples of a face with more than three points: the face is found at its first
+    # triple, the others are skipped (a set lookup, not a scan of the faces found).
+    done: set[tuple[int, int, int]] = set()
     faces = []
     for i, j, k in combinations(members, 3):
-        if any(i in f and j in f and k in f for f in found):
+        if (i, j, k) in done:
             continue
         (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = coords[i], coords[j], coords[k]
         ux, uy, uz, vx, vy, vz = x1 - x0, y1 - y0, z1 - z0, x2 - x0, y2 - y0, z2 - z0
@@ -59,8 +62,7 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
         offset = nx * x0 + ny * y0 + nz * z0
         above = below = False
         on_plane = []
-        for m in members:
-            x, y, z = coords[m]
+        for m, x, y, z in points:
             side = nx * x + ny * y + nz * z - offset
             if side > 0:
                 above = True
@@ -75,7 +77,8 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
         if not (above or below):
             raise ValueError("points are coplanar: no 3D hull")
         normal = (-nx, -ny, -nz) if above else (nx, ny, nz)
-        found.append(frozenset(on_plane))
+        if len(on_plane) > 3:
+            done.update(combinations(on_plane, 3))
         faces.append((_counter_clockwise(coords, on_plane, normal) if len(on_plane) > 3 else
                       _triangle(on_plane, (ux, uy, uz), (vx, vy, vz), normal), normal))
     return faces
