@@ -56,6 +56,38 @@ def test_symmetry_maps_configurations_and_points():
         assert {sym.node_map[i]: sym.point(p) for i, p in nodes.items()} == image_nodes
 
 
+@pytest.mark.parametrize("lengths", [("1", "1", "1"), ("1", "2", "2"), ("1", "2", "4")])
+def test_orbit_representatives_without_numpy_equal_numpy_ones(lengths):
+    # Without numpy loaded, a few thousand codes take the pure-Python path, one orbit at a
+    # time: the same representatives and the same (first) symmetries as the numpy path.
+    import random
+
+    import numpy as np
+
+    from cospherical.core import symmetry
+    from cospherical.studies.leaves import leaf_codes
+
+    symmetries = box_symmetries(Box.parse(lengths))
+    group = symmetry._group(symmetries)
+    assert group is not None and symmetry._group(symmetries[:5]) is None  # not a group: the numpy path
+    rng = random.Random(15)
+    scattered = ["".join(rng.choice("0123456789abcdefABCDEF") for _ in range(12)) for _ in range(500)]
+    scattered += [code + rng.choice(["+f", "+f0", "+f13", "+fb", "+f245b", "+f012345"]) for code in scattered[:200]]
+    for codes in (bisection_codes(), leaf_codes(), scattered):
+        masks = [symmetry._point_mask(code) if "+" in code else 0 for code in codes]
+        numpy_keys = symmetry.orbit_point_keys(symmetry.code_digits(codes), np.array(masks, dtype=np.int64),
+                                               symmetries)
+        assert symmetry._orbit_keys_python(codes, masks, group) == tuple(a.tolist() for a in numpy_keys)
+
+
+def test_a_bisection_study_loads_no_numpy():
+    # numpy takes a tenth of a second to import: the bisection study and its command do without it.
+    script = ("import sys; from cospherical.cli import main; main(['study', 'bisection', '--format', 'json']); "
+              "sys.exit('numpy' in sys.modules)")
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+
+
 @pytest.fixture(scope="module")
 def paper_studies():
     return {

@@ -11,11 +11,10 @@ from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..errors import UsageError
 from ..files.yamlio import atomic_write
-from ..formats.patterns import pattern_name, write_pattern_table, write_patterns
 from ..outputs.report import text_report
 from ..paper import paper_comparison, paper_study_key
 from ..studies.bisection import bisection_codes, run_study
-from ..studies.intersection import INSERTION_ORDERS, run_intersection, set_patterns
+from ..studies.insertion import INSERTION_ORDERS
 from ..studies.leaves import leaf_codes, run_leaves
 from ..studies.summary import compared_with, study_summary
 from .output import FACE_POINTS_HELP, dump, emit
@@ -108,6 +107,8 @@ def run(args) -> int:
             study = run_study("bisection", box, codes, args.face_points, progress=advance, element=args.element)
         summary = study_summary(study)
     if args.out:
+        from ..formats.patterns import pattern_name, write_patterns  # loads numpy: only when a table is written
+
         stem = pattern_name(study.name, box.texts, study.face_points, study.element)
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
         write_patterns(study, args.out / f"{stem}.yaml", shipped_catalogue()["version"])
@@ -127,6 +128,8 @@ def _report(summary: dict, args, study=None) -> int:
 
 
 def _intersection(args) -> int:
+    from ..formats.patterns import write_pattern_table
+    from ..studies.intersection import run_intersection, set_patterns  # numpy: not for the other studies
 
     if Box.parse(args.box).squared != (1, 1, 1) or args.face_points != "octree":
         raise UsageError("cospherical study: error: the intersection study is the paper's: the cube, octree points")

@@ -27,10 +27,10 @@ import numpy as np
 from ...core.configuration import Box, edge_axis
 from ...core.symmetry import box_symmetries, orbit_keys
 from ...errors import InputError
+from ..insertion import INSERTION_ORDERS
 
 __all__ = ["INSERTION_ORDERS", "PARALLEL_EDGES", "all_configurations", "intersection_codes", "orbits", "set_patterns"]
 
-INSERTION_ORDERS = ("edge", "rank", "reverse")
 PARALLEL_EDGES = tuple(tuple(k for k in range(12) if edge_axis(k) == axis) for axis in range(3))
 
 
