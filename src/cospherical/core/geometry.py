@@ -16,6 +16,7 @@ Python integers: no tolerance anywhere.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Mapping, Sequence
@@ -25,12 +26,14 @@ __all__ = ["Frame", "Sphere", "cross", "dot", "six_volume", "sub"]
 Vector = tuple[int, int, int]
 
 
+# map over operator functions, not generators: these run in the inner loops of the
+# Delaunay walk and the split search (about three times faster).
 def sub(p: Sequence[int], q: Sequence[int]) -> tuple[int, ...]:
-    return tuple(x - y for x, y in zip(p, q))
+    return tuple(map(operator.sub, p, q))
 
 
 def dot(p: Sequence[int], q: Sequence[int]) -> int:
-    return sum(x * y for x, y in zip(p, q))
+    return sum(map(operator.mul, p, q))
 
 
 def cross(p: Sequence[int], q: Sequence[int]) -> Vector:

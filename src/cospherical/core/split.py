@@ -52,21 +52,22 @@ class _Element:
         for face in self.faces:
             normal = cross(sub(coords[face[1]], coords[face[0]]), sub(coords[face[2]], coords[face[0]]))
             self.planes.append((normal, dot(normal, coords[face[0]])))
-        # The element's points on each face plane: a hull face lies on a boundary
-        # plane exactly when its points are among them (a set test instead of a
-        # dot product per point and plane, for every face the search meets).
-        self.on_plane = [frozenset(m for m in self.members if dot(normal, coords[m]) == offset)
-                         for normal, offset in self.planes]
+        # The boundary face of every three of its vertices: a hull face lies on a
+        # boundary plane exactly when its first three points are on that face (three
+        # points of a face span its plane; the element's vertices on a face plane are
+        # that face's vertices).
+        self.face_of_triple = {triple: f for f, face in enumerate(self.faces)
+                               for triple in combinations(sorted(face), 3)}
         self.edges = {frozenset((f[i], f[(i + 1) % len(f)])) for f in self.faces for i in range(len(f))}
+        # Ordered pairs (both ways round) that may be an edge of a piece.
+        self.allowed = {(v, w) for v in self.members for w in self.members
+                        if v != w and self._edge_allowed(frozenset((v, w)))}
+        self.points = [(m, *coords[m]) for m in self.members]
         self.six_volume = six_volume(coords, self.faces)
         self._pieces: dict[frozenset[int], tuple | None] = {}
 
     def _on_boundary_plane(self, cycle) -> int | None:
-        points = set(cycle)
-        for f, on_plane in enumerate(self.on_plane):
-            if points <= on_plane:
-                return f
-        return None
+        return self.face_of_triple.get(tuple(sorted(cycle[:3])))
 
     def _cuts_boundary(self, points: frozenset[int]) -> bool:
         """Whether the hull of ``points`` would have a face inside a boundary face, decided
@@ -108,20 +109,20 @@ class _Element:
 
     def _check(self, faces):
         checked = []
+        allowed = self.allowed
         for cycle, normal in faces:
             boundary = self._on_boundary_plane(cycle)
-            if boundary is not None and frozenset(cycle) != self.face_sets[boundary]:
+            if boundary is not None and len(cycle) != len(self.faces[boundary]):
                 return None  # part of a boundary face: the face would be cut
-            for i, v in enumerate(cycle):
-                if not self._edge_allowed(frozenset((v, cycle[(i + 1) % len(cycle)]))):
-                    return None
+            if any((v, w) not in allowed for v, w in zip(cycle, cycle[1:] + cycle[:1])):
+                return None
             checked.append((cycle, normal, boundary))
         return checked, six_volume(self.frame.coords, [c for c, _, _ in checked])
 
     def beyond(self, cycle, normal) -> list[int]:
-        coords = self.frame.coords
-        offset = dot(normal, coords[cycle[0]])
-        return [m for m in self.members if dot(normal, coords[m]) > offset]
+        nx, ny, nz = normal
+        offset = dot(normal, self.frame.coords[cycle[0]])
+        return [m for m, x, y, z in self.points if nx * x + ny * y + nz * z > offset]
 
 
 def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 200_000) -> list[tuple[Polyhedron, ...]]:
@@ -186,11 +187,13 @@ def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 20
 def _piece(element: _Element, points: frozenset[int]) -> Polyhedron:
     frame, poly = element.frame, element.poly
     faces, six = element.piece(points)
-    cycles = sorted(cycle for cycle, _, _ in faces)
+    faces = sorted(faces, key=lambda face: face[0])
     return Polyhedron(
         nodes=tuple(frame.ids[i] for i in sorted(points)),
-        faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle in cycles),
-        face_kinds=tuple(face_kind(frame, cycle) for cycle in cycles),
+        faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle, _, _ in faces),
+        # a piece's face on the boundary is the element's face there, of the same kind
+        face_kinds=tuple(face_kind(frame, cycle) if boundary is None else poly.face_kinds[boundary]
+                         for cycle, _, boundary in faces),
         unit_volume=poly.unit_volume * six / element.six_volume,
         center=poly.center,  # every piece lies on the element's sphere
     )
