@@ -578,7 +578,7 @@ def test_stale_temporaries_of_our_naming_are_removed(tmp_path, capsys):
 def test_study_bisection_refuses_intersection_options(tmp_path, capsys):
     for option in (["--resume"], ["--patterns"], ["--no-orbits"], ["--resolution", "4"], ["--order", "rank"],
                    ["--scheduler", "tcp://SCHEDULER:8786"], ["--dask-workers", "2"], ["--jobs", "2"],
-                   ["--chunk-size", "10"]):
+                   ["--chunk-size", "10"], ["--patterns-format", "store"]):
         refused(capsys, "study", "bisection", "--out", tmp_path, *option, needle=option[0])
     assert not list(tmp_path.iterdir())
 

@@ -117,12 +117,13 @@ def test_pattern_table_of_the_representatives(tmp_path):
     from cospherical.catalogue import shipped_catalogue
     from cospherical.cli import main
     from cospherical.core.symmetry import key_code
-    from cospherical.formats.patterns import load, write_pattern_table
+    from cospherical.formats.intersection_table import write_pattern_table
+    from cospherical.formats.patterns import load
     from cospherical.studies.intersection import orbits
 
     summary = run_intersection(2, jobs=1)
-    path = tmp_path / "patterns.yaml"
-    write_pattern_table(summary, path, shipped_catalogue()["version"], jobs=2, chunk=40)
+    path, store = tmp_path / "patterns.yaml", tmp_path / "patterns.sqlite"
+    write_pattern_table(summary, shipped_catalogue()["version"], yaml_path=path, store=store, jobs=2, chunk=40)
     table = load(path)
     reps, _, _ = orbits(2)
     assert sorted(table.configurations) == [key_code(k) for k in reps.tolist()]
@@ -131,8 +132,33 @@ def test_pattern_table_of_the_representatives(tmp_path):
         direct = tessellate(Configuration.from_code(code))
         assert [(e["type"], e["nodes"]) for e in table.elements(code)] == \
                [(e.type.id, list(e.nodes)) for e in direct.elements]
-    # every criterion's elements tile the cube exactly (the deep check)
-    assert main(["check", str(path)]) == 0
+    # every criterion's elements tile the cube exactly (the deep check), in either form
+    assert main(["check", str(path)]) == 0 and main(["check", str(store)]) == 0
+
+
+def test_table_lines_joined_from_cells_are_those_of_each_tessellation(pool_run):
+    # The table is joined from each distinct cell's text; the same lines, byte for byte,
+    # come from tessellating every configuration and splitting it under each kept set.
+    from cospherical import Configuration, tessellate
+    from cospherical.catalogue import split_tessellation
+    from cospherical.core.symmetry import key_code
+    from cospherical.formats.intersection_table import cell_texts, distinct_cells, table_lines
+    from cospherical.formats.patterns import configuration_line
+    from cospherical.studies.intersection import orbits
+
+    kept = {c: data["kept"] for c, data in pool_run["criteria"].items() if c != "optimal"}
+    reps, _, _ = orbits(4)
+    codes = reps[::40]
+    cells = [tuple(row) for row in distinct_cells(codes).tolist()]
+    index = {(mask, masked): i for i, (mask, masked, _) in enumerate(cells)}
+    joined = table_lines(codes, index, cell_texts(cells, kept), ["optimal", *kept])
+    expected = []
+    for code in map(key_code, codes.tolist()):
+        tess = tessellate(Configuration.from_code(code))
+        split = {c: split_tessellation(tess, frozenset(types), c)[0] for c, types in kept.items()}
+        expected.append(configuration_line(code, tess.fvm_adequate, {"optimal": tess, **split}))
+    assert joined == "".join(expected)
+    assert any('"internal_faces": [' in line for line in expected)  # some configurations are split
 
 
 def test_rank_and_reverse_are_mirror_families():
@@ -160,53 +186,44 @@ def test_the_catalogue_holds_every_type_of_the_intersection_studies():
 
 
 @pytest.fixture(scope="module")
-def r4_sample(pool_run, tmp_path_factory):
-    """The R = 4 pattern table of every 10th orbit representative, as YAML and as an indexed store."""
+def r4_table(pool_run, tmp_path_factory):
+    """The R = 4 pattern table, as YAML and as an indexed store."""
     from cospherical.catalogue import shipped_catalogue
-    from cospherical.files.flowyaml import mapping_entries
-    from cospherical.files.yamlio import atomic_write, yaml_text
-    from cospherical.formats.patterns import pattern_chunk
-    from cospherical.formats.store import write_store
-    from cospherical.studies.intersection import orbits
+    from cospherical.formats.intersection_table import write_pattern_table
 
-    reps, _, _ = orbits(4)
-    kept = {c: data["kept"] for c, data in pool_run["criteria"].items() if c != "optimal"}
-    header = {"schema_version": 1, "generator": "test", "catalogue_version": shipped_catalogue()["version"],
-              "study": "intersection", "box": ["1", "1", "1"], "face_points": "octree", "scheme": "test",
-              "criteria": ["optimal", *kept]}
     folder = tmp_path_factory.mktemp("r4")
-    text = pattern_chunk(reps[::10].tolist(), kept)
-    atomic_write(folder / "r4.yaml", yaml_text(header) + "configurations:\n" + text)
-    write_store(folder / "r4.sqlite", header, mapping_entries(text))
+    write_pattern_table(pool_run, shipped_catalogue()["version"], yaml_path=folder / "r4.yaml",
+                        store=folder / "r4.sqlite", jobs=2)
     return folder / "r4.yaml", folder / "r4.sqlite"
 
 
-def test_a_pattern_table_at_resolution_4_passes_check(r4_sample):
+def test_a_pattern_table_at_resolution_4_passes_check(r4_table):
     # Every type of the intersection studies is in the shipped catalogue, so `check`
     # (known types, node counts, exact tiling) passes their tables.
     from cospherical.cli import main
 
-    assert main(["check", str(r4_sample[0])]) == 0
+    assert main(["check", str(r4_table[0])]) == 0
 
 
-def test_the_indexed_store_answers_exactly_like_the_yaml(r4_sample):
+def test_the_indexed_store_answers_exactly_like_the_yaml(r4_table):
     from cospherical.cli import main
     from cospherical.formats.patterns import load
 
-    yaml_table, store = (load(path) for path in r4_sample)
+    yaml_table, store = (load(path) for path in r4_table)
     assert store.header == yaml_table.header and list(store.configurations) == list(yaml_table.configurations)
     for code in yaml_table.configurations:
+        assert store.configurations.text(code) == yaml_table.configurations.text(code)
+    for code in list(yaml_table.configurations)[::10]:
         for criterion in yaml_table.header["criteria"]:
             assert store.elements(code, criterion) == yaml_table.elements(code, criterion)
     with pytest.raises(KeyError):
         store.elements("fffffffffff0")
-    assert main(["check", str(r4_sample[1])]) == 0  # every type in the catalogue, every configuration tiles
-    assert main(["diff", *map(str, r4_sample)]) == 0
+    assert main(["diff", *map(str, r4_table)]) == 0
 
 
 @pytest.mark.parametrize("damage", ["truncated", "overwritten", "not a store"])
-def test_a_bad_store_is_refused_with_exit_2(r4_sample, tmp_path, damage):
-    data = bytearray(r4_sample[1].read_bytes())
+def test_a_bad_store_is_refused_with_exit_2(r4_table, tmp_path, damage):
+    data = bytearray(r4_table[1].read_bytes())
     if damage == "truncated":
         data = data[: len(data) // 2]
     elif damage == "overwritten":  # every page after the first: the tables' pages are garbage

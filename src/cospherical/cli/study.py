@@ -60,8 +60,11 @@ def add_parser(commands) -> None:
                         "the bisection study takes seconds and has no checkpoints)")
     parser.add_argument("--patterns", action="store_true",
                         help="intersection: also write the pattern table of the orbit representatives into DIR, "
-                        "as YAML and as an indexed store (.sqlite) that a mesher queries one configuration at a "
-                        "time (large: one tessellation per orbit in Python, about 1 ms each)")
+                        "as an indexed store (.sqlite) that a mesher queries one configuration at a time, and as "
+                        "YAML (see --patterns-format); built from the study's cells: about 1 min at R = 8")
+    parser.add_argument("--patterns-format", choices=("auto", "yaml", "store", "both"),
+                        help="intersection: the pattern table as yaml, store or both (default auto: both while the "
+                        "YAML stays small enough to read, up to R = 4; the store alone above, where it is over a GB)")
     parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree", help=FACE_POINTS_HELP)
     parser.add_argument("--out", type=Path, metavar="DIR",
                         help="also write the summary (JSON) and the pattern table (YAML) into DIR")
@@ -74,9 +77,9 @@ def add_parser(commands) -> None:
 
 # Options of the intersection study only: given to the bisection study they are refused, not ignored.
 INTERSECTION_ONLY = ("resolution", "order", "jobs", "chunk_size", "scheduler", "scheduler_timeout", "dask_workers",
-                     "no_orbits", "resume", "patterns")
+                     "no_orbits", "resume", "patterns", "patterns_format")
 INTERSECTION_DEFAULTS = {"resolution": 16, "order": "edge", "jobs": os.cpu_count() or 1, "chunk_size": 5000,
-                         "scheduler_timeout": 30.0}
+                         "scheduler_timeout": 30.0, "patterns_format": "auto"}
 
 
 def run(args) -> int:
@@ -128,7 +131,6 @@ def _report(summary: dict, args, study=None) -> int:
 
 
 def _intersection(args) -> int:
-    from ..formats.patterns import write_pattern_table
     from ..studies.intersection import run_intersection, set_patterns  # numpy: not for the other studies
 
     if Box.parse(args.box).squared != (1, 1, 1) or args.face_points != "octree":
@@ -137,6 +139,8 @@ def _intersection(args) -> int:
         raise UsageError(f"cospherical study: error: --resolution {args.resolution}: choose 2, 4, 8 or 16")
     if args.patterns and not args.out:
         raise UsageError("cospherical study: error: --patterns writes into --out DIR")
+    if args.patterns_format != "auto" and not args.patterns:
+        raise UsageError("cospherical study: error: --patterns-format is the form of the --patterns table")
     if args.resume and not args.out:
         raise UsageError("cospherical study: error: --resume keeps its checkpoints in --out DIR")
     if args.scheduler and args.dask_workers:
@@ -174,8 +178,17 @@ def _intersection(args) -> int:
         render_tables([summary], shipped_catalogue(), args.out / "latex",
                       f"Intersection study at 1/{args.resolution}, insertion order {args.order}")
         if args.patterns:
-            with progress_bar(summary["orbits"], "pattern table") as advance:
-                write_pattern_table(summary, args.out / f"{stem}-patterns.yaml", shipped_catalogue()["version"],
+            from ..formats.intersection_table import YAML_UP_TO, write_pattern_table
+
+            form = args.patterns_format
+            if form == "auto":
+                form = "both" if args.resolution <= YAML_UP_TO else "store"
+            with stage_bars({"cells": (summary["orbits"], "pattern table: cells", "cfg"),
+                             "elements": (None, "distinct cells written", "el"),
+                             "entries": (summary["orbits"], "pattern table: entries", "cfg")}) as advance:
+                write_pattern_table(summary, shipped_catalogue()["version"],
+                                    yaml_path=args.out / f"{stem}-patterns.yaml" if form != "store" else None,
+                                    store=args.out / f"{stem}-patterns.sqlite" if form != "yaml" else None,
                                     jobs=max(1, args.jobs), progress=advance, scheduler=args.scheduler,
-                                    dask_workers=args.dask_workers, store=args.out / f"{stem}-patterns.sqlite")
+                                    dask_workers=args.dask_workers)
     return _report(summary, args)

@@ -359,15 +359,17 @@ def _cube_points(digits, corners, starts, axes, face_edges, face_base, ids, coor
 
 
 @njit(cache=True)
-def cube_batch(codes, corners, starts, axes, face_edges, face_base, tets, closed, open_, polys, poly_mask, poly_code):
+def cube_batch(codes, corners, starts, axes, face_edges, face_base, tets, closed, open_, polys, poly_mask, poly_code,
+               every_cell=False):
     """Tessellate the cube configurations ``codes`` (base-16 numbers, 1/16 positions, octree points).
 
     Per configuration: ``tets`` the number of tetrahedra, ``closed``/``open_``
     whether every circumcenter lies in the closed/open box, ``polys`` the number
-    of other cells; each other cell is written as its node-id bit mask and the
+    of other cells (of all cells with ``every_cell``, for pattern tables); each
+    such cell is written, in the walk's order, as its node-id bit mask and the
     code masked to the digits its points depend on (equal pairs mean equal
-    geometry: same nodes at the same places).  Returns the number of other
-    cells written, or -1 - i when configuration i needs the Python walk.
+    geometry: same nodes at the same places).  Returns the number of cells
+    written, or -1 - i when configuration i needs the Python walk.
     """
     ids = np.empty(27, dtype=np.int64)
     coords = np.zeros((27, 3), dtype=np.int64)
@@ -423,7 +425,8 @@ def cube_batch(codes, corners, starts, axes, face_edges, face_base, tets, closed
                         relevant |= np.int64(1) << (node - 8)
             if count == 4:
                 tets[i] += 1
-                continue
+                if not every_cell:
+                    continue
             if written >= poly_mask.shape[0]:
                 return -1 - i
             masked = np.int64(0)

@@ -15,27 +15,23 @@ A mesh generator looks a configuration up like this::
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from ..catalogue import split_tessellation
-from ..core.configuration import POINT_POLICIES, Box, Configuration
+from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
-from ..core.symmetry import key_code
-from ..core.tessellation import Tessellation, tessellate
+from ..core.tessellation import Tessellation
 from ..errors import FormatError, InputError
-from ..files.flowyaml import decode_entry, mapping_entries, mapping_line, split_section
-from ..files.yamlio import atomic_open, atomic_write, parse_yaml, read_text, validate, yaml_text
+from ..files.flowyaml import decode_entry, mapping_line, split_section
+from ..files.yamlio import atomic_write, parse_yaml, read_text, validate, yaml_text
 from ..studies.bisection import Study
-from ..studies.intersection import completed, orbits
 from ..version import __version__
-from .store import is_store, open_store, write_store
+from .store import is_store, open_store
 
-__all__ = ["Entries", "PatternTable", "SCHEMA_VERSION", "configuration_line", "element_entries", "entry_elements", "load",
-           "pattern_chunk", "pattern_name", "patterns_text", "table_from_data", "table_from_text", "write_pattern_table",
+__all__ = ["Entries", "PatternTable", "SCHEMA_VERSION", "configuration_line", "element_entries", "element_entry",
+           "entry_elements", "load", "pattern_name", "patterns_text", "table_from_data", "table_from_text",
            "write_patterns"]
 
 SCHEMA_VERSION = 1
@@ -116,15 +112,19 @@ def configuration_line(code: str, fvm_adequate: bool, tessellations: Mapping[str
 
 
 def element_entries(tess) -> list[dict]:
-    """A tessellation's elements as pattern-table data: type id, nodes in reference order, circumcenter."""
-    entries = []
-    for element in tess.elements:
-        entry = {"type": element.type.id, "nodes": list(element.nodes),
-                 "circumcenter": [float(x) for x in tess.circumcenter(element)]}
-        if element.mirrored:
-            entry["mirror"] = True
-        entries.append(entry)
-    return entries
+    """A tessellation's elements as pattern-table data (see :func:`element_entry`)."""
+    scale = tess.configuration.box.to_float()
+    return [element_entry(element, scale) for element in tess.elements]
+
+
+def element_entry(element, scale) -> dict:
+    """An element as pattern-table data: type id, nodes in reference order, circumcenter in a
+    box of edge lengths ``scale`` (floats), and ``mirror`` where it is its type's mirror image."""
+    entry = {"type": element.type.id, "nodes": list(element.nodes),
+             "circumcenter": [float(x) * s for x, s in zip(element.polyhedron.center, scale)]}
+    if element.mirrored:
+        entry["mirror"] = True
+    return entry
 
 
 def write_patterns(study: Study, path: str | Path, catalogue_version: str) -> None:
@@ -175,6 +175,10 @@ class Entries(Mapping):
 
     def values(self):
         return (entry for _, entry in self.items())
+
+    def text(self, code: str) -> str:
+        """An entry as written (its JSON text): equal texts are equal entries, which ``diff`` skips."""
+        return self._texts[code]
 
     def __contains__(self, code) -> bool:
         return code in self._texts
@@ -294,74 +298,3 @@ def _check_entries(data, name: str) -> None:
             if isinstance(same, str) and same not in criteria[:i]:
                 raise FormatError(f"{name}: configuration {code}: {criterion} refers to {same!r}, "
                                   "which is not an earlier criterion of the table")
-
-
-# ---------------------------------------------------------------------------
-# The intersection study's pattern table: one entry per orbit representative
-# (large: written on request, in chunks on the workers).
-
-SYMMETRY_CONVENTION = (
-    "One entry per orbit of the cube's 48 symmetries. The representative is the configuration "
-    "whose code, read as a base-16 number, is the smallest of its images; a symmetry sends the "
-    "point at t on an edge to the image edge at t or, where the edge is reversed, at 1 - t. "
-    "To use an entry for another configuration: cospherical.symmetry.orbit_keys(digits, "
-    "box_symmetries(cube)) gives its representative and the index of a symmetry taking it there; "
-    "map the representative's nodes back with that symmetry's inverse (Symmetry.node_map).")
-
-
-def pattern_chunk(codes: list[int], kept: dict[str, list[str]]) -> str:
-    """Pattern-table entries (YAML text) of some representatives, every criterion of ``kept``."""
-    # Bulk work: load the compiled walk, which tessellate() then takes (the
-    # Python walk costs several ms per 1/16 configuration, the kernel ~10 us).
-    from ..core import compiled  # noqa: F401
-
-    lines = []
-    for code in codes:
-        text = key_code(code)
-        tess = tessellate(Configuration.from_code(text))
-        tessellations = {"optimal": tess}
-        for criterion, types in kept.items():
-            tessellations[criterion] = split_tessellation(tess, frozenset(types), criterion)[0]
-        lines.append(configuration_line(text, tess.fvm_adequate, tessellations))
-    return "".join(lines)
-
-
-def write_pattern_table(summary: dict, path, catalogue_version: str, jobs: int = 1, progress=None,
-                        chunk: int = 2000, scheduler: str | None = None, dask_workers: int | None = None,
-                        store=None) -> None:
-    """Write the pattern table of the study's orbit representatives (``summary`` gives the kept sets).
-
-    ``store``: also write the indexed store (:mod:`cospherical.formats.store`) there, from the
-    same entries in the same pass.
-    """
-    resolution, order = summary["resolution"], summary["insertion_order"]
-    reps, _, _ = orbits(resolution, order)
-    kept = {c: data["kept"] for c, data in summary["criteria"].items() if c != "optimal"}
-    header = {
-        "schema_version": SCHEMA_VERSION, "generator": f"cospherical {__version__}",
-        "catalogue_version": catalogue_version, "study": "intersection", "box": ["1", "1", "1"],
-        "face_points": "octree",
-        "scheme": f"midpoint scheme at multiples of 1/{resolution}, insertion order {order} (paper, section 5)",
-        "symmetry": SYMMETRY_CONVENTION, "criteria": ["optimal", *kept],
-    }
-    with atomic_open(path) as handle:
-        handle.write(yaml_text(header) + "configurations:\n")
-        tasks = {i: (reps[i:i + chunk].tolist(), kept) for i in range(0, len(reps), chunk)}
-
-        def entries():
-            waiting, next_start = {}, 0
-            for start, text in completed(pattern_chunk, tasks, jobs, scheduler, dask_workers):
-                waiting[start] = text
-                while next_start in waiting:  # in code order, whatever order the chunks finish in
-                    text = waiting.pop(next_start)
-                    handle.write(text)
-                    yield from mapping_entries(text)
-                    if progress:
-                        progress(len(tasks[next_start][0]))
-                    next_start += chunk
-
-        if store:
-            write_store(store, header, entries())
-        else:
-            for _ in entries():
-                pass

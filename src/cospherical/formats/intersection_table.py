@@ -1,0 +1,222 @@
+"""The intersection study's pattern table: one entry per orbit representative, built from cells.
+
+At 1/16 the table has 1.66 million entries; tessellating each again in Python
+(1-4 ms) would take an hour.  But the entries are made of few distinct elements:
+a cell is the same element, with the same pattern-table text under every
+criterion, wherever its nodes sit at the same places.  So the table is built in
+three passes:
+
+1. **cells**: the compiled walk gives every representative's cells, each as (node
+   mask, code masked to the digits its points depend on), as in the study's
+   stage 1; the distinct pairs are collected (workers, in chunks).
+2. **elements**: each distinct cell is classified, measured and split under every
+   criterion's kept set once, by the exact Python path, and written as its
+   pattern-table text (workers, in chunks): at 1/16 a few hundred thousand cells.
+3. **entries**: the walk runs again, chunk by chunk, and every representative's
+   line is joined from its cells' texts, exactly as
+   :func:`~cospherical.formats.patterns.configuration_line` writes it from a
+   tessellation (tested: the same bytes), and written in code order.
+
+The YAML holds one line per configuration; from R = 8 on (hundreds of MB and
+more, beyond what :func:`~cospherical.formats.patterns.load` reads as YAML) the
+table is written as the indexed store only, unless asked for.
+"""
+
+from __future__ import annotations
+
+from contextlib import nullcontext
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..catalogue import split_options
+from ..core.configuration import Configuration
+from ..core.delaunay import delaunay_cells
+from ..core.element_types import classify
+from ..core.geometry import Frame
+from ..core.polyhedron import polyhedron
+from ..core.symmetry import key_code
+from ..core.tessellation import Element
+from ..errors import InputError
+from ..files.flowyaml import flow, mapping_entries
+from ..files.yamlio import atomic_open, yaml_text
+from ..studies.intersection import completed, orbits
+from ..version import __version__
+from .patterns import SCHEMA_VERSION, element_entry
+from .store import write_store
+
+__all__ = ["SYMMETRY_CONVENTION", "YAML_UP_TO", "CellText", "cell_texts", "distinct_cells", "representative_cells",
+           "table_lines", "write_pattern_table"]
+
+SYMMETRY_CONVENTION = (
+    "One entry per orbit of the cube's 48 symmetries. The representative is the configuration "
+    "whose code, read as a base-16 number, is the smallest of its images; a symmetry sends the "
+    "point at t on an edge to the image edge at t or, where the edge is reversed, at 1 - t. "
+    "To use an entry for another configuration: cospherical.symmetry.orbit_keys(digits, "
+    "box_symmetries(cube)) gives its representative and the index of a symmetry taking it there; "
+    "map the representative's nodes back with that symmetry's inverse (Symmetry.node_map).")
+# The largest resolution whose table is also written as YAML by default: at R = 4 the
+# YAML is ~60 MB; at R = 8 ~1.4 GB, beyond the 512 MB the YAML reader accepts.
+YAML_UP_TO = 4
+CHUNK = 20_000
+CELL_CHUNK = 2_000
+
+
+def representative_cells(codes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pass 1 and 3: per configuration (base-16 codes) its cell count, and per cell, in the
+    walk's order, its node mask and masked code (see :func:`cospherical.core.compiled.cube_batch`)."""
+    from ..core import compiled
+
+    codes = np.ascontiguousarray(codes, dtype=np.int64)
+    n = len(codes)
+    tets, counts = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    closed, open_ = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
+    # A configuration of at most 27 points has fewer than 96 Delaunay cells in these
+    # families (27 at most measured at 1/16); a larger one is refused below, not lost.
+    masks, masked = np.empty(96 * n, dtype=np.int64), np.empty(96 * n, dtype=np.int64)
+    written = compiled.cube_batch(codes, *compiled.cube_tables(), tets, closed, open_, counts, masks, masked, True)
+    if written < 0:
+        raise RuntimeError(f"configuration {key_code(int(codes[-1 - written]))}: beyond the compiled walk's buffers")
+    return counts, masks[:written], masked[:written]
+
+
+def distinct_cells(codes) -> np.ndarray:
+    """Pass 1 on a chunk: its distinct cells as rows (node mask, masked code, a configuration holding it)."""
+    counts, masks, masked = representative_cells(codes)
+    owners = np.repeat(np.asarray(codes, dtype=np.int64), counts)
+    pairs = np.stack([masks, masked], axis=1)
+    _, first = np.unique(pairs, axis=0, return_index=True)
+    return np.stack([masks[first], masked[first], owners[first]], axis=1)
+
+
+@dataclass(frozen=True)
+class CellText:
+    """A distinct cell's part of every entry holding it.
+
+    ``closed``: its circumcenter lies in the closed box (the entry's ``fvm_adequate``);
+    ``pieces``: per criterion, the elements it becomes there, as (nodes in id order,
+    element text), the cell itself under ``optimal`` and wherever its type is kept.
+    """
+
+    closed: bool
+    pieces: tuple[tuple[tuple[tuple[int, ...], str], ...], ...]
+
+
+def cell_texts(cells: list[tuple[int, int, int]], kept: dict[str, list[str]]) -> list[CellText]:
+    """Pass 2: every cell ``(node mask, masked code, a configuration code holding it)`` as its
+    :class:`CellText`, criteria ``optimal`` then those of ``kept`` (criterion -> kept type ids)."""
+    squared = (1, 1, 1)
+    scale = (1.0, 1.0, 1.0)
+    kept_sets = {criterion: frozenset(types) for criterion, types in kept.items()}
+    found = []
+    for mask, _, owner in cells:
+        nodes = Configuration.from_code(key_code(owner)).nodes()
+        points = tuple((n, nodes[n]) for n in sorted(nodes) if mask >> n & 1)
+        frame = Frame.build(dict(points), squared)
+        (cell,) = delaunay_cells(frame)  # the points are co-spherical: one cell
+        poly = polyhedron(frame, cell)
+        etype, order, mirrored = classify(poly)
+        element = Element(etype, order, poly, mirrored)
+        pieces = [(element,)]
+        for criterion, types in kept_sets.items():
+            if element.type.id in types:
+                pieces.append((element,))
+                continue
+            fitting = [option for option in split_options(points, squared, poly, criterion)
+                       if all(piece.type.id in types for piece in option)]
+            if not fitting:
+                raise InputError(f"a {element.type.name} has no {criterion} split into the kept types")
+            pieces.append(fitting[0])
+        found.append(CellText(
+            poly.center_in_box(closed=True),
+            tuple(tuple((p.polyhedron.nodes, flow(element_entry(p, scale))) for p in option) for option in pieces)))
+    return found
+
+
+def table_lines(codes, index: dict[tuple[int, int], int], texts: list[CellText], criteria: list[str]) -> str:
+    """Pass 3 on a chunk of representatives: their pattern-table lines, joined from their cells' texts."""
+    counts, masks, masked = representative_cells(codes)
+    cells = [texts[index[pair]] for pair in zip(masks.tolist(), masked.tolist())]
+    lines = []
+    start = 0
+    for code, count in zip(codes, counts.tolist()):
+        mine = cells[start:start + count]
+        start += count
+        parts = [f'"fvm_adequate": {"true" if all(cell.closed for cell in mine) else "false"}']
+        written: dict[tuple, str] = {}
+        for k, criterion in enumerate(criteria):
+            # in node-id order, as a tessellation sorts its elements; the same
+            # elements as an earlier criterion are that criterion's name
+            pieces = sorted(piece for cell in mine for piece in cell.pieces[k])
+            key = tuple(nodes for nodes, _ in pieces)
+            if key in written:
+                parts.append(f'"{criterion}": "{written[key]}"')
+                continue
+            written[key] = criterion
+            parts.append(f'"{criterion}": [' + ", ".join(text for _, text in pieces) + "]")
+        lines.append(f"  '{key_code(int(code))}': {{" + ", ".join(parts) + "}\n")
+    return "".join(lines)
+
+
+def write_pattern_table(summary: dict, catalogue_version: str, yaml_path=None, store=None, jobs: int = 1,
+                        progress=None, scheduler: str | None = None, dask_workers: int | None = None,
+                        chunk: int = CHUNK) -> None:
+    """Write the pattern table of the study's orbit representatives (``summary`` gives the kept
+    sets) as YAML at ``yaml_path`` and/or as an indexed store (:mod:`cospherical.formats.store`)
+    at ``store``, from the same lines in one pass.
+
+    ``progress(stage, n)`` as work finishes: ``cells`` and ``entries`` in representatives,
+    ``elements`` in distinct cells.
+    """
+    resolution, order = summary["resolution"], summary["insertion_order"]
+    reps, _, _ = orbits(resolution, order)
+    kept = {c: data["kept"] for c, data in summary["criteria"].items() if c != "optimal"}
+    criteria = ["optimal", *kept]
+    header = {
+        "schema_version": SCHEMA_VERSION, "generator": f"cospherical {__version__}",
+        "catalogue_version": catalogue_version, "study": "intersection", "box": ["1", "1", "1"],
+        "face_points": "octree",
+        "scheme": f"midpoint scheme at multiples of 1/{resolution}, insertion order {order} (paper, section 5)",
+        "symmetry": SYMMETRY_CONVENTION, "criteria": criteria,
+    }
+    report = progress or (lambda stage, n: None)
+    backend = dict(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
+    starts = range(0, len(reps), chunk)
+
+    # Pass 1: the distinct cells.
+    found = []
+    for start, rows in completed(distinct_cells, {s: (reps[s:s + chunk],) for s in starts}, **backend):
+        found.append(rows)
+        report("cells", len(reps[start:start + chunk]))
+    rows = np.concatenate(found) if found else np.zeros((0, 3), dtype=np.int64)
+    _, first = np.unique(rows[:, :2], axis=0, return_index=True)
+    rows = rows[first]
+    cells = [tuple(row) for row in rows.tolist()]
+
+    # Pass 2: each distinct cell's text, once.
+    texts_of = {}
+    tasks = {s: (cells[s:s + CELL_CHUNK], kept) for s in range(0, len(cells), CELL_CHUNK)}
+    for start, part in completed(cell_texts, tasks, **backend):
+        texts_of[start] = part
+        report("elements", len(part))
+    texts = [text for s in sorted(texts_of) for text in texts_of[s]]
+    del texts_of
+    index = {(mask, masked): i for i, (mask, masked, _) in enumerate(cells)}
+
+    # Pass 3: the entries, in code order, into the YAML and the store at once.
+    def lines():
+        for s in starts:
+            text = table_lines(reps[s:s + chunk], index, texts, criteria)
+            if handle:
+                handle.write(text)
+            yield from mapping_entries(text)
+            report("entries", len(reps[s:s + chunk]))
+
+    with (atomic_open(yaml_path) if yaml_path else nullcontext()) as handle:
+        if handle:
+            handle.write(yaml_text(header) + "configurations:\n")
+        if store:
+            write_store(store, header, lines())
+        else:
+            for _ in lines():
+                pass
