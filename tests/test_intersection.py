@@ -150,8 +150,8 @@ def test_table_lines_joined_from_cells_are_those_of_each_tessellation(pool_run):
     reps, _, _ = orbits(4)
     codes = reps[::40]
     cells = [tuple(row) for row in distinct_cells(codes).tolist()]
-    index = {(mask, masked): i for i, (mask, masked, _) in enumerate(cells)}
-    joined = table_lines(codes, index, cell_texts(cells, kept), ["optimal", *kept])
+    texts = dict(zip([cell[:2] for cell in cells], cell_texts(cells, kept)))
+    joined = table_lines(codes, texts, ["optimal", *kept])
     expected = []
     for code in map(key_code, codes.tolist()):
         tess = tessellate(Configuration.from_code(code))

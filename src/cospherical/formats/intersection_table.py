@@ -24,6 +24,7 @@ table is written as the indexed store only, unless asked for.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from contextlib import nullcontext
 from dataclasses import dataclass
 
@@ -43,10 +44,10 @@ from ..files.yamlio import atomic_open, yaml_text
 from ..studies.intersection import completed, orbits
 from ..version import __version__
 from .patterns import SCHEMA_VERSION, element_entry
-from .store import write_store
+from .store import dictionary_of, pack, write_store
 
-__all__ = ["SYMMETRY_CONVENTION", "YAML_UP_TO", "CellText", "cell_texts", "distinct_cells", "representative_cells",
-           "table_lines", "write_pattern_table"]
+__all__ = ["SYMMETRY_CONVENTION", "YAML_UP_TO", "CellText", "cell_texts", "distinct_cells", "entry_chunk",
+           "representative_cells", "table_lines", "write_pattern_table"]
 
 SYMMETRY_CONVENTION = (
     "One entry per orbit of the cube's 48 symmetries. The representative is the configuration "
@@ -60,6 +61,7 @@ SYMMETRY_CONVENTION = (
 YAML_UP_TO = 4
 CHUNK = 20_000
 CELL_CHUNK = 2_000
+SAMPLES = 16  # about 40 kB of entries at R = 8: the dictionary is their last 32 kB
 
 
 def representative_cells(codes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -133,14 +135,15 @@ def cell_texts(cells: list[tuple[int, int, int]], kept: dict[str, list[str]]) ->
     return found
 
 
-def table_lines(codes, index: dict[tuple[int, int], int], texts: list[CellText], criteria: list[str]) -> str:
-    """Pass 3 on a chunk of representatives: their pattern-table lines, joined from their cells' texts."""
+def table_lines(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str]) -> str:
+    """The pattern-table lines of some representatives, joined from their cells' texts
+    (``cells``: (node mask, masked code) -> :class:`CellText`, every cell they hold)."""
     counts, masks, masked = representative_cells(codes)
-    cells = [texts[index[pair]] for pair in zip(masks.tolist(), masked.tolist())]
+    held = [cells[pair] for pair in zip(masks.tolist(), masked.tolist())]
     lines = []
     start = 0
     for code, count in zip(codes, counts.tolist()):
-        mine = cells[start:start + count]
+        mine = held[start:start + count]
         start += count
         parts = [f'"fvm_adequate": {"true" if all(cell.closed for cell in mine) else "false"}']
         written: dict[tuple, str] = {}
@@ -156,6 +159,14 @@ def table_lines(codes, index: dict[tuple[int, int], int], texts: list[CellText],
             parts.append(f'"{criterion}": [' + ", ".join(text for _, text in pieces) + "]")
         lines.append(f"  '{key_code(int(code))}': {{" + ", ".join(parts) + "}\n")
     return "".join(lines)
+
+
+def entry_chunk(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str], yaml: bool,
+                dictionary: bytes | None) -> tuple[str, list[tuple[str, bytes]]]:
+    """Pass 3 on a chunk: its YAML lines (if ``yaml``) and its store rows (if a ``dictionary``)."""
+    text = table_lines(codes, cells, criteria)
+    rows = [] if dictionary is None else [(code, pack(entry, dictionary)) for code, entry in mapping_entries(text)]
+    return text if yaml else "", rows
 
 
 def write_pattern_table(summary: dict, catalogue_version: str, yaml_path=None, store=None, jobs: int = 1,
@@ -183,40 +194,50 @@ def write_pattern_table(summary: dict, catalogue_version: str, yaml_path=None, s
     backend = dict(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
     starts = range(0, len(reps), chunk)
 
-    # Pass 1: the distinct cells.
+    # Pass 1: the distinct cells of each chunk, and of the whole table.
+    held: dict[int, list[tuple[int, int]]] = {}
     found = []
     for start, rows in completed(distinct_cells, {s: (reps[s:s + chunk],) for s in starts}, **backend):
+        held[start] = [(mask, masked) for mask, masked, _ in rows.tolist()]
         found.append(rows)
         report("cells", len(reps[start:start + chunk]))
     rows = np.concatenate(found) if found else np.zeros((0, 3), dtype=np.int64)
     _, first = np.unique(rows[:, :2], axis=0, return_index=True)
-    rows = rows[first]
-    cells = [tuple(row) for row in rows.tolist()]
+    distinct = [tuple(row) for row in rows[first].tolist()]
+    del found, rows
 
     # Pass 2: each distinct cell's text, once.
-    texts_of = {}
-    tasks = {s: (cells[s:s + CELL_CHUNK], kept) for s in range(0, len(cells), CELL_CHUNK)}
+    texts: dict[tuple[int, int], CellText] = {}
+    tasks = {s: (distinct[s:s + CELL_CHUNK], kept) for s in range(0, len(distinct), CELL_CHUNK)}
     for start, part in completed(cell_texts, tasks, **backend):
-        texts_of[start] = part
+        texts.update(((mask, masked), text) for (mask, masked, _), text in zip(tasks[start][0], part))
         report("elements", len(part))
-    texts = [text for s in sorted(texts_of) for text in texts_of[s]]
-    del texts_of
-    index = {(mask, masked): i for i, (mask, masked, _) in enumerate(cells)}
 
-    # Pass 3: the entries, in code order, into the YAML and the store at once.
-    def lines():
-        for s in starts:
-            text = table_lines(reps[s:s + chunk], index, texts, criteria)
-            if handle:
-                handle.write(text)
-            yield from mapping_entries(text)
-            report("entries", len(reps[s:s + chunk]))
+    # Pass 3: the entries, each chunk with the texts of its own cells, written in code order.
+    dictionary = None
+    if store:  # the store's compression dictionary: entries spread over the whole table
+        dictionary = dictionary_of([entry for _, entry in mapping_entries(
+            table_lines(reps[::max(1, len(reps) // SAMPLES)], texts, criteria))])
+    tasks = {s: (reps[s:s + chunk], {pair: texts[pair] for pair in held.pop(s)}, criteria, bool(yaml_path), dictionary)
+             for s in starts}
+
+    def rows_in_order(handle):
+        waiting, next_start = {}, 0
+        for start, part in completed(entry_chunk, tasks, **backend):
+            waiting[start] = part
+            while next_start in waiting:  # in code order, whatever order the chunks finish in
+                text, packed = waiting.pop(next_start)
+                if handle:
+                    handle.write(text)
+                yield from packed
+                report("entries", len(reps[next_start:next_start + chunk]))
+                next_start += chunk
 
     with (atomic_open(yaml_path) if yaml_path else nullcontext()) as handle:
         if handle:
             handle.write(yaml_text(header) + "configurations:\n")
         if store:
-            write_store(store, header, lines())
+            write_store(store, header, dictionary, rows_in_order(handle))
         else:
-            for _ in lines():
+            for _ in rows_in_order(handle):
                 pass
