@@ -2,10 +2,15 @@
 
     python benchmarks/bench_patterns.py [--resolution 8] [--order edge] [--jobs 2] [--out DIR]
 
-(a) ``cospherical study intersection --resolution R --patterns --out DIR``: wall time and
-    the peak memory of the whole process tree (resident set sizes summed, sampled every
-    0.1 s), and the sizes of the YAML table and of its indexed store;
-(b) in a fresh process: open the store and look up 1000 random configurations, one at a
+(a) ``cospherical study intersection --resolution R --format json``, the study alone, as a
+    whole process: wall time and peak memory of the process tree (resident set sizes
+    summed, sampled every 0.1 s);
+(b) the same with ``--patterns --out DIR``: wall time, peak memory, and the sizes of the
+    table's files (the store; the YAML too up to R = 4); the table's own time is (b) - (a);
+(c) the baseline, in this run: the table made as before, one tessellation (compiled walk)
+    and one split per criterion for each orbit representative, timed in this process on
+    every k-th representative and scaled to all of them, against (b) - (a);
+(d) in a fresh process: open the store and look up 1000 random configurations, one at a
     time (wall time per lookup, and the process's peak memory: the store is never read
     whole).
 """
@@ -13,6 +18,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -40,6 +46,39 @@ print(opened, each, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
 """
 
 
+def naive_seconds(summary: dict, resolution: int, order: str, sample: int = 2000) -> float:
+    """The table as it was made before, timed on ``sample`` representatives, scaled to all."""
+    from cospherical import Configuration, tessellate
+    from cospherical.catalogue import split_tessellation
+    from cospherical.core import compiled  # noqa: F401  (the bulk path: tessellate takes the compiled walk)
+    from cospherical.core.symmetry import key_code
+    from cospherical.formats.patterns import configuration_line
+    from cospherical.studies.intersection import orbits
+
+    reps, _, _ = orbits(resolution, order)
+    kept = {c: frozenset(data["kept"]) for c, data in summary["criteria"].items() if c != "optimal"}
+    codes = reps[:: max(1, len(reps) // sample)].tolist()
+    start = time.perf_counter()
+    for code in map(key_code, codes):
+        tess = tessellate(Configuration.from_code(code))
+        split = {c: split_tessellation(tess, types, c)[0] for c, types in kept.items()}
+        configuration_line(code, tess.fvm_adequate, {"optimal": tess, **split})
+    return (time.perf_counter() - start) / len(codes) * len(reps)
+
+
+def run(command) -> tuple[float, int]:
+    """Wall time and peak process-tree memory of a command."""
+    start = time.perf_counter()
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL)
+    peak = 0
+    while process.poll() is None:
+        peak = max(peak, tree_rss(process.pid))
+        time.sleep(0.1)
+    if process.returncode:
+        raise SystemExit(f"{' '.join(command)} failed (exit {process.returncode})")
+    return time.perf_counter() - start, peak
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--resolution", type=int, default=8)
@@ -48,25 +87,26 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="where the tables go (default: a temporary folder)")
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="bench-patterns-"))
-    command = [sys.executable, "-m", "cospherical", "study", "intersection", "--resolution", str(args.resolution),
-               "--order", args.order, "--jobs", str(args.jobs), "--patterns", "--out", str(out)]
-    start = time.perf_counter()
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL)
-    peak = 0
-    while process.poll() is None:
-        peak = max(peak, tree_rss(process.pid))
-        time.sleep(0.1)
-    wall = time.perf_counter() - start
-    if process.returncode:
-        raise SystemExit(f"the study failed (exit {process.returncode})")
+    study = [sys.executable, "-m", "cospherical", "study", "intersection", "--resolution", str(args.resolution),
+             "--order", args.order, "--jobs", str(args.jobs)]
+    print(f"load average before: {os.getloadavg()[0]:.1f}")
+    alone, alone_peak = run([*study, "--format", "json"])
+    print(f"(a) study intersection --resolution {args.resolution}, the study alone: {alone:.0f} s wall, "
+          f"peak {alone_peak / 2**30:.2f} GiB (process tree)")
+    wall, peak = run([*study, "--patterns", "--out", str(out)])
     stem = out / f"intersection-r{args.resolution}-{args.order}-patterns"
-    yaml_size, store_size = (Path(f"{stem}{suffix}").stat().st_size / 2**20 for suffix in (".yaml", ".sqlite"))
-    print(f"(a) study intersection --resolution {args.resolution} --patterns: {wall:.0f} s wall, "
-          f"peak {peak / 2**30:.2f} GiB (process tree); YAML {yaml_size:.0f} MB, store {store_size:.0f} MB")
+    sizes = ", ".join(f"{suffix[1:]} {Path(f'{stem}{suffix}').stat().st_size / 1e6:.0f} MB"
+                      for suffix in (".sqlite", ".yaml") if Path(f"{stem}{suffix}").exists())
+    print(f"(b) the same with --patterns: {wall:.0f} s wall ({wall - alone:.0f} s for the table and the other --out files), "
+          f"peak {peak / 2**30:.2f} GiB (process tree); {sizes}")
+    summary = json.loads((out / f"intersection-r{args.resolution}-{args.order}.json").read_text())
+    naive = naive_seconds(summary, args.resolution, args.order)
+    print(f"(c) the table one tessellation per representative (before), estimated: {naive:.0f} s in one process, "
+          f"{naive / args.jobs:.0f} s on {args.jobs}: {naive / args.jobs / max(wall - alone, 1e-9):.0f}x the table's time now")
     opened, each, rss = subprocess.run([sys.executable, "-c", LOOKUPS, f"{stem}.sqlite"], check=True,
                                        capture_output=True, text=True).stdout.split()
-    print(f"(b) store: opened in {float(opened) * 1000:.0f} ms, {float(each) * 1000:.2f} ms per lookup, "
-          f"peak {float(rss):.0f} MB")
+    print(f"(d) store: opened in {float(opened) * 1000:.0f} ms, {float(each) * 1000:.2f} ms per lookup, "
+          f"peak {float(rss):.0f} MB; load average after: {os.getloadavg()[0]:.1f}")
 
 
 if __name__ == "__main__":

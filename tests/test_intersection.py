@@ -134,6 +134,13 @@ def test_pattern_table_of_the_representatives(tmp_path):
                [(e.type.id, list(e.nodes)) for e in direct.elements]
     # every criterion's elements tile the cube exactly (the deep check), in either form
     assert main(["check", str(path)]) == 0 and main(["check", str(store)]) == 0
+    # the same bytes, however the work was cut and run
+    again = tmp_path / "again"
+    again.mkdir()
+    write_pattern_table(summary, shipped_catalogue()["version"], yaml_path=again / path.name,
+                        store=again / store.name, jobs=1, chunk=1000)
+    assert (again / path.name).read_bytes() == path.read_bytes()
+    assert (again / store.name).read_bytes() == store.read_bytes()
 
 
 def test_table_lines_joined_from_cells_are_those_of_each_tessellation(pool_run):

@@ -45,7 +45,9 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
         try:
             futures = {client.submit(function, *args, pure=False): key for key, args in tasks.items()}
             for future in as_completed(futures):
-                yield futures[future], future.result()
+                # dropped once yielded: a finished future keeps its result (chunks of a
+                # pattern table hold megabytes each)
+                yield futures.pop(future), future.result()
         finally:
             client.close()
             if cluster is not None:
@@ -54,14 +56,17 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
         for key, args in tasks.items():
             yield key, function(*args)
     else:
-        from concurrent.futures import as_completed
+        from concurrent.futures import FIRST_COMPLETED, wait
 
         from ..pool import process_pool
 
         pool = process_pool(jobs)
         try:
-            futures = {pool.submit(function, *args): key for key, args in tasks.items()}
-            for future in as_completed(futures):
-                yield futures[future], future.result()
+            pending = {pool.submit(function, *args): key for key, args in tasks.items()}
+            while pending:
+                # not as_completed, which keeps every future, and so every result, to the end
+                done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in done:
+                    yield pending.pop(future), future.result()
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
