@@ -27,8 +27,14 @@ __all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", 
 
 def element_options(tess: Tessellation, element: Element, criterion: str) -> tuple[tuple[Element, ...], ...]:
     """Every split of an element under a criterion (the element itself first), pieces classified."""
-    points = tuple((n, tess.nodes[n]) for n in element.polyhedron.nodes)
-    return split_options(points, tess.configuration.box.squared, element.polyhedron, criterion)
+    poly = element.polyhedron
+    if len(poly.nodes) == 4:
+        # A tetrahedron has no split: its one option without split_options' cache key,
+        # whose Fraction coordinates are slow to hash (half the elements of a study).
+        etype, order, mirrored = classify(poly)
+        return ((Element(etype, order, poly, mirrored),),)
+    points = tuple((n, tess.nodes[n]) for n in poly.nodes)
+    return split_options(points, tess.configuration.box.squared, poly, criterion)
 
 
 # The same element (same node ids at the same places) recurs across configurations.

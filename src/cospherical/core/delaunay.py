@@ -185,7 +185,8 @@ def delaunay_cells(frame: Frame, compiled: bool | None = None) -> list[Cell]:
                 (best_g * a - best_h * nx, best_g * b - best_h * ny, best_g * c - best_h * nz, best_g * d),
                 best_g * first.offset - best_h * offset,
             )
-            neighbour = [m for m, point in enumerate(lifted) if best.side(point) == 0]
+            a, b, c, d = best.normal  # best.side(point) == 0, inlined: the walk's innermost loop
+            neighbour = [m for m, (x, y, z, w) in enumerate(lifted) if a * x + b * y + c * z + d * w == best.offset]
             if frozenset(neighbour) not in seen:
                 seen.add(frozenset(neighbour))
                 queue.append((neighbour, best))
