@@ -65,3 +65,23 @@ def test_usage_errors_are_one_line_exit_2(args, needle):
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
     assert needle in lines[0] and "Traceback" not in result.stderr
+
+
+def test_main_freezes_the_collector_only_as_the_process_command(monkeypatch, capsys):
+    # Run as the process's command (no argument list), main moves what the command made
+    # out of the cycle collector's reach before the process exits; called with an
+    # argument list (tests, a program embedding it) it leaves the collector as it was.
+    import gc
+
+    from cospherical.cli import main
+
+    command = ["tessellate", "--box", "1", "1", "1", "--code", "800000000000"]
+    frozen = gc.get_freeze_count()
+    assert main(command) == 0, capsys.readouterr().err
+    assert gc.get_freeze_count() == frozen
+    monkeypatch.setattr(sys, "argv", ["cospherical", *command])
+    try:
+        assert main() == 0, capsys.readouterr().err
+        assert gc.get_freeze_count() > frozen
+    finally:
+        gc.unfreeze()

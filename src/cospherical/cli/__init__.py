@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import os
 import signal
@@ -86,6 +87,11 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout.flush()  # a full disk or /dev/full shows here, as one line, not at exit
         if _interrupted.is_set():
             raise KeyboardInterrupt
+        if argv is None:
+            # Run as the process's command, which ends now: what it made is moved out of
+            # the cycle collector's reach, so that the collector's pass at exit does not
+            # traverse it all once more (30-40 ms of the 0.4 s of `study bisection`).
+            gc.freeze()
         return status
     except UsageError as error:  # the message already names the command
         print(error, file=sys.stderr)
