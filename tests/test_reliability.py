@@ -140,3 +140,38 @@ def test_interrupted_study_leaves_complete_outputs_and_no_temporary_files(tmp_pa
             assert b"Traceback" not in stderr, stderr
         assert snapshot(tmp_path) == before, f"outputs changed after a signal at {delay} s"
         assert not list(tmp_path.glob(".*")), f"temporary files left after a signal at {delay} s"
+
+
+def _children(pid: int) -> list[int]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        try:
+            if entry.name.isdigit() and int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1]) == pid:
+                found.append(int(entry.name))
+        except (OSError, IndexError, ValueError):
+            pass  # a process that ended meanwhile
+    return found
+
+
+def test_a_terminated_pattern_table_leaves_no_worker_and_no_table(tmp_path):
+    # SIGTERM while the workers build the table: the command ends at once, its
+    # workers with it, and no partial table is left (the study's own files are complete).
+    args = [sys.executable, "-m", "cospherical", "study", "intersection", "--resolution", "4", "--jobs", "2",
+            "--patterns", "--out", str(tmp_path)]
+    process = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    workers: list[int] = []
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (tmp_path / "intersection-r4-edge.json").exists():
+        workers = _children(process.pid) or workers
+        time.sleep(0.05)
+    time.sleep(1.0)  # into the table's passes
+    workers = _children(process.pid) or workers
+    assert workers and process.poll() is None, "the study ended before the table was being built"
+    start = time.monotonic()
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 143 and b"Traceback" not in stderr, stderr
+    assert time.monotonic() - start < 10
+    time.sleep(0.5)
+    assert not [pid for pid in workers if Path(f"/proc/{pid}").exists()], "a worker outlived the command"
+    assert not list(tmp_path.glob("*patterns*")) and not list(tmp_path.glob(".*"))
