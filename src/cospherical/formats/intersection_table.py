@@ -12,14 +12,15 @@ three passes:
 2. **elements**: each distinct cell is classified, measured and split under every
    criterion's kept set once, by the exact Python path, and written as its
    pattern-table text (workers, in chunks): at 1/16 a few hundred thousand cells.
-3. **entries**: the walk runs again, chunk by chunk, and every representative's
-   line is joined from its cells' texts, exactly as
-   :func:`~cospherical.formats.patterns.configuration_line` writes it from a
-   tessellation (tested: the same bytes), and written in code order.
+3. **entries**: the walk runs again on each chunk (workers, each given the texts
+   of its chunk's cells) and every representative's line is joined from its
+   cells' texts, exactly as :func:`~cospherical.formats.patterns.configuration_line`
+   writes it from a tessellation (tested: the same bytes), and packed for the
+   store there; this process writes the chunks in code order.
 
-The YAML holds one line per configuration; from R = 8 on (hundreds of MB and
-more, beyond what :func:`~cospherical.formats.patterns.load` reads as YAML) the
-table is written as the indexed store only, unless asked for.
+The YAML holds one line per configuration; from R = 8 on (1.9 GB and more,
+beyond what :func:`~cospherical.formats.patterns.load` reads as YAML) the CLI
+writes the indexed store alone unless asked for both.
 """
 
 from __future__ import annotations
