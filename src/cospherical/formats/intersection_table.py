@@ -42,7 +42,7 @@ from ..core.tessellation import Element
 from ..errors import InputError
 from ..files.flowyaml import flow, mapping_entries
 from ..files.yamlio import atomic_open, yaml_text
-from ..studies.intersection import completed, orbits
+from ..studies.intersection import completed, orbits, tessellate_chunk
 from ..version import __version__
 from .patterns import SCHEMA_VERSION, element_entry
 from .store import dictionary_of, pack, write_store
@@ -66,21 +66,10 @@ SAMPLES = 16  # about 40 kB of entries at R = 8: the dictionary is their last 32
 
 
 def representative_cells(codes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Pass 1 and 3: per configuration (base-16 codes) its cell count, and per cell, in the
-    walk's order, its node mask and masked code (see :func:`cospherical.core.compiled.cube_batch`)."""
-    from ..core import compiled
-
-    codes = np.ascontiguousarray(codes, dtype=np.int64)
-    n = len(codes)
-    tets, counts = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
-    closed, open_ = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
-    # A configuration of at most 27 points has fewer than 96 Delaunay cells in these
-    # families (27 at most measured at 1/16); a larger one is refused below, not lost.
-    masks, masked = np.empty(96 * n, dtype=np.int64), np.empty(96 * n, dtype=np.int64)
-    written = compiled.cube_batch(codes, *compiled.cube_tables(), tets, closed, open_, counts, masks, masked, True)
-    if written < 0:
-        raise RuntimeError(f"configuration {key_code(int(codes[-1 - written]))}: beyond the compiled walk's buffers")
-    return counts, masks[:written], masked[:written]
+    """Per configuration (base-16 codes) its cell count, and per cell, in the walk's order, its
+    node mask and masked code (see :func:`cospherical.core.compiled.cube_batch`)."""
+    cells = tessellate_chunk(codes, every_cell=True)
+    return cells["polys"], cells["poly_mask"], cells["poly_code"]
 
 
 def distinct_cells(codes) -> np.ndarray:

@@ -68,18 +68,21 @@ def _cube_tables():
     return compiled.cube_tables()
 
 
-def tessellate_chunk(codes: np.ndarray) -> dict[str, np.ndarray]:
+def tessellate_chunk(codes: np.ndarray, every_cell: bool = False) -> dict[str, np.ndarray]:
     """Stage 1 on base-16 codes: per configuration ``tets``, ``closed``, ``open``, ``polys``;
-    per other cell ``poly_mask`` and ``poly_code`` (see :func:`cospherical.core.compiled.cube_batch`)."""
+    per other cell ``poly_mask`` and ``poly_code`` (see :func:`cospherical.core.compiled.cube_batch`).
+    ``every_cell``: tetrahedra too, in ``polys`` and the cell lists (what a pattern table needs)."""
     from ...core import compiled
 
     codes = np.ascontiguousarray(codes, dtype=np.int64)
     n = len(codes)
     tets, polys = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     closed, open_ = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
-    # A cell has at least four of the at most 27 points, so 27 other cells per configuration is ample.
-    poly_mask, poly_code = np.empty(27 * n, dtype=np.int64), np.empty(27 * n, dtype=np.int64)
-    written = compiled.cube_batch(codes, *_cube_tables(), tets, closed, open_, polys, poly_mask, poly_code)
+    # A cell other than a tetrahedron has at least five of the at most 27 points, so 27 per
+    # configuration is ample; with tetrahedra, 96 (27 measured at most at 1/16). Beyond, an error.
+    room = (96 if every_cell else 27) * n
+    poly_mask, poly_code = np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64)
+    written = compiled.cube_batch(codes, *_cube_tables(), tets, closed, open_, polys, poly_mask, poly_code, every_cell)
     if written < 0:
         raise RuntimeError(f"configuration {codes[-1 - written]:012x}: beyond the compiled walk's buffers")
     return {"tets": tets, "closed": closed, "open": open_, "polys": polys,
