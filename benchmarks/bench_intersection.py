@@ -32,8 +32,8 @@ from cospherical import Configuration, tessellate
 from cospherical.studies.intersection import intersection_codes, run_intersection
 
 
-def tree_rss(pid: int) -> int:
-    """Resident bytes of a process and all its descendants (Linux /proc)."""
+def tree_pids(pid: int) -> list[int]:
+    """A process and all its descendants (Linux /proc)."""
     children: dict[int, list[int]] = {}
     for entry in os.listdir("/proc"):
         if entry.isdigit():
@@ -43,14 +43,35 @@ def tree_rss(pid: int) -> int:
                 children.setdefault(int(fields[1]), []).append(int(entry))
             except OSError:
                 continue
-    total, todo = 0, [pid]
+    found, todo = [], [pid]
     while todo:
         p = todo.pop()
+        found.append(p)
         todo.extend(children.get(p, []))
+    return found
+
+
+def tree_rss(pid: int) -> int:
+    """Resident bytes of a process and all its descendants (pages shared by forked workers count in each)."""
+    total = 0
+    for p in tree_pids(pid):
         try:
             with open(f"/proc/{p}/statm") as handle:
                 total += int(handle.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
         except OSError:
+            continue
+    return total
+
+
+def tree_pss(pid: int) -> int:
+    """Proportional set size of a process tree: the memory it really holds, a page shared
+    by n processes counted 1/n in each (Linux /proc/PID/smaps_rollup)."""
+    total = 0
+    for p in tree_pids(pid):
+        try:
+            with open(f"/proc/{p}/smaps_rollup") as handle:
+                total += next(int(line.split()[1]) * 1024 for line in handle if line.startswith("Pss:"))
+        except (OSError, StopIteration):
             continue
     return total
 

@@ -3,8 +3,10 @@
     python benchmarks/bench_patterns.py [--resolution 8] [--order edge] [--jobs 2] [--out DIR]
 
 (a) ``cospherical study intersection --resolution R --format json``, the study alone, as a
-    whole process: wall time and peak memory of the process tree (resident set sizes
-    summed, sampled every 0.1 s);
+    whole process: wall time and peak memory of the process tree, sampled every 0.1 s, as
+    proportional set sizes (what the tree holds: pages that forked workers share with
+    their parent counted once) and as resident set sizes summed (those pages counted in
+    every process);
 (b) the same with ``--patterns --out DIR``: wall time, peak memory, and the sizes of the
     table's files (the store; the YAML too up to R = 4); the table's own time is (b) - (a);
 (c) the baseline, in this run: the table made as before, one tessellation (compiled walk)
@@ -27,7 +29,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_intersection import tree_rss  # noqa: E402  (one process-tree sampler for the benchmarks)
+from bench_intersection import tree_pss, tree_rss  # noqa: E402  (one process-tree sampler for the benchmarks)
 
 LOOKUPS = """
 import random, resource, sys, time
@@ -66,17 +68,17 @@ def naive_seconds(summary: dict, resolution: int, order: str, sample: int = 2000
     return (time.perf_counter() - start) / len(codes) * len(reps)
 
 
-def run(command) -> tuple[float, int]:
-    """Wall time and peak process-tree memory of a command."""
+def run(command) -> tuple[float, str]:
+    """Wall time and peak process-tree memory of a command (proportional, and resident summed)."""
     start = time.perf_counter()
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL)
-    peak = 0
+    pss = rss = 0
     while process.poll() is None:
-        peak = max(peak, tree_rss(process.pid))
+        pss, rss = max(pss, tree_pss(process.pid)), max(rss, tree_rss(process.pid))
         time.sleep(0.1)
     if process.returncode:
         raise SystemExit(f"{' '.join(command)} failed (exit {process.returncode})")
-    return time.perf_counter() - start, peak
+    return time.perf_counter() - start, f"peak {pss / 2**30:.2f} GiB (process tree, PSS; resident sum {rss / 2**30:.2f} GiB)"
 
 
 def main() -> None:
@@ -91,14 +93,13 @@ def main() -> None:
              "--order", args.order, "--jobs", str(args.jobs)]
     print(f"load average before: {os.getloadavg()[0]:.1f}")
     alone, alone_peak = run([*study, "--format", "json"])
-    print(f"(a) study intersection --resolution {args.resolution}, the study alone: {alone:.0f} s wall, "
-          f"peak {alone_peak / 2**30:.2f} GiB (process tree)")
+    print(f"(a) study intersection --resolution {args.resolution}, the study alone: {alone:.0f} s wall, {alone_peak}")
     wall, peak = run([*study, "--patterns", "--out", str(out)])
     stem = out / f"intersection-r{args.resolution}-{args.order}-patterns"
     sizes = ", ".join(f"{suffix[1:]} {Path(f'{stem}{suffix}').stat().st_size / 1e6:.0f} MB"
                       for suffix in (".sqlite", ".yaml") if Path(f"{stem}{suffix}").exists())
     print(f"(b) the same with --patterns: {wall:.0f} s wall ({wall - alone:.0f} s for the table and the other --out files), "
-          f"peak {peak / 2**30:.2f} GiB (process tree); {sizes}")
+          f"{peak}; {sizes}")
     summary = json.loads((out / f"intersection-r{args.resolution}-{args.order}.json").read_text())
     naive = naive_seconds(summary, args.resolution, args.order)
     print(f"(c) the table one tessellation per representative (before), estimated: {naive:.0f} s in one process, "
