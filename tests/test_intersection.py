@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import zlib
 
 import numpy as np
 import pytest
@@ -242,3 +243,37 @@ def test_a_bad_store_is_refused_with_exit_2(r4_table, tmp_path, damage):
     result = subprocess.run([sys.executable, "-m", "cospherical", "check", str(path)], capture_output=True, text=True)
     assert result.returncode == 2, result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and "bad.sqlite" in result.stderr
+
+
+def _bomb(connection):
+    # a few kB that would unpack into a gigabyte
+    (dictionary,) = connection.execute("SELECT data FROM dictionary").fetchone()
+    packer = zlib.compressobj(9, zdict=dictionary)
+    spaces = b" " * (1 << 20)
+    blob = packer.compress(b"{") + b"".join(packer.compress(spaces) for _ in range(1024)) + packer.flush()
+    connection.execute("UPDATE entries SET entry = ? WHERE code = (SELECT min(code) FROM entries)", (blob,))
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (_bomb, "unpacks to over"),
+    (lambda c: c.execute("UPDATE meta SET value = ? WHERE key = 'header'", ("[" * 30000 + "]" * 30000,)), "nest"),
+    (lambda c: c.execute("UPDATE meta SET value = ? WHERE key = 'header'", ("{}" + " " * (1 << 20),)), "header"),
+    (lambda c: c.execute("UPDATE dictionary SET data = ?", (b"x" * (1 << 24),)), "dictionary"),
+    (lambda c: c.execute("UPDATE meta SET value = '-5' WHERE key = 'count'"), "count"),
+])
+def test_a_hostile_store_is_refused_in_bounded_memory(r4_table, tmp_path, edit, needle):
+    import resource
+    import sqlite3
+
+    path = tmp_path / "hostile.sqlite"
+    path.write_bytes(r4_table[1].read_bytes())
+    connection = sqlite3.connect(path)
+    edit(connection)
+    connection.commit()
+    connection.close()
+    # in 1 GiB of address space: reading what the store says it holds would not fit
+    result = subprocess.run([sys.executable, "-m", "cospherical", "check", str(path)], capture_output=True, text=True,
+                            preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30)))
+    assert result.returncode == 2, result.stderr
+    (line,) = result.stderr.strip().splitlines()
+    assert "hostile.sqlite" in line and needle in line, line

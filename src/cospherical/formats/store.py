@@ -28,7 +28,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ..errors import FormatError
-from ..files.yamlio import atomic_path
+from ..files.yamlio import atomic_path, check_nesting
 
 __all__ = ["MAGIC", "StoreEntries", "dictionary_of", "is_store", "open_store", "pack", "write_store"]
 
@@ -38,6 +38,10 @@ LAYOUT = 1  # the store's own layout version, in its meta table
 # table: level 1 gives 400 bytes, 6 gives 230 (at 1.3 times level 1's time), 9 gives 215 (at 2.6).
 LEVEL = 6
 DICTIONARY_SIZE = 32768  # zlib's window: a longer dictionary is not used
+# Bounds on what a store's reader takes: far above anything written (an entry is a few kB;
+# the header a few hundred bytes), far below what would exhaust memory.
+MAX_ENTRY = 1 << 20
+MAX_HEADER = 1 << 16
 
 
 def is_store(path: str | Path) -> bool:
@@ -114,15 +118,25 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
         raise FormatError(f"{path}: not a complete pattern-table store (truncated, or not an SQLite database)")
     try:
         connection = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True, check_same_thread=False)
-        meta = dict(connection.execute("SELECT key, value FROM meta"))
+        # Only the rows we know, and only as long as we ever write them: a hostile
+        # store's gigabyte of header or dictionary is never read.
+        meta = dict(connection.execute("SELECT key, value FROM meta WHERE key IN ('layout', 'header', 'count') "
+                                       "AND length(value) <= ?", (MAX_HEADER,)))
         if meta.get("layout") != str(LAYOUT):
             raise FormatError(f"{path}: store layout {meta.get('layout')!r}, expected {LAYOUT}")
+        if "header" not in meta or "count" not in meta:
+            raise ValueError(f"no header and count of at most {MAX_HEADER} bytes")
+        check_nesting(meta["header"], str(path))
         header = json.loads(meta["header"])
         count = int(meta["count"])
-        (dictionary,) = connection.execute("SELECT data FROM dictionary").fetchone()
+        row = connection.execute("SELECT data FROM dictionary WHERE length(data) <= ?", (DICTIONARY_SIZE,)).fetchone()
+        if not isinstance(header, dict) or count < 0 or row is None or not isinstance(row[0], bytes):
+            raise ValueError(f"its header is not a mapping, its count is negative, or it has no dictionary of at "
+                             f"most {DICTIONARY_SIZE} bytes")
+        dictionary = row[0]
     except (sqlite3.Error, KeyError, ValueError, TypeError) as error:
         raise FormatError(f"{path}: not a pattern-table store: {str(error).splitlines()[0][:120]}") from None
-    return header, StoreEntries(connection, count, bytes(dictionary), str(path))
+    return header, StoreEntries(connection, count, dictionary, str(path))
 
 
 class StoreEntries(Mapping):
@@ -143,7 +157,11 @@ class StoreEntries(Mapping):
     def _text(self, blob) -> str:
         try:
             unpacker = zlib.decompressobj(zdict=self._dictionary)
-            return (unpacker.decompress(blob) + unpacker.flush()).decode("utf-8")
+            # bounded: a few hundred compressed bytes must not unpack into gigabytes
+            text = unpacker.decompress(blob, MAX_ENTRY + 1)
+            if len(text) > MAX_ENTRY or unpacker.unconsumed_tail:
+                raise FormatError(f"{self._name}: store damaged: an entry unpacks to over {MAX_ENTRY} bytes")
+            return (text + unpacker.flush()).decode("utf-8")
         except (zlib.error, UnicodeDecodeError, TypeError) as error:
             raise FormatError(f"{self._name}: store damaged: an entry does not decompress ({error})") from None
 
