@@ -229,11 +229,14 @@ def test_the_indexed_store_answers_exactly_like_the_yaml(r4_table):
     assert main(["diff", *map(str, r4_table)]) == 0
 
 
-@pytest.mark.parametrize("damage", ["truncated", "overwritten", "not a store"])
+@pytest.mark.parametrize("damage", ["truncated", "overwritten", "a page in the middle", "not a store"])
 def test_a_bad_store_is_refused_with_exit_2(r4_table, tmp_path, damage):
     data = bytearray(r4_table[1].read_bytes())
     if damage == "truncated":
         data = data[: len(data) // 2]
+    elif damage == "a page in the middle":  # found only when the entries are read
+        middle = len(data) // 2 // 4096 * 4096
+        data[middle:middle + 4096] = bytes(range(256)) * 16
     elif damage == "overwritten":  # every page after the first: the tables' pages are garbage
         data[4096:] = bytes(range(256)) * ((len(data) - 4096) // 256) + bytes((len(data) - 4096) % 256)
     else:
@@ -260,6 +263,12 @@ def _bomb(connection):
     (lambda c: c.execute("UPDATE meta SET value = ? WHERE key = 'header'", ("{}" + " " * (1 << 20),)), "header"),
     (lambda c: c.execute("UPDATE dictionary SET data = ?", (b"x" * (1 << 24),)), "dictionary"),
     (lambda c: c.execute("UPDATE meta SET value = '-5' WHERE key = 'count'"), "count"),
+    (lambda c: c.execute("UPDATE meta SET value = '5' WHERE key = 'count'"), "count says"),  # found reading all
+    (lambda c: c.execute("INSERT INTO dictionary VALUES (x'00')"), "dictionary"),
+    # a view that never ends, where the entries should be
+    (lambda c: c.executescript("DROP TABLE entries; CREATE VIEW entries(code, entry) AS WITH RECURSIVE r(n) AS "
+                               "(SELECT 1 UNION ALL SELECT n + 1 FROM r) SELECT printf('%012x', n), x'00' FROM r"),
+     "tables"),
 ])
 def test_a_hostile_store_is_refused_in_bounded_memory(r4_table, tmp_path, edit, needle):
     import resource

@@ -38,6 +38,14 @@ LAYOUT = 1  # the store's own layout version, in its meta table
 # table: level 1 gives 400 bytes, 6 gives 230 (at 1.3 times level 1's time), 9 gives 215 (at 2.6).
 LEVEL = 6
 DICTIONARY_SIZE = 32768  # zlib's window: a longer dictionary is not used
+# The store's tables, exactly as written and as the reader requires them: a file with
+# views (a recursive one never ends), triggers or other tables is not a store.
+TABLES = {
+    "meta": "CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL)",
+    "entries": "CREATE TABLE entries (code TEXT PRIMARY KEY, entry BLOB NOT NULL) WITHOUT ROWID",
+    "dictionary": "CREATE TABLE dictionary (data BLOB NOT NULL)",
+}
+SCHEMA = {*(("table", name, sql) for name, sql in TABLES.items()), ("index", "sqlite_autoindex_meta_1", None)}
 # Bounds on what a store's reader takes: far above anything written (an entry is a few kB;
 # the header a few hundred bytes), far below what would exhaust memory.
 MAX_ENTRY = 1 << 20
@@ -76,11 +84,10 @@ def write_store(path: str | Path, header: dict, dictionary: bytes, rows) -> None
         try:
             connection.execute("PRAGMA journal_mode = OFF")
             connection.execute("PRAGMA synchronous = OFF")
-            connection.execute("CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL)")
-            connection.execute("CREATE TABLE entries (code TEXT PRIMARY KEY, entry BLOB NOT NULL) WITHOUT ROWID")
+            for sql in TABLES.values():
+                connection.execute(sql)
             connection.executemany("INSERT INTO meta VALUES (?, ?)",
                                    [("layout", str(LAYOUT)), ("header", json.dumps(header, sort_keys=True))])
-            connection.execute("CREATE TABLE dictionary (data BLOB NOT NULL)")
             connection.execute("INSERT INTO dictionary VALUES (?)", (dictionary,))
             count = 0
             batch = []
@@ -118,6 +125,8 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
         raise FormatError(f"{path}: not a complete pattern-table store (truncated, or not an SQLite database)")
     try:
         connection = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True, check_same_thread=False)
+        if set(connection.execute("SELECT type, name, sql FROM sqlite_master")) != SCHEMA:
+            raise ValueError("its tables are not those of a store (meta, entries, dictionary as written)")
         # Only the rows we know, and only as long as we ever write them: a hostile
         # store's gigabyte of header or dictionary is never read.
         meta = dict(connection.execute("SELECT key, value FROM meta WHERE key IN ('layout', 'header', 'count') "
@@ -129,11 +138,13 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
         check_nesting(meta["header"], str(path))
         header = json.loads(meta["header"])
         count = int(meta["count"])
-        row = connection.execute("SELECT data FROM dictionary WHERE length(data) <= ?", (DICTIONARY_SIZE,)).fetchone()
-        if not isinstance(header, dict) or count < 0 or row is None or not isinstance(row[0], bytes):
-            raise ValueError(f"its header is not a mapping, its count is negative, or it has no dictionary of at "
-                             f"most {DICTIONARY_SIZE} bytes")
-        dictionary = row[0]
+        rows = connection.execute("SELECT data FROM dictionary WHERE length(data) <= ? LIMIT 2",
+                                  (DICTIONARY_SIZE,)).fetchall()
+        if not isinstance(header, dict) or not 0 <= count <= 16 ** 12 or len(rows) != 1 \
+                or not isinstance(rows[0][0], bytes):
+            raise ValueError(f"its header is not a mapping, its count is not that of a table, or it has not one "
+                             f"dictionary of at most {DICTIONARY_SIZE} bytes")
+        (dictionary,) = rows[0]
     except (sqlite3.Error, KeyError, ValueError, TypeError) as error:
         raise FormatError(f"{path}: not a pattern-table store: {str(error).splitlines()[0][:120]}") from None
     return header, StoreEntries(connection, count, dictionary, str(path))
@@ -148,11 +159,16 @@ class StoreEntries(Mapping):
         self._dictionary = dictionary
         self._name = name
 
-    def _query(self, sql: str, arguments=()):
+    def _rows(self, sql: str, arguments=()):
+        # SQLite reads pages as rows are stepped through: a damaged page shows while
+        # iterating, not only when the query starts
         try:
-            return self._connection.execute(sql, arguments)
+            yield from self._connection.execute(sql, arguments)
         except sqlite3.Error as error:
             raise FormatError(f"{self._name}: store damaged: {str(error).splitlines()[0][:120]}") from None
+
+    def _one(self, sql: str, arguments=()):
+        return next(self._rows(sql, arguments), None)
 
     def _text(self, blob) -> str:
         try:
@@ -166,20 +182,26 @@ class StoreEntries(Mapping):
             raise FormatError(f"{self._name}: store damaged: an entry does not decompress ({error})") from None
 
     def __getitem__(self, code: str) -> str:
-        row = self._query("SELECT entry FROM entries WHERE code = ?", (code,)).fetchone()
+        row = self._one("SELECT entry FROM entries WHERE code = ?", (code,))
         if row is None:
             raise KeyError(code)
         return self._text(row[0])
 
     def __contains__(self, code) -> bool:
-        return self._query("SELECT 1 FROM entries WHERE code = ?", (code,)).fetchone() is not None
+        return self._one("SELECT 1 FROM entries WHERE code = ?", (code,)) is not None
 
     def __iter__(self):
-        return (code for (code,) in self._query("SELECT code FROM entries ORDER BY code"))
+        return (code for (code,) in self._rows("SELECT code FROM entries ORDER BY code"))
 
     def __len__(self) -> int:
         return self._count
 
     def texts(self):
-        """Every (code, entry text), in code order, streamed."""
-        return ((code, self._text(blob)) for code, blob in self._query("SELECT code, entry FROM entries ORDER BY code"))
+        """Every (code, entry text), in code order, streamed; the rows must be as many as the store says
+        (what reads them all, such as ``check``, finds a store whose count is wrong)."""
+        seen = 0
+        for code, blob in self._rows("SELECT code, entry FROM entries ORDER BY code"):
+            seen += 1
+            yield code, self._text(blob)
+        if seen != self._count:
+            raise FormatError(f"{self._name}: store damaged: {seen} entries, but its count says {self._count}")
