@@ -575,6 +575,13 @@ def test_stale_temporaries_of_our_naming_are_removed(tmp_path, capsys):
     assert all(p.exists() for p in foreign)
 
 
+def test_patterns_format_needs_patterns(tmp_path, capsys):
+    for form in ("auto", "yaml", "store", "both"):
+        refused(capsys, "study", "intersection", "--resolution", "2", "--out", tmp_path, "--patterns-format", form,
+                needle="--patterns-format")
+    assert not list(tmp_path.iterdir())
+
+
 def test_study_bisection_refuses_intersection_options(tmp_path, capsys):
     for option in (["--resume"], ["--patterns"], ["--no-orbits"], ["--resolution", "4"], ["--order", "rank"],
                    ["--scheduler", "tcp://SCHEDULER:8786"], ["--dask-workers", "2"], ["--jobs", "2"],

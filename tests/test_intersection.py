@@ -265,6 +265,8 @@ def _bomb(connection):
     (lambda c: c.execute("UPDATE meta SET value = '-5' WHERE key = 'count'"), "count"),
     (lambda c: c.execute("UPDATE meta SET value = '5' WHERE key = 'count'"), "count says"),  # found reading all
     (lambda c: c.execute("INSERT INTO dictionary VALUES (x'00')"), "dictionary"),
+    (lambda c: c.execute("INSERT INTO entries VALUES ('000000000048\n', x'00')"), "not a configuration code"),
+    (lambda c: c.execute("PRAGMA journal_mode = WAL"), "WAL"),
     # a view that never ends, where the entries should be
     (lambda c: c.executescript("DROP TABLE entries; CREATE VIEW entries(code, entry) AS WITH RECURSIVE r(n) AS "
                                "(SELECT 1 UNION ALL SELECT n + 1 FROM r) SELECT printf('%012x', n), x'00' FROM r"),
@@ -286,3 +288,4 @@ def test_a_hostile_store_is_refused_in_bounded_memory(r4_table, tmp_path, edit, 
     assert result.returncode == 2, result.stderr
     (line,) = result.stderr.strip().splitlines()
     assert "hostile.sqlite" in line and needle in line, line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hostile.sqlite"]  # nothing written beside it

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import re
+import sys
 from pathlib import Path
 
 from ..catalogue import shipped_catalogue
@@ -79,7 +80,7 @@ def add_parser(commands) -> None:
 INTERSECTION_ONLY = ("resolution", "order", "jobs", "chunk_size", "scheduler", "scheduler_timeout", "dask_workers",
                      "no_orbits", "resume", "patterns", "patterns_format")
 INTERSECTION_DEFAULTS = {"resolution": 16, "order": "edge", "jobs": os.cpu_count() or 1, "chunk_size": 5000,
-                         "scheduler_timeout": 30.0, "patterns_format": "auto"}
+                         "scheduler_timeout": 30.0}
 
 
 def run(args) -> int:
@@ -139,7 +140,7 @@ def _intersection(args) -> int:
         raise UsageError(f"cospherical study: error: --resolution {args.resolution}: choose 2, 4, 8 or 16")
     if args.patterns and not args.out:
         raise UsageError("cospherical study: error: --patterns writes into --out DIR")
-    if args.patterns_format != "auto" and not args.patterns:
+    if args.patterns_format is not None and not args.patterns:
         raise UsageError("cospherical study: error: --patterns-format is the form of the --patterns table")
     if args.resume and not args.out:
         raise UsageError("cospherical study: error: --resume keeps its checkpoints in --out DIR")
@@ -180,9 +181,13 @@ def _intersection(args) -> int:
         if args.patterns:
             from ..formats.intersection_table import YAML_UP_TO, write_pattern_table
 
-            form = args.patterns_format
+            form = args.patterns_format or "auto"
             if form == "auto":
                 form = "both" if args.resolution <= YAML_UP_TO else "store"
+            elif form != "store" and args.resolution > YAML_UP_TO:
+                print(f"cospherical study: note: the YAML of a table at R = {args.resolution} is over a GB, more than "
+                      "load_patterns and check read (512 MB); they read the store (--patterns-format store)",
+                      file=sys.stderr)
             with stage_bars({"cells": (summary["orbits"], "pattern table: cells", "cfg"),
                              "elements": (None, "distinct cells written", "el"),
                              "entries": (summary["orbits"], "pattern table: entries", "cfg")}) as advance:

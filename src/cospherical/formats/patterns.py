@@ -15,8 +15,11 @@ A mesh generator looks a configuration up like this::
 
 from __future__ import annotations
 
+import json
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Callable
 
@@ -24,6 +27,7 @@ from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..core.tessellation import Tessellation
 from ..errors import FormatError, InputError
+from ..files.data import data_path
 from ..files.flowyaml import decode_entry, mapping_line, split_section
 from ..files.yamlio import atomic_write, parse_yaml, read_text, validate, yaml_text
 from ..studies.bisection import Study
@@ -164,6 +168,7 @@ class Entries(Mapping):
         pairs = self._texts.texts() if hasattr(self._texts, "texts") else self._texts.items()
         batch: dict = {}
         for code, text in pairs:
+            self._check_code(code)
             entry = self._decoded.get(code)
             batch[code] = entry if entry is not None else decode_entry(text, f"{self._name}: configurations/{code}")
             if len(batch) == chunk:
@@ -184,10 +189,27 @@ class Entries(Mapping):
         return code in self._texts
 
     def __iter__(self):
-        return iter(self._texts)
+        for code in self._texts:
+            self._check_code(code)
+            yield code
+
+    def _check_code(self, code) -> None:
+        # Codes are names read from the file, reported by check and diff: each must have
+        # the schema's syntax, matched whole (a store's keys are any text, newlines too,
+        # and the schema's "$" lets a trailing newline through).
+        if not isinstance(code, str) or not _code_syntax().fullmatch(code):
+            raise FormatError(f"{self._name}: configurations: {str(code)[:40]!r} is not a configuration code")
 
     def __len__(self) -> int:
         return len(self._texts)
+
+
+@lru_cache(maxsize=None)
+def _code_syntax() -> re.Pattern:
+    """The schema's pattern of configuration codes (its one home), to match whole."""
+    schema = json.loads(data_path("schemas/patterns.schema.json").read_text(encoding="utf-8"))
+    pattern = schema["properties"]["configurations"]["propertyNames"]["pattern"]
+    return re.compile(pattern.removeprefix("^").removesuffix("$"))
 
 
 @dataclass(frozen=True)

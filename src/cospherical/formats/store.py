@@ -9,7 +9,7 @@ of entries spread over the table: entries are short and alike, so the dictionary
 what lets each compress ten-fold and still be read alone::
 
     table = cospherical.load_patterns("intersection-r8-edge-patterns.sqlite")
-    table.elements("0000000000c8")
+    table.elements("000000000048")  # an orbit representative: see the header's "symmetry"
 
 :func:`cospherical.formats.patterns.load` opens either form; ``check`` and ``diff``
 read both.  A store is written atomically (a temporary file renamed into place) and
@@ -112,6 +112,8 @@ def _complete(path: Path) -> bool:
         head = handle.read(100)
     if len(head) < 100 or not head.startswith(MAGIC):
         return False
+    if head[18:20] != b"\x01\x01":  # file format versions: rollback journal, as written (WAL would write beside it)
+        return False
     page_size = int.from_bytes(head[16:18], "big")
     page_size = 65536 if page_size == 1 else page_size
     pages = int.from_bytes(head[28:32], "big")
@@ -122,7 +124,7 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
     """The header and the entries of a store; a bad or truncated store raises :class:`FormatError`."""
     path = Path(path)
     if not _complete(path):
-        raise FormatError(f"{path}: not a complete pattern-table store (truncated, or not an SQLite database)")
+        raise FormatError(f"{path}: not a complete pattern-table store (truncated, in WAL mode, or not an SQLite database)")
     try:
         connection = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True, check_same_thread=False)
         if set(connection.execute("SELECT type, name, sql FROM sqlite_master")) != SCHEMA:
@@ -182,13 +184,15 @@ class StoreEntries(Mapping):
             raise FormatError(f"{self._name}: store damaged: an entry does not decompress ({error})") from None
 
     def __getitem__(self, code: str) -> str:
+        if not isinstance(code, str):  # the caller's mistake, not the file's
+            raise KeyError(code)
         row = self._one("SELECT entry FROM entries WHERE code = ?", (code,))
         if row is None:
             raise KeyError(code)
         return self._text(row[0])
 
     def __contains__(self, code) -> bool:
-        return self._one("SELECT 1 FROM entries WHERE code = ?", (code,)) is not None
+        return isinstance(code, str) and self._one("SELECT 1 FROM entries WHERE code = ?", (code,)) is not None
 
     def __iter__(self):
         return (code for (code,) in self._rows("SELECT code FROM entries ORDER BY code"))
