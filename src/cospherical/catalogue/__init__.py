@@ -8,6 +8,7 @@ from .criteria import (
                        choose,
                        choose_kept,
                        element_options,
+                       kept_split,
                        minimal_kept_sets,
                        option_types,
                        split_options,
@@ -19,6 +20,6 @@ from .store import (SCHEMA_VERSION, catalogue_from_text, catalogue_path, known_n
 
 __all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "catalogue_from_text",
            "catalogue_path",
-           "choose", "choose_kept", "element_options", "known_name", "load_catalogue", "minimal_kept_sets",
+           "choose", "choose_kept", "element_options", "kept_split", "known_name", "load_catalogue", "minimal_kept_sets",
            "option_types", "shipped_catalogue", "split_options", "split_positions", "split_tessellation", "type_name",
            "type_names", "use_catalogue"]

@@ -22,7 +22,7 @@ from ..core.tessellation import Element, Tessellation
 from .store import shipped_catalogue
 
 __all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "choose", "choose_kept",
-           "element_options", "minimal_kept_sets", "option_types", "split_options", "split_positions", "split_tessellation"]
+           "element_options", "kept_split", "minimal_kept_sets", "option_types", "split_options", "split_positions", "split_tessellation"]
 
 
 def element_options(tess: Tessellation, element: Element, criterion: str) -> tuple[tuple[Element, ...], ...]:
@@ -125,17 +125,23 @@ def split_tessellation(tess: Tessellation, kept: frozenset[str], criterion: str,
         if element.type.id in kept or criterion == "optimal":
             elements.append(element)
             continue
-        fitting = [o for o in element_options(tess, element, criterion) if all(p.type.id in kept for p in o)]
-        if not fitting:
+        pieces = kept_split(element_options(tess, element, criterion), kept)
+        if pieces is None:
             if strict:
                 return None
             elements.append(element)
             continue
-        elements.extend(fitting[0])
-        used.append((element, fitting[0]))
+        elements.extend(pieces)
+        used.append((element, pieces))
     elements.sort(key=lambda e: e.polyhedron.nodes)
     # replace, not a new Tessellation: a shape's tessellation keeps its own FVM test
     return replace(tess, elements=tuple(elements)), used
+
+
+def kept_split(options: Sequence[tuple[Element, ...]], kept: frozenset[str]) -> tuple[Element, ...] | None:
+    """The split an element takes under a kept set: the first of its options (fewest pieces
+    first, see :func:`split_options`) whose pieces are all kept; ``None`` if there is none."""
+    return next((option for option in options if all(piece.type.id in kept for piece in option)), None)
 
 
 def option_types(option: Sequence[Element]) -> tuple[str, ...]:

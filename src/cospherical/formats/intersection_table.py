@@ -31,18 +31,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..catalogue import split_options
-from ..core.configuration import Configuration
-from ..core.delaunay import delaunay_cells
+from ..catalogue import kept_split, split_options
 from ..core.element_types import classify
-from ..core.geometry import Frame
-from ..core.polyhedron import polyhedron
 from ..core.symmetry import key_code
 from ..core.tessellation import Element
 from ..errors import InputError
 from ..files.flowyaml import flow, mapping_entries
 from ..files.yamlio import atomic_open, yaml_text
-from ..studies.intersection import completed, orbits, tessellate_chunk
+from ..studies.intersection import cell_polyhedron, completed, orbits, tessellate_chunk
 from ..version import __version__
 from .patterns import SCHEMA_VERSION, element_entry
 from .store import dictionary_of, pack, write_store
@@ -58,7 +54,7 @@ SYMMETRY_CONVENTION = (
     "box_symmetries(cube)) gives its representative and the index of a symmetry taking it there; "
     "map the representative's nodes back with that symmetry's inverse (Symmetry.node_map).")
 # The largest resolution whose table is also written as YAML by default: at R = 4 the
-# YAML is ~60 MB; at R = 8 ~1.4 GB, beyond the 512 MB the YAML reader accepts.
+# YAML is 71 MB; at R = 8 1.9 GB, beyond the 512 MB the YAML reader accepts.
 YAML_UP_TO = 4
 CHUNK = 20_000
 CELL_CHUNK = 2_000
@@ -97,16 +93,11 @@ class CellText:
 def cell_texts(cells: list[tuple[int, int, int]], kept: dict[str, list[str]]) -> list[CellText]:
     """Pass 2: every cell ``(node mask, masked code, a configuration code holding it)`` as its
     :class:`CellText`, criteria ``optimal`` then those of ``kept`` (criterion -> kept type ids)."""
-    squared = (1, 1, 1)
     scale = (1.0, 1.0, 1.0)
     kept_sets = {criterion: frozenset(types) for criterion, types in kept.items()}
     found = []
     for mask, _, owner in cells:
-        nodes = Configuration.from_code(key_code(owner)).nodes()
-        points = tuple((n, nodes[n]) for n in sorted(nodes) if mask >> n & 1)
-        frame = Frame.build(dict(points), squared)
-        (cell,) = delaunay_cells(frame)  # the points are co-spherical: one cell
-        poly = polyhedron(frame, cell)
+        points, poly = cell_polyhedron(mask, owner)
         etype, order, mirrored = classify(poly)
         element = Element(etype, order, poly, mirrored)
         pieces = [(element,)]
@@ -114,11 +105,10 @@ def cell_texts(cells: list[tuple[int, int, int]], kept: dict[str, list[str]]) ->
             if element.type.id in types:
                 pieces.append((element,))
                 continue
-            fitting = [option for option in split_options(points, squared, poly, criterion)
-                       if all(piece.type.id in types for piece in option)]
-            if not fitting:
+            split = kept_split(split_options(points, (1, 1, 1), poly, criterion), types)
+            if split is None:
                 raise InputError(f"a {element.type.name} has no {criterion} split into the kept types")
-            pieces.append(fitting[0])
+            pieces.append(split)
         found.append(CellText(
             poly.center_in_box(closed=True),
             tuple(tuple((p.polyhedron.nodes, flow(element_entry(p, scale))) for p in option) for option in pieces)))

@@ -37,7 +37,7 @@ from .backends import completed
 from .family import all_configurations, orbits
 from .statistics import statistics
 
-__all__ = ["CHUNK", "ELEMENT_CHUNK", "ElementEntry", "element_entries", "example_elements", "run_intersection",
+__all__ = ["CHUNK", "ELEMENT_CHUNK", "ElementEntry", "cell_polyhedron", "element_entries", "example_elements", "run_intersection",
            "tessellate_chunk"]
 
 CHUNK = 5000
@@ -89,17 +89,23 @@ def tessellate_chunk(codes: np.ndarray, every_cell: bool = False) -> dict[str, n
             "poly_mask": poly_mask[:written], "poly_code": poly_code[:written]}
 
 
+def cell_polyhedron(node_mask: int, code: int):
+    """A cell named as stage 1 names it, (node mask, a configuration code holding it), as
+    ``(points, polyhedron)``: its (node, unit coordinates) pairs and its exact polyhedron."""
+    nodes = Configuration.from_code(key_code(code)).nodes()
+    points = tuple((n, nodes[n]) for n in sorted(nodes) if node_mask >> n & 1)
+    frame = Frame.build(dict(points), (1, 1, 1))
+    (cell,) = delaunay_cells(frame)  # the points are co-spherical: one cell
+    return points, polyhedron(frame, cell)
+
+
 def element_entries(elements: list[tuple[int, int]]) -> tuple[list[ElementEntry], dict[str, TypeInfo]]:
     """Stage 2: per (node mask, code of a configuration holding it), the element's
     :class:`ElementEntry`; and every type met (pieces included), described."""
     squared = (1, 1, 1)
     entries, types = [], {}
     for node_mask, code in elements:
-        nodes = Configuration.from_code(key_code(code)).nodes()
-        points = tuple((n, nodes[n]) for n in sorted(nodes) if node_mask >> n & 1)
-        frame = Frame.build(dict(points), squared)
-        (cell,) = delaunay_cells(frame)  # the points are co-spherical: one cell
-        poly = polyhedron(frame, cell)
+        points, poly = cell_polyhedron(node_mask, code)
         etype = classify(poly)[0]
         types.setdefault(etype.id, TypeInfo.of(etype))
         options = {}
@@ -276,14 +282,11 @@ def example_elements(examples: dict) -> dict[str, tuple[str, tuple[int, ...]]]:
     found = {}
     for type_id, example in examples.items():
         mask, code = example[:2]
-        nodes = Configuration.from_code(key_code(code)).nodes()
-        points = tuple((n, nodes[n]) for n in sorted(nodes) if mask >> n & 1)
+        points, poly = cell_polyhedron(mask, code)
         if len(example) == 2:
             found[type_id] = (key_code(code), tuple(n for n, _ in points))
             continue
-        frame = Frame.build(dict(points), squared)
-        (cell,) = delaunay_cells(frame)
-        options = split_options(points, squared, polyhedron(frame, cell), example[2])
+        options = split_options(points, squared, poly, example[2])
         piece = next(p for option in options for p in option if p.type.id == type_id)
         found[type_id] = (key_code(code), piece.polyhedron.nodes)
     return found
