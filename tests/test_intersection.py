@@ -150,7 +150,8 @@ def test_table_lines_joined_from_cells_are_those_of_each_tessellation(pool_run):
     from cospherical import Configuration, tessellate
     from cospherical.catalogue import split_tessellation
     from cospherical.core.symmetry import key_code
-    from cospherical.formats.intersection_table import cell_texts, distinct_cells, table_lines
+    from cospherical.files.flowyaml import mapping_text
+    from cospherical.formats.intersection_table import cell_texts, distinct_cells, table_entries
     from cospherical.formats.patterns import configuration_line
     from cospherical.studies.intersection import orbits
 
@@ -159,7 +160,7 @@ def test_table_lines_joined_from_cells_are_those_of_each_tessellation(pool_run):
     codes = reps[::40]
     cells = [tuple(row) for row in distinct_cells(codes).tolist()]
     texts = dict(zip([cell[:2] for cell in cells], cell_texts(cells, kept)))
-    joined = table_lines(codes, texts, ["optimal", *kept])
+    joined = "".join(mapping_text(code, entry) for code, entry in table_entries(codes, texts, ["optimal", *kept]))
     expected = []
     for code in map(key_code, codes.tolist()):
         tess = tessellate(Configuration.from_code(code))

@@ -32,7 +32,7 @@ import re
 from ..errors import FormatError
 from .yamlio import yaml_float
 
-__all__ = ["decode_entry", "flow", "mapping_entries", "mapping_line", "sequence_line", "split_section"]
+__all__ = ["decode_entry", "flow", "mapping_entries", "mapping_line", "mapping_text", "sequence_line", "split_section"]
 
 # A mapping entry: two spaces, a single-quoted key without quotes in it, then a
 # JSON object.  A sequence entry: "- " then a JSON object.
@@ -71,7 +71,12 @@ def flow(value) -> str:
 
 def mapping_line(key: str, entry: dict) -> str:
     """One entry of a block mapping at indent 2, its value as a JSON flow mapping (with a newline)."""
-    return f"  '{key}': {flow(entry)}\n"
+    return mapping_text(key, flow(entry))
+
+
+def mapping_text(key: str, text: str) -> str:
+    """:func:`mapping_line` of a value already written as one line of flow JSON."""
+    return f"  '{key}': {text}\n"
 
 
 def sequence_line(entry: dict) -> str:

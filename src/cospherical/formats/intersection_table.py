@@ -36,7 +36,7 @@ from ..core.element_types import classify
 from ..core.symmetry import key_code
 from ..core.tessellation import Element
 from ..errors import InputError
-from ..files.flowyaml import flow, mapping_entries
+from ..files.flowyaml import flow, mapping_text
 from ..files.yamlio import atomic_open, yaml_text
 from ..studies.intersection import cell_polyhedron, completed, orbits, tessellate_chunk
 from ..version import __version__
@@ -44,7 +44,7 @@ from .patterns import SCHEMA_VERSION, element_entry
 from .store import dictionary_of, pack, write_store
 
 __all__ = ["SYMMETRY_CONVENTION", "YAML_UP_TO", "CellText", "cell_texts", "distinct_cells", "entry_chunk",
-           "representative_cells", "table_lines", "write_pattern_table"]
+           "representative_cells", "table_entries", "write_pattern_table"]
 
 SYMMETRY_CONVENTION = (
     "One entry per orbit of the cube's 48 symmetries. The representative is the configuration "
@@ -115,12 +115,12 @@ def cell_texts(cells: list[tuple[int, int, int]], kept: dict[str, list[str]]) ->
     return found
 
 
-def table_lines(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str]) -> str:
-    """The pattern-table lines of some representatives, joined from their cells' texts
-    (``cells``: (node mask, masked code) -> :class:`CellText`, every cell they hold)."""
+def table_entries(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str]) -> list[tuple[str, str]]:
+    """The pattern-table entries of some representatives as (code, entry JSON), joined from their
+    cells' texts (``cells``: (node mask, masked code) -> :class:`CellText`, every cell they hold)."""
     counts, masks, masked = representative_cells(codes)
     held = [cells[pair] for pair in zip(masks.tolist(), masked.tolist())]
-    lines = []
+    entries = []
     start = 0
     for code, count in zip(codes, counts.tolist()):
         mine = held[start:start + count]
@@ -137,16 +137,16 @@ def table_lines(codes, cells: Mapping[tuple[int, int], CellText], criteria: list
                 continue
             written[key] = criterion
             parts.append(f'"{criterion}": [' + ", ".join(text for _, text in pieces) + "]")
-        lines.append(f"  '{key_code(int(code))}': {{" + ", ".join(parts) + "}\n")
-    return "".join(lines)
+        entries.append((key_code(int(code)), "{" + ", ".join(parts) + "}"))
+    return entries
 
 
 def entry_chunk(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str], yaml: bool,
                 dictionary: bytes | None) -> tuple[str, list[tuple[str, bytes]]]:
     """Pass 3 on a chunk: its YAML lines (if ``yaml``) and its store rows (if a ``dictionary``)."""
-    text = table_lines(codes, cells, criteria)
-    rows = [] if dictionary is None else [(code, pack(entry, dictionary)) for code, entry in mapping_entries(text)]
-    return text if yaml else "", rows
+    entries = table_entries(codes, cells, criteria)
+    text = "".join(mapping_text(code, entry) for code, entry in entries) if yaml else ""
+    return text, [] if dictionary is None else [(code, pack(entry, dictionary)) for code, entry in entries]
 
 
 def write_pattern_table(summary: dict, catalogue_version: str, yaml_path=None, store=None, jobs: int = 1,
@@ -196,8 +196,8 @@ def write_pattern_table(summary: dict, catalogue_version: str, yaml_path=None, s
     # Pass 3: the entries, each chunk with the texts of its own cells, written in code order.
     dictionary = None
     if store:  # the store's compression dictionary: entries spread over the whole table
-        dictionary = dictionary_of([entry for _, entry in mapping_entries(
-            table_lines(reps[::max(1, len(reps) // SAMPLES)], texts, criteria))])
+        dictionary = dictionary_of([entry for _, entry in
+                                    table_entries(reps[::max(1, len(reps) // SAMPLES)], texts, criteria)])
     tasks = {s: (reps[s:s + chunk], {pair: texts[pair] for pair in held.pop(s)}, criteria, bool(yaml_path), dictionary)
              for s in starts}
 
