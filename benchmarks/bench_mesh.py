@@ -23,10 +23,10 @@ import time
 from cospherical import load_patterns
 from cospherical.core.configuration import Box
 from cospherical.formats.mesh import table_lookup
-from cospherical.studies.mesh.assembly import assemble
-from cospherical.studies.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
-from cospherical.studies.mesh.octree import build_octree, parse_shape
-from cospherical.studies.mesh.statistics import mesh_statistics
+from cospherical.mesh.assembly import assemble
+from cospherical.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
+from cospherical.mesh.octree import build_octree, parse_shape
+from cospherical.mesh.statistics import mesh_statistics
 
 
 def main() -> None:

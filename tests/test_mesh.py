@@ -13,9 +13,9 @@ from cospherical.core.tessellation import tessellate
 from cospherical.files.yamlio import atomic_write, yaml_text
 from cospherical.formats.mesh import read_leaves, table_lookup, to_meshio, write_vtu
 from cospherical.formats.patterns import configuration_line, load
-from cospherical.studies.mesh.assembly import assemble
-from cospherical.studies.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
-from cospherical.studies.mesh.octree import build_octree, leaves_octree, parse_shape
+from cospherical.mesh.assembly import assemble
+from cospherical.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
+from cospherical.mesh.octree import build_octree, leaves_octree, parse_shape
 
 CUBE = Box.parse(["1", "1", "1"])
 BRICK = Box.parse(["1", "2", "4"])

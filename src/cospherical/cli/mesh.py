@@ -11,9 +11,9 @@ from ..core.configuration import Box
 from ..core.exact import parse_rational
 from ..errors import InputError
 from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
-from ..studies.mesh.assembly import assemble
-from ..studies.mesh.octree import BALANCES, MAX_LEVEL, build_octree, leaves_octree, parse_shape
-from ..studies.mesh.report import mesh_report
+from ..mesh.assembly import assemble
+from ..mesh.octree import BALANCES, MAX_LEVEL, build_octree, leaves_octree, parse_shape
+from ..mesh.report import mesh_report
 from .progress import stage_bars
 
 

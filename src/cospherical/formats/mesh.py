@@ -25,7 +25,7 @@ import numpy as np
 from ..core.configuration import POINT_POLICIES, Box, Configuration
 from ..errors import FormatError, InputError
 from ..files.yamlio import atomic_write, check_nesting, read_text, validate
-from ..studies.mesh.assembly import Lookup, Mesh
+from ..mesh.assembly import Lookup, Mesh
 from .vtu import write_meshio
 
 __all__ = ["REPORT_SCHEMA_VERSION", "read_leaves", "report_json", "table_lookup", "to_meshio", "write_report",
@@ -82,7 +82,7 @@ def read_leaves(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def table_lookup(table, criterion: str, box: Box, name: str = "pattern table") -> Lookup:
-    """A lookup for :func:`cospherical.studies.mesh.assembly.assemble` reading a pattern table.
+    """A lookup for :func:`cospherical.mesh.assembly.assemble` reading a pattern table.
 
     The table is asked for the leaf's whole-point-set code (``800000000000+f``), and
     where its header names a point policy, for the bare edge code when that policy

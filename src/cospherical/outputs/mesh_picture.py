@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..studies.mesh.assembly import Mesh
+from ..mesh.assembly import Mesh
 from .latex import save_png
 
 __all__ = ["cut_png", "cut_polygons"]

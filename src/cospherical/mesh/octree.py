@@ -24,9 +24,9 @@ from typing import Sequence
 
 import numpy as np
 
-from ...core.configuration import Box
-from ...core.exact import parse_rational
-from ...errors import InputError
+from ..core.configuration import Box
+from ..core.exact import parse_rational
+from ..errors import InputError
 
 __all__ = ["BALANCES", "MAX_LEVEL", "Octree", "Shape", "build_octree", "leaves_octree", "parse_shape"]
 

@@ -34,8 +34,8 @@ def check_volume(mesh: Mesh) -> dict:
     Examples
     --------
     >>> from cospherical.core.configuration import Box
-    >>> from cospherical.studies.mesh.octree import build_octree, parse_shape
-    >>> from cospherical.studies.mesh.assembly import assemble
+    >>> from cospherical.mesh.octree import build_octree, parse_shape
+    >>> from cospherical.mesh.assembly import assemble
     >>> check_volume(assemble(build_octree(Box.parse([1, 2, 4]), 0, [])))
     {'volume_ok': True, 'volume': '1', 'flat_elements': 0}
     """
@@ -81,8 +81,8 @@ def check_conformity(mesh: Mesh, examples: int = 5) -> dict:
     Examples
     --------
     >>> from cospherical.core.configuration import Box
-    >>> from cospherical.studies.mesh.octree import build_octree, parse_shape
-    >>> from cospherical.studies.mesh.assembly import assemble
+    >>> from cospherical.mesh.octree import build_octree, parse_shape
+    >>> from cospherical.mesh.assembly import assemble
     >>> found = check_conformity(assemble(build_octree(Box.parse([1, 1, 1]), 1, [parse_shape("point:0.5,0.5,0.5")])))
     >>> found["nonconforming_faces"], found["interior_faces"], found["boundary_faces"]
     (0, 12, 24)

@@ -6,7 +6,7 @@ from typing import Callable
 
 import numpy as np
 
-from ...version import __version__
+from ..version import __version__
 from .assembly import Mesh
 from .checks import check_circumcenters, check_conformity, check_delaunay, check_volume
 from .statistics import level_counts, mesh_statistics, uniform_study
@@ -29,8 +29,8 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     Examples
     --------
     >>> from cospherical.core.configuration import Box
-    >>> from cospherical.studies.mesh.assembly import assemble
-    >>> from cospherical.studies.mesh.octree import build_octree, parse_shape
+    >>> from cospherical.mesh.assembly import assemble
+    >>> from cospherical.mesh.octree import build_octree, parse_shape
     >>> tree = build_octree(Box.parse([1, 1, 1]), 2, [parse_shape("point:0.1,0.1,0.1")])
     >>> report = mesh_report(assemble(tree), {"source": "refine"}, None, uniform=False)
     >>> [report[k] for k in ("leaves", "elements", "volume_ok", "nonconforming_faces", "delaunay_violations")]

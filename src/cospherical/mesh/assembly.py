@@ -24,14 +24,14 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from ...catalogue import apply_catalogue_criterion, shipped_catalogue
-from ...core.configuration import CORNERS, EDGES, FACES, Box, Configuration
-from ...core.delaunay import hull_faces
-from ...core.element_types import ElementType
-from ...core.geometry import Frame, Sphere, six_volume
-from ...core.tessellation import tessellate
-from ...errors import InputError
-from ...paper import paper_class
+from ..catalogue import apply_catalogue_criterion, shipped_catalogue
+from ..core.configuration import CORNERS, EDGES, FACES, Box, Configuration
+from ..core.delaunay import hull_faces
+from ..core.element_types import ElementType
+from ..core.geometry import Frame, Sphere, six_volume
+from ..core.tessellation import tessellate
+from ..errors import InputError
+from ..paper import paper_class
 from .octree import Octree
 
 __all__ = ["LocalElement", "LocalPattern", "Mesh", "NODE_OFFSETS", "assemble", "local_pattern"]
@@ -239,7 +239,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
 
     Examples
     --------
-    >>> from cospherical.studies.mesh.octree import build_octree, parse_shape
+    >>> from cospherical.mesh.octree import build_octree, parse_shape
     >>> mesh = assemble(build_octree(Box.parse([1, 1, 1]), 1, [parse_shape("point:0.5,0.5,0.5")]))
     >>> len(mesh.tree), len(mesh.vertices), len(mesh)
     (8, 27, 8)

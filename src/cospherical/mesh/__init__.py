@@ -1,0 +1,7 @@
+"""The mesher: a 1-irregular octree meshed from the pattern tables.
+
+Above the studies it uses (the leaf family, the catalogue's criteria) and below the
+formats that read and write its results: ``octree`` builds or reads the tree,
+``assembly`` meshes its leaves, ``checks`` decides conformity, volume and the Delaunay
+property exactly, ``statistics`` and ``report`` summarise the mesh.
+"""
