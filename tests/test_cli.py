@@ -85,3 +85,20 @@ def test_main_freezes_the_collector_only_as_the_process_command(monkeypatch, cap
         assert gc.get_freeze_count() > frozen
     finally:
         gc.unfreeze()
+
+
+def test_each_study_family_has_its_own_help(capsys):
+    from cospherical.cli import main
+
+    texts = {}
+    for family in ("bisection", "leaves", "intersection"):
+        with pytest.raises(SystemExit) as exit:
+            main(["study", family, "--help"])
+        assert exit.value.code == 0
+        texts[family] = capsys.readouterr().out
+    assert len(set(texts.values())) == 3
+    assert "--resume" in texts["intersection"] and "--resume" not in texts["bisection"]
+    assert "--element" in texts["bisection"] and "--element" not in texts["leaves"]
+    assert "--face-points" not in texts["leaves"] and "--box" not in texts["intersection"]
+    assert main(["study", "bisection", "--resume"]) == 2  # hidden, still refused by name
+    assert "option of the intersection study only" in capsys.readouterr().err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import re
 import sys
@@ -22,57 +23,84 @@ from .output import FACE_POINTS_HELP, dump, emit
 from .progress import progress_bar, stage_bars
 
 
+FAMILIES = {
+    "bisection": ("a midpoint or nothing on each of the 12 edges: the paper's section 4",
+                  "Tessellate all 4096 bisection configurations of a box (a midpoint or nothing on each of the 12 "
+                  "edges; 512, 256 or 64 for a prism, pyramid or tetrahedron), one per symmetry orbit, and report "
+                  "every element type's frequency, the FVM test and, if asked, the paper's figures beside ours."),
+    "leaves": ("the octree-leaf family: the bisection edges with every admissible set of face points",
+               "Tessellate the octree-leaf family of a box: every edge mask of the bisection study with every "
+               "admissible set of face points and no body point (6210 configurations), as a mesher meets them "
+               "at the leaves of a 2:1-balanced octree, and report it beside the octree-policy bisection study."),
+    "intersection": ("the paper's section 5: points at multiples of 1/R placed by the midpoint scheme",
+                     "Run the paper's intersection study on the cube: Steiner points at multiples of 1/RESOLUTION "
+                     "placed by the midpoint scheme (3,375,000 configurations at R = 16), on a process pool or a "
+                     "Dask cluster, with checkpoints, and optionally the pattern table of the orbit "
+                     "representatives as an indexed SQLite store."),
+}
+
+
 def add_parser(commands) -> None:
     parser = commands.add_parser(
         "study",
         help="run a study over every configuration of a family",
         description="Tessellate every configuration of a family (one per symmetry orbit) and report "
-        "the frequency of every element type.",
+        "the frequency of every element type. Each family has its own options: "
+        "cospherical study FAMILY --help.",
     )
-    parser.add_argument("family", choices=["bisection", "leaves", "intersection"],
-                        help="bisection: a midpoint or nothing on each of the 12 edges; leaves: the same edges with "
-                        "every admissible set of face points and no body point, as at octree leaves (beside the "
-                        "bisection study); intersection: the paper's section 5, points at multiples of 1/RESOLUTION "
-                        "placed by the midpoint scheme, on the cube")
-    parser.add_argument("--element", choices=ELEMENTS, default="cuboid",
-                        help="bisection: the base element in the box (default cuboid): prism, pyramid or tetrahedron "
-                        "(512, 256, 64 configurations)")
-    parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), default=["1", "1", "1"],
-                        help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2) (default: the cube)")
-    parser.add_argument("--resolution", type=int, help="intersection: positions at multiples of 1/R (2, 4, 8, 16; "
-                        "default 16)")
-    parser.add_argument("--order", choices=INSERTION_ORDERS,
-                        help="intersection: the order in which the midpoint scheme inserts the levels (default edge)")
-    parser.add_argument("--jobs", type=int, metavar="N",
-                        help="intersection: worker processes (default: all cores, here %d)" % (os.cpu_count() or 1))
-    parser.add_argument("--chunk-size", type=int, metavar="N",
-                        help="intersection: orbits per work unit and checkpoint (default 5000)")
-    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
-                        help="intersection: run the work units on this Dask scheduler's workers")
-    parser.add_argument("--scheduler-timeout", type=float, metavar="SECONDS",
-                        help="intersection: give up connecting to --scheduler after this long (default 30)")
-    parser.add_argument("--dask-workers", type=int, metavar="N",
-                        help="intersection: run the work units on a local Dask cluster of N processes")
-    parser.add_argument("--no-orbits", action="store_true",
-                        help="intersection: tessellate every configuration, not one per symmetry orbit (a check; "
-                        "the statistics must not change)")
-    parser.add_argument("--resume", action="store_true",
-                        help="intersection: keep finished chunks in DIR/checkpoints and reuse them (needs --out; "
-                        "the bisection study takes seconds and has no checkpoints)")
-    parser.add_argument("--patterns", action="store_true",
-                        help="intersection: also write the pattern table of the orbit representatives into DIR, "
-                        "as an indexed store (.sqlite) that a mesher queries one configuration at a time, and as "
-                        "YAML (see --patterns-format); built from the study's cells: about 1 min at R = 8")
-    parser.add_argument("--patterns-format", choices=("auto", "yaml", "store", "both"),
-                        help="intersection: the pattern table as yaml, store or both (default auto: both while the "
-                        "YAML stays small enough to read, up to R = 4; the store alone above, where it is over a GB)")
-    parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree", help=FACE_POINTS_HELP)
-    parser.add_argument("--out", type=Path, metavar="DIR",
-                        help="also write the summary (JSON) and the pattern table (YAML) into DIR")
-    parser.add_argument("--format", choices=("text", "json"), default="text",
-                        help="text (default): the frequency table; json: the summary as data")
-    parser.add_argument("--compare-paper", action="store_true",
-                        help="print the paper's figures beside ours, each difference marked and explained")
+    families = parser.add_subparsers(dest="family", required=True, metavar="{bisection,leaves,intersection}",
+                                     parser_class=type(parser))
+    for family, (summary, description) in FAMILIES.items():
+        _add_family(families.add_parser(family, help=summary, description=description), family)
+
+
+def _add_family(parser, family: str) -> None:
+    """The options of one family; the others' are accepted but hidden, so that ``run`` refuses them by name."""
+
+    def option(*flags, only=None, **kwargs):
+        if only is not None and family not in only:
+            kwargs["help"] = argparse.SUPPRESS
+        parser.add_argument(*flags, **kwargs)
+
+    intersection = ("intersection",)
+    option("--element", choices=ELEMENTS, default="cuboid", only=("bisection",),
+           help="the base element in the box (default cuboid): prism, pyramid or tetrahedron "
+           "(512, 256, 64 configurations)")
+    option("--box", nargs=3, metavar=("A", "B", "C"), default=["1", "1", "1"], only=("bisection", "leaves"),
+           help="edge lengths, exact: 1, 1.4142, 3/2, sqrt(2) (default: the cube)")
+    option("--resolution", type=int, only=intersection, help="positions at multiples of 1/R (2, 4, 8, 16; "
+           "default 16)")
+    option("--order", choices=INSERTION_ORDERS, only=intersection,
+           help="the order in which the midpoint scheme inserts the levels (default edge)")
+    option("--jobs", type=int, metavar="N", only=intersection,
+           help="worker processes (default: all cores, here %d)" % (os.cpu_count() or 1))
+    option("--chunk-size", type=int, metavar="N", only=intersection,
+           help="orbits per work unit and checkpoint (default 5000)")
+    option("--scheduler", metavar="tcp://HOST:PORT", only=intersection,
+           help="run the work units on this Dask scheduler's workers")
+    option("--scheduler-timeout", type=float, metavar="SECONDS", only=intersection,
+           help="give up connecting to --scheduler after this long (default 30)")
+    option("--dask-workers", type=int, metavar="N", only=intersection,
+           help="run the work units on a local Dask cluster of N processes")
+    option("--no-orbits", action="store_true", only=intersection,
+           help="tessellate every configuration, not one per symmetry orbit (a check; the statistics must not "
+           "change)")
+    option("--resume", action="store_true", only=intersection,
+           help="keep finished chunks in DIR/checkpoints and reuse them (needs --out)")
+    option("--patterns", action="store_true", only=intersection,
+           help="also write the pattern table of the orbit representatives into DIR, as an indexed store "
+           "(.sqlite) that a mesher queries one configuration at a time, and as YAML (see --patterns-format); "
+           "built from the study's cells: about 1 min at R = 8")
+    option("--patterns-format", choices=("auto", "yaml", "store", "both"), only=intersection,
+           help="the pattern table as yaml, store or both (default auto: both while the YAML stays small "
+           "enough to read, up to R = 4; the store alone above, where it is over a GB)")
+    option("--face-points", choices=POINT_POLICIES, default="octree", only=("bisection",), help=FACE_POINTS_HELP)
+    option("--out", type=Path, metavar="DIR",
+           help="also write the summary (JSON) and the pattern table into DIR")
+    option("--format", choices=("text", "json"), default="text",
+           help="text (default): the frequency table; json: the summary as data")
+    option("--compare-paper", action="store_true", only=("bisection", "intersection"),
+           help="print the paper's figures beside ours, each difference marked and explained")
     parser.set_defaults(run=run)
 
 
