@@ -3,5 +3,6 @@
 Above the studies it uses (the leaf family, the catalogue's criteria) and below the
 formats that read and write its results: ``octree`` builds or reads the tree,
 ``assembly`` meshes its leaves, ``checks`` decides conformity, volume and the Delaunay
-property exactly, ``statistics`` and ``report`` summarise the mesh.
+property exactly, ``dual`` gives its finite-volume dual (control volumes, coupling
+coefficients, the box method's matrix), ``statistics`` and ``report`` summarise the mesh.
 """

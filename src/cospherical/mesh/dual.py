@@ -1,0 +1,400 @@
+"""The finite-volume dual of a mesh: control volumes and coupling coefficients, exactly.
+
+The box method (vertex-centred finite volumes) gives every vertex the part of the
+domain nearer to it than to any other vertex (its Voronoi cell, clipped to the
+domain) and couples two vertices joined by a mesh edge with the area of their
+common Voronoi face over the edge's length.  In a mesh of co-spherical elements
+both are sums of element-wise pieces: inside an element with circumcenter ``c`` the
+dual face of its edge ``(u, v)`` is the polygon ``m, f1, c, f2`` (``m`` the edge's
+midpoint, ``f1, f2`` the centres of the circles of the two faces at the edge), and
+the vertex ``u`` gets the pyramids over those pieces, of volume ``|e| * area / 6``::
+
+            v
+           /|\\          one face at edge (u, v), seen from outside:
+          / | \\         f is the face's circle centre; the triangle
+         /  m--f        (m, f, c) is the face's share of the dual
+        /   |   \\       face of (u, v); c lies behind the page
+       u----+----
+
+A piece is signed (negative where ``c`` or ``f`` lies beyond the face or the edge), so
+the sums are right for every element list and never hide a non-Delaunay mesh: its
+coefficients come out negative, and are counted.  Only polygon edges of element
+faces are edges; a diagonal inside a polygon face has a dual face of zero area.
+
+Exact: with points ``(s*a, t*b, u*c)`` in unit coordinates and the squared lengths
+``w = (a^2, b^2, c^2)`` (rational also for sqrt boxes), a face centre is
+``c - (d.N / sum N_k^2/w_k) * N/w`` and a triangle's piece of ``area / length`` is
+``a*b*c * (x_u - x_v).((f - m) x (c - m)) / (2 |e|^2)``: a rational times ``a*b*c``.
+Volumes are rationals times ``a*b*c`` too, boundary areas rationals times the
+product of the two lengths of their plane.  Signs (negative coefficients) are
+therefore decided on the rationals.  The pieces of a leaf's configuration scale
+with the leaf's size (coefficients as ``h``, areas as ``h^2``, volumes as ``h^3``), so
+they are computed once per configuration, and the mesh's sums are integer sums,
+assembled by array indexing; floats appear only in the ``float`` outputs.
+
+Examples
+--------
+>>> from cospherical.core.configuration import Box
+>>> from cospherical.mesh.octree import build_octree, parse_shape
+>>> from cospherical.mesh.assembly import assemble
+>>> dual = mesh_dual(assemble(build_octree(Box.parse([1, 1, 1]), 1, [parse_shape("point:0.5,0.5,0.5")])))
+>>> len(dual.edges), dual.volume_sum(), float(dual.control_volume.max())
+(54, Fraction(1, 1), 0.125)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from ..core.configuration import Box
+from ..core.delaunay import hull_faces
+from ..core.geometry import Frame
+
+__all__ = ["Dual", "ElementPieces", "element_pieces", "mesh_dual"]
+
+Point = tuple[Fraction, Fraction, Fraction]
+
+
+@dataclass(frozen=True)
+class ElementPieces:
+    """One element's exact pieces, in a frame where the box has squared lengths ``w``.
+
+    ``edges``: ``{(u, v): q}`` with ``u < v`` node ids and ``q`` the element's share of
+    the edge's ``area / length`` over ``a*b*c``; ``volumes``: ``{u: q}`` each vertex's
+    share of the element's volume over ``a*b*c``; ``boundary``: for each face that
+    lies in a coordinate plane ``(axis, value)``, ``{u: q}`` each vertex's share of the
+    face's area over the product of the plane's two lengths.
+    """
+
+    edges: dict[tuple[int, int], Fraction]
+    volumes: dict[int, Fraction]
+    boundary: dict[tuple[int, Fraction], dict[int, Fraction]]
+
+
+def _cross(p: Sequence[Fraction], q: Sequence[Fraction]) -> tuple[Fraction, Fraction, Fraction]:
+    return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
+
+
+def _sub(p, q):
+    return (p[0] - q[0], p[1] - q[1], p[2] - q[2])
+
+
+def _dot(p, q):
+    return p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
+
+
+def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], center: Point,
+                   squared: Sequence[Fraction]) -> ElementPieces:
+    """The exact dual pieces of one co-spherical element.
+
+    ``points``: node id -> unit coordinates; ``faces``: the element's face cycles,
+    counter-clockwise seen from outside; ``center``: its circumcenter in unit
+    coordinates; ``squared``: the box's squared lengths.
+
+    Examples
+    --------
+    >>> cube = {n: tuple(Fraction(x) for x in p) for n, p in enumerate(
+    ...     [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)])}
+    >>> faces = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    >>> half = Fraction(1, 2)
+    >>> pieces = element_pieces(cube, faces, (half, half, half), (1, 1, 1))
+    >>> pieces.edges[0, 1], pieces.volumes[0], len(pieces.edges), pieces.boundary[2, 0][0]
+    (Fraction(1, 4), Fraction(1, 8), 12, Fraction(1, 4))
+    """
+    w = tuple(Fraction(x) for x in squared)
+    edges: dict[tuple[int, int], Fraction] = {}
+    volumes: dict[int, Fraction] = {n: Fraction(0) for n in points}
+    boundary: dict[tuple[int, Fraction], dict[int, Fraction]] = {}
+    for cycle in faces:
+        p0, p1, p2 = (points[n] for n in cycle[:3])
+        normal = _cross(_sub(p1, p0), _sub(p2, p0))  # no three points of a circle are collinear
+        t = _dot(_sub(center, p0), normal) / sum(normal[k] * normal[k] / w[k] for k in range(3))
+        face_center = tuple(center[k] - t * normal[k] / w[k] for k in range(3))
+        plane = [k for k in range(3) if normal[k] != 0]
+        shares = None
+        if len(plane) == 1:  # in a coordinate plane: it may be on the domain's boundary
+            k = plane[0]
+            shares = boundary.setdefault((k, p0[k]), {})
+            outward = 1 if normal[k] > 0 else -1
+        for u, v in zip(cycle, (*cycle[1:], cycle[0])):
+            xu, xv = points[u], points[v]
+            mid = tuple((xu[k] + xv[k]) / 2 for k in range(3))
+            along = _sub(xu, xv)
+            piece = _dot(along, _cross(_sub(face_center, mid), _sub(center, mid)))
+            length2 = sum(w[k] * along[k] * along[k] for k in range(3))
+            key = (u, v) if u < v else (v, u)
+            edges[key] = edges.get(key, Fraction(0)) + piece / (2 * length2)
+            volumes[u] += piece / 12
+            volumes[v] += piece / 12
+            if shares is not None:
+                # triangles (x_u, m, f) and (m, x_v, f): equal areas, half a base each
+                area = outward * _cross(_sub(mid, xu), _sub(face_center, xu))[k] / 2
+                shares[u] = shares.get(u, Fraction(0)) + area
+                shares[v] = shares.get(v, Fraction(0)) + area
+    return ElementPieces(edges, volumes, boundary)
+
+
+@dataclass
+class Dual:
+    """The dual of a mesh, as arrays (floats) with their exact integer forms.
+
+    Vertices: ``grid_vertices`` (n x 3, integers of the grid of ``grid`` intervals per
+    domain side) and ``vertices`` (their real coordinates); ``boundary`` (on the
+    domain's boundary), ``control_volume``, ``boundary_area``.  Edges: ``edges``
+    (m x 2, ``i < j``, sorted), ``length``, ``area`` (signed area of the dual face),
+    ``coefficient`` (``area / length``).  Exact: ``coefficient == coefficient_exact *
+    volume_factor / coefficient_denominator`` and ``control_volume == volume_exact *
+    volume_factor / volume_denominator`` with integer numerators (int64, or Python
+    integers in an object array when int64 could overflow) and ``volume_factor`` the
+    box's ``a*b*c`` (``volume_factor_squared`` exact).  ``element_circumcenter``: the
+    real circumcenter of every element, in the mesh's element order.
+    """
+
+    box: Box
+    grid: int
+    grid_vertices: np.ndarray
+    vertices: np.ndarray
+    edges: np.ndarray
+    length: np.ndarray
+    area: np.ndarray
+    coefficient: np.ndarray
+    control_volume: np.ndarray
+    boundary: np.ndarray
+    boundary_area: np.ndarray
+    coefficient_exact: np.ndarray
+    coefficient_denominator: int
+    volume_exact: np.ndarray
+    volume_denominator: int
+    volume_factor: float
+    volume_factor_squared: Fraction
+    element_circumcenter: np.ndarray = field(repr=False)
+
+    def laplacian(self):
+        """The box method's matrix: ``K[i, j] = -coefficient``, ``K[i, i]`` the row's sum (scipy.sparse CSR).
+
+        Symmetric with zero row sums: ``K @ u`` is ``-div grad u`` integrated over the
+        control volumes, so ``K u = M f`` with :meth:`mass` is the discrete Poisson
+        problem.
+        """
+        from scipy.sparse import coo_matrix
+
+        n = len(self.vertices)
+        i, j = self.edges[:, 0], self.edges[:, 1]
+        c = self.coefficient
+        rows = np.concatenate([i, j, i, j])
+        cols = np.concatenate([j, i, i, j])
+        data = np.concatenate([-c, -c, c, c])
+        return coo_matrix((data, (rows, cols)), shape=(n, n)).tocsr()
+
+    def mass(self):
+        """The lumped mass matrix: the control volumes on the diagonal (scipy.sparse)."""
+        from scipy.sparse import diags
+
+        return diags(self.control_volume).tocsr()
+
+    def volume_sum(self) -> Fraction:
+        """The control volumes' sum as an exact fraction of the domain's volume."""
+        return Fraction(int(np.sum(self.volume_exact.astype(object))), self.volume_denominator)
+
+    def negative_coefficients(self) -> dict:
+        """Edges whose coefficient is negative (decided on the exact integers), interior and boundary apart.
+
+        A boundary edge lies in one of the domain's boundary planes.
+        """
+        negative = self.coefficient_exact < 0
+        g = self.grid_vertices
+        a, b = g[self.edges[:, 0]], g[self.edges[:, 1]]
+        on_plane = np.zeros(len(self.edges), dtype=bool)
+        for side in (0, self.grid):
+            on_plane |= np.any((a == side) & (b == side), axis=1)
+        return {"interior": int((negative & ~on_plane).sum()), "boundary": int((negative & on_plane).sum())}
+
+
+def _lcm_denominator(values) -> int:
+    return math.lcm(1, *(v.denominator for v in values))
+
+
+class _Shape:
+    """The pieces of one element shape (or one configuration), keyed by local node ids, as integer arrays."""
+
+    __slots__ = ("edges", "edge_q", "volume_nodes", "volume_q", "boundary")
+
+    def __init__(self, pieces_list: list[ElementPieces]):
+        edges: dict[tuple[int, int], Fraction] = {}
+        volumes: dict[int, Fraction] = {}
+        boundary: dict[tuple[int, Fraction, int], Fraction] = {}
+        for pieces in pieces_list:
+            for key, q in pieces.edges.items():
+                edges[key] = edges.get(key, Fraction(0)) + q
+            for node, q in pieces.volumes.items():
+                volumes[node] = volumes.get(node, Fraction(0)) + q
+            for (axis, value), shares in pieces.boundary.items():
+                for node, q in shares.items():
+                    boundary[axis, value, node] = boundary.get((axis, value, node), Fraction(0)) + q
+        keys = sorted(edges)
+        self.edges = np.array(keys, dtype=np.int64).reshape(-1, 2)
+        self.edge_q = [edges[k] for k in keys]
+        nodes = sorted(volumes)
+        self.volume_nodes = np.array(nodes, dtype=np.int64)
+        self.volume_q = [volumes[n] for n in nodes]
+        self.boundary = sorted(boundary.items())
+
+
+def _integers(values: list[Fraction], denominator: int) -> np.ndarray:
+    return np.array([int(v * denominator) for v in values], dtype=object)
+
+
+def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Dual:
+    """The exact dual of a mesh.
+
+    By default the elements are the mesh's leaf pattern elements, and their pieces
+    are computed once per configuration.  ``elements`` (``(connectivity, sizes)`` as
+    :meth:`Mesh.connectivity` gives them, global vertex ids) takes any element list
+    on the mesh's vertices instead, for example cells that span leaves: each element
+    is then measured from its vertices (faces: the hull of its nodes; centre: the
+    sphere through them), once per distinct shape up to translation and scaling by
+    powers of two.
+    """
+    box = mesh.box
+    grid = int(mesh.grid)
+    squared = tuple(Fraction(x) for x in box.squared)
+    factor_squared = squared[0] * squared[1] * squared[2]
+    verts = np.asarray(mesh.vertices, dtype=np.int64)
+    n_vertices = len(verts)
+    # collected per group: global edge pairs and their integer numerators times the group's scaling
+    if elements is None:
+        groups, centers = _leaf_groups(mesh, squared)
+    else:
+        groups, centers = _element_groups(mesh, squared, *elements)
+    cden = math.lcm(1, *(_lcm_denominator(shape.edge_q) for shape, _, _ in groups))
+    vden = math.lcm(1, *(_lcm_denominator(shape.volume_q) for shape, _, _ in groups))
+    bden = math.lcm(1, *(_lcm_denominator([q for _, q in shape.boundary]) for shape, _, _ in groups))
+    max_size = max((int(sizes.max()) for _, _, sizes in groups if len(sizes)), default=1)
+    wide = vden * max_size ** 3 * 4096 >= 2**62 or cden * max_size * 4096 >= 2**62
+    dtype = object if wide else np.int64
+    edge_parts, coef_parts, vol_parts, vol_index, bnd_parts, bnd_index, bnd_axis = [], [], [], [], [], [], []
+    for shape, vertex_ids, sizes in groups:
+        size = sizes.astype(dtype)
+        if len(shape.edges):
+            pairs = vertex_ids[:, shape.edges]  # (k, E, 2)
+            lo, hi = np.minimum(pairs[..., 0], pairs[..., 1]), np.maximum(pairs[..., 0], pairs[..., 1])
+            edge_parts.append((lo.astype(np.int64) * n_vertices + hi).reshape(-1))
+            q = _integers(shape.edge_q, cden).astype(dtype)
+            coef_parts.append((size[:, None] * q[None, :]).reshape(-1))
+        q = _integers(shape.volume_q, vden).astype(dtype)
+        vol_parts.append((size[:, None] ** 3 * q[None, :]).reshape(-1))
+        vol_index.append(vertex_ids[:, shape.volume_nodes].reshape(-1))
+        for (axis, value, node), q in shape.boundary:
+            ids = vertex_ids[:, node]
+            on = (verts[ids, axis] == 0) | (verts[ids, axis] == grid)
+            # the face lies in the vertex's plane: on the boundary where that plane is a side of the domain
+            bnd_parts.append(sizes[on].astype(object if wide else np.int64) ** 2 * int(q * bden))
+            bnd_index.append(ids[on])
+            bnd_axis.append(np.full(int(on.sum()), axis, dtype=np.int64))
+    keys = np.concatenate(edge_parts) if edge_parts else np.zeros(0, dtype=np.int64)
+    coefs = np.concatenate(coef_parts) if coef_parts else np.zeros(0, dtype=dtype)
+    order = np.argsort(keys, kind="stable")
+    keys, coefs = keys[order], coefs[order]
+    first = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]]) if len(keys) else np.zeros(0, dtype=np.int64)
+    coefficient_exact = np.add.reduceat(coefs, first) if len(keys) else coefs
+    unique = keys[first]
+    edges = np.stack([unique // n_vertices, unique % n_vertices], axis=1)
+    volume_exact = np.zeros(n_vertices, dtype=dtype)
+    if vol_parts:
+        np.add.at(volume_exact, np.concatenate(vol_index), np.concatenate(vol_parts))
+    lengths = np.array(box.to_float())
+    real = verts * (lengths / grid)
+    factor = math.sqrt(factor_squared)
+    coefficient = coefficient_exact.astype(np.float64) * (factor / (cden * grid))
+    edge_vectors = real[edges[:, 1]] - real[edges[:, 0]]
+    length = np.sqrt((edge_vectors ** 2).sum(axis=1))
+    control_volume = volume_exact.astype(np.float64) * (factor / (vden * float(grid) ** 3))
+    boundary = np.any((verts == 0) | (verts == grid), axis=1)
+    boundary_area = np.zeros(n_vertices)
+    if bnd_parts:
+        plane_factor = np.array([math.sqrt(squared[(k + 1) % 3] * squared[(k + 2) % 3]) for k in range(3)])
+        pieces = np.concatenate(bnd_parts).astype(np.float64) * plane_factor[np.concatenate(bnd_axis)]
+        np.add.at(boundary_area, np.concatenate(bnd_index), pieces / (bden * float(grid) ** 2))
+    return Dual(box, grid, verts, real, edges, length, coefficient * length, coefficient, control_volume, boundary,
+                boundary_area, coefficient_exact, cden * grid, volume_exact, vden * grid ** 3, factor,
+                factor_squared, centers)
+
+
+def _leaf_groups(mesh, squared):
+    """Per configuration: its pieces, the global vertex ids of its leaves' slots, the leaves' sizes."""
+    sizes = mesh.leaf_size()
+    lengths = np.array(mesh.box.to_float())
+    origin = mesh.tree.positions.astype(np.int64) * sizes[:, None]
+    centers = np.zeros((len(mesh), 3))
+    groups = []
+    for _, pattern, leaves in mesh.groups():
+        first = mesh.element_offsets[leaves]
+        for j, element in enumerate(pattern.elements):
+            if element.center is None:
+                raise ValueError(f"configuration {pattern.code}: element {j} is not co-spherical: it has no dual")
+            centers[first + j] = (origin[leaves] + np.array([float(x) for x in element.center]) * sizes[leaves, None]
+                                  ) * (lengths / mesh.grid)
+        groups.append((_pattern_shape(pattern, squared), mesh.slots[leaves].astype(np.int64), sizes[leaves]))
+    return groups, centers
+
+
+_SHAPES: dict[tuple, _Shape] = {}
+
+
+def _pattern_shape(pattern, squared) -> _Shape:
+    """A configuration's pieces, remembered by its code, box and element node lists (meshes share them)."""
+    key = (pattern.code, squared, tuple(e.nodes for e in pattern.elements))
+    shape = _SHAPES.get(key)
+    if shape is None:
+        points = pattern.configuration.nodes()
+        shape = _SHAPES[key] = _Shape([element_pieces({n: points[n] for n in e.nodes}, e.faces, e.center, squared)
+                                       for e in pattern.elements])
+    return shape
+
+
+def _element_groups(mesh, squared, conn: np.ndarray, element_sizes: np.ndarray):
+    """Per distinct element shape (up to translation and powers of two): its pieces, vertex ids, scalings."""
+    verts = np.asarray(mesh.vertices, dtype=np.int64)
+    lengths = np.array(mesh.box.to_float())
+    centers = np.zeros((len(conn), 3))
+    by_shape: dict[tuple, tuple[_Shape, list, list]] = {}
+    for e in range(len(conn)):
+        ids = conn[e, :int(element_sizes[e])].astype(np.int64)
+        coords = verts[ids]
+        low = coords.min(axis=0)
+        rel = coords - low
+        scale = math.gcd(*(int(x) for x in rel.reshape(-1)))
+        scale = scale & -scale  # the largest power of two dividing every offset
+        key = tuple(map(tuple, (rel // scale).tolist()))
+        entry = by_shape.get(key)
+        if entry is None:
+            points = {n: tuple(Fraction(int(x)) for x in p) for n, p in enumerate(key)}
+            frame = Frame.build(points, squared)
+            members = list(range(len(key)))
+            faces = [cycle for cycle, _ in hull_faces(frame, members)]
+            sphere = frame.sphere(*_spanning(frame, members))
+            if sphere is None or any(sphere.side(frame.lifted[m]) != 0 for m in members):
+                raise ValueError(f"element {e} is not co-spherical: it has no dual")
+            center = frame.center(sphere)
+            entry = by_shape[key] = (_Shape([element_pieces(points, faces, center, squared)]), [], [], center)
+        entry[1].append(ids)
+        entry[2].append(scale)
+        centers[e] = (low + np.array([float(x) for x in entry[3]]) * scale) * (lengths / mesh.grid)
+    groups = [(shape, np.array(ids, dtype=np.int64), np.array(scales, dtype=np.int64))
+              for shape, ids, scales, _ in by_shape.values()]
+    return groups, centers
+
+
+def _spanning(frame: Frame, members: list[int]) -> tuple[int, int, int, int]:
+    """Four members not in one plane (an element has them: it has volume)."""
+    from itertools import combinations
+
+    for quad in combinations(members, 4):
+        if frame.orient(*quad) != 0:
+            return quad
+    raise ValueError("a flat element: it has no dual")
