@@ -11,7 +11,7 @@ from cospherical.cli import main
 from cospherical.core.configuration import Box, Configuration
 from cospherical.core.tessellation import tessellate
 from cospherical.files.yamlio import atomic_write, yaml_text
-from cospherical.formats.mesh import read_leaves, table_lookup, to_meshio, write_vtu
+from cospherical.formats.mesh import read_leaves, table_lookup
 from cospherical.formats.patterns import configuration_line, load
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
@@ -144,20 +144,6 @@ def test_global_delaunay_equals_brute_force_on_a_brick():
     assert (found["delaunay_violating_pairs"], found["delaunay_violations"]) == (pairs, elements)
     assert found["delaunay_violations"] > 0
     assert check_circumcenters(mesh)["leaves_not_fvm_adequate"] > 0
-
-
-def test_vtu_reads_back(tmp_path):
-    import meshio
-
-    mesh = assemble(octant_tree())
-    write_vtu(mesh, tmp_path / "mesh.vtu")
-    back = meshio.read(tmp_path / "mesh.vtu")
-    assert len(back.points) == len(mesh.vertices)
-    assert sum(len(block.data) for block in back.cells) == len(mesh)
-    leaves = np.concatenate(back.cell_data["leaf"])
-    assert sorted(leaves.tolist()) == sorted(mesh.element_leaf.tolist())
-    standard = assemble(build_octree(CUBE, 0, []))  # one cuboid: a VTK hexahedron
-    assert to_meshio(standard).cells[0].type == "hexahedron"
 
 
 def test_cli_report_and_outputs(tmp_path, capsys):

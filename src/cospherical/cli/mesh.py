@@ -141,12 +141,12 @@ def run(args) -> int:
         from ..formats.mesh import write_vtu
         from ..outputs.mesh_picture import cut_png
 
-        write_report(report, args.out / "report.json")
         write_vtu(mesh, args.out / "mesh.vtu")
         shapes = ", ".join(described.get("refine", [])) or described.get("file", "")
         cut_png(mesh, args.out / "mesh.png", at=at,
                 title=f"{' x '.join(box.texts)}: {shapes}; {report['leaves']:,} leaves, {report['elements']:,} "
                       f"elements, {report['types']} types (cut at z = {at * float(box.c):.4g})")
+        write_report(report, args.out / "report.json")  # last: no report beside a mesh that was not written
     timings["outputs"] = time.perf_counter() - clock
     if args.format == "json":
         sys.stdout.write(report_json(report))

@@ -26,9 +26,8 @@ from ..core.configuration import POINT_POLICIES, Box, Configuration
 from ..errors import FormatError, InputError
 from ..files.yamlio import atomic_write, check_nesting, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
-from .vtu import write_meshio
 
-__all__ = ["REPORT_SCHEMA_VERSION", "read_leaves", "report_json", "table_lookup", "to_meshio", "write_report",
+__all__ = ["REPORT_SCHEMA_VERSION", "read_leaves", "report_json", "table_lookup", "vtu_arrays", "write_report",
            "write_vtu"]
 
 REPORT_SCHEMA_VERSION = 1
@@ -118,57 +117,108 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table") -
     return lookup
 
 
-def to_meshio(mesh: Mesh):
-    """The mesh as a :class:`meshio.Mesh` in real coordinates.
+def vtu_arrays(mesh: Mesh) -> dict:
+    """The mesh as the arrays of a VTU grid (see :func:`write_vtu`), built per configuration, never per element.
 
-    Standard VTK cells (tetra, pyramid, wedge, hexahedron) when every element has
-    one, else every element as a polyhedron with its faces (VTU cannot mix them).
-    Cell data: ``type`` (index into the sorted type ids, listed in the report),
-    ``type_hash`` (the type id's 6 hex digits as an integer), ``leaf`` and ``fvm``
-    (its circumcenter lies in its closed leaf).
+    Cells are sorted by VTK cell type (stable: in element order within a type), so a
+    reader that groups cells into blocks of one type (meshio) meets few blocks;
+    ``order[c]`` is the element written as cell ``c``.
     """
-    import meshio
+    from .vtu import VTK_CELL
 
-    points = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
     ids, element_type = mesh.element_types()
-    hashes = np.array([int(t.rsplit("-", 1)[1], 16) for t in ids], dtype=np.int64)
-    fvm = mesh.element_fvm()
-    vtk = [mesh.types.get(t, {}).get("vtk") for t in ids]
+    kind_of_type = np.array([VTK_CELL[mesh.types.get(t, {}).get("vtk") or "polyhedron"] for t in ids],
+                            dtype=np.uint8)
+    kinds = kind_of_type[element_type] if len(ids) else np.zeros(0, dtype=np.uint8)
+    order = np.argsort(kinds, kind="stable")
     conn, sizes = mesh.connectivity()
-    cells, data = [], {"type": [], "type_hash": [], "leaf": [], "fvm": []}
+    conn = conn[order]
+    connectivity = conn[conn >= 0].astype(np.int64)  # row by row: each cell's points in turn
+    offsets = np.cumsum(sizes[order], dtype=np.int64)
+    # polyhedra: a face stream per element (faces, then per face its size and points), laid out per configuration
+    polyhedral = kinds == VTK_CELL["polyhedron"]
+    stream = np.zeros(len(mesh), dtype=np.int64)
+    templates = {}
+    for p, pattern in enumerate(mesh.patterns):
+        for j, element in enumerate(pattern.elements):
+            if kind_of_type[ids.index(element.type_id)] == VTK_CELL["polyhedron"]:
+                items = [-1 - len(element.faces)] + [x for f in element.faces for x in (-1 - len(f), *f)]
+                templates[p, j] = np.array(items, dtype=np.int64)
+    faces = faceoffsets = None
+    if polyhedral.any():
+        groups = list(mesh.groups())
+        for p, pattern, leaves in groups:
+            for j in range(len(pattern.elements)):
+                if (p, j) in templates:
+                    stream[mesh.element_offsets[leaves] + j] = len(templates[p, j])
+        cells = order[polyhedral[order]]  # the polyhedra in cell order
+        ends = np.cumsum(stream[cells])
+        start = np.zeros(len(mesh), dtype=np.int64)
+        start[cells] = ends - stream[cells]
+        faces = np.empty(int(ends[-1]), dtype=np.int64)
+        for p, pattern, leaves in groups:
+            for j in range(len(pattern.elements)):
+                template = templates.get((p, j))
+                if template is None or not len(leaves):
+                    continue
+                # node ids (>= 0) become the leaves' vertices; a count is stored as -1 - count
+                nodes = template >= 0
+                values = np.broadcast_to(np.where(nodes, 0, -1 - template), (len(leaves), len(template))).copy()
+                values[:, nodes] = mesh.slots[np.ix_(leaves, template[nodes])]
+                faces[(start[mesh.element_offsets[leaves] + j])[:, None] + np.arange(len(template))] = values
+        faceoffsets = np.full(len(mesh), -1, dtype=np.int64)
+        faceoffsets[polyhedral[order]] = ends
+    return {"ids": ids, "order": order, "types": kinds[order], "connectivity": connectivity, "offsets": offsets,
+            "faces": faces, "faceoffsets": faceoffsets, "element_type": element_type}
 
-    def block(rows: np.ndarray):
-        data["type"].append(element_type[rows])
-        data["type_hash"].append(hashes[element_type[rows]])
-        data["leaf"].append(mesh.element_leaf[rows].astype(np.int64))
-        data["fvm"].append(fvm[rows].astype(np.int8))
 
-    if all(vtk):
-        kinds = np.array(vtk, dtype=object)[element_type]
-        for kind in sorted(set(vtk)):
-            rows = np.flatnonzero(kinds == kind)
-            width = int(sizes[rows[0]])
-            cells.append(meshio.CellBlock(kind, conn[rows, :width].astype(np.int64)))
-            block(rows)
-    else:
-        element_faces: list = [None] * len(mesh)  # per element, its faces in global ids
-        for _, pattern, leaves in mesh.groups():
-            first = mesh.element_offsets[leaves]
-            slots = mesh.slots[leaves]
-            for j, element in enumerate(pattern.elements):
-                local = [slots[:, list(cycle)] for cycle in element.faces]
-                for n, e in enumerate((first + j).tolist()):
-                    element_faces[e] = [f[n] for f in local]
-        for width in sorted(set(sizes.tolist())):
-            rows = np.flatnonzero(sizes == width)
-            cells.append(meshio.CellBlock(f"polyhedron{width}", [element_faces[e] for e in rows.tolist()]))
-            block(rows)
-    return meshio.Mesh(points, cells, cell_data=data)
+def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell_data: dict | None = None) -> None:
+    """Write the mesh as one compressed binary VTU grid, atomically (a complete new file or the old one).
 
+    Standard VTK cells (tetra, pyramid, wedge, hexahedron, nodes in VTK order) for
+    the elements that are one, ``VTK_POLYHEDRON`` with faces for the others, sorted
+    by cell type; the cell data say which element each cell is.
 
-def write_vtu(mesh: Mesh, path: str | Path) -> None:
-    """Write the mesh as VTU, atomically (a complete new file or the old one)."""
-    write_meshio(to_meshio(mesh), path)
+    Point data: ``grid_coordinates`` (the exact integer grid point of each vertex),
+    then ``point_data`` (one row per vertex, in ``mesh.vertices`` order).
+    Cell data: ``element`` (the element's index in the mesh), ``type`` (index into
+    the field data ``type_ids``), ``leaf``, ``fvm`` (its circumcenter lies in its
+    closed leaf, decided exactly), then ``cell_data`` (one row per element, in
+    element order: written in cell order).
+    Field data (text as UTF-8 bytes, ``bytes(array).decode()``): ``type_ids`` and
+    ``type_names`` (one per line, in ``type`` order), ``domain`` (the lengths as
+    given), ``domain_squared`` (their exact squares), and ``grid_intervals``: a point's
+    exact coordinate along an axis is ``grid_coordinates * length / grid_intervals``;
+    the ``Points`` are the same as floats.
+    """
+    from .vtu import text_array, write_grid
+
+    arrays = vtu_arrays(mesh)
+    order = arrays["order"]
+    ids = arrays["ids"]
+    fields = {
+        "type_ids": text_array("\n".join(ids)),
+        "type_names": text_array("\n".join(mesh.types.get(t, {}).get("name") or t for t in ids)),
+        "domain": text_array(" ".join(mesh.box.texts)),
+        "domain_squared": text_array(" ".join(str(s) for s in mesh.box.squared)),
+        "grid_intervals": np.array([mesh.grid], dtype=np.int64),
+    }
+    cells = {"element": order.astype(np.int32), "type": arrays["element_type"][order].astype(np.int32),
+             "leaf": mesh.element_leaf[order].astype(np.int32), "fvm": mesh.element_fvm()[order].astype(np.uint8)}
+    for name, values in (cell_data or {}).items():
+        if name in cells:
+            raise ValueError(f"cell data {name!r}: the writer's own")
+        if len(values) != len(mesh):
+            raise ValueError(f"cell data {name!r}: {len(values)} rows for {len(mesh)} elements")
+        cells[name] = np.asarray(values)[order]
+    points = {"grid_coordinates": mesh.vertices.astype(np.int64)}
+    for name, values in (point_data or {}).items():
+        if name in points:
+            raise ValueError(f"point data {name!r}: the writer's own")
+        points[name] = values
+    coordinates = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+    write_grid(path, coordinates, arrays["types"], arrays["connectivity"], arrays["offsets"], arrays["faces"],
+               arrays["faceoffsets"], point_data=points, cell_data=cells, field_data=fields)
 
 
 def report_json(report: dict) -> str:

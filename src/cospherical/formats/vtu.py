@@ -1,23 +1,123 @@
-"""Mesh export: a tessellation as a VTU file (meshio) that opens in ParaView.
+"""VTU files (VTK XML unstructured grids) written from numpy arrays, and a tessellation as one.
 
-Standard elements are written as VTK tetra, pyramid, wedge and hexahedron cells.
-VTU cannot mix polyhedral cells with other kinds, so when any element has no
-VTK cell type every element is written as a VTK_POLYHEDRON with its faces.
-Cell data: ``type_hash`` (the 6 hex digits of the element type id, as an
-integer) and ``vertices``.
+:func:`write_grid` writes one unstructured grid, every array zlib-compressed in
+the file's appended section as raw binary (VTK's own layout: a ``UInt64``
+header of block sizes, then the compressed blocks).  That is what ParaView and
+``vtkXMLUnstructuredGridReader`` read fastest, and meshio reads it too.  The
+bytes depend only on the arrays: no time stamp, no machine name, so the same
+mesh gives the same file.
+
+Cells are VTK's standard ones (tetra, pyramid, wedge, hexahedron: nodes in
+VTK order) where an element is one, and ``VTK_POLYHEDRON`` with its faces
+(``faces``/``faceoffsets``, the layout VTK has always read) only for the
+others, all in the one grid.  meshio's VTU reader (5.3) refuses a grid that
+mixes polyhedra with other cells; VTK and ParaView read it.
 """
 
 from __future__ import annotations
 
+import zlib
 from pathlib import Path
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 from ..core.tessellation import Tessellation
 from ..errors import InputError
-from ..files.yamlio import atomic_path
+from ..files.yamlio import atomic_open, atomic_path
 
-__all__ = ["to_meshio", "write_meshio", "write_vtu"]
+__all__ = ["VTK_CELL", "to_meshio", "write_grid", "write_meshio", "write_vtu"]
+
+# VTK's cell type numbers (vtkCellType.h) of the cells an element can be.
+VTK_CELL = {"tetra": 10, "hexahedron": 12, "wedge": 13, "pyramid": 14, "polyhedron": 42}
+_VTK_TYPE = {np.dtype(t): name for t, name in (
+    (np.int8, "Int8"), (np.uint8, "UInt8"), (np.int16, "Int16"), (np.uint16, "UInt16"), (np.int32, "Int32"),
+    (np.uint32, "UInt32"), (np.int64, "Int64"), (np.uint64, "UInt64"), (np.float32, "Float32"),
+    (np.float64, "Float64"))}
+# Large blocks: fewer zlib calls and headers; meshio joins a file's blocks by repeated
+# concatenation, which is quadratic in their number.
+BLOCK = 1 << 22
+LEVEL = 1  # zlib's fastest level: the arrays are small integers, level 6 saves little more
+
+
+def _compressed(array: np.ndarray) -> bytes:
+    """An array in VTK's compressed layout: (blocks, block size, last block size, compressed sizes), blocks."""
+    raw = memoryview(np.ascontiguousarray(array).view(np.uint8).reshape(-1))
+    blocks = [zlib.compress(raw[i:i + BLOCK], LEVEL) for i in range(0, len(raw), BLOCK)]
+    header = np.array([len(blocks), BLOCK, len(raw) % BLOCK] + [len(b) for b in blocks], dtype="<u8")
+    return header.tobytes() + b"".join(blocks)
+
+
+def _array(name: str, data: np.ndarray) -> tuple[str, np.ndarray, int]:
+    data = np.asarray(data)
+    if data.dtype == bool:
+        data = data.astype(np.uint8)
+    if data.dtype.newbyteorder("=") not in _VTK_TYPE:
+        raise ValueError(f"{name}: no VTK array type for {data.dtype}")
+    data = data.astype(data.dtype.newbyteorder("<"), copy=False)
+    return name, data, 1 if data.ndim == 1 else int(np.prod(data.shape[1:]))
+
+
+def text_array(text: str) -> np.ndarray:
+    """Text as a ``UInt8`` array of its UTF-8 bytes: field data every VTU reader takes (meshio has no strings)."""
+    return np.frombuffer(text.encode(), dtype=np.uint8)
+
+
+def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, connectivity: np.ndarray,
+               offsets: np.ndarray, faces: np.ndarray | None = None, faceoffsets: np.ndarray | None = None,
+               point_data: dict | None = None, cell_data: dict | None = None,
+               field_data: dict | None = None) -> None:
+    """Write one unstructured grid as a compressed binary VTU, atomically.
+
+    ``connectivity`` lists every cell's points one after the other, ``offsets`` is
+    where each cell ends in it (VTK's layout); for ``VTK_POLYHEDRON`` cells ``faces``
+    holds each one's face stream (number of faces, then per face its number of points
+    and the points) and ``faceoffsets`` where that stream ends (-1 for other cells).
+    Data arrays have one row per point, per cell, or any length (field data).
+    """
+    arrays: list[tuple[str, list[tuple[str, np.ndarray, int]]]] = [
+        ("FieldData", [_array(k, v) for k, v in (field_data or {}).items()]),
+        ("PointData", [_array(k, v) for k, v in (point_data or {}).items()]),
+        ("CellData", [_array(k, v) for k, v in (cell_data or {}).items()]),
+        ("Points", [_array("Points", np.asarray(points, dtype=np.float64))]),
+        ("Cells", [_array("connectivity", connectivity), _array("offsets", offsets),
+                   _array("types", np.asarray(cell_types, dtype=np.uint8))]
+         + ([_array("faces", faces), _array("faceoffsets", faceoffsets)] if faces is not None else [])),
+    ]
+    n_points, n_cells = len(points), len(cell_types)
+    for section, items in arrays[1:3]:
+        for name, data, _ in items:
+            if len(data) != (n_points if section == "PointData" else n_cells):
+                raise ValueError(f"{section} {name}: {len(data)} rows for {n_points} points and {n_cells} cells")
+    xml, blobs, offset = [], [], 0
+
+    def data_array(name: str, data: np.ndarray, components: int, tuples: bool) -> str:
+        nonlocal offset
+        blob = _compressed(data)
+        blobs.append(blob)
+        text = (f'<DataArray type="{_VTK_TYPE[data.dtype.newbyteorder("=")]}" Name={quoteattr(name)} '
+                + (f'NumberOfTuples="{len(data)}" ' if tuples else "")
+                + (f'NumberOfComponents="{components}" ' if components != 1 or tuples else "")
+                + f'format="appended" offset="{offset}"/>')
+        offset += len(blob)
+        return text
+
+    for section, items in arrays:
+        if section == "FieldData":
+            xml.append("<UnstructuredGrid>")
+            body = [data_array(n, d, c, True) for n, d, c in items]
+            xml += ["<FieldData>", *body, "</FieldData>"] if body else []
+            xml.append(f'<Piece NumberOfPoints="{n_points}" NumberOfCells="{n_cells}">')
+        else:
+            xml += [f"<{section}>", *(data_array(n, d, c, False) for n, d, c in items), f"</{section}>"]
+    head = ('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+            'header_type="UInt64" compressor="vtkZLibDataCompressor">\n' + "\n".join(xml)
+            + '\n</Piece>\n</UnstructuredGrid>\n<AppendedData encoding="raw">\n_')
+    with atomic_open(path, binary=True) as handle:
+        handle.write(head.encode())
+        for blob in blobs:
+            handle.write(blob)
+        handle.write(b"\n</AppendedData>\n</VTKFile>\n")
 
 
 def to_meshio(tess: Tessellation):

@@ -1,0 +1,173 @@
+"""The mesh VTU: read back by VTK (ParaView's reader) and meshio, cell for cell; exact data alongside; atomic."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from fractions import Fraction
+
+import numpy as np
+import vtk
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from vtk.util.numpy_support import vtk_to_numpy
+
+from cospherical.core.configuration import Box
+from cospherical.formats.mesh import write_vtu
+from cospherical.mesh.assembly import assemble
+from cospherical.mesh.octree import build_octree, parse_shape
+
+CUBE = Box.parse(["1", "1", "1"])
+# 253 leaves, 449 elements of six types: two of them have no VTK cell (polyhedra)
+MIXED = ("plane:1,2,3,2", 3)
+
+
+def mixed_mesh(box=CUBE):
+    shape, levels = MIXED
+    return assemble(build_octree(box, levels, [parse_shape(shape)]))
+
+
+def read_vtk(path):
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    return reader.GetOutput()
+
+
+def cell_array(grid, name):
+    return vtk_to_numpy(grid.GetCellData().GetArray(name))
+
+
+def field_text(grid, name) -> str:
+    return bytes(vtk_to_numpy(grid.GetFieldData().GetArray(name))).decode()
+
+
+def test_vtk_reads_the_same_cells_node_orders_and_data(tmp_path):
+    mesh = mixed_mesh()
+    fvm = np.arange(len(mesh)) % 3 == 0  # any per-element data comes back with its element
+    write_vtu(mesh, tmp_path / "mesh.vtu", point_data={"label": np.arange(len(mesh.vertices)) * 7},
+              cell_data={"mark": fvm.astype(np.int8)})
+    grid = read_vtk(tmp_path / "mesh.vtu")
+    assert (grid.GetNumberOfPoints(), grid.GetNumberOfCells()) == (len(mesh.vertices), len(mesh))
+    element = cell_array(grid, "element")
+    assert sorted(element.tolist()) == list(range(len(mesh)))
+    types = vtk_to_numpy(grid.GetCellTypes())
+    kinds = set(types.tolist())
+    assert {vtk.VTK_TETRA, vtk.VTK_HEXAHEDRON, vtk.VTK_POLYHEDRON} <= kinds
+    # the type names come back from the field data, and say which cell each element is
+    ids = field_text(grid, "type_ids").split("\n")
+    names = field_text(grid, "type_names").split("\n")
+    assert len(ids) == len(names) == len(mesh.types)
+    expected = {"tetra": vtk.VTK_TETRA, "pyramid": vtk.VTK_PYRAMID, "wedge": vtk.VTK_WEDGE,
+                "hexahedron": vtk.VTK_HEXAHEDRON, None: vtk.VTK_POLYHEDRON}
+    assert [expected[mesh.types[ids[t]]["vtk"]] for t in cell_array(grid, "type")] == types.tolist()
+    conn, sizes = mesh.connectivity()
+    stream = vtk.vtkIdList()
+    for c in range(len(mesh)):
+        e = int(element[c])
+        points = vtk.vtkIdList()
+        grid.GetCellPoints(c, points)
+        assert [points.GetId(i) for i in range(points.GetNumberOfIds())] == conn[e, :sizes[e]].tolist()
+        if types[c] == vtk.VTK_POLYHEDRON:  # its faces, counter-clockwise from outside, as the element's
+            grid.GetFaceStream(c, stream)
+            got = [stream.GetId(i) for i in range(stream.GetNumberOfIds())]
+            leaf, local = int(mesh.element_leaf[e]), int(mesh.element_local[e])
+            faces = mesh.patterns[mesh.leaf_pattern[leaf]].elements[local].faces
+            want = [len(faces)] + [x for f in faces for x in (len(f), *mesh.slots[leaf, list(f)].tolist())]
+            assert got == want
+    assert (cell_array(grid, "leaf") == mesh.element_leaf[element]).all()
+    assert (cell_array(grid, "fvm") == mesh.element_fvm()[element]).all()
+    assert (cell_array(grid, "mark") == fvm[element]).all()
+    assert (vtk_to_numpy(grid.GetPointData().GetArray("label")) == np.arange(len(mesh.vertices)) * 7).all()
+    # exact coordinates alongside the floats
+    exact = vtk_to_numpy(grid.GetPointData().GetArray("grid_coordinates"))
+    assert (exact == mesh.vertices).all()
+    intervals = int(vtk_to_numpy(grid.GetFieldData().GetArray("grid_intervals"))[0])
+    assert intervals == mesh.grid
+    assert [Fraction(s) for s in field_text(grid, "domain_squared").split()] == list(mesh.box.squared)
+    points = vtk_to_numpy(grid.GetPoints().GetData())
+    assert (points == exact / intervals).all()  # dyadic: the floats are exact too
+
+
+def test_vtk_finds_every_cell_valid_and_the_volumes_exact(tmp_path):
+    """VTK's own validity test (orientation, convexity, faces) and its cell volumes against the exact ones."""
+    mesh = mixed_mesh()
+    write_vtu(mesh, tmp_path / "mesh.vtu")
+    grid = read_vtk(tmp_path / "mesh.vtu")
+    validator = vtk.vtkCellValidator()
+    validator.SetInputData(grid)
+    validator.Update()
+    assert (vtk_to_numpy(validator.GetOutput().GetCellData().GetArray("ValidityState")) == 0).all()
+    sizes = vtk.vtkCellSizeFilter()
+    sizes.SetInputData(grid)
+    sizes.Update()
+    volume = vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume"))
+    element = cell_array(grid, "element")
+    leaf = mesh.element_leaf[element]
+    exact = [float(mesh.patterns[mesh.leaf_pattern[i]].elements[j].unit_volume / 8 ** int(mesh.tree.levels[i]))
+             for i, j in zip(leaf.tolist(), mesh.element_local[element].tolist())]
+    assert np.allclose(volume, exact, rtol=1e-12, atol=0)
+    assert abs(volume.sum() - 1) < 1e-12
+
+
+def test_meshio_reads_it(tmp_path):
+    """meshio reads a grid of standard cells (its VTU reader refuses polyhedra mixed with other cells)."""
+    import meshio
+
+    mesh = assemble(build_octree(CUBE, 3, [parse_shape("point:0.3,0.4,0.45")]))
+    assert all(info["vtk"] for info in mesh.types.values())
+    write_vtu(mesh, tmp_path / "mesh.vtu")
+    back = meshio.read(tmp_path / "mesh.vtu")
+    assert (back.points == mesh.vertices / mesh.grid).all()
+    element = np.concatenate(back.cell_data["element"])
+    assert sorted(element.tolist()) == list(range(len(mesh)))
+    assert len(back.cells) == len({info["vtk"] for info in mesh.types.values()})  # one block per cell type
+    conn, _ = mesh.connectivity()
+    ids = bytes(back.field_data["type_ids"]).decode().split("\n")
+    types = np.concatenate(back.cell_data["type"])
+    at = 0
+    for block in back.cells:
+        rows = element[at:at + len(block.data)]
+        assert (block.data == conn[rows, :block.data.shape[1]]).all()
+        assert {mesh.types[ids[t]]["vtk"] for t in types[at:at + len(block.data)]} == {block.type}
+        at += len(block.data)
+    assert (back.point_data["grid_coordinates"] == mesh.vertices).all()
+
+
+@settings(max_examples=8, deadline=None)
+@given(st.tuples(*[st.integers(1, 15)] * 3), st.integers(1, 3))
+def test_the_same_mesh_gives_the_same_bytes_and_vtk_the_whole_volume(tmp_path_factory, point, levels):
+    folder = tmp_path_factory.mktemp("vtu")
+    shape = parse_shape("point:" + ",".join(f"{x / 16}" for x in point))
+    mesh = assemble(build_octree(CUBE, levels, [shape]))
+    write_vtu(mesh, folder / "a.vtu")
+    write_vtu(assemble(build_octree(CUBE, levels, [shape])), folder / "b.vtu")
+    assert (folder / "a.vtu").read_bytes() == (folder / "b.vtu").read_bytes()
+    sizes = vtk.vtkCellSizeFilter()
+    sizes.SetInputData(read_vtk(folder / "a.vtu"))
+    sizes.Update()
+    assert abs(vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume")).sum() - 1) < 1e-12
+
+
+def test_a_full_disk_leaves_the_old_file(tmp_path):
+    """A write that fails part way (a file size limit: the kernel refuses the bytes) leaves the old file, no temporary."""
+    path = tmp_path / "mesh.vtu"
+    path.write_bytes(b"old")
+    program = (
+        "import resource, signal, sys\n"
+        "from cospherical.core.configuration import Box\n"
+        "from cospherical.formats.mesh import write_vtu\n"
+        "from cospherical.mesh.assembly import assemble\n"
+        "from cospherical.mesh.octree import build_octree, parse_shape\n"
+        f"mesh = assemble(build_octree(Box.parse([1, 1, 1]), {MIXED[1]}, [parse_shape({MIXED[0]!r})]))\n"
+        "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+        "resource.setrlimit(resource.RLIMIT_FSIZE, (2000, 2000))\n"
+        "from cospherical.errors import InputError\n"
+        "try:\n"
+        f"    write_vtu(mesh, {str(path)!r})\n"
+        "except InputError as error:\n"
+        "    sys.exit(str(error))\n")
+    result = subprocess.run([sys.executable, "-c", program], check=False, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 1 and "cannot write" in result.stderr and "Traceback" not in result.stderr
+    assert path.read_bytes() == b"old"
+    assert [p.name for p in tmp_path.iterdir()] == ["mesh.vtu"]
