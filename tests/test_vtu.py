@@ -171,3 +171,36 @@ def test_a_full_disk_leaves_the_old_file(tmp_path):
     assert result.returncode == 1 and "cannot write" in result.stderr and "Traceback" not in result.stderr
     assert path.read_bytes() == b"old"
     assert [p.name for p in tmp_path.iterdir()] == ["mesh.vtu"]
+
+
+def test_the_picture_cuts_what_vtk_cuts(tmp_path):
+    """The picture's sections are VTK's cut of the same grid by the same plane (vtkCutter), element for element."""
+    from cospherical.outputs.mesh_picture import cut_polygons
+
+    mesh = mixed_mesh()
+    write_vtu(mesh, tmp_path / "mesh.vtu")
+    at = 0.3
+    polygons, types = cut_polygons(mesh, at)
+    plane = vtk.vtkPlane()
+    plane.SetOrigin(0, 0, (round(at * mesh.grid) + 1 / 3) / mesh.grid)
+    plane.SetNormal(0, 0, 1)
+    cutter = vtk.vtkCutter()
+    cutter.SetCutFunction(plane)
+    cutter.SetInputData(read_vtk(tmp_path / "mesh.vtu"))
+    sizes = vtk.vtkCellSizeFilter()
+    sizes.SetInputConnection(cutter.GetOutputPort())
+    sizes.Update()
+    cut = sizes.GetOutput()
+    element = vtk_to_numpy(cut.GetCellData().GetArray("element"))
+    area = np.bincount(element, vtk_to_numpy(cut.GetCellData().GetArray("Area")), minlength=len(mesh))
+    theirs = np.sort(area[area > 0])
+
+    def shoelace(p):
+        x, y = p[:, 0], p[:, 1]
+        return 0.5 * (x * np.roll(y, -1) - np.roll(x, -1) * y).sum()
+
+    ours = np.array([shoelace(p) for p in polygons])
+    assert (ours > 0).all()  # convex, counter-clockwise
+    assert len(ours) == len(theirs) == len(types)
+    assert np.allclose(np.sort(ours), theirs, rtol=1e-9, atol=1e-15)
+    assert abs(ours.sum() - 1) < 1e-12

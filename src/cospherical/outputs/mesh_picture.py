@@ -16,8 +16,10 @@ def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[st
     """The sections of the elements by the plane z = ``at`` (fraction of the domain height), in real x, y.
 
     The plane is moved by a third of the finest grid step off ``at`` so that no face
-    lies in it (a section is then always a proper polygon).  Returns the polygons and
-    each one's element type id.
+    lies in it (a section is then always a proper convex polygon, its corners where
+    the element's edges cross the plane).  Computed per configuration element on all
+    its leaves at once: the leaves whose edges cross in the same way share one array.
+    Returns the polygons and each one's element type id.
     """
     grid = mesh.grid
     z0 = round(at * grid) + 1 / 3
@@ -27,24 +29,28 @@ def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[st
         slots = mesh.slots[leaves]
         for element in pattern.elements:
             nodes = list(element.nodes)
-            pts = mesh.vertices[slots[:, nodes]].astype(float)  # (leaves, nodes, 3)
-            z = pts[:, :, 2]
+            z = mesh.vertices[slots[:, nodes], 2]  # (leaves, nodes)
             crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
             if not len(crossing):
                 continue
-            index = {n: i for i, n in enumerate(nodes)}
-            edges = {tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in element.faces for i in range(len(c))}
-            a = np.array([index[p] for p, _ in edges])
-            b = np.array([index[q] for _, q in edges])
-            for leaf_points in pts[crossing]:
-                za, zb = leaf_points[a, 2], leaf_points[b, 2]
-                cut = (za - z0) * (zb - z0) < 0
-                t = (z0 - za[cut]) / (zb[cut] - za[cut])
-                xy = leaf_points[a[cut], :2] + t[:, None] * (leaf_points[b[cut], :2] - leaf_points[a[cut], :2])
-                centre = xy.mean(axis=0)
-                xy = xy[np.argsort(np.arctan2(xy[:, 1] - centre[1], xy[:, 0] - centre[0]))]
-                polygons.append(xy * scale[:2])
-                types.append(element.type_id)
+            edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in element.faces for i in range(len(c))})
+            a = slots[np.ix_(crossing, [p for p, _ in edges])]  # (crossing leaves, edges): vertex ids
+            b = slots[np.ix_(crossing, [q for _, q in edges])]
+            pa, pb = mesh.vertices[a].astype(float), mesh.vertices[b].astype(float)  # (leaves, edges, 3)
+            za, zb = pa[..., 2] - z0, pb[..., 2] - z0
+            cut = za * zb < 0
+            masks = (cut.astype(np.int64) << np.arange(len(edges))).sum(axis=1)
+            for mask in np.unique(masks).tolist():
+                rows = np.flatnonzero(masks == mask)
+                which = np.flatnonzero(cut[rows[0]])
+                ra, rb = pa[rows][:, which], pb[rows][:, which]  # (rows, corners, 3)
+                t = (za[rows][:, which] / (za[rows][:, which] - zb[rows][:, which]))[..., None]
+                xy = (ra + t * (rb - ra))[..., :2]
+                centre = xy.mean(axis=1, keepdims=True)
+                angle = np.arctan2(xy[..., 1] - centre[..., 1], xy[..., 0] - centre[..., 0])
+                xy = np.take_along_axis(xy, np.argsort(angle, axis=1)[..., None], axis=1) * scale[:2]
+                polygons.extend(xy)
+                types.extend([element.type_id] * len(rows))
     return polygons, types
 
 
