@@ -184,3 +184,68 @@ def test_control_volumes_and_face_areas_are_voro_plus_plus_cells(name):
     """On cube octrees the dual is the Voronoi diagram clipped to the domain: voro++ agrees to 1e-12."""
     tree = OCTREES[name]()
     assert voro_agreement(assemble(tree, cache=CACHES.setdefault(tree.box.texts, {}))) <= 1e-12
+
+
+# ---- cospherical mesh --dual and dual.npz ----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def dual_run(tmp_path_factory):
+    from cospherical.cli import main
+
+    out = tmp_path_factory.mktemp("dual")
+    argv = ["mesh", "--domain", "1", "2", "4", "--refine", "point:1/5,3/10,2/5", "--levels", "3", "--dual",
+            "--no-uniform", "--format", "json"]
+    assert main([*argv, "--out", str(out / "a")]) == 0
+    assert main([*argv, "--out", str(out / "b")]) == 0
+    return out
+
+
+def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
+    import json
+
+    import meshio
+
+    from cospherical.formats.dual import read_dual
+
+    a, b = dual_run / "a", dual_run / "b"
+    assert (a / "dual.npz").read_bytes() == (b / "dual.npz").read_bytes()
+    report = json.loads((a / "report.json").read_text())
+    dual = read_dual(a / "dual.npz")
+    assert dual.volume_sum() == 1 and len(dual.edges) == report["dual"]["edges"]
+    # a 1 x 2 x 4 tree is not Delaunay: the report says so, the file keeps every edge
+    assert report["negative_coefficients"] == dual.negative_coefficients()
+    assert report["negative_coefficients"]["interior"] > 0
+    assert report["dual"]["mixed"]["nonzeros"] == dual.laplacian().nnz
+    vtu = meshio.read(a / "mesh.vtu")
+    assert np.array_equal(vtu.point_data["control_volume"], dual.control_volume)
+    ok = np.concatenate(vtu.cell_data["delaunay_ok"])
+    assert (ok == 0).sum() == report["delaunay_violations"] > 0
+    assert np.concatenate(vtu.cell_data["circumcenter"]).shape == (report["elements"], 3)
+
+
+def test_a_truncated_or_tampered_dual_npz_is_refused_with_one_line(dual_run, tmp_path, capsys):
+    import zipfile
+
+    from cospherical.cli import main
+
+    good = (dual_run / "a" / "dual.npz").read_bytes()
+    assert main(["check", str(dual_run / "a" / "dual.npz")]) == 0
+    (tmp_path / "truncated.npz").write_bytes(good[: len(good) // 2])
+    # a member rewritten with a valid zip CRC: only the manifest's checksum can tell
+    with zipfile.ZipFile(dual_run / "a" / "dual.npz") as source, \
+            zipfile.ZipFile(tmp_path / "tampered.npz", "w") as target:
+        for info in source.infolist():
+            data = source.read(info)
+            if info.filename == "coefficient.npy":
+                data = data[:-8] + np.float64(1e9).tobytes()
+            target.writestr(info, data)
+    flipped = bytearray(good)
+    flipped[len(good) // 3] ^= 0xFF
+    (tmp_path / "flipped.npz").write_bytes(bytes(flipped))
+    (tmp_path / "empty.npz").write_bytes(b"")
+    capsys.readouterr()
+    for name in ("truncated", "tampered", "flipped", "empty"):
+        assert main(["check", str(tmp_path / f"{name}.npz")]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{name}.npz" in err and "Traceback" not in err

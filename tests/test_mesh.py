@@ -32,6 +32,7 @@ def octant_tree(box=CUBE):
 def checks(mesh) -> dict:
     found = {**check_volume(mesh), **check_conformity(mesh), **check_circumcenters(mesh), **check_delaunay(mesh)}
     found.pop("_leaves")
+    found.pop("_elements")
     return found
 
 

@@ -1,4 +1,4 @@
-"""``cospherical check``: validate catalogue and pattern-table files, deeply."""
+"""``cospherical check``: validate catalogue and pattern-table files, deeply, and dual.npz files."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ def add_parser(commands) -> None:
         "check",
         help="validate catalogue and pattern-table files",
         description="Validate catalogues (schema, unique ids, consistent faces, known split types) and pattern "
-        "tables (schema, known types, node counts, and that every configuration's elements tile the box). "
+        "tables (schema, known types, node counts, and that every configuration's elements tile the box), and "
+        "dual.npz files of `cospherical mesh --dual` (members, checksums, control volumes summing to the domain). "
         "Exit status 0 when every file is valid, 2 at the first problem.",
     )
     parser.add_argument("files", nargs="+", type=Path, metavar="FILE",
@@ -28,6 +29,9 @@ def add_parser(commands) -> None:
 def run(args) -> int:
     catalogue = None
     for path in args.files:
+        if path.suffix == ".npz":
+            _check_dual(path)
+            continue
         kind, document = read_document_file(path)
         if kind == "catalogue":
             check_catalogue(document, str(path))
@@ -40,3 +44,17 @@ def run(args) -> int:
         check_patterns(document, catalogue, str(path), tiling=not args.no_tiling)
         print(f"{path}: ok, pattern table of {len(document.configurations)} configurations")
     return 0
+
+
+def _check_dual(path: Path) -> None:
+    from ..errors import FormatError
+    from ..formats.dual import read_dual
+
+    dual = read_dual(path)
+    total = dual.volume_sum()
+    if total != 1:
+        raise FormatError(f"{path}: the control volumes sum to {total} of the domain, not 1")
+    negative = dual.negative_coefficients()
+    print(f"{path}: ok, dual of {len(dual.vertices)} vertices and {len(dual.edges)} edges, control volumes sum "
+          f"to the domain exactly, {negative['interior']} interior and {negative['boundary']} boundary negative "
+          "coefficients")

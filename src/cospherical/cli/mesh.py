@@ -6,6 +6,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from ..catalogue import CRITERIA
 from ..core.configuration import Box
 from ..core.exact import parse_rational
@@ -42,11 +44,15 @@ def add_parser(commands) -> None:
                         help="pattern table of the domain's box (configurations it lacks are tessellated); "
                         "without it every configuration is tessellated")
     parser.add_argument("--criterion", choices=CRITERIA, default="optimal", help="which elements of the table")
-    parser.add_argument("--out", type=Path, metavar="DIR", help="write mesh.vtu, report.json and mesh.png here")
+    parser.add_argument("--out", type=Path, metavar="DIR", help="write mesh.vtu, report.json and mesh.png here (and dual.npz with --dual)")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="text (default): the main figures; json: the whole report on stdout")
     parser.add_argument("--cut", metavar="Z", help="height of the picture's cut as a fraction of the domain height "
                         "(default: through the first shape's centre, else 1/2)")
+    parser.add_argument("--dual", action="store_true",
+                        help="the exact finite-volume dual: dual.npz in --out (edges, coefficients, control volumes), "
+                        "point data control_volume, boundary_area and cell data circumcenter, delaunay_ok in mesh.vtu, "
+                        "negative_coefficients and the mixed mesh beside a tetrahedral one in the report")
     parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check")
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
@@ -133,15 +139,34 @@ def run(args) -> int:
             stages.append(name)
             clock = time.perf_counter()
 
+        violating: list = []
         report = mesh_report(mesh, described, args.patterns.name if args.patterns else None, args.criterion,
                              uniform=not args.no_uniform, delaunay=not args.no_delaunay, stage=stage,
-                             progress=(lambda n: advance("delaunay", n)) if large else None)
+                             progress=(lambda n: advance("delaunay", n)) if large else None, violating=violating)
+        dual = None
+        if args.dual:
+            from ..mesh.dual import dual_summary, mesh_dual
+
+            stage("dual")
+            dual = mesh_dual(mesh)
+            report.update(dual_summary(dual, len(mesh), report["interior_faces"] + report["boundary_faces"]))
     stage("outputs")
     if args.out is not None:
         from ..formats.mesh import write_vtu
         from ..outputs.mesh_picture import cut_png
 
-        write_vtu(mesh, args.out / "mesh.vtu")
+        point_data, cell_data = {}, {}
+        if dual is not None:
+            from ..formats.dual import write_dual
+
+            write_dual(dual, args.out / "dual.npz")
+            point_data = {"control_volume": dual.control_volume, "boundary_area": dual.boundary_area}
+            cell_data = {"circumcenter": dual.element_circumcenter}
+            if violating:
+                ok = np.ones(len(mesh), dtype=np.int8)
+                ok[violating[0]] = 0
+                cell_data["delaunay_ok"] = ok
+        write_vtu(mesh, args.out / "mesh.vtu", point_data=point_data, cell_data=cell_data)
         shapes = ", ".join(described.get("refine", [])) or described.get("file", "")
         cut_png(mesh, args.out / "mesh.png", at=at,
                 title=f"{' x '.join(box.texts)}: {shapes}; {report['leaves']:,} leaves, {report['elements']:,} "
@@ -152,6 +177,11 @@ def run(args) -> int:
         sys.stdout.write(report_json(report))
     else:
         sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in SUMMARY_KEYS))
+        if dual is not None:
+            negative = report["negative_coefficients"]
+            sys.stdout.write(f"dual_edges: {report['dual']['edges']:,}\n"
+                             f"negative_coefficients: {negative['interior']:,} interior, {negative['boundary']:,} "
+                             "boundary\n")
     if sys.stderr.isatty():
         print("cospherical mesh: seconds " + ", ".join(f"{k} {v:.2f}" for k, v in timings.items()), file=sys.stderr)
     return 0

@@ -182,7 +182,9 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
     Point data: ``grid_coordinates`` (the exact integer grid point of each vertex),
     then ``point_data`` (one row per vertex, in ``mesh.vertices`` order).
     Cell data: ``element`` (the element's index in the mesh), ``type`` (index into
-    the field data ``type_ids``), ``leaf``, ``fvm`` (its circumcenter lies in its
+    the field data ``type_ids``), ``leaf`` (the leaf's index in the octree's order: by
+    level, then by the key ``(i * 2**level + j) * 2**level + k`` of its position, not the
+    order of a ``--leaves`` file), ``fvm`` (its circumcenter lies in its
     closed leaf, decided exactly), then ``cell_data`` (one row per element, in
     element order: written in cell order).
     Field data (text as UTF-8 bytes, ``bytes(array).decode()``): ``type_ids`` and

@@ -146,8 +146,8 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     Returns ``delaunay_violations`` (elements whose sphere strictly holds a vertex),
     ``delaunay_violating_pairs`` (element, vertex), ``delaunay_violating_leaves``,
     ``delaunay_ties`` (a vertex of another element on an element's sphere: it could
-    merge with a neighbour), ``delaunay_exact_tests`` (pairs decided with integers) and
-    ``_leaves`` (the violating leaves' indices, an array, for the caller).
+    merge with a neighbour), ``delaunay_exact_tests`` (pairs decided with integers),
+    ``_leaves`` and ``_elements`` (the violating leaves' and elements' indices, arrays, for the caller).
     """
     from scipy.spatial import cKDTree
 
@@ -172,7 +172,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
             radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(leaves), len(element.nodes), dtype=np.int64))
     if not centres:
-        return {"_leaves": np.zeros(0, dtype=np.int64), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
+        return {"_leaves": np.zeros(0, dtype=np.int64), "_elements": np.zeros(0, dtype=np.int64), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
                 "delaunay_ties": 0, "delaunay_exact_tests": 0}
     rows_pattern, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_pattern, rows_local, rows_leaf))
     centres, radii, n_nodes = np.concatenate(centres), np.concatenate(radii), np.concatenate(n_nodes)
@@ -221,6 +221,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         inside[i] = side < 0
         ties += side == 0
     bad_rows = np.unique(pair_row[inside])
-    return {"_leaves": np.unique(rows_leaf[bad_rows]),"delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),
+    bad_elements = np.unique(mesh.element_offsets[rows_leaf[bad_rows]] + rows_local[bad_rows])
+    return {"_leaves": np.unique(rows_leaf[bad_rows]), "_elements": bad_elements,"delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),
             "delaunay_violating_leaves": int(len(np.unique(rows_leaf[bad_rows]))), "delaunay_ties": int(ties),
             "delaunay_exact_tests": int(len(pair_row))}

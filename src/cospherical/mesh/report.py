@@ -16,7 +16,7 @@ __all__ = ["mesh_report"]
 
 def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal", uniform: bool = True,
                 delaunay: bool = True, stage: Callable[[str], None] | None = None,
-                progress: Callable[[int], None] | None = None) -> dict:
+                progress: Callable[[int], None] | None = None, violating: list | None = None) -> dict:
     """Run every check on ``mesh`` and gather the report (the keys of ``schemas/mesh-report.schema.json``).
 
     ``tree`` describes where the octree came from; ``patterns`` names the table read
@@ -24,7 +24,8 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     bisection study of the box beside the mesh's frequencies; ``delaunay=False``
     skips the global Delaunay check (``delaunay_violations`` is then ``null``);
     ``stage(name)`` is told as each check starts, ``progress(n)`` as the Delaunay check
-    goes through the elements.
+    goes through the elements; ``violating``, a list, receives the array of the elements
+    whose sphere strictly holds a vertex (for the ``delaunay_ok`` cell data).
 
     Examples
     --------
@@ -63,6 +64,9 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
         start("delaunay")
         found = check_delaunay(mesh, progress=progress)
         bad_leaves = found.pop("_leaves")
+        bad_elements = found.pop("_elements")
+        if violating is not None:
+            violating.append(bad_elements)
         report.update(found)
         # the issue's point: a leaf can be fvm_adequate on its own and still not globally Delaunay
         fvm = np.array([p.fvm_adequate for p in mesh.patterns], dtype=bool)[mesh.leaf_pattern[bad_leaves]]

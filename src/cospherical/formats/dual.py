@@ -1,0 +1,202 @@
+"""``dual.npz``: the finite-volume dual of a mesh, for a solver (reading and writing only).
+
+A zip of ``.npy`` arrays (``numpy.load`` opens it; no pickles), written
+deterministically (fixed member order and time stamps: the same mesh gives the
+same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` elements:
+
+===========================  ==========  ==================================================
+``manifest``                 uint8       JSON text: ``format`` (``cospherical-dual``),
+                                         ``version``, ``domain`` (the box, exact texts),
+                                         ``grid``, the exact denominators, ``sha256`` of
+                                         every other member
+``grid_vertices``            int64 n x3  exact vertices: integers of the grid of ``grid``
+                                         intervals per domain side
+``vertices``                 f8 n x 3    real coordinates (``grid_vertices / grid * box``)
+``edges``                    int64 m x2  vertex pairs ``i < j``, sorted
+``length``, ``area``,        f8 m        edge length, signed dual-face area,
+``coefficient``                          ``area / length`` (the box method's coupling)
+``coefficient_exact``        int64 m     ``coefficient = coefficient_exact * sqrt(
+                                         volume_factor_squared) / coefficient_denominator``
+                                         (decimal text, ``U``, when int64 is too narrow)
+``control_volume``           f8 n        each vertex's control volume
+``volume_exact``             int64 n     ``control_volume = volume_exact * sqrt(
+                                         volume_factor_squared) / volume_denominator``
+``boundary``                 bool n      the vertex is on the domain's boundary
+``boundary_area``            f8 n        the boundary's area in its control volume
+``element_circumcenter``     f8 e x 3    the real circumcenter of each element (mesh order)
+===========================  ==========  ==================================================
+
+The reader refuses, with one line, a file that is not such a zip, lacks or adds a
+member, has an array of the wrong kind or shape, fails a checksum (a truncated or
+tampered file) or has edges that name no vertex.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import math
+import os
+import stat
+import zipfile
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+
+from ..core.configuration import Box
+from ..errors import FormatError
+from ..files.yamlio import atomic_write
+from ..mesh.dual import Dual
+
+__all__ = ["DUAL_FORMAT_VERSION", "read_dual", "write_dual"]
+
+DUAL_FORMAT_VERSION = 1
+MAX_DUAL_FILE = 16 * 1024**3
+# member -> (dtype kind, columns or None, which count: n vertices, m edges, e elements)
+MEMBERS = {
+    "grid_vertices": ("i", 3, "n"), "vertices": ("f", 3, "n"), "edges": ("i", 2, "m"), "length": ("f", None, "m"),
+    "area": ("f", None, "m"), "coefficient": ("f", None, "m"), "coefficient_exact": ("iU", None, "m"),
+    "control_volume": ("f", None, "n"), "volume_exact": ("iU", None, "n"), "boundary": ("b", None, "n"),
+    "boundary_area": ("f", None, "n"), "element_circumcenter": ("f", 3, "e"),
+}
+_STAMP = (1980, 1, 1, 0, 0, 0)
+_MAX_DIGITS = 200
+
+
+def _npy(array: np.ndarray) -> bytes:
+    buffer = io.BytesIO()
+    np.lib.format.write_array(buffer, np.ascontiguousarray(array), allow_pickle=False)
+    return buffer.getvalue()
+
+
+def _exact(array: np.ndarray) -> np.ndarray:
+    return array if array.dtype != object else np.array([str(int(x)) for x in array], dtype=f"U{_MAX_DIGITS}")
+
+
+def write_dual(dual: Dual, path: str | Path) -> None:
+    """Write ``dual`` as ``dual.npz`` (see the module), atomically and deterministically."""
+    arrays = {name: getattr(dual, name) for name in MEMBERS}
+    arrays["coefficient_exact"] = _exact(arrays["coefficient_exact"])
+    arrays["volume_exact"] = _exact(arrays["volume_exact"])
+    blobs = {name: _npy(array) for name, array in arrays.items()}
+    manifest = {
+        "format": "cospherical-dual", "version": DUAL_FORMAT_VERSION, "domain": list(dual.box.texts),
+        "grid": int(dual.grid), "coefficient_denominator": str(dual.coefficient_denominator),
+        "volume_denominator": str(dual.volume_denominator), "volume_factor_squared": str(dual.volume_factor_squared),
+        "sha256": {name: hashlib.sha256(blob).hexdigest() for name, blob in blobs.items()},
+    }
+    blobs = {"manifest": _npy(np.frombuffer(json.dumps(manifest, sort_keys=True).encode(), dtype=np.uint8)), **blobs}
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED, allowZip64=True) as archive:
+        for name, blob in blobs.items():
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=_STAMP)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = 0o644 << 16
+            archive.writestr(info, blob, compresslevel=6)
+    atomic_write(path, buffer.getvalue())
+
+
+def _regular(path: Path) -> None:
+    try:
+        info = os.stat(path)
+    except OSError as error:
+        raise FormatError(f"{path}: cannot read: {error.strerror or error}") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise FormatError(f"{path}: cannot read: not a regular file")
+    if info.st_size > MAX_DUAL_FILE:
+        raise FormatError(f"{path}: cannot read: too large ({info.st_size} bytes; at most {MAX_DUAL_FILE})")
+
+
+def _member(archive: zipfile.ZipFile, name: str, path: Path, limit: int) -> tuple[bytes, np.ndarray]:
+    info = archive.getinfo(f"{name}.npy")
+    if info.file_size > limit:
+        raise FormatError(f"{path}: member {name}: {info.file_size} bytes, more than the file can hold")
+    blob = archive.read(info)  # checks the zip's CRC: a damaged member raises here
+    try:
+        array = np.lib.format.read_array(io.BytesIO(blob), allow_pickle=False)
+    except (ValueError, EOFError, OSError) as error:
+        raise FormatError(f"{path}: member {name}: not a numpy array: {error}") from None
+    return blob, array
+
+
+def read_dual(path: str | Path) -> Dual:
+    """Read a ``dual.npz``; a malformed, truncated or tampered file raises :class:`FormatError` (one line)."""
+    path = Path(path)
+    _regular(path)
+    size = os.stat(path).st_size
+    try:
+        with zipfile.ZipFile(path) as archive:
+            names = sorted(archive.namelist())
+            expected = sorted(f"{name}.npy" for name in ("manifest", *MEMBERS))
+            if names != expected:
+                extra = sorted(set(names) ^ set(expected))
+                raise FormatError(f"{path}: not a cospherical dual: member {extra[0] if extra else '?'} "
+                                  f"{'unexpected' if extra and extra[0] in names else 'missing'}")
+            limit = max(size * 1100, 1 << 20)  # deflate's best ratio is about 1000
+            _, raw = _member(archive, "manifest", path, 1 << 20)
+            manifest = _manifest(raw, path)
+            arrays = {}
+            for name in MEMBERS:
+                blob, arrays[name] = _member(archive, name, path, limit)
+                if hashlib.sha256(blob).hexdigest() != manifest["sha256"].get(name):
+                    raise FormatError(f"{path}: member {name}: checksum mismatch (the file was changed or damaged)")
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, OSError, ValueError) as error:
+        if isinstance(error, FormatError):
+            raise
+        raise FormatError(f"{path}: not a readable dual.npz (truncated or damaged): {error}") from None
+    return _dual(arrays, manifest, path)
+
+
+def _manifest(raw: np.ndarray, path: Path) -> dict:
+    try:
+        manifest = json.loads(raw.astype(np.uint8).tobytes().decode())
+    except (ValueError, UnicodeDecodeError):
+        raise FormatError(f"{path}: member manifest: not JSON") from None
+    if not isinstance(manifest, dict) or manifest.get("format") != "cospherical-dual":
+        raise FormatError(f"{path}: not a cospherical dual (its manifest names no format cospherical-dual)")
+    if manifest.get("version") != DUAL_FORMAT_VERSION:
+        raise FormatError(f"{path}: dual format version {manifest.get('version')!r}; this reads {DUAL_FORMAT_VERSION}")
+    for key, kind in (("domain", list), ("grid", int), ("coefficient_denominator", str), ("volume_denominator", str),
+                      ("volume_factor_squared", str), ("sha256", dict)):
+        if not isinstance(manifest.get(key), kind):
+            raise FormatError(f"{path}: manifest: {key} missing or not a {kind.__name__}")
+    return manifest
+
+
+def _integers(array: np.ndarray, name: str, path: Path) -> np.ndarray:
+    if array.dtype.kind == "i":
+        return array.astype(np.int64)
+    text = array.astype(str)
+    if any(not (x.lstrip("-").isascii() and x.lstrip("-").isdigit()) for x in text.tolist()):
+        raise FormatError(f"{path}: member {name}: not integers")
+    return np.array([int(x) for x in text.tolist()], dtype=object)
+
+
+def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
+    counts = {"n": len(arrays["grid_vertices"]), "m": len(arrays["edges"]), "e": len(arrays["element_circumcenter"])}
+    for name, (kinds, columns, count) in MEMBERS.items():
+        array = arrays[name]
+        shape = (counts[count],) if columns is None else (counts[count], columns)
+        if array.dtype.kind not in kinds or array.shape != shape:
+            raise FormatError(f"{path}: member {name}: {array.dtype} {array.shape}, expected "
+                              f"{'/'.join(kinds)} {shape}")
+    edges = arrays["edges"]
+    if len(edges) and (edges.min() < 0 or edges.max() >= counts["n"] or np.any(edges[:, 0] >= edges[:, 1])):
+        raise FormatError(f"{path}: member edges: a pair that is not two vertices i < j")
+    try:
+        box = Box.parse(manifest["domain"])
+        grid = int(manifest["grid"])
+        cden, vden = int(manifest["coefficient_denominator"]), int(manifest["volume_denominator"])
+        factor_squared = Fraction(manifest["volume_factor_squared"])
+    except (ValueError, TypeError, ZeroDivisionError) as error:
+        raise FormatError(f"{path}: manifest: {error}") from None
+    if grid <= 0 or cden <= 0 or vden <= 0 or factor_squared <= 0:
+        raise FormatError(f"{path}: manifest: grid and denominators must be positive")
+    return Dual(box, grid, arrays["grid_vertices"].astype(np.int64), arrays["vertices"], edges.astype(np.int64),
+                arrays["length"], arrays["area"], arrays["coefficient"], arrays["control_volume"],
+                arrays["boundary"], arrays["boundary_area"],
+                _integers(arrays["coefficient_exact"], "coefficient_exact", path), cden,
+                _integers(arrays["volume_exact"], "volume_exact", path), vden, math.sqrt(factor_squared),
+                factor_squared, arrays["element_circumcenter"])
