@@ -14,7 +14,7 @@ from ..core.exact import parse_rational
 from ..errors import InputError
 from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
 from ..mesh.assembly import assemble
-from ..mesh.octree import BALANCES, MAX_LEVEL, build_octree, leaves_octree, parse_shape
+from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, build_octree, leaves_octree, parse_shape
 from ..mesh.report import mesh_report
 from .progress import stage_bars
 
@@ -37,6 +37,9 @@ def add_parser(commands) -> None:
                       help="the leaves as a list of 'level i j k' (text, one per line) or JSON "
                       '{"leaves": [[level, i, j, k], ...]}; checked to tile the domain and be 1-irregular')
     parser.add_argument("--levels", metavar="L", help=f"refine down to level L (0..{MAX_LEVEL}); with --refine")
+    parser.add_argument("--max-leaves", metavar="N",
+                        help="refuse a tree of more leaves than N, estimated before it is built (default: what half "
+                        f"of this machine's memory holds at {BYTES_PER_LEAF} bytes a leaf)")
     parser.add_argument("--balance", choices=BALANCES, default="vertex",
                         help="2:1 balance across faces, edges and corners (vertex, default) or faces and edges "
                         "(edge); face alone is refused: it is not 1-irregular")
@@ -57,6 +60,15 @@ def add_parser(commands) -> None:
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
     parser.set_defaults(run=run)
+
+
+def _max_leaves(text: str | None) -> int | None:
+    if text is None:
+        return None
+    value = text.strip()
+    if not (value.isascii() and value.isdigit() and 0 < len(value) <= 15) or int(value) == 0:
+        raise InputError(f"--max-leaves {text!r}: must be a positive integer")
+    return int(value)
 
 
 def _levels(text: str | None) -> int:
@@ -100,17 +112,18 @@ def _text(value) -> str:
 def run(args) -> int:
     box = Box.parse(args.domain)
     at = _cut(args, box)  # before the work: a bad --cut is refused at once
+    max_leaves = _max_leaves(args.max_leaves)
     clock = time.perf_counter()
     if args.leaves is not None:
         if args.levels is not None:
             raise InputError("--levels goes with --refine, not with --leaves")
-        levels, positions = read_leaves(args.leaves)
+        levels, positions = read_leaves(args.leaves, max_leaves)
         tree = leaves_octree(box, levels, positions, where=str(args.leaves))
         described = {"source": "leaves", "file": args.leaves.name, "depth": tree.depth}
     else:
         shapes = [parse_shape(text) for text in args.refine]
         levels = _levels(args.levels)
-        tree = build_octree(box, levels, shapes, args.balance)
+        tree = build_octree(box, levels, shapes, args.balance, max_leaves)
         described = {"source": "refine", "levels": levels, "refine": [s.text for s in shapes],
                      "balance": args.balance, "depth": tree.depth}
     timings = {"tree": time.perf_counter() - clock}

@@ -18,7 +18,7 @@ import yaml
 from ..errors import FormatError, InputError
 from .data import data_path
 
-__all__ = ["FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_yaml", "parse_yaml", "validate", "yaml_float"]
+__all__ = ["FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
 
 _Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 
@@ -243,10 +243,41 @@ def _refuse_aliases(data, name: str) -> None:
 
 
 def _unique_pairs(pairs):
-    keys = [key for key, _ in pairs]
-    if len(set(keys)) != len(keys):
-        raise ValueError("repeated key")
-    return dict(pairs)
+    mapping = dict(pairs)
+    if len(mapping) != len(pairs):
+        seen: set = set()
+        repeated = next(key for key, _ in pairs if key in seen or seen.add(key))
+        raise ValueError(f"repeated key {repeated!r}")
+    return mapping
+
+
+# No number in our files has more digits than this; int() of thousands of digits is
+# quadratic, and Python refuses more than 4,300 with an error of its own.
+MAX_INTEGER_DIGITS = 40
+_LONG_NUMBER = re.compile(rf"[0-9]{{{MAX_INTEGER_DIGITS + 1},}}")
+
+
+def parse_json(text: str, name: str):
+    """Parse JSON text as every reader of ours does: no repeated key, no nesting deeper than
+    we write, no integer of more than :data:`MAX_INTEGER_DIGITS` digits; errors as one-line
+    :class:`FormatError`.
+
+    >>> parse_json('{"a": 1, "a": 2}', "demo.json")
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.FormatError: demo.json: not valid JSON: repeated key 'a'
+    """
+    check_nesting(text, name)
+    long = _LONG_NUMBER.search(text)  # a scan of the text: a hook per number costs more than the parse
+    if long:
+        raise FormatError(f"{name}: not valid JSON: a number of {len(long.group(0)):,} digits "
+                          f"(at most {MAX_INTEGER_DIGITS})")
+    try:
+        return json.loads(text, object_pairs_hook=_unique_pairs)
+    except json.JSONDecodeError as error:
+        raise FormatError(f"{name}: line {error.lineno}: not valid JSON: {error.msg}") from None
+    except (ValueError, RecursionError) as error:
+        raise FormatError(f"{name}: not valid JSON: {str(error).splitlines()[0][:120]}") from None
 
 
 def parse_yaml(text: str, name: str):

@@ -95,14 +95,10 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
                 missing = [n for n in element["nodes"] if n not in nodes]
                 if missing:
                     raise FormatError(f"{where}/{k}: node {missing[0]} is not a point of this configuration")
-                if len(set(element["nodes"])) != len(element["nodes"]):
-                    raise FormatError(f"{where}/{k}: a node appears twice")
                 if types is not None:
                     t = types.get(element["type"])
                     if t is None:
                         raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
-                    if len(element["nodes"]) != t["vertices"]:
-                        raise FormatError(f"{where}/{k}: {len(element['nodes'])} nodes for a type with {t['vertices']} vertices")
             if tiling and types:
                 _check_tiling(nodes, positions, box.squared, elements, types, geometry, where, shape)
         if tiling and types:

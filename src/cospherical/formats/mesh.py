@@ -17,25 +17,40 @@ it is written.
 
 from __future__ import annotations
 
+import itertools
 import json
+import os
+import re
 from pathlib import Path
 
 import numpy as np
 
 from ..core.configuration import POINT_POLICIES, Box, Configuration
 from ..errors import FormatError, InputError
-from ..files.yamlio import atomic_write, check_nesting, read_text, validate
+from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
+from ..mesh.octree import check_leaf_count, leaf_bound
 
 __all__ = ["REPORT_SCHEMA_VERSION", "read_leaves", "report_json", "table_lookup", "vtu_arrays", "write_report",
            "write_vtu"]
 
 REPORT_SCHEMA_VERSION = 1
 MAX_LEAF_FILE = 2 * 1024**3
+# A level is at most MAX_LEVEL and a position below 2**MAX_LEVEL: a longer number is out of
+# range whatever its value, and int() of thousands of digits is slow and then refused.
+MAX_LEAF_DIGITS = 12
+_LEAF_NUMBER = re.compile(rf"-?[0-9]{{1,{MAX_LEAF_DIGITS}}}")
+_LONG_NUMBER = re.compile(rf"[0-9]{{{MAX_LEAF_DIGITS + 1},}}")
 
 
-def read_leaves(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+def read_leaves(path: str | Path, max_leaves: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Levels and positions of a leaf list (JSON or text); a malformed file raises :class:`FormatError`.
+
+    More leaves than a mesh may have (``max_leaves``, default
+    :func:`~cospherical.mesh.octree.leaf_bound`) are refused from a count of the
+    file's lines (or brackets) before any is parsed, and each number must be a
+    plain integer of at most :data:`MAX_LEAF_DIGITS` digits, so a hostile file
+    costs the time of reading it.
 
     Examples
     --------
@@ -47,36 +62,51 @@ def read_leaves(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     ([0], [[0, 0, 0]])
     """
     path = Path(path)
-    text = read_text(path, MAX_LEAF_FILE)
+    bound = leaf_bound() if max_leaves is None else max_leaves
+    # a leaf takes at least 8 bytes ("0 0 0 0\\n"); a line of a hand-written list rarely more than 64
+    most = min(MAX_LEAF_FILE, 64 * bound + 4096)
+    try:
+        size = os.stat(path).st_size
+    except OSError:
+        size = 0  # the reader says why it cannot read it
+    if size > most:
+        raise FormatError(f"{path}: {size:,} bytes, more than a list of {bound:,} leaves (the bound; "
+                          f"--max-leaves N sets it) takes at 64 bytes a leaf")
+    text = read_text(path, most)
     stripped = text.lstrip()
-    rows = []
     if stripped.startswith(("{", "[")):
-        check_nesting(text, str(path))
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as error:
-            raise FormatError(f"{path}: line {error.lineno}: not valid JSON: {error.msg}") from None
+        # every leaf opens a bracket: count them before the parser builds a list per leaf
+        check_leaf_count(text.count("[") - 1, f"{path}: up to", bound)
+        long = _LONG_NUMBER.search(text)
+        if long:
+            raise FormatError(f"{path}: a number of {len(long.group(0)):,} digits (at most {MAX_LEAF_DIGITS})")
+        data = parse_json(text, str(path))
         leaves = data.get("leaves") if isinstance(data, dict) else data
         if not isinstance(leaves, list):
             raise FormatError(f'{path}: expected {{"leaves": [[level, i, j, k], ...]}}')
-        for n, leaf in enumerate(leaves):
-            if not (isinstance(leaf, list) and len(leaf) == 4
-                    and all(isinstance(x, int) and not isinstance(x, bool) for x in leaf)):
-                raise FormatError(f"{path}: leaf {n}: {json.dumps(leaf)[:60]} is not [level, i, j, k] (four integers)")
-            rows.append(leaf)
+        # the types of all numbers at once (a loop per leaf costs seconds on millions); the first bad leaf named
+        if not all(type(leaf) is list and len(leaf) == 4 for leaf in leaves) \
+                or set(map(type, itertools.chain.from_iterable(leaves))) - {int}:
+            n, leaf = next((n, leaf) for n, leaf in enumerate(leaves) if not (
+                type(leaf) is list and len(leaf) == 4 and all(type(x) is int for x in leaf)))
+            raise FormatError(f"{path}: leaf {n}: {json.dumps(leaf)[:60]} is not [level, i, j, k] (four integers)")
+        rows = leaves
     else:
+        # lines bound the leaves: a file of more lines than the bound is refused before any is read
+        lines = text.count("\n") + (not text.endswith("\n"))
+        check_leaf_count(lines, f"{path}: {lines:,} lines, so up to", bound)
+        rows = []
         for number, line in enumerate(text.splitlines(), 1):
             content = line.split("#", 1)[0].split()
             if not content:
                 continue
-            if len(content) != 4 or not all(x.lstrip("-").isascii() and x.lstrip("-").isdigit() for x in content):
-                raise FormatError(f"{path}: line {number}: {line.strip()[:60]!r} is not 'level i j k' (four integers)")
+            if len(content) != 4 or not all(_LEAF_NUMBER.fullmatch(x) for x in content):
+                raise FormatError(f"{path}: line {number}: {line.strip()[:60]!r} is not 'level i j k' "
+                                  f"(four integers of at most {MAX_LEAF_DIGITS} digits)")
             rows.append([int(x) for x in content])
     if not rows:
         raise FormatError(f"{path}: no leaves")
-    if any(abs(x) >= 2**40 for row in rows for x in row):
-        raise FormatError(f"{path}: a number is out of range")
-    array = np.array(rows, dtype=np.int64)
+    array = np.array(rows, dtype=np.int64)  # every number below 10**MAX_LEAF_DIGITS: int64 holds it
     return array[:, 0], array[:, 1:]
 
 
@@ -89,6 +119,10 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table") -
     (every leaf is the domain scaled down).
     """
     header = getattr(table, "header", None) or {}
+    element = header.get("element", "cuboid")
+    if element != "cuboid":
+        raise InputError(f"{name}: a table of {element} elements, but the mesh's leaves are cuboids "
+                         f"of the domain {' x '.join(box.texts)}")
     if "criteria" in header and criterion not in header["criteria"]:
         raise InputError(f"{name}: no {criterion!r} elements (it has {', '.join(header['criteria'])})")
     if "box" in header:

@@ -222,6 +222,9 @@ class PatternTable:
     def elements(self, code: str, criterion: str = "optimal") -> list[dict]:
         """The elements of one configuration: dicts with ``type``, ``nodes``, ``circumcenter``.
 
+        A code the table does not hold, or that is not a string, raises :class:`KeyError`
+        naming it, whether the table is YAML or an indexed store.
+
         Examples
         --------
         >>> text = ("schema_version: 1\\ngenerator: g\\ncatalogue_version: c\\nstudy: s\\nbox: ['1', '1', '1']\\n"
@@ -232,7 +235,7 @@ class PatternTable:
         >>> table.elements("000000000000")[0]["nodes"]
         [0, 1, 2, 3, 4, 5, 6, 7]
         """
-        if code not in self.configurations:
+        if not isinstance(code, str) or code not in self.configurations:
             raise KeyError(f"configuration {code!r} is not in this table")
         if criterion not in self.header["criteria"]:
             raise KeyError(f"criterion {criterion!r} is not in this table: {', '.join(self.header['criteria'])}")
@@ -308,8 +311,10 @@ def table_from_data(data, name: str) -> PatternTable:
 
 
 def _check_entries(data, name: str) -> None:
-    # The schema, then what it cannot say: every criterion present, references
-    # only to earlier criteria.
+    # The one validation of entries, for every reader (check, mesh, load_patterns; YAML
+    # or store), before any geometry: the schema (node ids 0..26, each once, at most 27),
+    # then what it cannot say: every criterion present, references only to earlier
+    # criteria, as many nodes as the type id's vertex count (v<V>f<F>-...).
     validate(data, "patterns", name)
     criteria = data["criteria"]
     for code, entry in data["configurations"].items():
@@ -317,6 +322,13 @@ def _check_entries(data, name: str) -> None:
             if criterion not in entry:
                 raise FormatError(f"{name}: configuration {code}: no {criterion!r} elements")
             same = entry[criterion]
-            if isinstance(same, str) and same not in criteria[:i]:
-                raise FormatError(f"{name}: configuration {code}: {criterion} refers to {same!r}, "
-                                  "which is not an earlier criterion of the table")
+            if isinstance(same, str):
+                if same not in criteria[:i]:
+                    raise FormatError(f"{name}: configuration {code}: {criterion} refers to {same!r}, "
+                                      "which is not an earlier criterion of the table")
+                continue
+            for k, element in enumerate(same):
+                vertices = int(element["type"][1:element["type"].index("f")])
+                if len(element["nodes"]) != vertices:
+                    raise FormatError(f"{name}: configurations/{code}/{criterion}/{k}: {len(element['nodes'])} "
+                                      f"nodes for a type of {vertices} vertices ({element['type']})")

@@ -1,0 +1,284 @@
+"""Every input of the mesher and the table readers bounded and checked before the work.
+
+Hostile files through the real CLI: one line on stderr, exit 2, no traceback.  The
+heavy ones run in a child process under a 1 GiB address-space limit and a time
+limit, so a reader that inflates what it is given fails the test instead of the
+machine.  Hypothesis fuzzes the leaf-list and refine grammars (exit 0 or 2, never
+a traceback) and compares the exact cell tests with a brute force in Fractions.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+import os
+import resource
+import subprocess
+import sys
+import time
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from cospherical.cli import main
+from cospherical.core.configuration import Box
+from cospherical.mesh import octree
+
+ROOT = Path(__file__).resolve().parents[1]
+PATTERNS = ROOT / "patterns"
+GiB = 1 << 30
+QUICK = ("--no-delaunay", "--no-uniform")
+
+
+def run(*argv) -> tuple[int, str, str]:
+    """The CLI in-process: (exit status, stdout, stderr)."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        status = main([str(a) for a in argv])
+    return status, out.getvalue(), err.getvalue()
+
+
+def one_line(status: int, err: str, *needles: str) -> str:
+    assert status == 2, (status, err)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle.lower() in lines[0].lower(), lines[0]
+    return lines[0]
+
+
+def _limits(seconds: int):
+    def apply():
+        resource.setrlimit(resource.RLIMIT_AS, (GiB, GiB))
+        resource.setrlimit(resource.RLIMIT_CPU, (seconds, seconds))
+    return apply
+
+
+def bounded(*argv, seconds: int = 60) -> tuple[subprocess.CompletedProcess, float]:
+    """The CLI as a child under 1 GiB of address space and ``seconds`` of CPU: (result, wall seconds)."""
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
+    start = time.perf_counter()
+    result = subprocess.run([sys.executable, "-m", "cospherical", *map(str, argv)], capture_output=True, text=True,
+                            timeout=3 * seconds, preexec_fn=_limits(seconds), env=env)
+    return result, time.perf_counter() - start
+
+
+# ---------------------------------------------------------------------------
+# Leaf lists
+
+
+@pytest.mark.parametrize("name, text, needle", [
+    ("double-minus.txt", "--0 0 0 0\n", "line 1"),
+    ("long.txt", "0 0 0 " + "1" * 5000 + "\n", "12 digits"),
+    ("long.json", '{"leaves": [[0, 0, 0, ' + "1" * 5000 + "]]}", "5,000 digits"),
+    ("repeated.json", '{"leaves": [[1, 0, 0, 0]], "leaves": [[0, 0, 0, 0]]}', "repeated key 'leaves'"),
+    ("float.json", '{"leaves": [[0, 0, 0, 0.0]]}', "leaf 0"),
+    ("bool.json", '{"leaves": [[0, 0, 0, true]]}', "leaf 0"),
+    ("unicode.txt", "0 0 0 \u0661\n", "line 1"),
+])
+def test_hostile_leaf_lists_are_refused_in_one_line(tmp_path, name, text, needle):
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    one_line(*run("mesh", "--domain", 1, 1, 1, "--leaves", path, *QUICK)[::2], needle)
+
+
+def test_leaf_count_is_bounded_before_the_leaves_are_read(tmp_path):
+    # Lines (text) and brackets (JSON) bound the leaves: refused from that count, in the
+    # time it takes to read the file, with the bound in the line.
+    text = tmp_path / "many.txt"
+    text.write_text("0 0 0 0\n" * 200_000)
+    listed = tmp_path / "many.json"
+    listed.write_text(json.dumps({"leaves": [[0, 0, 0, 0]] * 200_000}))
+    for path in (text, listed):
+        result, seconds = bounded("mesh", "--domain", 1, 1, 1, "--leaves", path, "--max-leaves", 100_000, seconds=30)
+        one_line(result.returncode, result.stderr, "200,000 leaves", "bound of 100,000")
+        assert seconds < 20
+        one_line(*run("mesh", "--domain", 1, 1, 1, "--leaves", path, "--max-leaves", 1000)[::2],
+                 "more than a list of 1,000 leaves")
+    # the default bound is what the machine holds; a tree within it passes
+    assert octree.leaf_bound() > 100_000
+    status, out, err = run("mesh", "--domain", 1, 1, 1, "--leaves", _write(tmp_path, "one.txt", "0 0 0 0\n"),
+                           "--max-leaves", 1, *QUICK)
+    assert status == 0 and "leaves: 1\n" in out, err
+
+
+def _write(folder: Path, name: str, text: str) -> Path:
+    path = folder / name
+    path.write_text(text)
+    return path
+
+
+LEAF_LINES = st.lists(st.one_of(
+    st.tuples(*[st.integers(-3, 9)] * 4).map(lambda t: " ".join(map(str, t))),
+    st.text(alphabet="0123456789- #\t1e.+", max_size=16),
+    st.sampled_from(["# note", "", "0 0 0 0", "1 0 0 0", "1 1 1 1", "99999999999999 0 0 0"]),
+), max_size=10)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck))
+@given(lines=LEAF_LINES, as_json=st.booleans())
+def test_fuzz_leaf_lists_never_traceback(tmp_path_factory, lines, as_json):
+    folder = tmp_path_factory.mktemp("leaves")
+    if as_json:
+        rows = [line.split() for line in lines]
+        text = json.dumps({"leaves": [[int(x) if x.lstrip("-").isdigit() else x for x in row] for row in rows]})
+    else:
+        text = "\n".join(lines)
+    status, out, err = run("mesh", "--domain", 1, 1, 1, "--leaves", _write(folder, "l.txt", text), *QUICK)
+    assert status in (0, 2) and "Traceback" not in err
+    if status == 2:
+        one_line(status, err)
+
+
+# ---------------------------------------------------------------------------
+# Refinement shapes and the tree's size
+
+
+@pytest.mark.parametrize("domain, shape", [
+    ((1, 1, 1), "point:0.1234567891,0.5,0.5"),
+    ((1, 1, 1), "point:1e-10,0.5,0.5"),
+    (("3e9", 1, 1), "point:1,0.5,0.5"),
+    (("3e9", 1, 1), "box:0,0,0,1e9,1,1"),
+    (("3e9", 1, 1), "sphere:1e9,0.5,0.5,3"),
+    (("sqrt(2)", "1e-12", 1), "box:0.1234567891,0,0,0.2,1e-13,0.5"),
+])
+def test_refine_numbers_beyond_int64_are_decided_exactly(domain, shape):
+    status, out, err = run("mesh", "--domain", *domain, "--refine", shape, "--levels", 3, *QUICK)
+    assert status == 0, err
+    assert "volume_ok: true" in out
+
+
+def test_tree_size_is_estimated_and_refused_at_once():
+    for argv in (("--levels", 16, "--refine", "box:0,0,0,1,1,1"), ("--levels", 11, "--refine", "plane:1,1,1,1.5")):
+        result, seconds = bounded("mesh", "--domain", 1, 1, 1, *argv, seconds=30)
+        line = one_line(result.returncode, result.stderr, "an estimated", "bound of", "--max-leaves")
+        assert seconds < 15, (seconds, line)
+    one_line(*run("mesh", "--domain", 1, 1, 1, "--refine", "point:0.3,0.3,0.3", "--levels", 4,
+                  "--max-leaves", 10)[::2], "bound of 10")
+    one_line(*run("mesh", "--domain", 1, 1, 1, "--refine", "point:0.3,0.3,0.3", "--levels", 4,
+                  "--max-leaves", "-5")[::2], "--max-leaves")
+
+
+NUMBERS = st.sampled_from(["0", "1", "1/3", "0.5", "-0.25", "2", "0.1234567891", "1e-10", "7/16", "sqrt(2)"])
+BOXES = st.sampled_from([("1", "1", "1"), ("1", "2", "4"), ("3/2", "1", "0.75"), ("sqrt(2)", "1", "1")])
+
+
+@st.composite
+def shapes(draw):
+    kind = draw(st.sampled_from(["point", "box", "plane", "sphere"]))
+    count = {"point": 3, "box": 6, "plane": 4, "sphere": 4}[kind]
+    values = [draw(NUMBERS) for _ in range(count)]
+    if kind == "box":
+        for a in range(3):
+            lo, hi = sorted(values[a::3][:2], key=lambda v: float(eval(v.replace("sqrt", "math.sqrt"))))
+            values[a], values[a + 3] = lo, hi
+    return f"{kind}:{','.join(values)}"
+
+
+def _brute_meets(shape: octree.Shape, box: Box, level: int, cell) -> bool:
+    """Does the closed cell meet the shape: Fractions, one cell at a time (rational lengths only)."""
+    n = 1 << level
+    lengths = [math.sqrt(float(s)) for s in box.squared]  # sqrt lengths only reach point and box
+    v = shape.values
+    if shape.kind in ("point", "box"):
+        lo, hi = (v[:3], v[:3]) if shape.kind == "point" else (v[:3], v[3:])
+        # i * len / n <= hi and (i + 1) * len / n >= lo, squared with signs
+        def le(i, q, b):  # i * sqrt(q) <= b, i >= 0
+            return b >= 0 and i * i * q <= b * b
+        return all(le(cell[a], box.squared[a], hi[a] * n) and not (lo[a] * n > 0 and (cell[a] + 1) ** 2 * box.squared[a]
+                   < (lo[a] * n) ** 2) for a in range(3))
+    del lengths
+    side = [Fraction(math.isqrt(q.numerator), math.isqrt(q.denominator)) for q in box.squared]
+    lo = [Fraction(cell[a], n) * side[a] for a in range(3)]
+    hi = [Fraction(cell[a] + 1, n) * side[a] for a in range(3)]
+    if shape.kind == "plane":
+        corners = [sum(v[a] * (hi[a] if bits >> a & 1 else lo[a]) for a in range(3)) for bits in range(8)]
+        return min(corners) <= v[3] <= max(corners)
+    near = sum(max(lo[a] - v[a], Fraction(0), v[a] - hi[a]) ** 2 for a in range(3))
+    far = sum(max(abs(lo[a] - v[a]), abs(hi[a] - v[a])) ** 2 for a in range(3))
+    return near <= v[3] ** 2 <= far
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=list(HealthCheck))
+@given(text=shapes(), texts=BOXES, level=st.integers(0, 3))
+def test_cell_tests_match_a_brute_force_and_the_size_bound_holds(text, texts, level):
+    box = Box.parse(texts)
+    try:
+        shape = octree.parse_shape(text)
+        n = 1 << level
+        cells = np.array([(i, j, k) for i in range(n) for j in range(n) for k in range(n)], dtype=np.int64)
+        hits = octree._meets(shape, box, level, cells)
+    except Exception as error:  # only the library's own refusal (a sphere over a sqrt length, a bad radius)
+        assert type(error).__name__ == "InputError", error
+        return
+    expected = [_brute_meets(shape, box, level, tuple(cell)) for cell in cells.tolist()]
+    assert hits.tolist() == expected
+    bound = octree._hits_bound(shape, box, level)
+    assert int(hits.sum()) <= bound
+    if shape.kind == "box":
+        assert int(hits.sum()) == bound
+    # the estimate bounds the unbalanced refinement's leaves
+    assert octree.estimate_leaves(box, level, [shape]) >= 1 + 7 * sum(
+        int(octree._meets(shape, box, m, np.array([(i, j, k) for i in range(1 << m) for j in range(1 << m)
+                                                   for k in range(1 << m)], dtype=np.int64)).sum())
+        for m in range(level))
+
+
+REFINE_TEXT = st.one_of(shapes(), st.text(alphabet="pointboxsphereplane:,.0123456789-e/+()sqrt ", max_size=30))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck))
+@given(text=REFINE_TEXT, texts=BOXES, levels=st.sampled_from(["0", "1", "2", "x", "-1", "17"]))
+def test_fuzz_refine_never_tracebacks(text, texts, levels):
+    status, out, err = run("mesh", "--domain", *texts, "--refine", text, "--levels", levels, *QUICK)
+    assert status in (0, 2) and "Traceback" not in err, err
+    if status == 2:
+        one_line(status, err)
+
+
+# ---------------------------------------------------------------------------
+# Element node lists: one validation for check and mesh, before any geometry
+
+
+def _table(folder: Path, name: str, nodes, type_id: str) -> Path:
+    source = (PATTERNS / "leaves-1x1x1.yaml").read_text()
+    header = source[:source.index("configurations:\n") + len("configurations:\n")]
+    entry = {"fvm_adequate": True, "optimal": [{"type": type_id, "nodes": nodes, "circumcenter": [0.5, 0.5, 0.5]}],
+             "internal_faces": "optimal", "internal_edges_and_faces": "optimal"}
+    return _write(folder, name, header + "  '000000000000+f': " + json.dumps(entry) + "\n")
+
+
+@pytest.mark.parametrize("nodes, type_id, needle", [
+    ([0] * 300, "v8f6-c3cb81", "27 items"),
+    ([0, 1, 2, 3, 4, 5, 6, 6], "v8f6-c3cb81", "unique"),
+    ([0, 1, 2, 3, 4], "v4f4-8f0284", "5 nodes for a type of 4 vertices"),
+    ([0, 1, 2, 3, 4, 5, 6, 7, 8], "v8f6-c3cb81", "9 nodes for a type of 8 vertices"),
+])
+def test_bad_node_lists_are_refused_by_check_and_mesh_alike(tmp_path, nodes, type_id, needle):
+    path = _table(tmp_path, "bad.yaml", nodes, type_id)
+    one_line(*run("check", path)[::2], needle)
+    result, seconds = bounded("mesh", "--domain", 1, 1, 1, "--refine", "point:0.5,0.5,0.5", "--levels", 0,
+                              "--patterns", path, "--out", tmp_path / "out", *QUICK, seconds=60)
+    one_line(result.returncode, result.stderr, needle)
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+
+
+def test_a_table_of_another_element_is_refused_naming_both():
+    line = one_line(*run("mesh", "--domain", 1, 1, 1, "--refine", "point:0.5,0.5,0.5", "--levels", 1,
+                         "--patterns", PATTERNS / "bisection-prism-1x1x1.yaml", *QUICK)[::2], "prism", "cuboid")
+    assert "1 x 1 x 1" in line
+
+
+def test_elements_of_a_code_not_held_is_a_key_error():
+    from cospherical.formats.patterns import load
+
+    table = load(PATTERNS / "bisection-1x1x1.yaml")
+    for code in (["x"], None, 7, "zzz"):
+        with pytest.raises(KeyError):
+            table.elements(code)
