@@ -10,6 +10,7 @@ packages=()
 command -v qdelaunay >/dev/null 2>&1 || packages+=(qhull-bin)   # Qhull's merged Delaunay regions: the oracle
 command -v pdflatex >/dev/null 2>&1 || packages+=(texlive-latex-base texlive-latex-recommended texlive-pictures)
 command -v pdftoppm >/dev/null 2>&1 || packages+=(poppler-utils)  # PDF page -> PNG in the tests
+command -v tetgen >/dev/null 2>&1 || packages+=(tetgen)  # benchmarks/bench_outputs.py: the tetrahedral mesher beside ours
 python3 -c "import ensurepip, venv" >/dev/null 2>&1 || packages+=(python3-venv)  # stock Ubuntu lacks it
 if [ ${#packages[@]} -gt 0 ]; then
   $sudo apt-get update -qq

@@ -1,0 +1,130 @@
+"""The whole ``cospherical mesh`` command with every output, against TetGen on the same vertices, in one run.
+
+    python benchmarks/bench_outputs.py [--levels 8] [--radius 0.3] [--patterns patterns/leaves-1x1x1.yaml]
+
+Whole processes, as a person runs them, each measured by the kernel (``os.wait4``:
+user + system CPU, peak resident memory) and by the wall clock:
+
+(1) ``cospherical mesh --domain 1 1 1 --levels L --refine sphere:0.5,0.5,0.5,R
+    --patterns TABLE`` without ``--out`` (tree, assembly, every exact check, report);
+(2) the same with ``--out DIR``: ``mesh.vtu``, ``mesh.png`` and ``report.json`` too;
+(3) TetGen (Debian's ``tetgen``, its version printed) on the same vertices, read from
+    the VTU just written into a ``.node`` file (not timed): ``tetgen -Q points.node``,
+    a Delaunay tetrahedralization with its own text input and output;
+(4) reading ``mesh.vtu`` back in a fresh interpreter with VTK
+    (``vtkXMLUnstructuredGridReader``, what ParaView uses) and with meshio, timed from
+    the call to the mesh in memory (the imports apart).
+
+The targets: (2) at most the CPU of (3); VTK read < 3 s; meshio read < 10 s; peak of
+(2) < 1.5 GB.  meshio (5.3) refuses a grid that mixes polyhedra with standard cells
+(its VTU reader raises); the script then says so instead of a time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+READ = """
+import sys, time
+path, reader = sys.argv[1], sys.argv[2]
+if reader == "vtk":
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+    start, cpu = time.perf_counter(), time.process_time()
+    r = vtkXMLUnstructuredGridReader()
+    r.SetFileName(path)
+    r.Update()
+    cells = r.GetOutput().GetNumberOfCells()
+else:
+    import meshio
+    start, cpu = time.perf_counter(), time.process_time()
+    try:
+        cells = sum(len(b.data) for b in meshio.read(path).cells)
+    except Exception as error:
+        print(f"refused: {type(error).__name__}: {error}")
+        sys.exit(0)
+print(f"{time.perf_counter() - start:.2f} s wall {time.process_time() - cpu:.2f} s cpu, {cells:,} cells")
+"""
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--levels", type=int, default=8)
+    parser.add_argument("--radius", default="0.3")
+    parser.add_argument("--patterns", default="patterns/leaves-1x1x1.yaml")
+    args = parser.parse_args()
+    tetgen = shutil.which("tetgen")
+    if tetgen is None:
+        sys.exit("tetgen not found: apt-get install tetgen")
+    version = subprocess.run(["dpkg-query", "-W", "-f", "${Version}", "tetgen"], capture_output=True,
+                             text=True, check=False).stdout.strip() or "unknown"
+    cospherical = str(Path(sys.executable).with_name("cospherical"))
+    mesh = [cospherical, "mesh", "--domain", "1", "1", "1", "--levels", str(args.levels), "--refine",
+            f"sphere:0.5,0.5,0.5,{args.radius}", "--patterns", args.patterns]
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="bench-outputs-") as folder:
+        folder = Path(folder)
+        wall, cpu, peak, out = run_usage(mesh)
+        figures = dict(line.split(": ", 1) for line in out.splitlines() if ": " in line)
+        rows.append(("cospherical mesh (no --out)", wall, cpu, peak))
+        wall, cpu, peak, _ = run_usage(mesh + ["--out", str(folder / "out")])
+        rows.append(("cospherical mesh --out (vtu, png, report)", wall, cpu, peak))
+        vtu = folder / "out" / "mesh.vtu"
+        size = vtu.stat().st_size
+        node = folder / "points.node"
+        _write_node(vtu, node)
+        wall, cpu, peak, _ = run_usage([tetgen, "-Q", str(node)])
+        tetrahedra = int((folder / "points.1.ele").read_text().split(None, 1)[0])
+        rows.append((f"tetgen -Q (Debian tetgen {version}), same vertices", wall, cpu, peak))
+        reads = {reader: run_usage([sys.executable, "-c", READ, str(vtu), reader])[3].strip()
+                 for reader in ("vtk", "meshio")}
+    print(f"sphere octree L {args.levels}, R {args.radius}: {figures.get('leaves')} leaves, "
+          f"{figures.get('vertices')} vertices, {figures.get('elements')} elements; TetGen: {tetrahedra:,} tetrahedra")
+    print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores; mesh.vtu {size / 1e6:.1f} MB")
+    print(f"{'':58s} {'CPU s':>8s} {'wall s':>8s} {'peak GB':>8s}")
+    for name, wall, cpu, peak in rows:
+        print(f"{name:58s} {cpu:8.2f} {wall:8.2f} {peak:8.2f}")
+    print(f"ratio: cospherical mesh --out CPU / TetGen CPU = {rows[1][2] / rows[2][2]:.2f} (target <= 1)")
+    for reader, text in reads.items():
+        print(f"reading mesh.vtu with {reader}: {text}")
+
+
+def run_usage(command: list[str]) -> tuple[float, float, float, str]:
+    """Wall seconds, CPU seconds (user + system), peak GB and stdout of one whole process (``os.wait4``)."""
+    start = time.perf_counter()
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        process = subprocess.Popen(command, stdout=out, stderr=err, text=True)
+        _, status, usage = os.wait4(process.pid, 0)
+        wall = time.perf_counter() - start
+        process.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        err.seek(0)
+        if process.returncode:
+            sys.exit(f"{' '.join(command)}: exit {process.returncode}: {err.read().strip()[-500:]}")
+        return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024**2, out.read()
+
+
+def _write_node(vtu: Path, node: Path) -> None:
+    """The VTU's points as a TetGen ``.node`` file (exact: the grid's points are dyadic, 17 digits are exact)."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+    reader = vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(vtu))
+    reader.Update()
+    points = vtk_to_numpy(reader.GetOutput().GetPoints().GetData()).astype(np.float64)
+    with node.open("w") as handle:
+        handle.write(f"{len(points)} 3 0 0\n")
+        np.savetxt(handle, np.column_stack([np.arange(1, len(points) + 1), points]),
+                   fmt=["%d", "%.17g", "%.17g", "%.17g"])
+
+
+if __name__ == "__main__":
+    main()
