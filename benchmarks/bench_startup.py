@@ -99,6 +99,11 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=7)
     parser.add_argument("--before", type=Path, metavar="SRC", help="also measure the package in this src folder")
     args = parser.parse_args()
+    if args.before and not (args.before / "cospherical" / "__init__.py").is_file():
+        # PYTHONPATH pointing nowhere would measure this version as "before" without a word
+        print(f"bench_startup.py: error: --before {args.before}: not a src folder with the cospherical package",
+              file=sys.stderr)
+        sys.exit(2)
     if not shutil.which("qdelaunay"):
         raise SystemExit("qdelaunay not found: install qhull-bin (scripts/setup.sh does)")
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")

@@ -13,8 +13,11 @@ command -v pdftoppm >/dev/null 2>&1 || packages+=(poppler-utils)  # PDF page -> 
 command -v tetgen >/dev/null 2>&1 || packages+=(tetgen)  # benchmarks/bench_outputs.py: the tetrahedral mesher beside ours
 python3 -c "import ensurepip, venv" >/dev/null 2>&1 || packages+=(python3-venv)  # stock Ubuntu lacks it
 if [ ${#packages[@]} -gt 0 ]; then
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${packages[@]}" >/dev/null
+  # Wait up to 10 minutes for another apt-get or dpkg (unattended upgrades on a fresh
+  # machine) to release the lock, instead of failing at once.
+  apt=(apt-get -o DPkg::Lock::Timeout=600)
+  $sudo "${apt[@]}" update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo "${apt[@]}" install -y -qq "${packages[@]}" >/dev/null
 fi
 
 python3 -m venv .venv

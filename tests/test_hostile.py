@@ -600,16 +600,18 @@ def test_vtu_has_ordinary_permissions(tmp_path, capsys):
 
 
 def test_render_removes_its_own_old_outputs(tmp_path, capsys):
+    # its own: what the folder's manifest says an earlier render wrote; a file named like a
+    # table but put there by the user is not
     out = tmp_path / "out"
-    mine = out / "frequencies-bisection-9x9x9-optimal.tex"
+    users = out / "frequencies-bisection-9x9x9-optimal.tex"
     foreign = out / "notes.tex"
     out.mkdir()
-    mine.write_text("old")
+    users.write_text("old")
     foreign.write_text("keep")
     assert main(["render", "--summary", str(SUMMARY), "--out", str(out)]) == 0
-    assert not mine.exists() and foreign.read_text() == "keep"
+    assert users.read_text() == "old" and foreign.read_text() == "keep"
     assert main(["render", "--summary", str(ROOT / "results" / "bisection-1x1x1.json"), "--out", str(out)]) == 0
-    assert not list(out.glob("*1x2x4*"))
+    assert not list(out.glob("*1x2x4*")) and users.read_text() == "old"
     capsys.readouterr()
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import gc
 import importlib
 import os
@@ -74,11 +75,41 @@ def _in_compiler(frame) -> bool:
     return False
 
 
+class _ClosedStdout:
+    """Standard output when the command was started with it closed (``>&-``): the first write
+    fails as a write to a closed descriptor does, and the error policy turns that into one line."""
+
+    def write(self, text: str) -> int:
+        raise OSError(errno.EBADF, "standard output is closed")
+
+    def flush(self) -> None:
+        pass
+
+    def fileno(self) -> int:
+        return 1  # /dev/null by now (see _closed_standard_streams)
+
+
+def _closed_standard_streams() -> None:
+    # A closed descriptor 1 or 2 would be reused by the next file opened (an output's
+    # temporary file, a pipe to pdflatex), and whatever is written to the stream would land
+    # in it: /dev/null takes the place first.
+    for fd, name in ((1, "stdout"), (2, "stderr")):
+        try:
+            os.fstat(fd)
+        except OSError:
+            null = os.open(os.devnull, os.O_WRONLY)
+            if null != fd:
+                os.dup2(null, fd)
+                os.close(null)
+            setattr(sys, name, _ClosedStdout() if fd == 1 else open(fd, "w", closefd=False))
+
+
 def main(argv: list[str] | None = None) -> int:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminated)
         signal.signal(signal.SIGINT, _interrupt)
     _interrupted.clear()
+    _closed_standard_streams()
     try:
         words = sys.argv[1:] if argv is None else argv
         command = next((word for word in words if not word.startswith("-")), None)
@@ -100,6 +131,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"cospherical: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
+        _stop_workers()
         print("cospherical: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
@@ -114,13 +146,23 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except Exception:
         if _interrupted.is_set():  # an interrupt that a library turned into its own error (numpy: ImportError)
+            _stop_workers()
             print("cospherical: interrupted", file=sys.stderr)
             return 130
         raise
     except SystemExit as exit:
         if exit.code == 128 + signal.SIGTERM:
+            _stop_workers()
             print("cospherical: terminated", file=sys.stderr)
         raise
+
+
+def _stop_workers() -> None:
+    # Worker processes still running (a pool, a local Dask cluster) are stopped now, not
+    # joined at exit, which would wait for the chunks they are running.
+    pool = sys.modules.get("cospherical.studies.pool")  # loaded only if workers were started
+    if pool is not None:
+        pool.stop_all()
 
 
 def _silence_stdout() -> None:

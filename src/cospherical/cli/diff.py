@@ -5,11 +5,11 @@ Exit status as diff(1): 0 no difference, 1 differences, 2 trouble.
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
-from ..errors import FormatError, UsageError
+from ..errors import UsageError
+from ..files.git import git_text
 from ..formats.check import document_data, read_document, read_document_file
 from ..formats.diff import diff_documents, has_changes, text_report
 from .output import dump
@@ -34,16 +34,7 @@ def _from_git(rev: str, path: Path):
     # A revision is data, never an option: refuse a leading '-' and end git's options before it.
     if not rev or rev.startswith("-") or any(ch.isspace() or ch == ":" or not ch.isprintable() for ch in rev):
         raise UsageError(f"cospherical diff: error: --rev {rev!r}: not a git revision")
-    path = path.resolve()
-    try:
-        result = subprocess.run(["git", "show", "--end-of-options", f"{rev}:./{path.name}"], cwd=path.parent,
-                                capture_output=True, text=True)
-    except OSError as error:
-        raise FormatError(f"git: {error.strerror}") from None
-    if result.returncode != 0:
-        message = (result.stderr.strip().splitlines() or ["git show failed"])[-1]
-        raise FormatError(f"{path.name} at {rev}: {message}")
-    return result.stdout
+    return git_text(rev, path)
 
 
 def run(args) -> int:

@@ -12,6 +12,7 @@ from ..catalogue import CRITERIA
 from ..core.configuration import Box
 from ..core.exact import parse_rational
 from ..errors import InputError
+from ..files.outputs import OutputFolder
 from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
 from ..mesh.assembly import assemble
 from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, build_octree, leaves_octree, parse_shape
@@ -109,7 +110,18 @@ def _text(value) -> str:
     return f"{value:,}" if isinstance(value, int) else str(value)
 
 
+OUTPUTS = ("mesh.vtu", "report.json", "mesh.png")
+
+
 def run(args) -> int:
+    if args.out is None:
+        return _run(args, None)
+    names = OUTPUTS + (("dual.npz",) if args.dual else ())
+    with OutputFolder(args.out, "mesh", names) as out:  # locked from the start; every file or none
+        return _run(args, out)
+
+
+def _run(args, out: OutputFolder | None) -> int:
     box = Box.parse(args.domain)
     at = _cut(args, box)  # before the work: a bad --cut is refused at once
     max_leaves = _max_leaves(args.max_leaves)
@@ -164,7 +176,7 @@ def run(args) -> int:
             dual = mesh_dual(mesh)
             report.update(dual_summary(dual, len(mesh), report["interior_faces"] + report["boundary_faces"]))
     stage("outputs")
-    if args.out is not None:
+    if out is not None:
         from ..formats.mesh import write_vtu
         from ..outputs.mesh_picture import cut_png
 
@@ -172,19 +184,19 @@ def run(args) -> int:
         if dual is not None:
             from ..formats.dual import write_dual
 
-            write_dual(dual, args.out / "dual.npz")
+            write_dual(dual, out.path("dual.npz"))
             point_data = {"control_volume": dual.control_volume, "boundary_area": dual.boundary_area}
             cell_data = {"circumcenter": dual.element_circumcenter}
             if violating:
                 ok = np.ones(len(mesh), dtype=np.int8)
                 ok[violating[0]] = 0
                 cell_data["delaunay_ok"] = ok
-        write_vtu(mesh, args.out / "mesh.vtu", point_data=point_data, cell_data=cell_data)
+        write_vtu(mesh, out.path("mesh.vtu"), point_data=point_data, cell_data=cell_data)
         shapes = ", ".join(described.get("refine", [])) or described.get("file", "")
-        cut_png(mesh, args.out / "mesh.png", at=at,
+        cut_png(mesh, out.path("mesh.png"), at=at,
                 title=f"{' x '.join(box.texts)}: {shapes}; {report['leaves']:,} leaves, {report['elements']:,} "
                       f"elements, {report['types']} types (cut at z = {at * float(box.c):.4g})")
-        write_report(report, args.out / "report.json")  # last: no report beside a mesh that was not written
+        write_report(report, out.path("report.json"))
     timings["outputs"] = time.perf_counter() - clock
     if args.format == "json":
         sys.stdout.write(report_json(report))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from ..catalogue import shipped_catalogue
@@ -10,7 +11,7 @@ from ..core.shapes import ELEMENTS
 from ..errors import FormatError, InputError, UsageError
 from ..files.yamlio import load_yaml, validate
 from ..formats.catalogue_file import build_catalogue
-from ..outputs.latex import compile_pdf, render_tables
+from ..outputs.latex import render_tables
 from ..studies.bisection import bisection_codes, run_study
 from ..studies.summary import study_summary
 from .output import FACE_POINTS_HELP
@@ -36,8 +37,10 @@ def add_parser(commands) -> None:
     parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree",
                         help="with --study: " + FACE_POINTS_HELP)
     parser.add_argument("--out", type=Path, required=True, metavar="DIR",
-                        help="folder for the .tex files (created; tables of an earlier render there are replaced)")
-    parser.add_argument("--pdf", action="store_true", help="compile document.tex with pdflatex into DIR")
+                        help="folder for the .tex files (created; locked for the run; a file an earlier render "
+                        "wrote there and this one does not is removed, nothing else)")
+    parser.add_argument("--pdf", action="store_true",
+                        help="compile document.tex with pdflatex (in a private folder) into DIR/document.pdf")
     parser.set_defaults(run=run)
 
 
@@ -48,6 +51,7 @@ def _load_summary(path: Path) -> dict:
         missing = [k for k in SUMMARY_KEYS if k not in data]
         raise FormatError(f"{path}: not a study summary (missing {', '.join(missing)})")
     validate(data, "summary", path)
+    _refuse_non_finite(data, path)
     try:
         Box.parse(data["box"])
     except InputError as error:
@@ -55,6 +59,20 @@ def _load_summary(path: Path) -> dict:
     if data["study"] == "intersection" and ("resolution" not in data or "insertion_order" not in data):
         raise FormatError(f"{path}: an intersection study summary needs resolution and insertion_order")
     return data
+
+
+def _refuse_non_finite(data, path: Path) -> None:
+    """JSON Schema's numbers admit NaN and infinities (``"share": NaN`` parses); no summary holds one,
+    and a table would print ``nan \\%``."""
+    stack = [((), data)]
+    while stack:
+        where, item = stack.pop()
+        if isinstance(item, float) and not math.isfinite(item):
+            raise FormatError(f"{path}: at {'.'.join(where) or 'top level'}: {item!r} is not a finite number")
+        if isinstance(item, dict):
+            stack.extend(((*where, str(k)), v) for k, v in item.items())
+        elif isinstance(item, list):
+            stack.extend(((*where, str(i)), v) for i, v in enumerate(item))
 
 
 def run(args) -> int:
@@ -72,8 +90,9 @@ def run(args) -> int:
     else:
         summaries = [_load_summary(path) for path in args.summary]
         catalogue = shipped_catalogue()
-    written = render_tables(summaries, catalogue, args.out, "Delaunay tessellations of 1-irregular elements")
+    written = render_tables(summaries, catalogue, args.out, "Delaunay tessellations of 1-irregular elements",
+                            pdf=args.pdf)
     print(f"wrote {len(written)} files in {args.out}")
     if args.pdf:
-        print(f"wrote {compile_pdf(args.out)}")
+        print(f"wrote {args.out / 'document.pdf'}")
     return 0

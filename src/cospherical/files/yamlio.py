@@ -1,22 +1,20 @@
-"""YAML in and out: safe loading only, atomic writes, JSON Schema validation."""
+"""YAML in and out: safe loading only, atomic writes (:mod:`.outputs`), JSON Schema validation."""
 
 from __future__ import annotations
 
-import fcntl
 import itertools
 import json
 import os
 import re
 import stat
-import tempfile
-from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 
 import yaml
 
-from ..errors import FormatError, InputError
+from ..errors import FormatError
 from .data import data_path
+from .outputs import atomic_open, atomic_path, atomic_write
 
 __all__ = ["FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
 
@@ -57,107 +55,6 @@ class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
 MAX_INPUT_BYTES = 512 * 2**20
 MAX_DEPTH = 64
 MAX_INDENT = 256
-
-
-def _output_error(path: Path, error: OSError) -> InputError:
-    return InputError(f"{path}: cannot write: {error.strerror or error}")
-
-
-def _refuse_special(path: Path) -> None:
-    """An existing output must be a regular file: never replace a device, a FIFO, a symlink or a folder."""
-    try:
-        mode = os.lstat(path).st_mode
-    except FileNotFoundError:
-        return
-    except OSError as error:
-        raise _output_error(path, error) from None
-    if not stat.S_ISREG(mode):
-        kind = "a symbolic link" if stat.S_ISLNK(mode) else "a folder" if stat.S_ISDIR(mode) else "a special file"
-        raise InputError(f"{path}: exists and is {kind}, not a regular file: not replacing it")
-
-
-def _remove_stale_temporaries(path: Path) -> None:
-    """Remove ``.NAME.XXXXXXXX.tmp`` files of earlier runs that were killed (SIGKILL, power loss).
-
-    A live writer holds an exclusive lock on its temporary file, so a file whose
-    lock can be taken belongs to a dead process: removing it never disturbs a
-    concurrent run.
-    """
-    prefix = f".{path.name}."
-    try:
-        candidates = [p for p in path.parent.iterdir() if p.name.startswith(prefix) and p.name.endswith(".tmp")
-                      and re.fullmatch(r"[a-z0-9_]{8}", p.name[len(prefix):-4])]
-    except OSError:
-        return
-    for candidate in candidates:
-        try:
-            fd = os.open(candidate, os.O_RDONLY | os.O_NOFOLLOW)
-        except OSError:
-            continue
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            candidate.unlink(missing_ok=True)
-        except OSError:
-            pass  # locked: a live writer
-        finally:
-            os.close(fd)
-
-
-@contextmanager
-def atomic_path(path: str | Path):
-    """A temporary path to write, renamed to ``path`` only when the block ends without an error.
-
-    The temporary file is in the same folder, so the rename is atomic: never a
-    half-written file, and no temporary file left behind (one left by a killed
-    run is removed by the next).  An existing ``path`` that is not a regular file
-    is refused; an unwritable place raises :class:`InputError` with one line.
-    """
-    path = Path(path)
-    _refuse_special(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        _remove_stale_temporaries(path)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    except OSError as error:
-        raise _output_error(path, error) from None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX)  # held until the rename: marks the file as live
-        try:
-            yield Path(tmp)
-            _refuse_special(path)
-            os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file ordinary permissions
-            os.replace(tmp, path)
-        except OSError as error:
-            raise _output_error(path, error) from None
-        finally:
-            os.close(fd)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-@contextmanager
-def atomic_open(path: str | Path, binary: bool = False):
-    """A file to write, in place at ``path`` only when the block ends without an error (see :func:`atomic_path`)."""
-    with atomic_path(path) as tmp:
-        try:
-            handle = open(tmp, "wb") if binary else open(tmp, "w", encoding="utf-8", newline="\n")
-        except OSError as error:
-            raise _output_error(Path(path), error) from None
-        with handle:
-            yield handle
-
-
-def atomic_write(path: str | Path, text: str | bytes) -> None:
-    """Write text (UTF-8) or bytes atomically (see :func:`atomic_open`)."""
-    with atomic_open(path, binary=isinstance(text, bytes)) as handle:
-        handle.write(text)
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def yaml_text(data) -> str:

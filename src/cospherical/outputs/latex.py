@@ -19,12 +19,12 @@ import jinja2
 from ..core.element_types import face_summary
 from ..errors import InputError
 from ..files.data import data_path
-from ..files.yamlio import atomic_open, atomic_write
+from ..files.outputs import OutputFolder, atomic_open
 from ..formats.patterns import pattern_name
 from ..paper import comparison_notes, paper_comparison, paper_notes, paper_studies, paper_study_key
 from ..version import __version__
 
-__all__ = ["compile_pdf", "element_png", "render_tables", "tex", "tikz_picture"]
+__all__ = ["element_png", "render_tables", "tex", "tikz_picture"]
 
 _TEX = {
     "\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_",
@@ -176,17 +176,33 @@ def _readable(name: str) -> str:
     return name.replace("_", " ")
 
 
-def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str) -> list[Path]:
-    """Write every table of the studies' summaries, and ``document.tex`` including them all."""
+def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str, pdf: bool = False) -> list[Path]:
+    """Write every table of the studies' summaries, and ``document.tex`` including them all
+    (and, with ``pdf``, ``document.pdf`` compiled from it, with its log).
+
+    The folder is written as one :class:`~cospherical.files.outputs.OutputFolder`:
+    all files appear together when everything, the PDF included, has succeeded,
+    and a table, PDF or log of an earlier render that this one does not write
+    again is removed only if the folder's manifest says an earlier render wrote
+    it, unchanged since.
+    """
+    known = ("document.tex", "document.pdf", "document.log") if pdf else ("document.tex",)
+    with OutputFolder(out, "render", known) as folder:  # a link at a known name is refused before the work
+        names = _write_tables(summaries, catalogue, folder, title)
+        if pdf:
+            names += _compile_pdf(folder, out)
+    return [out / name for name in names]
+
+
+def _write_tables(summaries: list[dict], catalogue: dict, folder: OutputFolder, title: str) -> list[str]:
     env = environment()
-    written: list[Path] = []
+    written: list[str] = []
 
     def write(name: str, template: str, **context) -> str:
         if not _OUR_NAME.fullmatch(name):  # names come from validated summaries; never a path
             raise InputError(f"{name!r}: not a file name of a rendered table")
-        path = out / name
-        atomic_write(path, env.get_template(template).render(**context))
-        written.append(path)
+        folder.path(name).write_text(env.get_template(template).render(**context), encoding="utf-8", newline="\n")
+        written.append(name)
         return name
 
     sections = [{"title": "Element types",
@@ -228,33 +244,30 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str)
                                         caption="Configurations whose element circumcenters all lie in the box "
                                         "(in the base element for a prism, pyramid or tetrahedron)")]})
     write("document.tex", "document.tex.j2", title=title, version=__version__, sections=sections)
-    _remove_old_tables(out, written)
     return written
 
 
-# The files render_tables writes; the tables of an earlier render into the same
-# folder (another study's) are removed, nothing else.
+# The names of the files render_tables writes.
 _OUR_NAME = re.compile(r"[0-9a-z][0-9a-z._-]*\.tex")
-_OUR_TABLE = re.compile(r"(frequencies|comparison)-[0-9a-z._-]+\.tex")
 
 
-def _remove_old_tables(out: Path, written: list[Path]) -> None:
-    keep = {path.name for path in written}
-    for path in out.iterdir():
-        if _OUR_TABLE.fullmatch(path.name) and path.name not in keep and path.is_file() and not path.is_symlink():
-            path.unlink()
-
-
-def compile_pdf(out: Path, document: str = "document.tex") -> Path:
-    """Compile with pdflatex (twice, for the long tables) and leave the PDF in ``out``."""
+def _compile_pdf(folder: OutputFolder, out: Path, document: str = "document.tex") -> list[str]:
+    """Compile the staged ``document.tex`` with pdflatex (twice, for the long tables) in the private
+    staging folder, where nothing it writes can follow a link in ``out``; the PDF and its log are
+    then outputs like the tables."""
     pdflatex = shutil.which("pdflatex")
     if pdflatex is None:
         raise InputError("pdflatex not found: install a TeX engine (Debian: texlive-latex-base, "
                          "texlive-latex-recommended, texlive-pictures)")
+    stem = Path(document).stem
     for _ in range(2):
-        result = subprocess.run([pdflatex, "-interaction=nonstopmode", "-halt-on-error", document],
-                                cwd=out, capture_output=True, text=True)
+        result = subprocess.run([pdflatex, "-interaction=nonstopmode", "-halt-on-error", "-no-shell-escape",
+                                 document], cwd=folder.staging, capture_output=True, text=True,
+                                stdin=subprocess.DEVNULL, errors="replace")
         if result.returncode != 0:
             error = next((line for line in result.stdout.splitlines() if line.startswith("!")), "pdflatex failed")
-            raise InputError(f"{out / document}: {error} (see {out / Path(document).with_suffix('.log').name})")
-    return out / Path(document).with_suffix(".pdf")
+            raise InputError(f"{out / document}: {error}")
+    names = [f"{stem}.pdf", f"{stem}.log"]
+    for name in names:
+        folder.path(name)
+    return names

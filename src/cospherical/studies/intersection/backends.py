@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from typing import Any, Callable, Hashable, Iterator
 
 from ...errors import InputError
@@ -32,26 +33,7 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
     [('a', 8), ('b', 9)]
     """
     if scheduler or dask_workers:
-        # Imported here: dask is an optional extra, and a heavy import the other backends never need.
-        from dask.distributed import Client, LocalCluster, as_completed
-
-        cluster = None if scheduler else LocalCluster(n_workers=dask_workers, threads_per_worker=1,
-                                                      processes=True, dashboard_address=None)
-        try:  # the connect timeout is dask's distributed.comm.timeouts.connect (--scheduler-timeout)
-            client = Client(scheduler or cluster)
-        except (OSError, TimeoutError, ValueError, TypeError) as error:
-            raise InputError(f"Dask scheduler {scheduler}: cannot connect: "
-                             f"{str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
-        try:
-            futures = {client.submit(function, *args, pure=False): key for key, args in tasks.items()}
-            for future in as_completed(futures):
-                # dropped once yielded: a finished future keeps its result (chunks of a
-                # pattern table hold megabytes each)
-                yield futures.pop(future), future.result()
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+        yield from _dask_completed(function, tasks, scheduler, dask_workers)
     elif jobs <= 1:
         for key, args in tasks.items():
             yield key, function(*args)
@@ -60,13 +42,123 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
 
         from ..pool import process_pool
 
-        pool = process_pool(jobs)
-        try:
+        with process_pool(jobs) as pool:  # left by an error, Ctrl-C or SIGTERM: the workers are stopped at once
             pending = {pool.submit(function, *args): key for key, args in tasks.items()}
             while pending:
                 # not as_completed, which keeps every future, and so every result, to the end
                 done, _ = wait(pending, return_when=FIRST_COMPLETED)
                 for future in done:
                     yield pending.pop(future), future.result()
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler: str | None,
+                    dask_workers: int | None) -> Iterator[tuple[Hashable, Any]]:
+    """:func:`completed` on Dask: a running scheduler, or a local cluster whose scratch space
+    (its lock files included) is a private temporary folder, removed at the end however the run ends."""
+    import logging
+    import shutil
+    import signal
+    import tempfile
+
+    # Imported here: dask is an optional extra, and a heavy import the other backends never need.
+    import dask
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    from ..pool import register_stop, unregister_stop
+
+    scratch = None if scheduler else tempfile.mkdtemp(prefix="cospherical-dask-")
+    cluster = client = None
+    try:
+        if scratch is not None:
+            # Ctrl-C reaches the whole process group, and a worker caught by it while it starts
+            # prints a traceback. Workers are forked from a fork server started with SIGINT ignored
+            # (for the few milliseconds of its spawn), so they ignore it too, and only this
+            # process, which stops them, sees it. silence_logs: a cluster shut down by Ctrl-C logs
+            # lost heartbeats as tracebacks; a task's own error still reaches us through its future.
+            from multiprocessing import forkserver
+
+            previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+            try:
+                forkserver.ensure_running()
+            finally:
+                signal.signal(signal.SIGINT, previous)
+            settings = {"temporary-directory": scratch,  # the scheduler's scratch space too
+                        "distributed.worker.multiprocessing-method": "forkserver"}
+            with dask.config.set(settings), _interrupt_deferred():  # a half-made cluster cannot be closed
+                cluster = LocalCluster(n_workers=dask_workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, local_directory=scratch,
+                                       silence_logs=logging.CRITICAL)
+        try:  # the connect timeout is dask's distributed.comm.timeouts.connect (--scheduler-timeout)
+            client = Client(scheduler or cluster)
+        except (OSError, TimeoutError, ValueError, TypeError) as error:
+            raise InputError(f"Dask scheduler {scheduler}: cannot connect: "
+                             f"{str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
+        register_stop(id(client), lambda: (_kill_workers(cluster), _close_dask(client, cluster)))
+        futures = {client.submit(function, *args, pure=False): key for key, args in tasks.items()}
+        for future in as_completed(futures):
+            # dropped once yielded: a finished future keeps its result (chunks of a
+            # pattern table hold megabytes each)
+            yield futures.pop(future), future.result()
+    except BaseException:
+        _kill_workers(cluster)  # an error, Ctrl-C or SIGTERM: no wait for the chunks still running
+        raise
+    finally:
+        unregister_stop(id(client))
+        _close_dask(client, cluster)
+        if scratch is not None:
+            shutil.rmtree(scratch, ignore_errors=True)
+
+
+@contextmanager
+def _interrupt_deferred():
+    """Hold a Ctrl-C back until the block has ended, then raise it."""
+    import signal
+
+    held = []
+    try:
+        previous = signal.signal(signal.SIGINT, lambda signum, frame: held.append(signum))
+    except ValueError:  # not the main thread: signals are not ours to handle
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if held:
+        raise KeyboardInterrupt
+
+
+def _kill_workers(cluster) -> None:
+    """Kill the worker processes of a local cluster, whose nannies would wait seconds for running tasks."""
+    import os
+    import signal
+
+    from distributed.core import Status
+
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        pid = getattr(nanny, "pid", None)
+        nanny.status = Status.closing_gracefully  # the nanny then closes, instead of starting the worker again
+        if pid:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass
+
+
+def _close_dask(client, cluster) -> None:
+    """Close the client and the local cluster without a word, even when a second Ctrl-C arrives meanwhile.
+
+    Once closed they are also no longer in dask's own exit handlers, which would
+    otherwise try again at interpreter exit and print a traceback.
+    """
+    for closable in (client, cluster):
+        if closable is None:
+            continue
+        for _ in range(3):
+            try:
+                closable.close(timeout=5)
+                break
+            except KeyboardInterrupt:
+                continue
+            except Exception:
+                break

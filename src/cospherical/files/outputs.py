@@ -1,0 +1,317 @@
+"""Writing outputs: whole files renamed into place, never through a link, in folders locked for the run.
+
+Two shapes of the same rule, that an output is either as it was or complete:
+
+- :func:`atomic_path` (and :func:`atomic_open`, :func:`atomic_write`) for one
+  file: written to a temporary file in the same folder, renamed when complete.
+- :class:`OutputFolder` for the several files of one run (``mesh --out``,
+  ``render --out``): the folder is locked for the run, every file is made in a
+  private staging folder inside it (programs the tool runs, such as pdflatex,
+  work there too, so nothing they write can follow a link in the user's
+  folder), and only when the whole run has succeeded are the files renamed into
+  place, together.  A failed run leaves the folder as it found it.
+
+Neither ever replaces what is not a regular file at an output's name (a
+symbolic link, a folder, a FIFO, a device): the run is refused with one line
+and the link's target is never touched.  A folder keeps a manifest of what each
+command wrote there (name and SHA-256); a later run of that command removes a
+file of its earlier run that it did not write again (another study's table, a
+PDF not made this time) only if the manifest names it and its content is still
+what was written. A file the user put there, or changed, is never removed.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import hashlib
+import json
+import os
+import re
+import shutil
+import stat
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+from ..errors import InputError
+
+__all__ = ["MANIFEST", "OutputFolder", "atomic_open", "atomic_path", "atomic_write", "refuse_special"]
+
+MANIFEST = ".cospherical-manifest.json"
+_STAGING_PREFIX = ".cospherical-staging."
+_MAX_MANIFEST_BYTES = 1 << 20
+# A name an output folder holds: one plain file name, never a path and never hidden.
+_PLAIN_NAME = re.compile(r"[0-9A-Za-z][0-9A-Za-z._-]*")
+
+
+def _output_error(path: Path, error: OSError) -> InputError:
+    return InputError(f"{path}: cannot write: {error.strerror or error}")
+
+
+def refuse_special(path: Path) -> None:
+    """An existing output must be a regular file: never replace a device, a FIFO, a symlink or a folder."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return
+    except OSError as error:
+        raise _output_error(path, error) from None
+    if not stat.S_ISREG(mode):
+        kind = "a symbolic link" if stat.S_ISLNK(mode) else "a folder" if stat.S_ISDIR(mode) else "a special file"
+        raise InputError(f"{path}: exists and is {kind}, not a regular file: not replacing it")
+
+
+def _remove_stale_temporaries(path: Path) -> None:
+    """Remove ``.NAME.XXXXXXXX.tmp`` files of earlier runs that were killed (SIGKILL, power loss).
+
+    A live writer holds an exclusive lock on its temporary file, so a file whose
+    lock can be taken belongs to a dead process: removing it never disturbs a
+    concurrent run.
+    """
+    prefix = f".{path.name}."
+    try:
+        candidates = [p for p in path.parent.iterdir() if p.name.startswith(prefix) and p.name.endswith(".tmp")
+                      and re.fullmatch(r"[a-z0-9_]{8}", p.name[len(prefix):-4])]
+    except OSError:
+        return
+    for candidate in candidates:
+        try:
+            fd = os.open(candidate, os.O_RDONLY | os.O_NOFOLLOW)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            candidate.unlink(missing_ok=True)
+        except OSError:
+            pass  # locked: a live writer
+        finally:
+            os.close(fd)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+@contextmanager
+def atomic_path(path: str | Path):
+    """A temporary path to write, renamed to ``path`` only when the block ends without an error.
+
+    The temporary file is in the same folder, so the rename is atomic: never a
+    half-written file, and no temporary file left behind (one left by a killed
+    run is removed by the next).  An existing ``path`` that is not a regular file
+    is refused; an unwritable place raises :class:`InputError` with one line.
+    """
+    path = Path(path)
+    refuse_special(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        _remove_stale_temporaries(path)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as error:
+        raise _output_error(path, error) from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)  # held until the rename: marks the file as live
+        try:
+            yield Path(tmp)
+            refuse_special(path)
+            os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file ordinary permissions
+            os.replace(tmp, path)
+        except OSError as error:
+            raise _output_error(path, error) from None
+        finally:
+            os.close(fd)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+@contextmanager
+def atomic_open(path: str | Path, binary: bool = False):
+    """A file to write, in place at ``path`` only when the block ends without an error (see :func:`atomic_path`)."""
+    with atomic_path(path) as tmp:
+        try:
+            handle = open(tmp, "wb") if binary else open(tmp, "w", encoding="utf-8", newline="\n")
+        except OSError as error:
+            raise _output_error(Path(path), error) from None
+        with handle:
+            yield handle
+
+
+def atomic_write(path: str | Path, text: str | bytes) -> None:
+    """Write text (UTF-8) or bytes atomically (see :func:`atomic_open`)."""
+    with atomic_open(path, binary=isinstance(text, bytes)) as handle:
+        handle.write(text)
+
+
+def _sha256(path: Path) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+class OutputFolder:
+    """The outputs of one run into one folder: locked, staged, renamed into place together at the end.
+
+    Use it as a context manager; write each output to :meth:`path` (a file of
+    that name in the private staging folder).  When the block ends without an
+    error every staged file is renamed to its name in the folder and the
+    manifest is updated; on an error (or Ctrl-C, or SIGTERM) the staging folder
+    is removed and the folder is as it was.  A second run into the same folder
+    while this one holds it is refused at once with one line, rather than made
+    to wait: it would overwrite this run's files the moment it got the folder,
+    and a wait of minutes with no word is worse than a clear refusal.
+
+    Parameters
+    ----------
+    folder : path
+        The output folder; created (with its parents) if missing, and removed
+        again if the run fails and the folder is still empty.
+    writer : str
+        The command writing (``mesh``, ``render``): the manifest keeps each
+        command's files apart, so one never removes another's.
+    names : iterable of str, optional
+        Outputs known from the start: refused at once if their names are taken
+        by a link, a folder or a special file, before any long work.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     with OutputFolder(Path(d) / "out", "example") as out:
+    ...         _ = out.path("a.txt").write_text("A")
+    ...     sorted(p.name for p in (Path(d) / "out").iterdir())
+    ['.cospherical-manifest.json', 'a.txt']
+    """
+
+    def __init__(self, folder: str | Path, writer: str, names=()):
+        self.folder = Path(folder)
+        self.writer = writer
+        self.staging: Path | None = None
+        self._names = list(names)
+        self._staged: list[str] = []
+        self._fd: int | None = None
+        self._created = False
+
+    def __enter__(self) -> OutputFolder:
+        folder = self.folder
+        try:
+            self._created = not folder.exists()
+            folder.mkdir(parents=True, exist_ok=True)
+            self._fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+        except OSError as error:
+            raise _output_error(folder, error) from None
+        try:
+            fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(self._fd)
+            self._fd = None
+            raise InputError(f"{folder}: another cospherical run is writing into this folder; "
+                             "wait for it to end, or choose another folder") from None
+        try:
+            for name in self._names:
+                self._check_name(name)
+            self._remove_stale_staging()
+            self.staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=folder))
+        except BaseException:
+            self._release(failed=True)
+            raise
+        return self
+
+    def path(self, name: str) -> Path:
+        """Where to write the output ``name``: a file in the staging folder, moved into place at the end."""
+        self._check_name(name)
+        if name not in self._staged:
+            self._staged.append(name)
+        return self.staging / name
+
+    def __exit__(self, kind, value, traceback) -> None:
+        if kind is not None:
+            self._release(failed=True)
+            return
+        try:
+            self._commit()
+        except BaseException:
+            self._release(failed=True)
+            raise
+        self._release(failed=False)
+
+    def _check_name(self, name: str) -> None:
+        if not _PLAIN_NAME.fullmatch(name) or name == MANIFEST:
+            raise InputError(f"{name!r}: not a plain file name for an output")
+        refuse_special(self.folder / name)
+
+    def _remove_stale_staging(self) -> None:
+        # The folder is locked: any staging folder in it is a killed run's.
+        for path in self.folder.iterdir():
+            if path.name.startswith(_STAGING_PREFIX) and path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path, ignore_errors=True)
+
+    def _read_manifest(self) -> dict:
+        """The manifest, or an empty one if it is missing or damaged: then nothing is removed."""
+        path = self.folder / MANIFEST
+        try:
+            fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+        except OSError:
+            return {}
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                return {}
+            with os.fdopen(os.dup(fd), "rb") as handle:
+                text = handle.read(_MAX_MANIFEST_BYTES + 1)
+            data = json.loads(text.decode("utf-8")) if len(text) <= _MAX_MANIFEST_BYTES else {}
+        except (OSError, ValueError, RecursionError):
+            return {}
+        finally:
+            os.close(fd)
+        if not isinstance(data, dict):
+            return {}
+        return {writer: {name: digest for name, digest in files.items()
+                         if isinstance(name, str) and _PLAIN_NAME.fullmatch(name) and isinstance(digest, str)}
+                for writer, files in data.items() if isinstance(writer, str) and isinstance(files, dict)}
+
+    def _commit(self) -> None:
+        missing = [name for name in self._staged if not os.path.isfile(self.staging / name)]
+        if missing:
+            raise InputError(f"{self.folder / missing[0]}: was not written")
+        for name in self._staged:  # every name checked before the first rename
+            refuse_special(self.folder / name)
+        manifest = self._read_manifest()
+        ours = {name: _sha256(self.staging / name) for name in self._staged}
+        earlier = manifest.get(self.writer, {})
+        mode = 0o666 & ~_umask()
+        try:
+            for name in self._staged:
+                os.chmod(self.staging / name, mode)  # files made by mkstemp or pdflatex: ordinary permissions
+                os.replace(self.staging / name, self.folder / name)
+            for name, digest in sorted(earlier.items()):
+                if name not in ours:
+                    self._remove_if_ours(self.folder / name, digest)
+        except OSError as error:
+            raise _output_error(self.folder / getattr(error, "filename", ""), error) from None
+        manifest[self.writer] = dict(sorted(ours.items()))
+        atomic_write(self.folder / MANIFEST, json.dumps(dict(sorted(manifest.items())), indent=1) + "\n")
+
+    @staticmethod
+    def _remove_if_ours(path: Path, digest: str) -> None:
+        try:
+            if stat.S_ISREG(os.lstat(path).st_mode) and _sha256(path) == digest:
+                path.unlink()
+        except OSError:
+            pass  # gone, or unreadable: not ours to remove
+
+    def _release(self, failed: bool) -> None:
+        if self.staging is not None:
+            shutil.rmtree(self.staging, ignore_errors=True)
+            self.staging = None
+        if self._fd is not None:
+            os.close(self._fd)  # releases the lock
+            self._fd = None
+        if failed and self._created:
+            try:
+                self.folder.rmdir()  # made by this run, and still empty
+            except OSError:
+                pass
