@@ -160,7 +160,8 @@ def test_cli_report_and_outputs(tmp_path, capsys):
         (15, 46, 7, 7)
     assert json.loads((tmp_path / "out" / "report.json").read_text()) == report
     assert (tmp_path / "out" / "mesh.png").stat().st_size > 1000
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["mesh.png", "mesh.vtu", "report.json"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [".cospherical-manifest.json", "mesh.png", "mesh.vtu",
+                                                                    "report.json"]
 
 
 def test_text_leaf_list(tmp_path):
