@@ -11,6 +11,10 @@ command -v qdelaunay >/dev/null 2>&1 || packages+=(qhull-bin)   # Qhull's merged
 command -v pdflatex >/dev/null 2>&1 || packages+=(texlive-latex-base texlive-latex-recommended texlive-pictures)
 command -v pdftoppm >/dev/null 2>&1 || packages+=(poppler-utils)  # PDF page -> PNG in the tests
 command -v tetgen >/dev/null 2>&1 || packages+=(tetgen)  # benchmarks/bench_outputs.py: the tetrahedral mesher beside ours
+command -v chromium >/dev/null 2>&1 || packages+=(chromium)  # the docs site's pages opened headless in the tests
+command -v cc >/dev/null 2>&1 || packages+=(gcc)  # the docs' C reader of the pattern-table store, compiled in the tests
+[ -e /usr/include/sqlite3.h ] || packages+=(libsqlite3-dev)
+[ -e /usr/include/zlib.h ] || packages+=(zlib1g-dev)
 python3 -c "import ensurepip, venv" >/dev/null 2>&1 || packages+=(python3-venv)  # stock Ubuntu lacks it
 if [ ${#packages[@]} -gt 0 ]; then
   # Wait up to 10 minutes for another apt-get or dpkg (unattended upgrades on a fresh
@@ -22,7 +26,7 @@ fi
 
 python3 -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e '.[test]'
+.venv/bin/python -m pip install -q -e '.[test,docs]'
 # Bytecode for our own modules now: an editable install leaves them uncompiled, and where
 # PYTHONDONTWRITEBYTECODE is set every command would compile them again (~30 ms a start).
 .venv/bin/python -m compileall -q src >/dev/null

@@ -1,14 +1,9 @@
 """Every Python snippet of the README runs as written, from the repository root."""
 
-import contextlib
-import io
-import re
-from pathlib import Path
-
 import pytest
+from examples import ROOT, python_examples, run_python_example
 
-ROOT = Path(__file__).resolve().parents[1]
-SNIPPETS = re.findall(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), flags=re.S)
+SNIPPETS = python_examples((ROOT / "README.md").read_text())
 
 
 def test_the_readme_has_python_snippets():
@@ -16,9 +11,6 @@ def test_the_readme_has_python_snippets():
 
 
 @pytest.mark.parametrize("snippet", SNIPPETS, ids=[f"snippet{i}" for i in range(len(SNIPPETS))])
-def test_snippet_runs(snippet, monkeypatch):
-    monkeypatch.chdir(ROOT)
-    printed = io.StringIO()
-    with contextlib.redirect_stdout(printed):
-        exec(compile(snippet, "README.md", "exec"), {"__name__": "__readme__"})
-    assert printed.getvalue().strip(), "a README snippet shows its result"
+def test_snippet_runs(snippet):
+    printed = run_python_example(snippet, ROOT, "README.md")
+    assert printed.strip(), "a README snippet shows its result"

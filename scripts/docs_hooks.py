@@ -1,0 +1,347 @@
+"""MkDocs hooks: the pages' generated parts, made at build time from the code and results/.
+
+Nothing generated is typed into ``docs/``: a page holds a marker such as
+``<!-- generated: cli -->`` and this module replaces it, so the CLI reference is
+the parser itself, the tables are ``results/*.json`` as ``cospherical reproduce``
+last wrote them, and the gallery is whatever pictures ``results/elements/`` holds.
+The JSON Schemas and the pictures are added to the site from where they live.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+from pathlib import Path
+
+from mkdocs.structure.files import File
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "results"
+SCHEMAS = ROOT / "src" / "cospherical" / "data" / "schemas"
+MARKER = re.compile(r"<!-- generated: ([a-z-]+)(?::([a-z-]+))? -->")
+CRITERIA = ("optimal", "internal_faces", "internal_edges_and_faces")
+
+
+# --- files taken into the site from where they live -------------------------------------------
+
+def _assets() -> dict[str, Path]:
+    """Site path -> source file, for every schema and every picture the pages show."""
+    assets = {f"schemas/{path.name}": path for path in sorted(SCHEMAS.glob("*.json"))}
+    for path in sorted((RESULTS / "elements").glob("*.png")):
+        assets[f"figures/elements/{path.name}"] = path
+    for path in sorted((RESULTS / "sweep").glob("*.png")):
+        assets[f"figures/sweep/{path.name}"] = path
+    for path in sorted(RESULTS.glob("mesh/*/mesh.png")):
+        assets[f"figures/mesh/{path.parent.name}.png"] = path
+    return assets
+
+
+def on_files(files, config):
+    for uri, path in _assets().items():
+        files.append(File.generated(config, uri, abs_src_path=str(path)))
+    return files
+
+
+def on_page_markdown(markdown, page, config, files):
+    depth = page.file.src_uri.count("/")
+    up = "../" * depth  # from the page's folder to the site's root, as MkDocs resolves links
+
+    def generated(match):
+        name, argument = match.groups()
+        return GENERATORS[name](up, argument) if argument else GENERATORS[name](up)
+
+    return MARKER.sub(generated, markdown)
+
+
+# --- the CLI reference, from the parser ---------------------------------------------------------
+
+def _cell(text) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
+def _options_table(parser: argparse.ArgumentParser) -> list[str]:
+    formatter = parser._get_formatter()
+    rows = ["| option | value | default | what it does |", "|---|---|---|---|"]
+    for action in parser._actions:
+        if action.help == argparse.SUPPRESS or isinstance(action, (argparse._SubParsersAction,
+                                                                     argparse._HelpAction)):
+            continue
+        names = ", ".join(f"`{name}`" for name in action.option_strings) or f"`{action.dest}`"
+        if action.choices is not None:
+            value = " \\| ".join(f"`{choice}`" for choice in action.choices)
+        elif action.nargs == 0:
+            value = "(flag)"
+        else:
+            metavar = action.metavar or action.dest.upper()
+            value = "`" + " ".join(metavar if isinstance(metavar, tuple) else [metavar]) + "`"
+        default = action.default
+        shown = "" if default in (None, False, argparse.SUPPRESS) or action.nargs == 0 else f"`{_cell(default)}`"
+        if isinstance(default, list):
+            shown = "`" + " ".join(default) + "`"
+        rows.append(f"| {names} | {value} | {shown} | {_cell(formatter._expand_help(action))} |")
+    return rows
+
+
+def _command_section(parser: argparse.ArgumentParser, level: int) -> list[str]:
+    lines = [f"{'#' * level} `{parser.prog}`", ""]
+    if parser.description:
+        lines += [parser.description, ""]
+    lines += ["```text", parser.format_usage().strip(), "```", ""]
+    lines += _options_table(parser) + [""]
+    for child in _subparsers(parser).values():
+        lines += _command_section(child, level + 1)
+    return lines
+
+
+def cli_reference(up: str) -> str:
+    os.environ["COLUMNS"] = "100"  # argparse wraps usage to the terminal: the same page on every machine
+    from cospherical.cli import build_parser
+
+    parser = build_parser()
+    lines = ["```text", parser.format_usage().strip(), "```", ""]
+    for child in _subparsers(parser).values():
+        lines += _command_section(child, 2)
+    return "\n".join(lines)
+
+
+# --- results tables, from results/*.json ---------------------------------------------------------
+
+def _summaries() -> list[tuple[str, dict]]:
+    return [(path.stem, json.loads(path.read_text())) for path in sorted(RESULTS.glob("*.json"))]
+
+
+def _n(value) -> str:
+    return "-" if value is None else f"{value:,}" if isinstance(value, int) else str(value)
+
+
+def studies_table(up: str) -> str:
+    from cospherical.paper import paper_comparison, paper_study_key
+
+    names = {"optimal": "optimal", "internal_faces": "internal faces", "internal_edges_and_faces": "internal edges"}
+    rows = ["| study | box | points | configurations (orbits) | FVM closed / open | "
+            + " | ".join(f"{names[c]}: elements / types" for c in CRITERIA) + " | paper: elements / classes / FVM |",
+            "|---|---|---|---:|---:|" + "---:|" * len(CRITERIA) + "---|"]
+    for stem, summary in _summaries():
+        key, _ = paper_study_key(summary)
+        paper = "-"
+        if key:
+            optimal = paper_comparison(summary, key)
+            paper = " / ".join(_n(x) for x in (optimal["total"]["paper"], optimal["classes"]["paper"],
+                                               optimal["fvm_adequate"]["paper"]))
+        criteria = [f"{_n(summary['criteria'][c]['total'])} / {summary['criteria'][c]['types_count']}"
+                    for c in CRITERIA]
+        element = summary.get("element", "cuboid")
+        study = summary["study"] + ("" if element == "cuboid" else f" ({element})")
+        rows.append(f"| {study} | {' x '.join(summary['box'])} | {summary['face_points']} | "
+                    f"{_n(summary['configurations'])} ({_n(summary['orbits'])}) | "
+                    f"{_n(summary['fvm_adequate'])} / {_n(summary['fvm_adequate_open'])} | "
+                    + " | ".join(criteria) + f" | {paper} |")
+    return "\n".join(rows)
+
+
+def paper_tables(up: str) -> str:
+    """Per study the paper compares with, and per criterion it publishes: class by class."""
+    from cospherical.paper import paper_comparison, paper_study_key
+    from cospherical.paper.published import paper_studies
+
+    out = []
+    for stem, summary in _summaries():
+        key, notes = paper_study_key(summary)
+        if not key or summary["face_points"] != "octree":
+            continue
+        for criterion in CRITERIA:
+            if criterion not in paper_studies()[key]:
+                continue
+            table = paper_comparison(summary, key, criterion)
+            out += [f"### {stem}: {criterion.replace('_', ' ')} (paper: {key})", ""]
+            out += ["| paper class | paper | ours | |", "|---|---:|---:|---|"]
+            for row in table["rows"]:
+                mark = "" if row["paper"] == row["ours"] else "differs"
+                out.append(f"| {row['class']} | {_n(row['paper'])} | {_n(row['ours'])} | {mark} |")
+            total = table["total"]
+            out.append(f"| **total** | {_n(total['paper'])} | {_n(total['ours'])} | "
+                       f"{'' if total['paper'] == total['ours'] else 'differs'} |")
+            out.append("")
+    return "\n".join(out)
+
+
+def intersection_table(up: str) -> str:
+    from cospherical.paper import paper_comparison
+
+    tables = {}
+    for path in sorted(RESULTS.glob("intersection/*/intersection-r*-*.json")):
+        summary = json.loads(path.read_text())
+        tables[summary["insertion_order"]] = (summary, paper_comparison(summary, "intersection_cube"))
+    if not tables:
+        return "*(no intersection results in results/intersection/)*"
+    orders = list(tables)
+    first = tables[orders[0]][1]
+    rows = ["| paper class | paper | " + " | ".join(f"ours, order `{o}`" for o in orders) + " |",
+            "|---|---:|" + "---:|" * len(orders)]
+    labels = [row["class"] for row in first["rows"]]
+    for order in orders[1:]:
+        labels += [row["class"] for row in tables[order][1]["rows"] if row["class"] not in labels]
+    for label in labels:
+        paper = next((r["paper"] for r in first["rows"] if r["class"] == label), None)
+        ours = [next((r["ours"] for r in tables[o][1]["rows"] if r["class"] == label), None) for o in orders]
+        rows.append(f"| {label} | {_n(paper)} | " + " | ".join(_n(x) for x in ours) + " |")
+    rows.append("| **total elements** | " + _n(first["total"]["paper"]) + " | "
+                + " | ".join(_n(tables[o][1]["total"]["ours"]) for o in orders) + " |")
+    rows.append("| configurations (orbits) | - | "
+                + " | ".join(f"{_n(tables[o][0]['configurations'])} ({_n(tables[o][0]['orbits'])})" for o in orders)
+                + " |")
+    rows.append("| FVM-adequate, closed / open | - | "
+                + " | ".join(f"{_n(tables[o][0]['fvm_adequate'])} / {_n(tables[o][0]['fvm_adequate_open'])}"
+                             for o in orders) + " |")
+    return "\n".join(rows)
+
+
+MESH_ROWS = [("leaves", "leaves"), ("vertices", "vertices"), ("elements", "elements"), ("types", "element types"),
+             ("volume_ok", "volume_ok"), ("nonconforming_faces", "nonconforming faces"),
+             ("circumcenters_outside_leaf", "circumcenters outside their leaf"),
+             ("leaves_not_fvm_adequate", "leaves not FVM-adequate"),
+             ("delaunay_violations", "Delaunay violations (elements)"),
+             ("delaunay_violating_pairs", "(element, vertex) pairs"), ("delaunay_ties", "co-spherical ties"),
+             ("configurations", "distinct configurations"), ("tessellated_on_the_fly", "tessellated on the fly"),
+             ("paper_final_share", "share of the paper's seven final elements")]
+
+
+def mesh_table(up: str) -> str:
+    reports = [(path.parent.name, json.loads(path.read_text())) for path in sorted(RESULTS.glob("mesh/*/report.json"))]
+    rows = ["| | " + " | ".join(f"`{name}`" for name, _ in reports) + " |", "|---|" + "---:|" * len(reports)]
+    rows.append("| tree | " + " | ".join(
+        f"{' x '.join(r['domain'])}, levels {r['tree'].get('levels', r['tree'].get('depth'))}, "
+        + ", ".join(f"`{s}`" for s in r["tree"].get("refine", [])) for _, r in reports) + " |")
+    for key, label in MESH_ROWS:
+        rows.append(f"| {label} | " + " | ".join(_n(r.get(key)) for _, r in reports) + " |")
+    pictures = [f"![{name}]({up}figures/mesh/{name}.png)" for name, _ in reports]
+    return "\n".join(rows) + "\n\n" + "\n\n".join(pictures)
+
+
+def gallery(up: str) -> str:
+    from cospherical import shipped_catalogue
+
+    types = {entry["id"]: entry for entry in shipped_catalogue()["types"]}
+    def order(path):
+        entry = types.get(path.stem, {})
+        return entry.get("vertices", 99), entry.get("faces", 99), path.stem
+
+    pictures = sorted((RESULTS / "elements").glob("*.png"), key=order)
+    out = [f"{len(pictures)} pictures, one per element type of the shipped catalogue "
+           f"({len(types)} types), by number of vertices, then faces.", ""]
+    for path in pictures:
+        entry = types.get(path.stem, {})
+        name = entry.get("name", "(not in the catalogue)")
+        faces = ", ".join(f"{n} {kind}" for kind, n in sorted(entry.get("face_kinds", {}).items()))
+        out += ['<figure class="element" markdown>', "",
+                f'![{name}]({up}figures/elements/{path.name}){{ width="160" }}', "",
+                f"<figcaption><b>{name}</b><br><code>{path.stem}</code> V {entry.get('vertices')}, "
+                f"E {entry.get('edges')}, F {entry.get('faces')}: {faces}</figcaption>", "</figure>", ""]
+    return '<div class="gallery" markdown>\n\n' + "\n".join(out) + "\n</div>"
+
+
+def sweep_figures(up: str) -> str:
+    return "\n\n".join(f"![{path.stem}]({up}figures/sweep/{path.name})"
+                       for path in sorted((RESULTS / "sweep").glob("*.png")))
+
+
+def schemas_list(up: str) -> str:
+    return "\n".join(f"- [`{path.name}`]({up}schemas/{path.name}) (`src/cospherical/data/schemas/{path.name}`)"
+                     for path in sorted(SCHEMAS.glob("*.json")))
+
+
+# --- a schema's fields, from the schema itself -------------------------------------------------
+
+def _resolve(node: dict, schema: dict) -> dict:
+    while "$ref" in node:
+        node = schema["$defs"][node["$ref"].rsplit("/", 1)[-1]]
+    return node
+
+
+def _kind(node: dict, schema: dict) -> str:
+    node = _resolve(node, schema)
+    if "const" in node:
+        return f"`{json.dumps(node['const'])}`"
+    if "enum" in node:
+        return " \\| ".join(f"`{json.dumps(value)}`" for value in node["enum"])
+    if "oneOf" in node or "anyOf" in node:
+        return " or ".join(_kind(option, schema) for option in node.get("oneOf", node.get("anyOf")))
+    kind = node.get("type", "any")
+    kind = " or ".join(kind) if isinstance(kind, list) else kind
+    if kind == "array" and "items" in node:
+        kind = f"array of {_kind(node['items'], schema)}"
+    limits = [f"{word} {node[key]}" for key, word in (("minimum", ">="), ("maximum", "<="), ("minItems", "items >="),
+                                                         ("maxItems", "items <="), ("minLength", "length >="))
+              if key in node]
+    if "pattern" in node:
+        limits.append(f"matches `{node['pattern']}`")
+    return kind + (f" ({', '.join(limits)})" if limits else "")
+
+
+def _fields(node: dict, schema: dict, path: str, depth: int = 0):
+    node = _resolve(node, schema)
+    required = set(node.get("required", ()))
+    for name, child in node.get("properties", {}).items():
+        resolved = _resolve(child, schema)
+        where = f"{path}.{name}" if path else name
+        yield where, _kind(child, schema), name in required, resolved.get("description", "")
+        if depth < 3:
+            if resolved.get("type") == "object":
+                yield from _fields(resolved, schema, where, depth + 1)
+            items = _resolve(resolved.get("items", {}), schema)
+            if items.get("type") == "object":
+                yield from _fields(items, schema, where + "[]", depth + 1)
+    extra = node.get("additionalProperties")
+    if isinstance(extra, dict) and depth < 3:
+        extra = _resolve(extra, schema)
+        where = f"{path}.<key>" if path else "<key>"
+        yield where, _kind(extra, schema), False, extra.get("description", "any key" if not node.get(
+            "propertyNames") else f"keys match `{node['propertyNames'].get('pattern', '')}`")
+        if extra.get("type") == "object":
+            yield from _fields(extra, schema, where, depth + 1)
+
+
+def schema_fields(up: str, name: str) -> str:
+    """The fields of one JSON Schema as a table: where, type and limits, required, meaning."""
+    schema = json.loads((SCHEMAS / f"{name}.schema.json").read_text())
+    rows = [f"Generated from [`{name}.schema.json`]({up}schemas/{name}.schema.json) "
+            f"(`src/cospherical/data/schemas/`); the schema is what `check` and the readers enforce.", "",
+            "| field | type | required | meaning |", "|---|---|---|---|"]
+    for where, kind, required, description in _fields(schema, schema, ""):
+        rows.append(f"| `{where}` | {kind} | {'yes' if required else ''} | {_cell(description)} |")
+    return "\n".join(rows)
+
+
+def benchmarks(up: str) -> str:
+    """Each benchmark script's own docstring: what it measures, against what, and how to run it."""
+    import ast
+
+    out = []
+    for path in sorted((ROOT / "benchmarks").glob("bench_*.py")):
+        text = ast.get_docstring(ast.parse(path.read_text())) or ""
+        first, _, rest = text.partition("\n")
+        out += [f"## `benchmarks/{path.name}`", "", first, "", "```text", rest.strip("\n"), "```", ""]
+    return "\n".join(out)
+
+
+GENERATORS = {
+    "benchmarks": benchmarks,
+    "schema": schema_fields,
+    "cli": cli_reference,
+    "studies": studies_table,
+    "paper": paper_tables,
+    "intersection": intersection_table,
+    "meshes": mesh_table,
+    "gallery": gallery,
+    "sweep": sweep_figures,
+    "schemas": schemas_list,
+}

@@ -1,0 +1,198 @@
+"""The documentation site: it builds with warnings as errors, its examples run, it renders.
+
+The site is built once per module into a temporary folder (``mkdocs build --strict``:
+a broken link, a missing anchor or reference, a snippet that is not there fails the
+build). Its shell and Python examples run as the README's do, through ``examples.py``;
+a line that is also a README example runs there, once. Chromium (Debian's package)
+opens the start page and the element gallery from disk, headless, and must log nothing
+to the console.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from examples import (ROOT, heavy_lines_without_figures, make_scratch, python_examples, run_python_example,
+                      run_shell_example, shell_examples)
+
+DOCS = ROOT / "docs"
+PAGES = {path.relative_to(DOCS).as_posix(): path.read_text() for path in sorted(DOCS.rglob("*.md"))}
+README_LINES = set(shell_examples((ROOT / "README.md").read_text()))
+# Not run here, and why: the set-up made this environment; the site build and the compiled
+# store reader are run by the tests below (test_site_builds_strict, test_c_reader_...).
+NOT_RUN = ("scripts/setup.sh", "mkdocs ", "./lookup")
+MKDOCS = Path(sys.executable).parent / "mkdocs"
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("site")
+    env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}
+    result = subprocess.run([str(MKDOCS), "build", "--strict", "--site-dir", str(folder)], cwd=ROOT, env=env,
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    return folder
+
+
+@pytest.fixture(scope="module")
+def scratch(tmp_path_factory):
+    return make_scratch(tmp_path_factory.mktemp("docs") / "repo")
+
+
+def _text(html: str) -> str:
+    return re.sub(r"<[^>]+>", "", html)
+
+
+def test_site_builds_strict_with_every_page_in_the_navigation(site):
+    for page in PAGES:
+        assert (site / page.replace(".md", ".html")).is_file(), page
+
+
+def test_cli_reference_lists_every_command_and_option_of_the_parser(site):
+    import argparse
+
+    from cospherical.cli import build_parser
+
+    page = _text((site / "reference" / "cli.html").read_text())
+
+    def walk(parser):
+        yield parser
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for child in action.choices.values():
+                    yield from walk(child)
+
+    parsers = list(walk(build_parser()))
+    assert len(parsers) > 10
+    for parser in parsers:
+        assert parser.prog in page, parser.prog
+        for action in parser._actions:
+            if action.help != argparse.SUPPRESS:
+                for flag in action.option_strings:
+                    assert flag in page, (parser.prog, flag)
+
+
+def test_results_pages_show_what_results_holds(site):
+    gallery = (site / "results" / "gallery.html").read_text()
+    pictures = sorted(path.name for path in (ROOT / "results" / "elements").glob("*.png"))
+    assert sorted(set(re.findall(r'figures/elements/([\w-]+\.png)', gallery))) == pictures
+    for name in pictures:
+        assert (site / "figures" / "elements" / name).read_bytes() == (ROOT / "results" / "elements" / name).read_bytes()
+    paper = _text((site / "results" / "paper.html").read_text())
+    summary = json.loads((ROOT / "results" / "bisection-1x2x4.json").read_text())
+    assert f"{summary['criteria']['optimal']['total']:,}" in paper
+    assert f"{summary['fvm_adequate']:,} / {summary['fvm_adequate_open']:,}" in paper
+    formats = (site / "reference" / "formats.html").read_text()
+    for schema in (ROOT / "src" / "cospherical" / "data" / "schemas").glob("*.json"):
+        assert f"schemas/{schema.name}" in formats
+        assert json.loads((site / "schemas" / schema.name).read_text()) == json.loads(schema.read_text())
+        for field in json.loads(schema.read_text())["properties"]:
+            assert f"<code>{field}</code>" in formats, (schema.name, field)
+
+
+def test_every_example_file_a_page_names_ships():
+    named = {name for text in PAGES.values() for name in re.findall(r"examples/[\w.-]+\w", text)}
+    assert named, "the pages name the shipped examples"
+    for name in named:
+        assert (ROOT / name).is_file(), name
+
+
+def test_heavy_examples_say_their_time_and_size():
+    assert [(page, line) for page, text in PAGES.items() for line in heavy_lines_without_figures(text)] == []
+
+
+def _docs_lines() -> list[str]:
+    lines = dict.fromkeys(line for text in PAGES.values() for line in shell_examples(text))
+    return [line for line in lines if line not in README_LINES and not any(skip in line for skip in NOT_RUN)]
+
+
+@pytest.mark.parametrize("line", _docs_lines())
+def test_docs_shell_example_runs(scratch, line):
+    run_shell_example(line, scratch)
+
+
+SNIPPETS = [(page, snippet) for page, text in PAGES.items() for snippet in python_examples(text)]
+
+
+@pytest.mark.parametrize("page, snippet", SNIPPETS, ids=[f"{page}-{i}" for i, (page, _) in enumerate(SNIPPETS)])
+def test_docs_python_example_runs(scratch, page, snippet):
+    assert run_python_example(snippet, scratch, page).strip(), "an example shows its result"
+
+
+def test_cuboid_diagram_numbers_the_nodes_as_the_code_does():
+    from cospherical import Configuration
+
+    page = PAGES["concepts/conventions.md"]
+    block = re.search(r" z = 0 \(bottom\).*?```", page, re.S).group(0)
+    rows = [re.findall(r"\d+", line) for line in block.splitlines() if re.search(r"\d", line) and "z =" not in line]
+    assert [len(row) for row in rows] == [9, 9, 9], rows  # y = B, B/2, 0: three layers of three columns each
+    nodes = Configuration.from_code("888888888888").nodes()
+    seen = {}
+    for row, y in zip(rows, (2, 1, 0)):
+        for n, node in enumerate(row):
+            z, x = divmod(n, 3)
+            seen[int(node)] = (x, y, z)  # in half box lengths
+    assert sorted(seen) == list(range(27))
+    for node, position in seen.items():
+        assert tuple(2 * c for c in nodes[node]) == position, node
+
+
+def test_c_reader_of_the_store_gives_the_entries_python_gives(tmp_path):
+    from cospherical.formats.patterns import load
+    from cospherical.formats.store import dictionary_of, pack, write_store
+
+    cc = shutil.which("cc") or shutil.which("gcc")
+    assert cc, "scripts/setup.sh installs gcc, libsqlite3-dev and zlib1g-dev"
+    program = tmp_path / "lookup"
+    subprocess.run([cc, "-Wall", "-Werror", str(ROOT / "examples" / "lookup.c"), "-lsqlite3", "-lz", "-o",
+                    str(program)], check=True, capture_output=True, timeout=120)
+    table = load(ROOT / "patterns" / "bisection-tetrahedron-1x1x1.yaml")
+    codes = sorted(table.configurations)[:20]
+    texts = {code: json.dumps(table.configurations[code]) for code in codes}
+    dictionary = dictionary_of(list(texts.values()))
+    store = tmp_path / "t.sqlite"
+    write_store(store, table.header, dictionary, [(code, pack(texts[code], dictionary)) for code in codes])
+    for code in codes[::5]:
+        result = subprocess.run([str(program), str(store), code], capture_output=True, text=True, timeout=30)
+        assert result.returncode == 0, result.stderr
+        assert json.loads(result.stdout) == json.loads(texts[code])
+        assert json.loads(result.stdout) == load(store).configurations[code]
+    missing = subprocess.run([str(program), str(store), "fffffffff"], capture_output=True, text=True, timeout=30)
+    assert missing.returncode == 2 and len(missing.stderr.strip().splitlines()) == 1
+
+
+CONSOLE = re.compile(r":CONSOLE[^\]]*\] (.*)")
+
+
+def _screenshot(url: str, png: Path) -> list[str]:
+    """A headless Chromium's picture of a page, and every console message it logged."""
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    assert chromium, "scripts/setup.sh installs Debian's chromium"
+    result = subprocess.run([chromium, "--headless=new", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                             "--enable-logging=stderr", "--v=0", "--virtual-time-budget=3000",
+                             "--window-size=1280,1400", f"--screenshot={png}", url],
+                            capture_output=True, text=True, timeout=120)
+    assert png.is_file(), result.stderr[-2000:]
+    return CONSOLE.findall(result.stderr)
+
+
+def test_the_console_check_sees_an_error(tmp_path):
+    page = tmp_path / "bad.html"
+    page.write_text('<html><body><script>console.error("boom"); notDefined();</script></body></html>')
+    messages = _screenshot(page.as_uri(), tmp_path / "bad.png")
+    assert any("boom" in m for m in messages) and any("notDefined" in m for m in messages), messages
+
+
+@pytest.mark.parametrize("page", ["index", "results/gallery"])
+def test_page_renders_in_chromium_without_console_errors(site, page):
+    png = site / f"screenshot-{page.replace('/', '-')}.png"  # kept with the site while the tests run
+    assert _screenshot((site / f"{page}.html").as_uri(), png) == []
+    data = png.read_bytes()
+    assert data.startswith(b"\x89PNG") and len(data) > 50_000  # a blank page compresses to a few kB
