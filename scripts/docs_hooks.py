@@ -20,7 +20,7 @@ from mkdocs.structure.files import File
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "results"
 SCHEMAS = ROOT / "src" / "cospherical" / "data" / "schemas"
-MARKER = re.compile(r"<!-- generated: ([a-z-]+)(?::([a-z-]+))? -->")
+MARKER = re.compile(r"<!-- generated: ([a-z-]+)(?::([a-z._-]+))? -->")
 CRITERIA = ("optimal", "internal_faces", "internal_edges_and_faces")
 
 
@@ -86,7 +86,7 @@ def _options_table(parser: argparse.ArgumentParser) -> list[str]:
         default = action.default
         shown = "" if default in (None, False, argparse.SUPPRESS) or action.nargs == 0 else f"`{_cell(default)}`"
         if isinstance(default, list):
-            shown = "`" + " ".join(default) + "`"
+            shown = "`" + " ".join(default) + "`" if default else ""
         rows.append(f"| {names} | {value} | {shown} | {_cell(formatter._expand_help(action))} |")
     return rows
 
@@ -96,7 +96,9 @@ def _command_section(parser: argparse.ArgumentParser, level: int) -> list[str]:
     if parser.description:
         lines += [parser.description, ""]
     lines += ["```text", parser.format_usage().strip(), "```", ""]
-    lines += _options_table(parser) + [""]
+    table = _options_table(parser)
+    if len(table) > 2:  # a command whose only option is --help has no table
+        lines += table + [""]
     for child in _subparsers(parser).values():
         lines += _command_section(child, level + 1)
     return lines
@@ -333,7 +335,16 @@ def benchmarks(up: str) -> str:
     return "\n".join(out)
 
 
+def module_doc(up: str, module: str) -> str:
+    """A module's docstring as it stands (the specification of its file format), verbatim."""
+    import importlib
+
+    text = importlib.import_module(module).__doc__ or ""
+    return f"From the docstring of `{module}`:\n\n```text\n{text.strip()}\n```"
+
+
 GENERATORS = {
+    "module-doc": module_doc,
     "benchmarks": benchmarks,
     "schema": schema_fields,
     "cli": cli_reference,

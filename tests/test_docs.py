@@ -144,6 +144,15 @@ def test_cuboid_diagram_numbers_the_nodes_as_the_code_does():
         assert tuple(2 * c for c in nodes[node]) == position, node
 
 
+def test_edge_table_is_the_code_s():
+    from cospherical.core.configuration import EDGES, edge_axis
+
+    rows = re.findall(r"^\| (\d+) \| (\d+)-(\d+) \| ([xyz]) \| node (\d+) \|$", PAGES["concepts/conventions.md"], re.M)
+    assert [(int(a), int(b)) for _, a, b, _, _ in rows] == list(EDGES)
+    assert [int(node) for *_, node in rows] == [8 + k for k in range(12)]
+    assert ["xyz"[edge_axis(k)] for k in range(12)] == [axis for *_, axis, _ in rows]
+
+
 def test_c_reader_of_the_store_gives_the_entries_python_gives(tmp_path):
     from cospherical.formats.patterns import load
     from cospherical.formats.store import dictionary_of, pack, write_store
