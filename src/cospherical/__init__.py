@@ -5,6 +5,8 @@ bottom: ``core`` -> ``paper`` -> ``catalogue`` -> ``studies`` -> ``formats`` ->
 ``outputs`` -> ``cli``; each imports only from those before it).  The names load
 on first use, so ``import cospherical`` stays cheap for the command line.
 
+Examples
+--------
 >>> from cospherical import Configuration, tessellate
 >>> tess = tessellate(Configuration.from_code("888888888888"))
 >>> len(tess.elements), tess.elements[0].type.name

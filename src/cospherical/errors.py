@@ -5,6 +5,8 @@ message names the value, or the file and the place in it, so that one line on
 stderr tells a user what to fix.  The library never exits; ``cospherical.cli``
 maps these to exit status 2.
 
+Examples
+--------
 >>> issubclass(FormatError, InputError), issubclass(UsageError, CosphericalError)
 (True, True)
 """

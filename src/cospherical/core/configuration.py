@@ -70,6 +70,8 @@ _EDGE_STARTS = tuple(min((_CORNER_POINTS[i] for i in EDGES[k])) for k in range(1
 class Box:
     """Edge lengths a, b, c of the cuboid, exact.
 
+    Examples
+    --------
     >>> Box.parse(["1", "sqrt(2)", "1.4142"]).texts
     ('1', 'sqrt(2)', '1.4142')
     """

@@ -288,6 +288,8 @@ def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
     apex at the box centre, a sixth of a box; ``tetrahedron``: the corner
     tetrahedron (0,0,0) (A,0,0) (0,B,0) (0,0,C).
 
+    Examples
+    --------
     >>> standard_shape("pyramid").unit_volume
     Fraction(1, 6)
     >>> standard_shape("cube")
@@ -313,6 +315,8 @@ class ShapeConfiguration:
     quadrilateral face whose four edges are split, opposite ones at the same
     parameter) or ``none``.
 
+    Examples
+    --------
     >>> cfg = ShapeConfiguration.from_code(standard_shape("pyramid"), "88880000")
     >>> sorted(cfg.nodes())[-1], cfg.point_faces
     (13, frozenset({0}))
@@ -437,6 +441,8 @@ class ShapeTessellation(Tessellation):
 def tessellate_shape(configuration: ShapeConfiguration) -> ShapeTessellation:
     """The Delaunay tessellation of a 1-irregular element, its elements the largest co-spherical sets.
 
+    Examples
+    --------
     >>> tess = tessellate_shape(ShapeConfiguration.from_code(standard_shape("tetrahedron"), "800000"))
     >>> [e.type.name for e in tess.elements], sum(e.polyhedron.unit_volume for e in tess.elements)
     (['Tetrahedron', 'Tetrahedron'], Fraction(1, 6))
