@@ -15,6 +15,7 @@ from ..errors import InputError
 from ..files.outputs import OutputFolder
 from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
 from ..mesh.assembly import assemble
+from ..mesh.delaunay import MODES, delaunay_mesh
 from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, build_octree, leaves_octree, parse_shape
 from ..mesh.report import mesh_report
 from .progress import stage_bars
@@ -57,7 +58,11 @@ def add_parser(commands) -> None:
                         help="the exact finite-volume dual: dual.npz in --out (edges, coefficients, control volumes), "
                         "point data control_volume, boundary_area and cell data circumcenter, delaunay_ok in mesh.vtu, "
                         "negative_coefficients and the mixed mesh beside a tetrahedral one in the report")
-    parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check")
+    parser.add_argument("--delaunay", choices=MODES, default=None,
+                        help="global (default with the optimal criterion): the exact Delaunay subdivision of the "
+                        "vertices, the leaves whose elements fail the exact check re-tessellated together; leaf "
+                        "(default with a split criterion): each leaf's elements from its table")
+    parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check of the result")
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
     parser.set_defaults(run=run)
@@ -81,8 +86,9 @@ def _levels(text: str | None) -> int:
     return int(value)
 
 
-SUMMARY_KEYS = ("leaves", "vertices", "elements", "types", "volume_ok", "nonconforming_faces",
-                "circumcenters_outside_leaf", "leaves_not_fvm_adequate", "delaunay_violations",
+SUMMARY_KEYS = ("delaunay_mode", "leaves", "vertices", "elements", "types", "volume_ok", "nonconforming_faces",
+                "circumcenters_outside_leaf", "leaves_not_fvm_adequate", "boundary_circumcenters_outside",
+                "delaunay_violations", "regions_retessellated", "cells_spanning_leaves",
                 "configurations", "tessellated_on_the_fly", "paper_final_share")
 
 
@@ -123,6 +129,10 @@ def run(args) -> int:
 
 def _run(args, out: OutputFolder | None) -> int:
     box = Box.parse(args.domain)
+    mode = args.delaunay or ("global" if args.criterion == "optimal" else "leaf")
+    if mode == "global" and args.criterion != "optimal":
+        raise InputError(f"--delaunay global gives the largest co-spherical cells, which --criterion "
+                         f"{args.criterion} splits; use --delaunay leaf with it")
     at = _cut(args, box)  # before the work: a bad --cut is refused at once
     max_leaves = _max_leaves(args.max_leaves)
     clock = time.perf_counter()
@@ -148,12 +158,18 @@ def _run(args, out: OutputFolder | None) -> int:
         timings["table"] = time.perf_counter() - clock
         clock = time.perf_counter()
     large = len(tree) > 50_000  # bars on large trees only (and only on a terminal: tqdm's disable=None)
-    bars = {"assembly": (len(tree), "assembling", "leaf"), "delaunay": (None, "Delaunay check", "element")}
+    bars = {"assembly": (len(tree), "assembling", "leaf"), "regions": (None, "Delaunay check (leaf mesh)", "element"),
+            "delaunay": (None, "Delaunay check", "element")}
     with stage_bars(bars) as advance:
         mesh = assemble(tree, lookup, progress=(lambda n: advance("assembly", n)) if large else None,
                         criterion=args.criterion)
         timings["assembly"] = time.perf_counter() - clock
         clock = time.perf_counter()
+        bars["regions"] = (len(mesh), "Delaunay check (leaf mesh)", "element")
+        mesh, leaf_mesh = delaunay_mesh(mesh, mode, progress=(lambda n: advance("regions", n)) if large else None)
+        if leaf_mesh is not None:
+            timings["global Delaunay"] = time.perf_counter() - clock
+            clock = time.perf_counter()
         bars["delaunay"] = (len(mesh), "Delaunay check", "element")  # read when its bar opens
         stages = []
 
@@ -167,7 +183,8 @@ def _run(args, out: OutputFolder | None) -> int:
         violating: list = []
         report = mesh_report(mesh, described, args.patterns.name if args.patterns else None, args.criterion,
                              uniform=not args.no_uniform, delaunay=not args.no_delaunay, stage=stage,
-                             progress=(lambda n: advance("delaunay", n)) if large else None, violating=violating)
+                             progress=(lambda n: advance("delaunay", n)) if large else None, violating=violating,
+                             leaf_mesh=leaf_mesh)
         dual = None
         if args.dual:
             from ..mesh.dual import dual_summary, mesh_dual

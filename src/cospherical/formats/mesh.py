@@ -152,7 +152,7 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table") -
 
 
 def vtu_arrays(mesh: Mesh) -> dict:
-    """The mesh as the arrays of a VTU grid (see :func:`write_vtu`), built per configuration, never per element.
+    """The mesh as the arrays of a VTU grid (see :func:`write_vtu`), built per block of alike elements, never per element.
 
     Cells are sorted by VTK cell type (stable: in element order within a type), so a
     reader that groups cells into blocks of one type (meshio) meets few blocks;
@@ -172,34 +172,25 @@ def vtu_arrays(mesh: Mesh) -> dict:
     # polyhedra: a face stream per element (faces, then per face its size and points), laid out per configuration
     polyhedral = kinds == VTK_CELL["polyhedron"]
     stream = np.zeros(len(mesh), dtype=np.int64)
-    templates = {}
-    for p, pattern in enumerate(mesh.patterns):
-        for j, element in enumerate(pattern.elements):
-            if kind_of_type[ids.index(element.type_id)] == VTK_CELL["polyhedron"]:
-                items = [-1 - len(element.faces)] + [x for f in element.faces for x in (-1 - len(f), *f)]
-                templates[p, j] = np.array(items, dtype=np.int64)
     faces = faceoffsets = None
     if polyhedral.any():
-        groups = list(mesh.groups())
-        for p, pattern, leaves in groups:
-            for j in range(len(pattern.elements)):
-                if (p, j) in templates:
-                    stream[mesh.element_offsets[leaves] + j] = len(templates[p, j])
+        # per block of alike elements, a face stream template: counts as -1 - count, else node columns
+        blocks = [(rows, nodes, np.array([-1 - len(cycles)] + [x for f in cycles for x in (-1 - len(f), *f)],
+                                         dtype=np.int64))
+                  for rows, nodes, cycles, type_id in mesh.blocks()
+                  if kind_of_type[ids.index(type_id)] == VTK_CELL["polyhedron"] and len(rows)]
+        for rows, _, template in blocks:
+            stream[rows] = len(template)
         cells = order[polyhedral[order]]  # the polyhedra in cell order
         ends = np.cumsum(stream[cells])
         start = np.zeros(len(mesh), dtype=np.int64)
         start[cells] = ends - stream[cells]
         faces = np.empty(int(ends[-1]), dtype=np.int64)
-        for p, pattern, leaves in groups:
-            for j in range(len(pattern.elements)):
-                template = templates.get((p, j))
-                if template is None or not len(leaves):
-                    continue
-                # node ids (>= 0) become the leaves' vertices; a count is stored as -1 - count
-                nodes = template >= 0
-                values = np.broadcast_to(np.where(nodes, 0, -1 - template), (len(leaves), len(template))).copy()
-                values[:, nodes] = mesh.slots[np.ix_(leaves, template[nodes])]
-                faces[(start[mesh.element_offsets[leaves] + j])[:, None] + np.arange(len(template))] = values
+        for rows, nodes, template in blocks:
+            columns = template >= 0
+            values = np.broadcast_to(np.where(columns, 0, -1 - template), (len(rows), len(template))).copy()
+            values[:, columns] = nodes[:, template[columns]]
+            faces[start[rows][:, None] + np.arange(len(template))] = values
         faceoffsets = np.full(len(mesh), -1, dtype=np.int64)
         faceoffsets[polyhedral[order]] = ends
     return {"ids": ids, "order": order, "types": kinds[order], "connectivity": connectivity, "offsets": offsets,

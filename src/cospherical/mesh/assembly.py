@@ -17,6 +17,7 @@ work on whole arrays of leaves that share a configuration.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from itertools import combinations
@@ -34,7 +35,7 @@ from ..errors import InputError
 from ..paper import paper_class
 from .octree import Octree
 
-__all__ = ["LocalElement", "LocalPattern", "Mesh", "NODE_OFFSETS", "assemble", "local_pattern"]
+__all__ = ["CellShape", "Cells", "LocalElement", "LocalPattern", "Mesh", "NODE_OFFSETS", "assemble", "local_pattern"]
 
 # Twice the unit coordinates of the 27 nodes (corners, edge midpoints, face centres, body).
 NODE_OFFSETS = np.array(
@@ -125,6 +126,53 @@ def local_pattern(configuration: Configuration, elements: Iterable[tuple[str, It
                         frame.weights, on_the_fly)
 
 
+@dataclass(frozen=True)
+class CellShape:
+    """A Delaunay cell up to translation, measured exactly on the vertex grid.
+
+    Cells of the global Delaunay subdivision are not leaf elements: they are kept
+    once per shape (most are translates of a few), in grid units of the mesh.
+    ``offsets``: the vertices relative to the cell's anchor (its lowest vertex id),
+    in the type's reference order; ``faces``: cycles of indices into ``offsets``,
+    counter-clockwise seen from outside; ``grid_volume``: its volume in grid cells;
+    ``sphere``: its circumsphere in the frame of the offsets (integer coordinates,
+    the box's squared lengths as weights); ``center``: the circumcenter's offset
+    from the anchor in grid units, exact.
+    """
+
+    type_id: str
+    offsets: tuple[tuple[int, int, int], ...]
+    faces: tuple[tuple[int, ...], ...]
+    grid_volume: Fraction
+    sphere: Sphere
+    center: tuple[Fraction, Fraction, Fraction]
+
+
+@dataclass(frozen=True)
+class Cells:
+    """Cells that replace the elements of whole leaves (see :mod:`cospherical.mesh.delaunay`).
+
+    Cell ``i`` has shape ``shapes[shape[i]]``, its anchor at grid point ``anchor[i]``
+    and its vertices ``nodes[i, :len(offsets)]`` (global ids, -1 padded) in the
+    shape's order.  ``leaf[i]`` is the cell's first leaf: the leaf whose box holds
+    an interior point of it (the centroid of one of its tetrahedra); ``spanning[i]``
+    whether the cell reaches beyond that leaf.  ``regions`` and ``largest_region``
+    (in vertices) describe what was re-tessellated.
+    """
+
+    shapes: list[CellShape]
+    shape: np.ndarray
+    anchor: np.ndarray
+    nodes: np.ndarray
+    leaf: np.ndarray
+    spanning: np.ndarray
+    regions: int = 0
+    largest_region: int = 0
+
+    def __len__(self) -> int:
+        return len(self.shape)
+
+
 @dataclass
 class Mesh:
     """A global mesh assembled from an octree, as arrays.
@@ -135,6 +183,9 @@ class Mesh:
     ``slots[i, s]`` (-1: no point there).  Elements are listed leaf by leaf, in each
     leaf in its pattern's order: element ``e`` is element ``element_local[e]`` of
     leaf ``element_leaf[e]``; ``element_offsets[i]`` is the first element of leaf ``i``.
+    Leaves marked in ``replaced`` contribute no elements: their part of the domain
+    is tiled by ``cells``, listed after every leaf element (``element_local`` -1,
+    ``element_leaf`` the cell's first leaf).
     """
 
     tree: Octree
@@ -147,6 +198,8 @@ class Mesh:
     element_leaf: np.ndarray
     element_local: np.ndarray
     types: dict[str, dict] = field(default_factory=dict)
+    replaced: np.ndarray | None = None
+    cells: Cells | None = None
     _groups: list | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -156,51 +209,108 @@ class Mesh:
     def __len__(self) -> int:
         return len(self.element_leaf)
 
+    @property
+    def leaf_elements(self) -> int:
+        """How many elements come from the leaves' patterns (the cells follow them)."""
+        return len(self) - (len(self.cells) if self.cells is not None else 0)
+
     def leaf_size(self) -> np.ndarray:
         """Leaf edge lengths in grid units."""
         return (self.grid >> self.tree.levels.astype(np.int64)).astype(np.int64)
 
-    def groups(self):
-        """Yield ``(pattern index, pattern, leaf indices)`` for every configuration that occurs, in order."""
+    def groups(self, all_leaves: bool = False):
+        """Yield ``(pattern index, pattern, leaf indices)`` for every configuration that occurs, in order.
+
+        The leaves are those whose elements are in the mesh; ``all_leaves`` also
+        yields the replaced ones (for counting configurations).
+        """
         if self._groups is None:  # every check walks the groups: sort the leaves once
             order = np.argsort(self.leaf_pattern, kind="stable")
             counts = np.bincount(self.leaf_pattern, minlength=len(self.patterns))
             starts = np.r_[0, np.cumsum(counts)]
-            self._groups = [order[starts[p]:starts[p + 1]] for p in range(len(self.patterns))]
-        for p, leaves in enumerate(self._groups):
-            yield p, self.patterns[p], leaves
+            groups = [order[starts[p]:starts[p + 1]] for p in range(len(self.patterns))]
+            kept = groups if self.replaced is None else [g[~self.replaced[g]] for g in groups]
+            self._groups = [groups, kept]
+        for p, leaves in enumerate(self._groups[0 if all_leaves else 1]):
+            if len(leaves) or all_leaves:
+                yield p, self.patterns[p], leaves
 
-    def connectivity(self) -> tuple[np.ndarray, np.ndarray]:
-        """Global vertex ids of every element: (elements x widest) int32 padded with -1, and the sizes."""
-        width = max((len(e.nodes) for p in self.patterns for e in p.elements), default=0)
-        conn = np.full((len(self), width), -1, dtype=np.int32)
-        sizes = np.zeros(len(self), dtype=np.int8)
+    def blocks(self):
+        """Yield ``(element indices, global vertex ids (elements x nodes), faces, type id)`` per kind of element.
+
+        One block per element of a configuration (over its leaves) and per cell
+        shape; ``faces`` are cycles of column indices into the vertex ids.
+        """
         for _, pattern, leaves in self.groups():
             first = self.element_offsets[leaves]
             for j, element in enumerate(pattern.elements):
-                conn[first + j, :len(element.nodes)] = self.slots[np.ix_(leaves, element.nodes)]
-                sizes[first + j] = len(element.nodes)
+                column = {n: i for i, n in enumerate(element.nodes)}
+                yield (first + j, self.slots[np.ix_(leaves, element.nodes)],
+                       tuple(tuple(column[n] for n in cycle) for cycle in element.faces), element.type_id)
+        if self.cells is not None:
+            order = np.argsort(self.cells.shape, kind="stable")
+            counts = np.bincount(self.cells.shape, minlength=len(self.cells.shapes))
+            starts = np.r_[0, np.cumsum(counts)]
+            for s, shape in enumerate(self.cells.shapes):
+                rows = order[starts[s]:starts[s + 1]]
+                yield (self.leaf_elements + rows, self.cells.nodes[rows, :len(shape.offsets)], shape.faces,
+                       shape.type_id)
+
+    def connectivity(self) -> tuple[np.ndarray, np.ndarray]:
+        """Global vertex ids of every element: (elements x widest) int32 padded with -1, and the sizes."""
+        blocks = list(self.blocks())
+        width = max((nodes.shape[1] for _, nodes, _, _ in blocks), default=0)
+        conn = np.full((len(self), width), -1, dtype=np.int32)
+        sizes = np.zeros(len(self), dtype=np.int8)
+        for rows, nodes, _, _ in blocks:
+            conn[rows, :nodes.shape[1]] = nodes
+            sizes[rows] = nodes.shape[1]
         return conn, sizes
 
     def element_types(self) -> tuple[list[str], np.ndarray]:
         """The type ids met (sorted) and each element's index into them."""
-        ids = sorted({e.type_id for p in self.patterns for e in p.elements})
+        blocks = [(rows, type_id) for rows, _, _, type_id in self.blocks()]
+        ids = sorted({type_id for _, type_id in blocks})
         position = {t: i for i, t in enumerate(ids)}
         codes = np.zeros(len(self), dtype=np.int32)
-        for _, pattern, leaves in self.groups():
-            first = self.element_offsets[leaves]
-            for j, element in enumerate(pattern.elements):
-                codes[first + j] = position[element.type_id]
+        for rows, type_id in blocks:
+            codes[rows] = position[type_id]
         return ids, codes
 
     def element_fvm(self) -> np.ndarray:
-        """Per element: its circumcenter lies in its closed leaf (exact, per configuration)."""
+        """Per element: its circumcenter lies in its closed leaf (exact; a cell's leaf is its first leaf)."""
         flags = np.zeros(len(self), dtype=bool)
         for _, pattern, leaves in self.groups():
             first = self.element_offsets[leaves]
             for j, element in enumerate(pattern.elements):
                 flags[first + j] = element.center_in_leaf
+        if self.cells is not None:
+            flags[self.leaf_elements:] = self.cell_center_in_leaf()
         return flags
+
+    def cell_centers(self) -> tuple[np.ndarray, np.ndarray]:
+        """The cells' circumcenters in grid units, exact: numerators (cells x 3, object ints) and denominators."""
+        cells = self.cells
+        num = np.empty((len(cells), 3), dtype=object)
+        den = np.empty(len(cells), dtype=object)
+        for s, shape in enumerate(cells.shapes):
+            rows = np.flatnonzero(cells.shape == s)
+            common = math.lcm(*(c.denominator for c in shape.center))
+            for axis in range(3):
+                c = shape.center[axis]
+                num[rows, axis] = cells.anchor[rows, axis].astype(object) * common + c.numerator * (
+                    common // c.denominator)
+            den[rows] = common
+        return num, den
+
+    def cell_center_in_leaf(self) -> np.ndarray:
+        """Per cell: its circumcenter lies in the closed box of its first leaf, decided exactly."""
+        num, den = self.cell_centers()
+        size = self.leaf_size()[self.cells.leaf].astype(object)
+        low = self.tree.positions[self.cells.leaf].astype(object) * size[:, None]
+        scaled = den[:, None]
+        inside = (num >= low * scaled) & (num <= (low + size[:, None]) * scaled)
+        return inside.all(axis=1).astype(bool)
 
 
 def _type_info(type_id: str, etype: ElementType | None) -> dict:

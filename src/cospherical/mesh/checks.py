@@ -16,6 +16,7 @@ violation and every tie is decided exactly; the float slack only widens the net.
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 
 import numpy as np
@@ -48,20 +49,20 @@ def check_volume(mesh: Mesh) -> dict:
         total += sum((e.unit_volume for e in pattern.elements), Fraction(0)) * weight
         flat += sum(e.unit_volume <= 0 for e in pattern.elements) * len(leaves)
     share = total / 8 ** depth
+    if mesh.cells is not None:
+        per_shape = np.bincount(mesh.cells.shape, minlength=len(mesh.cells.shapes)).tolist()
+        share += sum((shape.grid_volume * n for shape, n in zip(mesh.cells.shapes, per_shape)), Fraction(0)) \
+            / mesh.grid ** 3
+        flat += sum(n for shape, n in zip(mesh.cells.shapes, per_shape) if shape.grid_volume <= 0)
     return {"volume_ok": share == 1 and flat == 0, "volume": str(share), "flat_elements": int(flat)}
 
 
 def _faces(mesh: Mesh) -> dict[int, list[np.ndarray]]:
     """Every element face as a row of global vertex ids, by face size."""
     by_size: dict[int, list[np.ndarray]] = {}
-    for _, pattern, leaves in mesh.groups():
-        local: dict[int, list[tuple[int, ...]]] = {}
-        for element in pattern.elements:
-            for cycle in element.faces:
-                local.setdefault(len(cycle), []).append(cycle)
-        slots = mesh.slots[leaves]
-        for size, cycles in local.items():
-            by_size.setdefault(size, []).append(slots[:, np.array(cycles)].reshape(-1, size))
+    for _, nodes, faces, _ in mesh.blocks():
+        for cycle in faces:
+            by_size.setdefault(len(cycle), []).append(nodes[:, list(cycle)])
     return by_size
 
 
@@ -126,9 +127,14 @@ def check_conformity(mesh: Mesh, examples: int = 5) -> dict:
 def check_circumcenters(mesh: Mesh) -> dict:
     """Circumcenters in their own closed leaf, decided exactly per configuration, counted over the leaves.
 
-    Returns ``circumcenters_outside_leaf`` (elements), ``leaves_not_fvm_adequate``
-    (leaves with at least one) and ``elements_not_cospherical`` (elements whose nodes
-    are not on one sphere: not Delaunay elements at all).
+    Returns ``circumcenters_outside_leaf`` (elements; a cell of the global Delaunay
+    subdivision counts against its first leaf), ``leaves_not_fvm_adequate`` (leaves
+    with at least one such leaf element), ``elements_not_cospherical`` (elements whose
+    nodes are not on one sphere: not Delaunay elements at all) and
+    ``boundary_circumcenters_outside``: elements whose circumcenter lies outside the
+    closed domain.  Only elements at the boundary can have one (an empty sphere
+    whose centre is beyond a boundary plane cuts it); there the box method's
+    control volumes need the circumcenter inside, as the paper says.
     """
     outside = leaves_bad = not_spherical = 0
     for _, pattern, leaves in mesh.groups():
@@ -136,8 +142,32 @@ def check_circumcenters(mesh: Mesh) -> dict:
         not_spherical += sum(e.sphere is None for e in pattern.elements) * len(leaves)
         if not pattern.fvm_adequate:
             leaves_bad += len(leaves)
+    if mesh.cells is not None:
+        outside += int((~mesh.cell_center_in_leaf()).sum())
     return {"circumcenters_outside_leaf": int(outside), "leaves_not_fvm_adequate": int(leaves_bad),
-            "elements_not_cospherical": int(not_spherical)}
+            "elements_not_cospherical": int(not_spherical),
+            "boundary_circumcenters_outside": _outside_domain(mesh)}
+
+
+def _outside_domain(mesh: Mesh) -> int:
+    """Elements whose circumcenter lies outside the closed domain, decided exactly in grid units."""
+    grid = mesh.grid
+    size = mesh.leaf_size()
+    outside = 0
+    for _, pattern, leaves in mesh.groups():
+        low = mesh.tree.positions[leaves].astype(object) * size[leaves, None]
+        for element in pattern.elements:
+            if element.center is None:
+                continue
+            # the centre in grid units is low + c * size, for c = p / q: compare q * low + p * size with 0 and q * grid
+            p = np.array([c.numerator for c in element.center], dtype=object)
+            q = np.array([c.denominator for c in element.center], dtype=object)
+            at = low * q[None] + p[None] * size[leaves, None].astype(object)
+            outside += int(((at < 0) | (at > q[None] * grid)).any(axis=1).sum())
+    if mesh.cells is not None:
+        num, den = mesh.cell_centers()
+        outside += int(((num < 0) | (num > den[:, None] * grid)).any(axis=1).sum())
+    return outside
 
 
 def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
@@ -147,7 +177,9 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     ``delaunay_violating_pairs`` (element, vertex), ``delaunay_violating_leaves``,
     ``delaunay_ties`` (a vertex of another element on an element's sphere: it could
     merge with a neighbour), ``delaunay_exact_tests`` (pairs decided with integers),
-    ``_leaves`` and ``_elements`` (the violating leaves' and elements' indices, arrays, for the caller).
+    ``_leaves`` and ``_elements`` (the violating leaves' and elements' indices, arrays,
+    for the caller) and ``_not_cells`` (the elements that violate or tie: the ones
+    that are not cells of the Delaunay subdivision of the vertices).
     """
     from scipy.spatial import cKDTree
 
@@ -171,8 +203,22 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
             centres.append(centre)
             radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(leaves), len(element.nodes), dtype=np.int64))
+    cells = mesh.cells
+    if cells is not None and len(cells):
+        # a cell is a row of pattern -1 whose "leaf" is its index among the cells
+        for s, shape in enumerate(cells.shapes):
+            rows = np.flatnonzero(cells.shape == s)
+            centre = (cells.anchor[rows] + np.array([float(x) for x in shape.center])[None]) * scale
+            first = points[cells.nodes[rows, 0]]
+            rows_pattern.append(np.full(len(rows), -1, dtype=np.int32))
+            rows_local.append(np.full(len(rows), s, dtype=np.int16))
+            rows_leaf.append(rows.astype(np.int64))
+            centres.append(centre)
+            radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
+            n_nodes.append(np.full(len(rows), len(shape.offsets), dtype=np.int64))
     if not centres:
-        return {"_leaves": np.zeros(0, dtype=np.int64), "_elements": np.zeros(0, dtype=np.int64), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
+        return {"_leaves": np.zeros(0, dtype=np.int64), "_elements": np.zeros(0, dtype=np.int64),
+                "_not_cells": np.zeros(0, dtype=np.int64), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
                 "delaunay_ties": 0, "delaunay_exact_tests": 0}
     rows_pattern, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_pattern, rows_local, rows_leaf))
     centres, radii, n_nodes = np.concatenate(centres), np.concatenate(radii), np.concatenate(n_nodes)
@@ -196,32 +242,60 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     pair_row = np.concatenate(pairs_row) if pairs_row else np.zeros(0, dtype=np.int64)
     pair_vertex = np.concatenate(pairs_vertex) if pairs_vertex else np.zeros(0, dtype=np.int64)
     # drop each element's own nodes: a (pattern, element) -> local node table, padded with slot 26 (never a vertex)
-    width = max(len(e.nodes) for p in mesh.patterns for e in p.elements)
-    widest = max(len(p.elements) for p in mesh.patterns)
+    width = max((len(e.nodes) for p in mesh.patterns for e in p.elements), default=1)
+    widest = max((len(p.elements) for p in mesh.patterns), default=1)
     local = np.full((len(mesh.patterns), widest, width), 26, dtype=np.int64)
     for p, pattern in enumerate(mesh.patterns):
         for j, element in enumerate(pattern.elements):
             local[p, j, :len(element.nodes)] = element.nodes
-    leaf_of_pair = rows_leaf[pair_row]
-    nodes = mesh.slots[leaf_of_pair[:, None], local[rows_pattern[pair_row], rows_local[pair_row]]]
-    own = (nodes == pair_vertex[:, None]).any(axis=1)
+    is_cell = rows_pattern[pair_row] < 0
+    own = np.zeros(len(pair_row), dtype=bool)
+    leafy = np.flatnonzero(~is_cell)
+    leaf_of_pair = rows_leaf[pair_row[leafy]]
+    nodes = mesh.slots[leaf_of_pair[:, None], local[rows_pattern[pair_row[leafy]], rows_local[pair_row[leafy]]]]
+    own[leafy] = (nodes == pair_vertex[leafy, None]).any(axis=1)
+    celly = np.flatnonzero(is_cell)
+    if len(celly):
+        own[celly] = (cells.nodes[rows_leaf[pair_row[celly]]] == pair_vertex[celly, None]).any(axis=1)
     pair_row, pair_vertex = pair_row[~own], pair_vertex[~own]
-    inside = np.zeros(len(pair_row), dtype=bool)
-    ties = 0
+    sides = np.zeros(len(pair_row), dtype=np.int8)
+    w0, w1, w2 = _weights(mesh)
     for i, (row, vertex) in enumerate(zip(pair_row.tolist(), pair_vertex.tolist())):
-        pattern = mesh.patterns[rows_pattern[row]]
-        element = pattern.elements[rows_local[row]]
-        leaf = rows_leaf[row]
-        m = int(size[leaf])
-        x = [pattern.scale * (int(v) - int(o)) for v, o in zip(mesh.vertices[vertex], origin[leaf])]
-        n0, n1, n2, n3 = element.sphere.normal
-        w0, w1, w2 = pattern.weights
-        side = (n0 * x[0] + n1 * x[1] + n2 * x[2]) * m + n3 * (w0 * x[0] ** 2 + w1 * x[1] ** 2 + w2 * x[2] ** 2) \
-            - element.sphere.offset * m * m
-        inside[i] = side < 0
-        ties += side == 0
+        if rows_pattern[row] < 0:
+            shape = cells.shapes[rows_local[row]]
+            x = [int(v) - int(o) for v, o in zip(mesh.vertices[vertex], cells.anchor[rows_leaf[row]])]
+            side = shape.sphere.side((*x, w0 * x[0] ** 2 + w1 * x[1] ** 2 + w2 * x[2] ** 2))
+        else:
+            pattern = mesh.patterns[rows_pattern[row]]
+            element = pattern.elements[rows_local[row]]
+            leaf = rows_leaf[row]
+            m = int(size[leaf])
+            x = [pattern.scale * (int(v) - int(o)) for v, o in zip(mesh.vertices[vertex], origin[leaf])]
+            n0, n1, n2, n3 = element.sphere.normal
+            p0, p1, p2 = pattern.weights
+            side = (n0 * x[0] + n1 * x[1] + n2 * x[2]) * m + n3 * (p0 * x[0] ** 2 + p1 * x[1] ** 2 + p2 * x[2] ** 2) \
+                - element.sphere.offset * m * m
+        sides[i] = (side > 0) - (side < 0)
+    inside = sides < 0
     bad_rows = np.unique(pair_row[inside])
-    bad_elements = np.unique(mesh.element_offsets[rows_leaf[bad_rows]] + rows_local[bad_rows])
-    return {"_leaves": np.unique(rows_leaf[bad_rows]), "_elements": bad_elements,"delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),
-            "delaunay_violating_leaves": int(len(np.unique(rows_leaf[bad_rows]))), "delaunay_ties": int(ties),
+
+    def elements(rows: np.ndarray) -> np.ndarray:
+        cell = rows_pattern[rows] < 0
+        return np.sort(np.where(cell, mesh.leaf_elements + rows_leaf[rows],
+                                mesh.element_offsets[np.where(cell, 0, rows_leaf[rows])] + rows_local[rows])
+                       ).astype(np.int64)
+
+    leaf_rows = bad_rows[rows_pattern[bad_rows] >= 0]
+    bad_leaves = np.unique(np.r_[rows_leaf[leaf_rows], cells.leaf[rows_leaf[bad_rows[rows_pattern[bad_rows] < 0]]]
+                                 if cells is not None else np.zeros(0, dtype=np.int64)])
+    return {"_leaves": bad_leaves, "_elements": elements(bad_rows), "_not_cells": elements(np.unique(pair_row[sides <= 0])),
+            "delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),
+            "delaunay_violating_leaves": int(len(bad_leaves)), "delaunay_ties": int((sides == 0).sum()),
             "delaunay_exact_tests": int(len(pair_row))}
+
+
+def _weights(mesh: Mesh) -> tuple[int, int, int]:
+    """The box's squared lengths as integers in one ratio: the weights of the grid frame."""
+    squared = mesh.box.squared
+    den = math.lcm(*(w.denominator for w in squared))
+    return tuple(int(w * den) for w in squared)

@@ -2,21 +2,43 @@
 
 from __future__ import annotations
 
+from fractions import Fraction
 from typing import Callable
 
 import numpy as np
 
+from ..catalogue import shipped_catalogue
 from ..version import __version__
 from .assembly import Mesh
 from .checks import check_circumcenters, check_conformity, check_delaunay, check_volume
 from .statistics import level_counts, mesh_statistics, uniform_study
 
-__all__ = ["mesh_report"]
+__all__ = ["mesh_report", "outside_catalogue"]
+
+
+def outside_catalogue(mesh: Mesh) -> list[dict]:
+    """The element types of the mesh the shipped catalogue does not name: id, systematic name, count, one example.
+
+    The example is one element's vertices in domain units (exact fractions of the
+    domain's sides, as text).  Nothing is added to the catalogue.
+    """
+    known = {entry["id"] for entry in shipped_catalogue()["types"]}
+    found: dict[str, dict] = {}
+    for rows, nodes, _, type_id in mesh.blocks():
+        if type_id in known:
+            continue
+        entry = found.setdefault(type_id, {"id": type_id, "name": mesh.types.get(type_id, {}).get("name", type_id),
+                                           "count": 0, "example": None})
+        entry["count"] += int(len(rows))
+        if entry["example"] is None:
+            entry["example"] = [[str(Fraction(int(x), mesh.grid)) for x in mesh.vertices[v]] for v in nodes[0]]
+    return sorted(found.values(), key=lambda e: (-e["count"], e["id"]))
 
 
 def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal", uniform: bool = True,
                 delaunay: bool = True, stage: Callable[[str], None] | None = None,
-                progress: Callable[[int], None] | None = None, violating: list | None = None) -> dict:
+                progress: Callable[[int], None] | None = None, violating: list | None = None,
+                leaf_mesh: dict | None = None) -> dict:
     """Run every check on ``mesh`` and gather the report (the keys of ``schemas/mesh-report.schema.json``).
 
     ``tree`` describes where the octree came from; ``patterns`` names the table read
@@ -26,6 +48,9 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     ``stage(name)`` is told as each check starts, ``progress(n)`` as the Delaunay check
     goes through the elements; ``violating``, a list, receives the array of the elements
     whose sphere strictly holds a vertex (for the ``delaunay_ok`` cell data).
+    ``leaf_mesh``: what :func:`~cospherical.mesh.delaunay.delaunay_mesh` found on the
+    leaf mesh when ``mesh`` is its global Delaunay subdivision (``delaunay_mode`` is
+    then ``global``, else ``leaf``).
 
     Examples
     --------
@@ -52,7 +77,13 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
         "leaves_per_level": level_counts(mesh),
         "vertices": int(len(mesh.vertices)),
         "elements": len(mesh),
-        "types": len({e.type_id for _, p, _ in mesh.groups() for e in p.elements}),
+        "types": len(mesh.element_types()[0]),
+        "delaunay_mode": "leaf" if leaf_mesh is None else "global",
+        "leaf_mesh": leaf_mesh,
+        "cells_spanning_leaves": int(mesh.cells.spanning.sum()) if mesh.cells is not None else 0,
+        "regions_retessellated": mesh.cells.regions if mesh.cells is not None else 0,
+        "largest_region_vertices": mesh.cells.largest_region if mesh.cells is not None else 0,
+        "types_outside_catalogue": outside_catalogue(mesh),
     }
     start("volume")
     report.update(check_volume(mesh))
@@ -65,6 +96,7 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
         found = check_delaunay(mesh, progress=progress)
         bad_leaves = found.pop("_leaves")
         bad_elements = found.pop("_elements")
+        found.pop("_not_cells")
         if violating is not None:
             violating.append(bad_elements)
         report.update(found)
@@ -73,11 +105,11 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
         report["delaunay_violating_fvm_leaves"] = int(fvm.sum())
     else:
         report["delaunay_violations"] = None
-    on_the_fly = [p for _, p, _ in mesh.groups() if p.on_the_fly]
+    on_the_fly = [p for _, p, _ in mesh.groups(all_leaves=True) if p.on_the_fly]
     report["configurations"] = len(mesh.patterns)
     report["tessellated_on_the_fly"] = len(on_the_fly)
     report["leaves_tessellated_on_the_fly"] = int(sum(
-        len(leaves) for _, p, leaves in mesh.groups() if p.on_the_fly))
+        len(leaves) for _, p, leaves in mesh.groups(all_leaves=True) if p.on_the_fly))
     start("statistics")
     report.update(mesh_statistics(mesh, uniform_study(mesh.box) if uniform else None))
     return report

@@ -56,9 +56,9 @@ def mesh_statistics(mesh: Mesh, uniform: dict | None = None) -> dict:
     type_counts: Counter = Counter()
     configurations = []
     total_leaves = len(mesh.tree)
-    for _, pattern, leaves in mesh.groups():
-        for element in pattern.elements:
-            type_counts[element.type_id] += len(leaves)
+    for rows, _, _, type_id in mesh.blocks():
+        type_counts[type_id] += len(rows)
+    for _, pattern, leaves in mesh.groups(all_leaves=True):
         configurations.append({
             "code": pattern.code,
             "leaves": int(len(leaves)),

@@ -17,40 +17,37 @@ def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[st
 
     The plane is moved by a third of the finest grid step off ``at`` so that no face
     lies in it (a section is then always a proper convex polygon, its corners where
-    the element's edges cross the plane).  Computed per configuration element on all
-    its leaves at once: the leaves whose edges cross in the same way share one array.
+    the element's edges cross the plane).  Computed per block of alike elements (a configuration's
+    element on all its leaves, a cell shape): those whose edges cross alike share one array.
     Returns the polygons and each one's element type id.
     """
     grid = mesh.grid
     z0 = round(at * grid) + 1 / 3
     scale = np.array(mesh.box.to_float()) / grid
     polygons, types = [], []
-    for _, pattern, leaves in mesh.groups():
-        slots = mesh.slots[leaves]
-        for element in pattern.elements:
-            nodes = list(element.nodes)
-            z = mesh.vertices[slots[:, nodes], 2]  # (leaves, nodes)
-            crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
-            if not len(crossing):
-                continue
-            edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in element.faces for i in range(len(c))})
-            a = slots[np.ix_(crossing, [p for p, _ in edges])]  # (crossing leaves, edges): vertex ids
-            b = slots[np.ix_(crossing, [q for _, q in edges])]
-            pa, pb = mesh.vertices[a].astype(float), mesh.vertices[b].astype(float)  # (leaves, edges, 3)
-            za, zb = pa[..., 2] - z0, pb[..., 2] - z0
-            cut = za * zb < 0
-            masks = (cut.astype(np.int64) << np.arange(len(edges))).sum(axis=1)
-            for mask in np.unique(masks).tolist():
-                rows = np.flatnonzero(masks == mask)
-                which = np.flatnonzero(cut[rows[0]])
-                ra, rb = pa[rows][:, which], pb[rows][:, which]  # (rows, corners, 3)
-                t = (za[rows][:, which] / (za[rows][:, which] - zb[rows][:, which]))[..., None]
-                xy = (ra + t * (rb - ra))[..., :2]
-                centre = xy.mean(axis=1, keepdims=True)
-                angle = np.arctan2(xy[..., 1] - centre[..., 1], xy[..., 0] - centre[..., 0])
-                xy = np.take_along_axis(xy, np.argsort(angle, axis=1)[..., None], axis=1) * scale[:2]
-                polygons.extend(xy)
-                types.extend([element.type_id] * len(rows))
+    for _, nodes, faces, type_id in mesh.blocks():
+        z = mesh.vertices[nodes, 2]  # (elements, nodes)
+        crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
+        if not len(crossing):
+            continue
+        edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in faces for i in range(len(c))})
+        a = nodes[np.ix_(crossing, [p for p, _ in edges])]  # (crossing elements, edges): vertex ids
+        b = nodes[np.ix_(crossing, [q for _, q in edges])]
+        pa, pb = mesh.vertices[a].astype(float), mesh.vertices[b].astype(float)  # (elements, edges, 3)
+        za, zb = pa[..., 2] - z0, pb[..., 2] - z0
+        cut = za * zb < 0
+        masks = (cut.astype(np.int64) << np.arange(len(edges))).sum(axis=1)
+        for mask in np.unique(masks).tolist():
+            rows = np.flatnonzero(masks == mask)
+            which = np.flatnonzero(cut[rows[0]])
+            ra, rb = pa[rows][:, which], pb[rows][:, which]  # (rows, corners, 3)
+            t = (za[rows][:, which] / (za[rows][:, which] - zb[rows][:, which]))[..., None]
+            xy = (ra + t * (rb - ra))[..., :2]
+            centre = xy.mean(axis=1, keepdims=True)
+            angle = np.arctan2(xy[..., 1] - centre[..., 1], xy[..., 0] - centre[..., 0])
+            xy = np.take_along_axis(xy, np.argsort(angle, axis=1)[..., None], axis=1) * scale[:2]
+            polygons.extend(xy)
+            types.extend([type_id] * len(rows))
     return polygons, types
 
 

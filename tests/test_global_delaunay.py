@@ -1,0 +1,185 @@
+"""The global Delaunay mode against the Delaunay subdivision computed another way, on whole octrees.
+
+The oracle triangulates all mesh vertices at once with scipy's Qhull and merges
+its tetrahedra with an exact integer in-sphere test across shared faces (no
+regions, no leaf tables, no circumcenters): the cells of the global mode must be
+its cells, as sets of vertex sets.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from cospherical.cli import main
+from cospherical.core.configuration import Box
+from cospherical.mesh.assembly import assemble
+from cospherical.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
+from cospherical.mesh.delaunay import global_delaunay
+from cospherical.mesh.octree import build_octree, parse_shape
+
+
+def _det3(a, b, c):
+    return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]))
+
+
+def _det4(rows):
+    total = 0
+    for j in range(4):
+        minor = [[r[k] for k in range(4) if k != j] for r in rows[1:]]
+        total += (-1) ** j * rows[0][j] * _det3(*minor)
+    return total
+
+
+def oracle_cells(mesh) -> set[frozenset[int]]:
+    """Qhull's tetrahedra of every vertex, merged across faces when the fifth point is exactly on the sphere."""
+    from scipy.spatial import Delaunay
+
+    den = math.lcm(*(w.denominator for w in mesh.box.squared))
+    w = [int(x * den) for x in mesh.box.squared]
+    coords = [tuple(int(x) for x in v) for v in mesh.vertices]
+    tri = Delaunay(mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid), qhull_options="Qbb Qc Qz Q12 Qt")
+    assert len(tri.coplanar) == 0
+    simplices = tri.simplices.tolist()
+
+    def on_sphere(tet, v) -> bool:
+        o = coords[tet[0]]
+        rows = []
+        for u in (*tet[1:], v):
+            d = [coords[u][a] - o[a] for a in range(3)]
+            rows.append([*d, sum(w[a] * d[a] ** 2 for a in range(3))])
+        return _det4(rows) == 0
+
+    def flat(tet) -> bool:
+        o = coords[tet[0]]
+        return _det3(*([coords[u][a] - o[a] for a in range(3)] for u in tet[1:])) == 0
+
+    parent = list(range(len(simplices)))
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    is_flat = [flat(t) for t in simplices]
+    for t, tet in enumerate(simplices):
+        for i, u in enumerate(tri.neighbors[t].tolist()):
+            if u < 0 or is_flat[t] or is_flat[u]:
+                continue
+            if on_sphere(tet, simplices[u][list(tri.neighbors[u]).index(t)]):
+                parent[find(t)] = find(u)
+    # through flat tetrahedra (four co-circular points): join their solid neighbours that share a sphere
+    flat_parent = {t: t for t, f in enumerate(is_flat) if f}
+
+    def flat_find(x):
+        while flat_parent[x] != x:
+            x = flat_parent[x]
+        return x
+
+    for t in flat_parent:
+        for u in tri.neighbors[t].tolist():
+            if u in flat_parent:
+                flat_parent[flat_find(t)] = flat_find(u)
+    around: dict[int, set[int]] = {}
+    for t in flat_parent:
+        around.setdefault(flat_find(t), set()).update(u for u in tri.neighbors[t].tolist()
+                                                      if u >= 0 and not is_flat[u])
+    for solid in around.values():
+        solid = sorted(solid)
+        for i, a in enumerate(solid):
+            for b in solid[i + 1:]:
+                if all(on_sphere(simplices[a], v) for v in simplices[b]):
+                    parent[find(a)] = find(b)
+    cells: dict[int, set[int]] = {}
+    for t, tet in enumerate(simplices):
+        if not is_flat[t]:
+            cells.setdefault(find(t), set()).update(tet)
+    return {frozenset(c) for c in cells.values()}
+
+
+def mesh_cells(mesh) -> set[frozenset[int]]:
+    conn, sizes = mesh.connectivity()
+    return {frozenset(row[:n].tolist()) for row, n in zip(conn, sizes)}
+
+
+def whole(mesh) -> dict:
+    found = {**check_volume(mesh), **check_conformity(mesh), **check_delaunay(mesh)}
+    return {k: found[k] for k in ("volume_ok", "nonconforming_faces", "delaunay_violations", "delaunay_ties")}
+
+
+WHOLE = {"volume_ok": True, "nonconforming_faces": 0, "delaunay_violations": 0, "delaunay_ties": 0}
+
+CASES = [
+    (["1", "2", "4"], 4, ["sphere:0.5,1,2,0.6"], "vertex"),
+    (["1", "2", "4"], 4, ["plane:1,1,1,3"], "edge"),
+    (["1", "2", "4"], 5, ["point:0.3,0.61,0.77"], "vertex"),
+    (["1", "1", "4"], 4, ["sphere:0.5,0.5,2,0.4"], "edge"),
+    (["1", "1", "4"], 4, ["point:0.2,0.7,3.1"], "vertex"),
+    (["1", "sqrt(2)", "sqrt(2)"], 4, ["point:0.3,0.61,0.77"], "vertex"),
+    (["1", "sqrt(2)", "sqrt(2)"], 3, ["box:0.1,0.2,0.3,0.4,0.5,0.6"], "edge"),
+    (["1", "1", "1"], 4, ["sphere:0.5,0.5,0.5,0.3"], "vertex"),
+]
+
+
+@pytest.mark.parametrize("domain, levels, shapes, balance", CASES)
+def test_global_mode_equals_qhull_merged_exactly(domain, levels, shapes, balance):
+    box = Box.parse(domain)
+    leaf = assemble(build_octree(box, levels, [parse_shape(s) for s in shapes], balance))
+    mesh = global_delaunay(leaf)
+    expected = oracle_cells(leaf)
+    assert mesh_cells(mesh) == expected
+    assert whole(mesh) == WHOLE
+    if domain == ["1", "1", "1"]:
+        assert mesh is leaf and mesh.cells is None  # cube octrees: already Delaunay, untouched
+    elif check_delaunay(leaf)["delaunay_violations"]:
+        assert mesh_cells(leaf) != expected and mesh.cells is not None and mesh.cells.regions >= 1
+    # every leaf element kept is a cell; the replaced leaves hold none of the mesh's leaf elements
+    assert mesh_cells(leaf) & expected <= mesh_cells(mesh)
+    circumcenters = check_circumcenters(mesh)
+    assert circumcenters["elements_not_cospherical"] == 0
+
+
+def _box(values):
+    return Box.parse([str(Fraction(p, q)) for p, q in values])
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.integers(1, 7), st.integers(1, 5)), min_size=3, max_size=3),
+       st.integers(2, 3), st.tuples(*[st.fractions(0, 1, max_denominator=16)] * 3),
+       st.sampled_from(["vertex", "edge"]))
+def test_random_trees_on_random_rational_boxes(lengths, levels, where, balance):
+    box = _box(lengths)
+    point = ",".join(str(float(x) * float(length)) for x, length in zip(where, box.lengths))
+    leaf = assemble(build_octree(box, levels, [parse_shape(f"point:{point}")], balance))
+    mesh = global_delaunay(leaf)
+    assert mesh_cells(mesh) == oracle_cells(leaf)
+    assert whole(mesh) == WHOLE
+
+
+def test_cli_reports_both_modes(capsys):
+    argv = ["mesh", "--domain", "1", "2", "4", "--levels", "3", "--refine", "point:0.1,0.1,0.1", "--format", "json",
+            "--no-uniform"]
+    reports = {}
+    for mode in ("global", "leaf"):
+        assert main(argv + ["--delaunay", mode]) == 0
+        reports[mode] = json.loads(capsys.readouterr().out)
+    g, leaf = reports["global"], reports["leaf"]
+    assert (g["delaunay_mode"], leaf["delaunay_mode"]) == ("global", "leaf")
+    assert leaf["delaunay_violations"] > 0 and g["delaunay_violations"] == 0 and g["delaunay_ties"] == 0
+    assert g["leaf_mesh"]["delaunay_violations"] == leaf["delaunay_violations"]
+    assert g["regions_retessellated"] >= 1 and g["largest_region_vertices"] > 8
+    assert leaf["regions_retessellated"] == 0 and leaf["leaf_mesh"] is None
+    assert g["volume_ok"] and g["nonconforming_faces"] == 0
+    for report in (g, leaf):
+        assert sum(t["count"] for t in report["type_frequencies"]) == report["elements"]
+        assert sum(c["leaves"] for c in report["configuration_frequencies"]) == report["leaves"]
+    assert main(argv + ["--criterion", "internal_faces", "--delaunay", "global"]) == 2
+    assert "--delaunay leaf" in capsys.readouterr().err
