@@ -166,7 +166,7 @@ def test_random_trees_on_random_rational_boxes(lengths, levels, where, balance):
 
 def test_cli_reports_both_modes(capsys):
     argv = ["mesh", "--domain", "1", "2", "4", "--levels", "3", "--refine", "point:0.1,0.1,0.1", "--format", "json",
-            "--no-uniform"]
+            "--no-uniform", "--dual"]
     reports = {}
     for mode in ("global", "leaf"):
         assert main(argv + ["--delaunay", mode]) == 0
@@ -178,6 +178,7 @@ def test_cli_reports_both_modes(capsys):
     assert g["regions_retessellated"] >= 1 and g["largest_region_vertices"] > 8
     assert leaf["regions_retessellated"] == 0 and leaf["leaf_mesh"] is None
     assert g["volume_ok"] and g["nonconforming_faces"] == 0
+    assert g["negative_coefficients"]["interior"] == 0
     for report in (g, leaf):
         assert sum(t["count"] for t in report["type_frequencies"]) == report["elements"]
         assert sum(c["leaves"] for c in report["configuration_frequencies"]) == report["leaves"]

@@ -224,10 +224,11 @@ def _cells(mesh: Mesh, tets: np.ndarray, weights, located: _Locator, types: dict
         index: dict = {}
         cell_of_tet = np.array([index.setdefault(tuple(row), len(index)) for row in key.tolist()], dtype=np.int64)
     else:
-        _, cell_of_tet = np.unique(key, axis=0, return_inverse=True)
+        cell_of_tet = _row_classes(key)
     cell_of_tet = cell_of_tet.reshape(-1)
     # a cell's vertices are its tetrahedra's: unique (cell, vertex) pairs, vertices in increasing id
-    pairs = np.unique(np.stack([np.repeat(cell_of_tet, 4), tets.reshape(-1)], axis=1), axis=0)
+    pairs = np.unique(np.repeat(cell_of_tet, 4) * np.int64(len(coords)) + tets.reshape(-1))
+    pairs = np.stack([pairs // len(coords), pairs % len(coords)], axis=1)
     n_cells = int(cell_of_tet.max()) + 1
     counts = np.bincount(pairs[:, 0], minlength=n_cells)
     width = int(counts.max())
@@ -243,10 +244,9 @@ def _cells(mesh: Mesh, tets: np.ndarray, weights, located: _Locator, types: dict
     base = 2 * span + 1
     code = ((offsets[:, :, 0] + span) * base + offsets[:, :, 1] + span) * base + offsets[:, :, 2] + span
     code[members < 0] = -1
-    shape_rows, shape_of_cell = np.unique(np.c_[counts, code], axis=0, return_inverse=True)
-    shape_of_cell = shape_of_cell.reshape(-1)
+    shape_of_cell = _row_classes(np.c_[counts, code])
     shapes, orders = [], []
-    for s in range(len(shape_rows)):
+    for s in range(int(shape_of_cell.max()) + 1):
         cell = int(np.flatnonzero(shape_of_cell == s)[0])
         k = int(counts[cell])
         shape, order = _shape([tuple(int(x) for x in o) for o in offsets[cell, :k]], mesh.box.squared, types)
@@ -267,6 +267,16 @@ def _cells(mesh: Mesh, tets: np.ndarray, weights, located: _Locator, types: dict
     below = np.where(valid[:, :, None], points < low[:, None], False).any(axis=(1, 2))
     above = np.where(valid[:, :, None], points > (low + size[:, None])[:, None], False).any(axis=(1, 2))
     return Cells(shapes, shape_of_cell.astype(np.int32), anchor, nodes, leaf.astype(np.int64), below | above)
+
+
+def _row_classes(rows: np.ndarray) -> np.ndarray:
+    """Per row, the rank of its value among the distinct rows (lexicographic): equal rows, equal class."""
+    order = np.lexsort(rows.T[::-1])
+    ordered = rows[order]
+    new = np.r_[True, np.any(ordered[1:] != ordered[:-1], axis=1)]
+    classes = np.empty(len(rows), dtype=np.int64)
+    classes[order] = np.cumsum(new) - 1
+    return classes
 
 
 def _shape(offsets: list[tuple[int, int, int]], squared, types: dict) -> tuple[CellShape, list[int]]:

@@ -254,7 +254,8 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
     """The exact dual of a mesh.
 
     By default the elements are the mesh's leaf pattern elements, and their pieces
-    are computed once per configuration.  ``elements`` (``(connectivity, sizes)`` as
+    are computed once per configuration, and the cells that replace leaves (global
+    Delaunay mode) once per shape.  ``elements`` (``(connectivity, sizes)`` as
     :meth:`Mesh.connectivity` gives them, global vertex ids) takes any element list
     on the mesh's vertices instead, for example cells that span leaves: each element
     is then measured from its vertices (faces: the hull of its nodes; centre: the
@@ -270,6 +271,8 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
     # collected per group: global edge pairs and their integer numerators times the group's scaling
     if elements is None:
         groups, centers = _leaf_groups(mesh, squared)
+        if mesh.cells is not None:
+            groups += _cell_groups(mesh, squared, centers)
     else:
         groups, centers = _element_groups(mesh, squared, *elements)
     cden = math.lcm(1, *(_lcm_denominator(shape.edge_q) for shape, _, _ in groups))
@@ -342,6 +345,22 @@ def _leaf_groups(mesh, squared):
                                   ) * (lengths / mesh.grid)
         groups.append((_pattern_shape(pattern, squared), mesh.slots[leaves].astype(np.int64), sizes[leaves]))
     return groups, centers
+
+
+def _cell_groups(mesh, squared, centers: np.ndarray):
+    """Per shape of the cells that replace leaves: its pieces (grid units, scale 1), vertex ids; fills ``centers``."""
+    cells = mesh.cells
+    lengths = np.array(mesh.box.to_float())
+    groups = []
+    for s, shape in enumerate(cells.shapes):
+        rows = np.flatnonzero(cells.shape == s)
+        points = {n: tuple(Fraction(x) for x in o) for n, o in enumerate(shape.offsets)}
+        pieces = _Shape([element_pieces(points, shape.faces, shape.center, squared)])
+        groups.append((pieces, cells.nodes[rows, :len(shape.offsets)].astype(np.int64),
+                       np.ones(len(rows), dtype=np.int64)))
+        centers[mesh.leaf_elements + rows] = (cells.anchor[rows] + np.array([float(x) for x in shape.center])) * (
+            lengths / mesh.grid)
+    return groups
 
 
 _SHAPES: dict[tuple, _Shape] = {}
