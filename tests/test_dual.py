@@ -195,7 +195,7 @@ def dual_run(tmp_path_factory):
 
     out = tmp_path_factory.mktemp("dual")
     argv = ["mesh", "--domain", "1", "2", "4", "--refine", "point:1/5,3/10,2/5", "--levels", "3", "--dual",
-            "--no-uniform", "--format", "json"]
+            "--no-uniform", "--format", "json", "--delaunay", "leaf"]
     assert main([*argv, "--out", str(out / "a")]) == 0
     assert main([*argv, "--out", str(out / "b")]) == 0
     return out
@@ -213,7 +213,7 @@ def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
     report = json.loads((a / "report.json").read_text())
     dual = read_dual(a / "dual.npz")
     assert dual.volume_sum() == 1 and len(dual.edges) == report["dual"]["edges"]
-    # a 1 x 2 x 4 tree is not Delaunay: the report says so, the file keeps every edge
+    # a 1 x 2 x 4 leaf mesh is not Delaunay: the report says so, the file keeps every edge
     assert report["negative_coefficients"] == dual.negative_coefficients()
     assert report["negative_coefficients"]["interior"] > 0
     assert report["dual"]["mixed"]["nonzeros"] == dual.laplacian().nnz

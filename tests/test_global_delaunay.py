@@ -14,6 +14,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+import vtk
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -23,6 +24,7 @@ from cospherical.mesh.assembly import assemble
 from cospherical.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
 from cospherical.mesh.delaunay import global_delaunay
 from cospherical.mesh.octree import build_octree, parse_shape
+from vtk.util.numpy_support import vtk_to_numpy
 
 
 def _det3(a, b, c):
@@ -164,13 +166,22 @@ def test_random_trees_on_random_rational_boxes(lengths, levels, where, balance):
     assert whole(mesh) == WHOLE
 
 
-def test_cli_reports_both_modes(capsys):
+def test_cli_reports_both_modes(capsys, tmp_path):
     argv = ["mesh", "--domain", "1", "2", "4", "--levels", "3", "--refine", "point:0.1,0.1,0.1", "--format", "json",
             "--no-uniform", "--dual"]
     reports = {}
     for mode in ("global", "leaf"):
-        assert main(argv + ["--delaunay", mode]) == 0
+        assert main(argv + ["--delaunay", mode, "--out", str(tmp_path / mode)]) == 0
         reports[mode] = json.loads(capsys.readouterr().out)
+        # VTK reads every cell, polyhedra too, and its own cell volumes fill the 1 x 2 x 4 domain
+        reader = vtk.vtkXMLUnstructuredGridReader()
+        reader.SetFileName(str(tmp_path / mode / "mesh.vtu"))
+        reader.Update()
+        sizes = vtk.vtkCellSizeFilter()
+        sizes.SetInputData(reader.GetOutput())
+        sizes.Update()
+        volumes = vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume"))
+        assert len(volumes) == reports[mode]["elements"] and abs(volumes.sum() - 8) < 1e-9 and volumes.min() > 0
     g, leaf = reports["global"], reports["leaf"]
     assert (g["delaunay_mode"], leaf["delaunay_mode"]) == ("global", "leaf")
     assert leaf["delaunay_violations"] > 0 and g["delaunay_violations"] == 0 and g["delaunay_ties"] == 0

@@ -33,6 +33,7 @@ def checks(mesh) -> dict:
     found = {**check_volume(mesh), **check_conformity(mesh), **check_circumcenters(mesh), **check_delaunay(mesh)}
     found.pop("_leaves")
     found.pop("_elements")
+    found.pop("_not_cells")
     return found
 
 
