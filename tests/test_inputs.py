@@ -282,3 +282,76 @@ def test_elements_of_a_code_not_held_is_a_key_error():
     for code in (["x"], None, 7, "zzz"):
         with pytest.raises(KeyError):
             table.elements(code)
+
+
+# ---------------------------------------------------------------------------
+# Stores, YAML and shape files: sizes bounded before they are read
+
+
+def _store(folder: Path) -> Path:
+    from cospherical.formats.patterns import load
+    from cospherical.formats.store import dictionary_of, pack, write_store
+
+    table = load(PATTERNS / "leaves-1x1x1.yaml")
+    codes = sorted(table.configurations)[:20]
+    texts = [table.configurations.text(code) for code in codes]
+    dictionary = dictionary_of(texts)
+    path = folder / "t.sqlite"
+    write_store(path, table.header, dictionary, [(c, pack(t, dictionary)) for c, t in zip(codes, texts)])
+    return path
+
+
+def test_a_store_entry_is_bounded_by_its_stored_size_and_its_header_by_its_keys(tmp_path):
+    import sqlite3
+
+    path = _store(tmp_path)
+    assert run("check", path)[0] == 0
+    from cospherical.formats.store import MAX_ENTRY
+
+    connection = sqlite3.connect(path)
+    code = connection.execute("SELECT code FROM entries ORDER BY code LIMIT 1").fetchone()[0]
+    connection.execute("UPDATE entries SET entry = zeroblob(?) WHERE code = ?", (4 * MAX_ENTRY, code))
+    connection.commit()
+    connection.close()
+    result, seconds = bounded("check", path, seconds=30)
+    one_line(result.returncode, result.stderr, f"stored in over {MAX_ENTRY} bytes")
+    from cospherical.formats.patterns import load
+
+    with pytest.raises(Exception, match="stored in over"):
+        load(path).elements(code)
+    with pytest.raises(KeyError):  # the store's contract is the YAML table's
+        load(path).elements(["x"])
+
+    (tmp_path / "b").mkdir()
+    again = _store(tmp_path / "b")
+    connection = sqlite3.connect(again)
+    header = connection.execute("SELECT value FROM meta WHERE key = 'header'").fetchone()[0]
+    connection.execute("UPDATE meta SET value = ? WHERE key = 'header'",
+                       ('{"study": "x", ' + header[1:],))
+    connection.commit()
+    connection.close()
+    one_line(*run("check", again)[::2], "repeated key 'study'")
+
+
+def test_block_style_yaml_beyond_the_parser_bound_is_refused_at_once(tmp_path):
+    from cospherical.files.yamlio import MAX_YAML_PARSE
+
+    path = tmp_path / "block.yaml"
+    row = "  - type: v8f6-c3cb81\n    nodes:\n    - 0\n    - 1\n"
+    path.write_text("schema_version: 1\nconfigurations:\n  '000000000000':\n    optimal:\n"
+                    + row * (MAX_YAML_PARSE // len(row) + 1))
+    result, seconds = bounded("check", path, seconds=30)
+    one_line(result.returncode, result.stderr, f"at most {MAX_YAML_PARSE:,}")
+    assert seconds < 15
+
+
+@pytest.mark.parametrize("count, needle", [(2000, "4 to 64 corners"), (60, "coplanar")])
+def test_shape_corners_are_bounded_and_coplanarity_is_one_pass(tmp_path, count, needle):
+    # every corner on the parabola y = x**2 in z = 0: no three on a line, all on one plane
+    shape = {"corners": [[str(i), str(i * i), "0"] for i in range(count)],
+             "edges": [[i, (i + 1) % count] for i in range(count)],
+             "faces": [list(range(count)), list(range(count))[::-1]]}
+    path = _write(tmp_path, "flat.json", json.dumps(shape))
+    start = time.perf_counter()
+    one_line(*run("tessellate", "--shape", path, "--box", 1, 1, 1)[::2], needle)
+    assert time.perf_counter() - start < 5

@@ -73,6 +73,9 @@ STANDARD_SHAPES: dict[str, tuple[tuple, tuple, tuple]] = {
     ),
 }
 ELEMENTS = ("cuboid", *STANDARD_SHAPES)
+# A base element of a mesh has a handful of corners; its tessellation's exact tests grow
+# with their number, so a shape file of thousands is refused before any is read.
+MAX_CORNERS = 64
 
 
 def _sub(p, q):
@@ -148,15 +151,26 @@ class Shape:
         cospherical.errors.InputError: element: the corners are coplanar: no solid
         """
         box = box if isinstance(box, Box) else Box.parse(box)
+        if not all(isinstance(x, Sequence) and not isinstance(x, str) for x in (vertices, edges, faces)):
+            raise InputError(f"{name}: corners, edges and faces must be lists")
+        if not 4 <= len(vertices) <= MAX_CORNERS:
+            raise InputError(f"{name}: needs 4 to {MAX_CORNERS} corners, got {len(vertices)}")
+        # a convex polyhedron has at most 2n - 4 faces and 3n - 6 edges: longer lists are refused unread
+        if len(faces) > 2 * len(vertices) or len(edges) > 3 * len(vertices):
+            raise InputError(f"{name}: {len(faces)} faces and {len(edges)} edges: more than {len(vertices)} "
+                             "corners of a convex polyhedron can have")
         corners = tuple(_point(v, f"corner {i}") for i, v in enumerate(vertices))
         n = len(corners)
-        if n < 4:
-            raise InputError(f"{name}: needs at least 4 corners, got {n}")
-        for i, j in combinations(range(n), 2):
-            if corners[i] == corners[j]:
+        first: dict = {}
+        for j, corner in enumerate(corners):
+            i = first.setdefault(corner, j)
+            if i != j:
                 raise InputError(f"{name}: corners {i} and {j} are the same point")
-        if all(_volume6(corners[0], corners[1], corners[j], corners[k]) == 0
-               for j in range(2, n) for k in range(j + 1, n)):
+        # Coplanar in one pass, exactly: a corner off the line of corners 0 and 1 spans their
+        # plane (none: all on one line); the corners are a solid iff one is off that plane.
+        p, q = corners[0], corners[1]
+        r = next((c for c in corners[2:] if any(_cross(_sub(q, p), _sub(c, p)))), None)
+        if r is None or all(_volume6(p, q, r, c) == 0 for c in corners[2:]):
             raise InputError(f"{name}: the corners are coplanar: no solid")
         cycles = []
         for f, face in enumerate(faces):

@@ -53,6 +53,11 @@ class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
 # larger file, or one nested deeper than any we write, is refused before parsing
 # (deep nesting overflows the C parser's stack).
 MAX_INPUT_BYTES = 512 * 2**20
+# The full YAML parser builds about 60-100 bytes of nodes and objects per byte of block-style
+# text (an 8.8 MB table: 0.5 GB; 100 MB: 9.4 GB): it takes at most this much, so that its peak
+# stays below ~1.5 GB.  The files we write (one JSON line per entry) are split before it and
+# have no such bound.
+MAX_YAML_PARSE = 16 * 2**20
 MAX_DEPTH = 64
 MAX_INDENT = 256
 
@@ -177,14 +182,24 @@ def parse_json(text: str, name: str):
         raise FormatError(f"{name}: not valid JSON: {str(error).splitlines()[0][:120]}") from None
 
 
+def _refuse_size(text: str, name: str):
+    raise FormatError(f"{name}: {len(text):,} characters of YAML not in the form cospherical writes (one line "
+                      f"per entry); the full YAML parser takes at most {MAX_YAML_PARSE:,}")
+
+
 def parse_yaml(text: str, name: str):
     """Parse YAML text safely: no aliases, no deep nesting, no Python tags; errors as one-line FormatError."""
+    json_like = text.lstrip().startswith("{")
+    if len(text) > MAX_YAML_PARSE and not json_like:  # before the nesting scan, which takes seconds on it
+        _refuse_size(text, name)
     check_nesting(text, name)
-    if text.lstrip().startswith("{"):  # JSON (our summaries): read as JSON, where 4e-06 is a number
+    if json_like:  # JSON (our summaries): read as JSON, where 4e-06 is a number
         try:
             return json.loads(text, object_pairs_hook=_unique_pairs)
         except ValueError:
             pass  # a YAML flow mapping, or broken: the YAML reader says where
+    if len(text) > MAX_YAML_PARSE:
+        _refuse_size(text, name)
     try:
         data = yaml.load(text, Loader=_Loader)
     except yaml.YAMLError as error:

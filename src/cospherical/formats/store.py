@@ -28,7 +28,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ..errors import FormatError
-from ..files.yamlio import atomic_path, check_nesting
+from ..files.yamlio import atomic_path, parse_json
 
 __all__ = ["MAGIC", "StoreEntries", "dictionary_of", "is_store", "open_store", "pack", "write_store"]
 
@@ -50,6 +50,10 @@ SCHEMA = {*(("table", name, sql) for name, sql in TABLES.items()), ("index", "sq
 # the header a few hundred bytes), far below what would exhaust memory.
 MAX_ENTRY = 1 << 20
 MAX_HEADER = 1 << 16
+# An entry as stored is never longer than its text (a few hundred bytes packed): the stored
+# size is bounded in the query, which reads a blob's length from its record header, so a
+# gigabyte blob is never loaded.
+_BOUNDED_ENTRY = f"CASE WHEN length(entry) <= {MAX_ENTRY} THEN entry END"
 
 
 def is_store(path: str | Path) -> bool:
@@ -137,8 +141,7 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
             raise FormatError(f"{path}: store layout {meta.get('layout')!r}, expected {LAYOUT}")
         if "header" not in meta or "count" not in meta:
             raise ValueError(f"no header and count of at most {MAX_HEADER} bytes")
-        check_nesting(meta["header"], str(path))
-        header = json.loads(meta["header"])
+        header = parse_json(meta["header"], f"{path}: header")
         count = int(meta["count"])
         rows = connection.execute("SELECT data FROM dictionary WHERE length(data) <= ? LIMIT 2",
                                   (DICTIONARY_SIZE,)).fetchall()
@@ -147,6 +150,8 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
             raise ValueError(f"its header is not a mapping, its count is not that of a table, or it has not one "
                              f"dictionary of at most {DICTIONARY_SIZE} bytes")
         (dictionary,) = rows[0]
+    except FormatError:
+        raise  # names the store and the place already
     except (sqlite3.Error, KeyError, ValueError, TypeError) as error:
         raise FormatError(f"{path}: not a pattern-table store: {str(error).splitlines()[0][:120]}") from None
     return header, StoreEntries(connection, count, dictionary, str(path))
@@ -173,6 +178,8 @@ class StoreEntries(Mapping):
         return next(self._rows(sql, arguments), None)
 
     def _text(self, blob) -> str:
+        if blob is None:  # the query's bound on the stored size: the blob was never read
+            raise FormatError(f"{self._name}: store damaged: an entry is stored in over {MAX_ENTRY} bytes")
         try:
             unpacker = zlib.decompressobj(zdict=self._dictionary)
             # bounded: a few hundred compressed bytes must not unpack into gigabytes
@@ -186,7 +193,7 @@ class StoreEntries(Mapping):
     def __getitem__(self, code: str) -> str:
         if not isinstance(code, str):  # the caller's mistake, not the file's
             raise KeyError(code)
-        row = self._one("SELECT entry FROM entries WHERE code = ?", (code,))
+        row = self._one(f"SELECT {_BOUNDED_ENTRY} FROM entries WHERE code = ?", (code,))
         if row is None:
             raise KeyError(code)
         return self._text(row[0])
@@ -204,7 +211,7 @@ class StoreEntries(Mapping):
         """Every (code, entry text), in code order, streamed; the rows must be as many as the store says
         (what reads them all, such as ``check``, finds a store whose count is wrong)."""
         seen = 0
-        for code, blob in self._rows("SELECT code, entry FROM entries ORDER BY code"):
+        for code, blob in self._rows(f"SELECT code, {_BOUNDED_ENTRY} FROM entries ORDER BY code"):
             seen += 1
             yield code, self._text(blob)
         if seen != self._count:
