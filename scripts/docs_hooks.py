@@ -207,12 +207,15 @@ def intersection_table(up: str) -> str:
     return "\n".join(rows)
 
 
-MESH_ROWS = [("leaves", "leaves"), ("vertices", "vertices"), ("elements", "elements"), ("types", "element types"),
+MESH_ROWS = [("delaunay_mode", "mode (--delaunay; - : made before the choice, each leaf from its table)"),
+             ("leaves", "leaves"), ("vertices", "vertices"), ("elements", "elements"), ("types", "element types"),
              ("volume_ok", "volume_ok"), ("nonconforming_faces", "nonconforming faces"),
              ("circumcenters_outside_leaf", "circumcenters outside their leaf"),
              ("leaves_not_fvm_adequate", "leaves not FVM-adequate"),
              ("delaunay_violations", "Delaunay violations (elements)"),
              ("delaunay_violating_pairs", "(element, vertex) pairs"), ("delaunay_ties", "co-spherical ties"),
+             ("regions_retessellated", "regions re-tessellated (global mode)"),
+             ("cells_spanning_leaves", "cells spanning leaves (global mode)"),
              ("configurations", "distinct configurations"), ("tessellated_on_the_fly", "tessellated on the fly"),
              ("paper_final_share", "share of the paper's seven final elements")]
 
