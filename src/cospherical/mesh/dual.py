@@ -302,7 +302,7 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
             bnd_axis.append(np.full(int(on.sum()), axis, dtype=np.int64))
     keys = np.concatenate(edge_parts) if edge_parts else np.zeros(0, dtype=np.int64)
     coefs = np.concatenate(coef_parts) if coef_parts else np.zeros(0, dtype=dtype)
-    order = np.argsort(keys, kind="stable")
+    order = np.argsort(keys)  # integer sums: the order among equal keys does not matter
     keys, coefs = keys[order], coefs[order]
     first = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]]) if len(keys) else np.zeros(0, dtype=np.int64)
     coefficient_exact = np.add.reduceat(coefs, first) if len(keys) else coefs
@@ -310,7 +310,15 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
     edges = np.stack([unique // n_vertices, unique % n_vertices], axis=1)
     volume_exact = np.zeros(n_vertices, dtype=dtype)
     if vol_parts:
-        np.add.at(volume_exact, np.concatenate(vol_index), np.concatenate(vol_parts))
+        index, parts = np.concatenate(vol_index), np.concatenate(vol_parts)
+        # float64 sums of integers are exact while every partial sum stays below 2**53: bounded by the
+        # most pieces a vertex gets times the largest piece; beyond that, integer sums
+        wide_sums = dtype is object or len(parts) == 0 or \
+            int(np.bincount(index).max()) * int(np.abs(parts).max()) >= 2**53
+        if not wide_sums:
+            volume_exact = np.rint(np.bincount(index, weights=parts, minlength=n_vertices)).astype(np.int64)
+        else:
+            np.add.at(volume_exact, index, parts)
     lengths = np.array(box.to_float())
     real = verts * (lengths / grid)
     factor = math.sqrt(factor_squared)
