@@ -157,8 +157,8 @@ def main(argv=None) -> None:
         for kind, levels in (("uniform", args.uniform), ("graded", args.graded)):
             trees = [octree(kind, level) for level in levels]
             for method in methods:
-                rows = [box_method(t, exact, source, cache, lookup) if method == "box" else cell_centred(t, exact, source)
-                        for t in trees]
+                rows = [box_method(t, exact, source, cache, lookup) if method == "box"
+                        else cell_centred(t, exact, source) for t in trees]
                 for level, row, o_max, o_l2 in zip(levels, rows, order(rows, "max"), order(rows, "l2")):
                     line = (f"{name:9s} {kind:8s} {level:5d}  {method:10s} {row['unknowns']:9,d} {row['nonzeros']:10,d}"
                             f"  {row['max']:9.3e} {o_max:>6s}  {row['l2']:9.3e} {o_l2:>6s}")

@@ -28,6 +28,9 @@ SMALLER = [
     (re.compile(r"^(python benchmarks/bench_outputs.py)"), r"\1 --levels 3"),
     (re.compile(r"^(python benchmarks/bench_startup.py)"), r"\1 --runs 1"),
     (re.compile(r"^(cospherical mesh .*)--levels \d+"), r"\1--levels 3"),
+    (re.compile(r"^(python examples/poisson.py).*"), r"\1 --uniform 2 3 --graded 4"),
+    (re.compile(r"^(python benchmarks/bench_dual.py --poisson).*"), r"\1 --uniform 2 --graded 4"),
+    (re.compile(r"^(python benchmarks/bench_dual.py)(?! --poisson)"), r"\1 --levels 4"),
 ]
 
 

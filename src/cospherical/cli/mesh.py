@@ -49,7 +49,8 @@ def add_parser(commands) -> None:
                         help="pattern table of the domain's box (configurations it lacks are tessellated); "
                         "without it every configuration is tessellated")
     parser.add_argument("--criterion", choices=CRITERIA, default="optimal", help="which elements of the table")
-    parser.add_argument("--out", type=Path, metavar="DIR", help="write mesh.vtu, report.json and mesh.png here (and dual.npz with --dual)")
+    parser.add_argument("--out", type=Path, metavar="DIR",
+                        help="write mesh.vtu, report.json and mesh.png here (and dual.npz with --dual)")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="text (default): the main figures; json: the whole report on stdout")
     parser.add_argument("--cut", metavar="Z", help="height of the picture's cut as a fraction of the domain height "
