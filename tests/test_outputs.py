@@ -119,6 +119,8 @@ def test_two_runs_into_one_folder_the_second_is_refused_at_once(tmp_path, capsys
         start = time.monotonic()
         refused(capsys, *MESH, "--out", out, needle="another cospherical run")
         refused(capsys, "render", "--summary", SUMMARY, "--out", out, needle="another cospherical run")
+        refused(capsys, "study", "bisection", "--out", out, needle="another cospherical run")
+        refused(capsys, "sweep", "--ray", "1,2,2", "--out", out, needle="another cospherical run")
         assert time.monotonic() - start < 5
         assert [p.name for p in out.iterdir() if not p.name.startswith(".cospherical-staging.")] == []
     assert main([*MESH, "--out", str(out)]) == 0
@@ -161,6 +163,7 @@ def test_render_pdf_never_writes_through_links_and_keeps_the_users_files(tmp_pat
     capsys.readouterr()
     assert target.read_text() == "the user's own file\n" and os.readlink(out / "document.aux") == str(target)
     assert (out / "document.pdf").read_bytes().startswith(b"%PDF") and (out / "document.log").is_file()
+    assert b"/CreationDate (D:19700101" in (out / "document.pdf").read_bytes()  # no time stamp: the same bytes
     assert not [p for p in out.iterdir() if p.name.startswith(".cospherical-staging.")]
     # without --pdf, the PDF and log of the earlier render go (the manifest says they are ours), nothing else
     assert main(["render", "--summary", str(ROOT / "results" / "bisection-1x2x4.json"), "--out", str(out)]) == 0

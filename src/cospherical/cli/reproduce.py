@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..catalogue import SCHEMA_VERSION, use_catalogue
 from ..core.configuration import POINT_POLICIES, Box
+from ..files.outputs import FolderLock
 from ..files.yamlio import atomic_write
 from ..formats.catalogue_file import build_catalogue, intersection_examples, write_catalogue
 from ..formats.patterns import pattern_name, write_patterns
@@ -45,7 +46,8 @@ def run(args) -> int:
     # nor trusted; everything is named by the catalogue this run builds.
     use_catalogue({"schema_version": SCHEMA_VERSION, "version": "none", "types": []})
     try:
-        return _reproduce(args.root)
+        with FolderLock(args.root):  # one run at a time regenerates a tree
+            return _reproduce(args.root)
     finally:
         use_catalogue(None)
 

@@ -12,6 +12,7 @@ from ..catalogue import shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..errors import UsageError
+from ..files.outputs import FolderLock
 from ..files.yamlio import atomic_write
 from ..outputs.report import text_report
 from ..paper import paper_comparison, paper_study_key
@@ -112,6 +113,13 @@ INTERSECTION_DEFAULTS = {"resolution": 16, "order": "edge", "jobs": os.cpu_count
 
 
 def run(args) -> int:
+    if args.out is None:
+        return _run(args)
+    with FolderLock(args.out):  # one run at a time fills a folder
+        return _run(args)
+
+
+def _run(args) -> int:
     if args.element != "cuboid" and args.family != "bisection":
         raise UsageError(f"cospherical study: error: --element {args.element}: the {args.family} study is of cuboids; "
                          "other base elements have the bisection study")

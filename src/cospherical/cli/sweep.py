@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ..core.exact import parse_rational
 from ..errors import InputError
+from ..files.outputs import FolderLock
 from ..files.yamlio import atomic_write
 from ..outputs.figures import heatmap_png, heatmap_tex, steps_png, steps_tex
 from ..outputs.latex import environment
@@ -36,6 +37,13 @@ def add_parser(commands) -> None:
 
 
 def run(args) -> int:
+    if args.out is None:
+        return _run(args)
+    with FolderLock(args.out):  # one run at a time fills a folder
+        return _run(args)
+
+
+def _run(args) -> int:
     if args.ray:
         return _ray(args)
     b_values = grid_values(args.ratios[0], "b range")

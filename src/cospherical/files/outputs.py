@@ -4,6 +4,8 @@ Two shapes of the same rule, that an output is either as it was or complete:
 
 - :func:`atomic_path` (and :func:`atomic_open`, :func:`atomic_write`) for one
   file: written to a temporary file in the same folder, renamed when complete.
+- :class:`FolderLock` for a folder a command fills over a long run (``study --out``,
+  with checkpoints that must outlive a failed run): locked for the run, nothing else.
 - :class:`OutputFolder` for the several files of one run (``mesh --out``,
   ``render --out``): the folder is locked for the run, every file is made in a
   private staging folder inside it (programs the tool runs, such as pdflatex,
@@ -35,7 +37,7 @@ from pathlib import Path
 
 from ..errors import InputError
 
-__all__ = ["MANIFEST", "OutputFolder", "atomic_open", "atomic_path", "atomic_write", "refuse_special"]
+__all__ = ["MANIFEST", "FolderLock", "OutputFolder", "atomic_open", "atomic_path", "atomic_write", "refuse_special"]
 
 MANIFEST = ".cospherical-manifest.json"
 _STAGING_PREFIX = ".cospherical-staging."
@@ -193,29 +195,16 @@ class OutputFolder:
         self.staging: Path | None = None
         self._names = list(names)
         self._staged: list[str] = []
-        self._fd: int | None = None
-        self._created = False
+        self._lock: FolderLock | None = None
 
     def __enter__(self) -> OutputFolder:
-        folder = self.folder
-        try:
-            self._created = not folder.exists()
-            folder.mkdir(parents=True, exist_ok=True)
-            self._fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
-        except OSError as error:
-            raise _output_error(folder, error) from None
-        try:
-            fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(self._fd)
-            self._fd = None
-            raise InputError(f"{folder}: another cospherical run is writing into this folder; "
-                             "wait for it to end, or choose another folder") from None
+        self._lock = FolderLock(self.folder)
+        self._lock.acquire()
         try:
             for name in self._names:
                 self._check_name(name)
             self._remove_stale_staging()
-            self.staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=folder))
+            self.staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=self.folder))
         except BaseException:
             self._release(failed=True)
             raise
@@ -307,6 +296,37 @@ class OutputFolder:
         if self.staging is not None:
             shutil.rmtree(self.staging, ignore_errors=True)
             self.staging = None
+        self._lock.release(failed)
+
+
+class FolderLock:
+    """An output folder held by one run: created if missing, locked (``flock`` on the folder itself,
+    so no lock file is left), and removed again by a run that created it, failed, and left it empty.
+
+    A second run that asks for the folder while it is held is refused at once with one
+    line (see :class:`OutputFolder` for why it is not made to wait).
+    """
+
+    def __init__(self, folder: str | Path):
+        self.folder = Path(folder)
+        self._fd: int | None = None
+        self._created = False
+
+    def acquire(self) -> None:
+        try:
+            self._created = not self.folder.exists()
+            self.folder.mkdir(parents=True, exist_ok=True)
+            self._fd = os.open(self.folder, os.O_RDONLY | os.O_DIRECTORY)
+        except OSError as error:
+            raise _output_error(self.folder, error) from None
+        try:
+            fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.release(failed=True)
+            raise InputError(f"{self.folder}: another cospherical run is writing into this folder; "
+                             "wait for it to end, or choose another folder") from None
+
+    def release(self, failed: bool) -> None:
         if self._fd is not None:
             os.close(self._fd)  # releases the lock
             self._fd = None
@@ -315,3 +335,10 @@ class OutputFolder:
                 self.folder.rmdir()  # made by this run, and still empty
             except OSError:
                 pass
+
+    def __enter__(self) -> FolderLock:
+        self.acquire()
+        return self
+
+    def __exit__(self, kind, value, traceback) -> None:
+        self.release(failed=kind is not None)

@@ -9,6 +9,7 @@ one fixed oblique view, visible edges solid, hidden edges dashed.
 from __future__ import annotations
 
 import math
+import os
 import re
 import shutil
 import subprocess
@@ -251,6 +252,10 @@ def _write_tables(summaries: list[dict], catalogue: dict, folder: OutputFolder, 
 _OUR_NAME = re.compile(r"[0-9a-z][0-9a-z._-]*\.tex")
 
 
+# pdfTeX stamps the time of the run into the PDF (dates and the file id) unless told a fixed one.
+_REPRODUCIBLE_TEX = {"SOURCE_DATE_EPOCH": "0", "FORCE_SOURCE_DATE": "1"}
+
+
 def _compile_pdf(folder: OutputFolder, out: Path, document: str = "document.tex") -> list[str]:
     """Compile the staged ``document.tex`` with pdflatex (twice, for the long tables) in the private
     staging folder, where nothing it writes can follow a link in ``out``; the PDF and its log are
@@ -263,7 +268,7 @@ def _compile_pdf(folder: OutputFolder, out: Path, document: str = "document.tex"
     for _ in range(2):
         result = subprocess.run([pdflatex, "-interaction=nonstopmode", "-halt-on-error", "-no-shell-escape",
                                  document], cwd=folder.staging, capture_output=True, text=True,
-                                stdin=subprocess.DEVNULL, errors="replace")
+                                stdin=subprocess.DEVNULL, errors="replace", env={**os.environ, **_REPRODUCIBLE_TEX})
         if result.returncode != 0:
             error = next((line for line in result.stdout.splitlines() if line.startswith("!")), "pdflatex failed")
             raise InputError(f"{out / document}: {error}")
