@@ -9,7 +9,12 @@ and vertex balance); assembly (each leaf's configuration from the vertex set,
 elements from the table, global vertex ids; the distinct configurations are looked
 up and measured once each, shown separately as "configurations"); the volume,
 conformity and circumcenter checks; the exact global Delaunay check; the
-frequency statistics (without the uniform study).  Peak memory is the process's
+frequency statistics (without the uniform study).  Then the global mode
+(``--delaunay global``): the exact Delaunay subdivision from the leaf mesh and its
+check (the regions re-tessellated), and the same checks and statistics on it.
+Leaf mode = assembly + checks + statistics; global mode = the same assembly +
+the leaf mesh's Delaunay check + re-tessellation + checks + statistics of the
+result; their ratio is printed (target: at most 3).  Peak memory is the process's
 maximum resident set size.  Targets (issue 14): assembly >= 100,000 leaves/s,
 volume + conformity + circumcenters < 2 min, Delaunay < 5 min, peak < 4 GB.
 """
@@ -25,6 +30,7 @@ from cospherical.core.configuration import Box
 from cospherical.formats.mesh import table_lookup
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
+from cospherical.mesh.delaunay import global_delaunay
 from cospherical.mesh.octree import build_octree, parse_shape
 from cospherical.mesh.statistics import mesh_statistics
 
@@ -57,6 +63,12 @@ def main() -> None:
     centres = stage("circumcenters", lambda: check_circumcenters(mesh))
     delaunay = stage("delaunay", lambda: check_delaunay(mesh))
     stage("statistics", lambda: mesh_statistics(mesh))
+    whole = stage("global: re-tessellation", lambda: global_delaunay(mesh, delaunay))
+    found = {}
+    for name, check in (("volume", check_volume), ("conformity", check_conformity),
+                        ("circumcenters", check_circumcenters), ("delaunay", check_delaunay)):
+        found.update(stage(f"global: {name}", lambda: check(whole)))
+    stage("global: statistics", lambda: mesh_statistics(whole))
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     print(f"leaves {len(tree):,}  vertices {len(mesh.vertices):,}  elements {len(mesh):,}  "
           f"configurations {len(mesh.patterns)}  on the fly {sum(p.on_the_fly for p in mesh.patterns)}")
@@ -67,7 +79,18 @@ def main() -> None:
     checks = sum(clock[k][0] for k in ("volume", "conformity", "circumcenters"))
     print(f"volume + conformity + circumcenters {checks:.1f} s; delaunay {clock['delaunay'][0]:.1f} s; "
           f"peak {peak:.2f} GB")
-    print({**volume, **conformity, **centres, **{k: v for k, v in delaunay.items() if k != "_leaves"}})
+    print({**volume, **conformity, **centres, **{k: v for k, v in delaunay.items() if not k.startswith("_")}})
+    leaf_stages = ("assembly", "volume", "conformity", "circumcenters", "delaunay", "statistics")
+    global_stages = ("assembly", "delaunay", *(name for name in clock if name.startswith("global: ")))
+    leaf_mode, global_mode = (sum(clock[k][0] for k in stages) for stages in (leaf_stages, global_stages))
+    leaf_cpu, global_cpu = (sum(clock[k][1] for k in stages) for stages in (leaf_stages, global_stages))
+    cells = whole.cells
+    print(f"global: {len(whole):,} elements, {len(cells) if cells else 0:,} cells in "
+          f"{cells.regions if cells else 0} regions (largest {cells.largest_region if cells else 0:,} vertices), "
+          f"{int(cells.spanning.sum()) if cells else 0:,} spanning leaves")
+    print({k: v for k, v in found.items() if not k.startswith("_") and k != "nonconforming_examples"})
+    print(f"leaf mode {leaf_mode:.1f} s wall, {leaf_cpu:.1f} s cpu; global mode {global_mode:.1f} s wall, "
+          f"{global_cpu:.1f} s cpu: {global_mode / leaf_mode:.2f}x wall, {global_cpu / leaf_cpu:.2f}x cpu")
 
 
 if __name__ == "__main__":
