@@ -149,7 +149,8 @@ def test_fuzz_leaf_lists_never_traceback(tmp_path_factory, lines, as_json):
     (("sqrt(2)", "1e-12", 1), "box:0.1234567891,0,0,0.2,1e-13,0.5"),
 ])
 def test_refine_numbers_beyond_int64_are_decided_exactly(domain, shape):
-    status, out, err = run("mesh", "--domain", *domain, "--refine", shape, "--levels", 3, *QUICK)
+    # the leaves' own tessellations: what the octree decides is the subject here, not the global subdivision
+    status, out, err = run("mesh", "--domain", *domain, "--refine", shape, "--levels", 3, "--delaunay", "leaf", *QUICK)
     assert status == 0, err
     assert "volume_ok: true" in out
 
@@ -355,3 +356,103 @@ def test_shape_corners_are_bounded_and_coplanarity_is_one_pass(tmp_path, count, 
     start = time.perf_counter()
     one_line(*run("tessellate", "--shape", path, "--box", 1, 1, 1)[::2], needle)
     assert time.perf_counter() - start < 5
+
+
+# ---------------------------------------------------------------------------
+# Checkpoints of the intersection study: a checksum each, bounds on every value
+
+
+def _with_checksum(payload: bytes) -> bytes:
+    from cospherical.studies.intersection.run import _checkpoint_bytes
+
+    return _checkpoint_bytes(payload)  # what an attacker who knows the format writes: the sum holds
+
+
+def _payload(path: Path) -> bytes:
+    return path.read_bytes().split(b"\n", 1)[1]
+
+
+def _cells_with(path: Path, **changes) -> bytes:
+    from cospherical.studies.intersection.run import CELL_NAMES
+
+    with np.load(io.BytesIO(_payload(path))) as data:
+        arrays = {name: data[name] for name in CELL_NAMES}
+    arrays.update({k: v(arrays[k]) for k, v in changes.items()})
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    return buffer.getvalue()
+
+
+def _deflated(path: Path) -> bytes:
+    import zipfile
+
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(_payload(path))) as source, \
+            zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as target:
+        for info in source.infolist():
+            target.writestr(info.filename, source.read(info))
+    return buffer.getvalue()
+
+
+def _elements_with(path: Path, change) -> bytes:
+    entries, types = json.loads(_payload(path))
+    return json.dumps(change(entries, types)).encode()
+
+
+def _claiming(path: Path) -> bytes:
+    """A stage-1 archive whose first array's header claims 500 M int64 (4 GB) it does not hold."""
+    import zipfile
+
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(_payload(path))) as source, zipfile.ZipFile(buffer, "w") as target:
+        for n, info in enumerate(source.infolist()):
+            data = source.read(info)
+            if n == 0:
+                header = np.lib.format.header_data_from_array_1_0(np.zeros(1, dtype=np.int64))
+                header["shape"] = (500_000_000,)
+                head = io.BytesIO()
+                np.lib.format.write_array_header_1_0(head, header)
+                data = head.getvalue() + data[-64:]
+            target.writestr(info.filename, data)
+    return buffer.getvalue()
+
+
+DAMAGE = {
+    "garbage": ("cells", lambda p: b"\x00garbage"),
+    "one mask everywhere, sum not renewed": ("cells", lambda p: p.read_bytes().split(b"\n", 1)[0] + b"\n" + _cells_with(
+        p, poly_mask=lambda a: np.full_like(a, a[0]))),
+    "tetrahedra 10**15": ("cells", lambda p: _with_checksum(_cells_with(p, tets=lambda a: a + 10**15))),
+    "closed stored as 7": ("cells", lambda p: _with_checksum(_cells_with(p, closed=lambda a: np.full(len(a), 7)))),
+    "a deflated array": ("cells", lambda p: _with_checksum(_deflated(p))),
+    "an array claiming 500 M int64": ("cells", lambda p: _with_checksum(_claiming(p))),
+    "nested 100,000 deep": ("elements", lambda p: _with_checksum(b"[" * 100_000 + b"]" * 100_000)),
+    "a type not among its chunk's": ("elements", lambda p: _with_checksum(_elements_with(
+        p, lambda e, t: [[{**e[0], "type": "v9f9-000000"}, *e[1:]], t]))),
+    "fewer entries than elements": ("elements", lambda p: _with_checksum(_elements_with(p, lambda e, t: [e[:-1], t]))),
+}
+
+
+@pytest.fixture(scope="module")
+def intersection_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("study")
+    args = ["study", "intersection", "--resolution", 2, "--jobs", 1, "--out", out, "--resume", "--chunk-size", 20,
+            "--format", "json"]
+    status, summary, err = run(*args)
+    assert status == 0, err
+    return out, args, json.loads(summary)
+
+
+@pytest.mark.parametrize("damage", sorted(DAMAGE))
+def test_a_damaged_checkpoint_is_computed_again_never_counted(intersection_run, damage):
+    out, args, full = intersection_run
+    stage, write = DAMAGE[damage]
+    path = sorted((out / "checkpoints").glob(f"*-{stage}-*"))[0]
+    original = path.read_bytes()
+    path.write_bytes(write(path))
+    status, summary, err = run(*args)
+    assert status == 0 and "Traceback" not in err, err
+    notes = [line for line in err.splitlines() if "damaged checkpoint" in line]
+    assert len(notes) == 1 and path.name in notes[0] and "computed again" in notes[0], err
+    assert json.loads(summary) == full
+    assert path.read_bytes() == original  # rewritten whole, the same bytes
+

@@ -205,7 +205,8 @@ def _intersection(args) -> int:
         summary = run_intersection(args.resolution, args.order, jobs=max(1, args.jobs),
                                    checkpoints=checkpoints if args.resume else None, progress=advance,
                                    chunk=max(1, args.chunk_size), scheduler=args.scheduler,
-                                   dask_workers=args.dask_workers, brute_force=args.no_orbits)
+                                   dask_workers=args.dask_workers, brute_force=args.no_orbits,
+                                   notice=lambda line: print(f"cospherical study: note: {line}", file=sys.stderr))
     if args.out:
         stem = f"intersection-r{args.resolution}-{args.order}"
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))

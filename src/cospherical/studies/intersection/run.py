@@ -14,11 +14,14 @@ sizes.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
+import re
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -30,8 +33,7 @@ from ...core.geometry import Frame
 from ...core.polyhedron import polyhedron
 from ...core.split import SPLIT_CRITERIA
 from ...core.symmetry import key_code
-from ...errors import FormatError
-from ...files.yamlio import atomic_write
+from ...files.yamlio import atomic_write, parse_json
 from ..summary import TypeInfo
 from .backends import completed
 from .family import all_configurations, orbits
@@ -43,7 +45,8 @@ __all__ = ["CHUNK", "ELEMENT_CHUNK", "ElementEntry", "cell_polyhedron", "element
 CHUNK = 5000
 ELEMENT_CHUNK = 500
 # Bumped when a checkpoint's content changes, so --resume never reads an older layout.
-CHECKPOINT_FORMAT = 2
+CHECKPOINT_FORMAT = 3
+CELLS_PER_CONFIGURATION = 96  # the compiled walk's room per configuration, tetrahedra included
 
 
 @dataclass(frozen=True)
@@ -80,7 +83,7 @@ def tessellate_chunk(codes: np.ndarray, every_cell: bool = False) -> dict[str, n
     closed, open_ = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
     # A cell other than a tetrahedron has at least five of the at most 27 points, so 27 per
     # configuration is ample; with tetrahedra, 96 (27 measured at most at 1/16). Beyond, an error.
-    room = (96 if every_cell else 27) * n
+    room = (CELLS_PER_CONFIGURATION if every_cell else 27) * n
     poly_mask, poly_code = np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64)
     written = compiled.cube_batch(codes, *_cube_tables(), tets, closed, open_, polys, poly_mask, poly_code, every_cell)
     if written < 0:
@@ -123,38 +126,105 @@ def _element_chunk_json(part) -> str:
     return json.dumps([[asdict(e) for e in entries], {k: asdict(t) for k, t in types.items()}], sort_keys=True)
 
 
-def _element_chunk_from_json(text: str):
-    entries, types = json.loads(text)
-    return [ElementEntry.from_json(e) for e in entries], {k: TypeInfo(**t) for k, t in types.items()}
+# A checkpoint is one line naming the SHA-256 of its content, then the content: a file
+# damaged in any byte fails the sum and is computed again, never counted.
+_CHECKSUM = re.compile(rb"cospherical checkpoint sha256 ([0-9a-f]{64})\n")
+ALL_NODES = (1 << 27) - 1
+# Bytes of a checkpoint per unit, far above what is written (stage 1: 18 bytes per configuration
+# and 16 per cell; stage 2: about 1 kB per element), so that a damaged file is never read whole.
+CELL_BYTES = 18 + 16 * CELLS_PER_CONFIGURATION
+ELEMENT_BYTES = 64 * 1024
 
 
-def _damaged(path) -> FormatError:
-    return FormatError(f"{path}: damaged checkpoint: remove it (it is computed again) and run again")
+def _checkpoint_bytes(payload: bytes) -> bytes:
+    return b"cospherical checkpoint sha256 %s\n" % hashlib.sha256(payload).hexdigest().encode() + payload
 
 
-def _read_cells(path, count: int) -> dict[str, np.ndarray]:
-    """A stage-1 checkpoint, checked: the arrays of ``count`` configurations, or FormatError."""
+def _checked_payload(path: Path, most: int) -> bytes:
+    """A checkpoint's content after its checksum, at most ``most`` bytes; ValueError says why not."""
+    with open(path, "rb") as handle:
+        data = handle.read(most + 100)
+    if len(data) > most + 100:
+        raise ValueError(f"over {most:,} bytes")
+    found = _CHECKSUM.match(data)
+    if found is None:
+        raise ValueError("no checksum line")
+    payload = data[found.end():]
+    if hashlib.sha256(payload).hexdigest().encode() != found.group(1):
+        raise ValueError("its checksum does not match its content")
+    return payload
+
+
+CELL_NAMES = ("tets", "closed", "open", "polys", "poly_mask", "poly_code")
+
+
+def _read_cells(path: Path, count: int) -> dict[str, np.ndarray]:
+    """A stage-1 checkpoint of ``count`` configurations, checked (checksum, sizes before reading, every
+    value in its range); ValueError says why it cannot be used."""
     import zipfile
 
-    names = ("tets", "closed", "open", "polys", "poly_mask", "poly_code")
+    payload = _checked_payload(path, 4096 + CELL_BYTES * count)
     try:
-        with np.load(path, allow_pickle=False) as data:
-            part = {name: data[name] for name in names}
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
-        raise _damaged(path) from None
-    if any(part[name].ndim != 1 or part[name].dtype.kind not in "iub" for name in names) \
-            or any(len(part[name]) != count for name in names[:4]) \
-            or not len(part["poly_mask"]) == len(part["poly_code"]) == int(part["polys"].sum()):
-        raise _damaged(path)
+        with zipfile.ZipFile(io.BytesIO(payload)) as archive:
+            # stored, never deflated: what an array claims is what the file holds
+            members = {info.filename: info for info in archive.infolist()}
+            if set(members) != {f"{name}.npy" for name in CELL_NAMES} or any(
+                    info.compress_type != zipfile.ZIP_STORED for info in members.values()):
+                raise ValueError("not the arrays of a stage-1 checkpoint")
+            for info in members.values():  # an array's header must not claim more than its member holds
+                with archive.open(info) as member:
+                    version = np.lib.format.read_magic(member)
+                    header = np.lib.format.read_array_header_1_0 if version == (1, 0) \
+                        else np.lib.format.read_array_header_2_0
+                    shape, _, dtype = header(member)
+                if len(shape) != 1 or shape[0] * dtype.itemsize > info.file_size:
+                    raise ValueError(f"{info.filename} claims {shape} of {dtype}, more than it holds")
+        with np.load(io.BytesIO(payload), allow_pickle=False) as data:
+            part = {name: data[name] for name in CELL_NAMES}
+    except (OSError, KeyError, EOFError, zipfile.BadZipFile) as error:
+        raise ValueError(f"not a readable archive ({error})") from None
+    if any(part[name].ndim != 1 for name in CELL_NAMES) or any(len(part[name]) != count for name in CELL_NAMES[:4]):
+        raise ValueError(f"not arrays of {count} configurations")
+    if part["closed"].dtype != np.bool_ or part["open"].dtype != np.bool_ \
+            or any(part[name].dtype != np.int64 for name in ("tets", "polys", "poly_mask", "poly_code")):
+        raise ValueError("arrays of the wrong types")
+    tets, polys, mask, code = part["tets"], part["polys"], part["poly_mask"], part["poly_code"]
+    if tets.min(initial=0) < 0 or polys.min(initial=0) < 0 \
+            or (tets + polys).max(initial=0) > CELLS_PER_CONFIGURATION or len(mask) != len(code) \
+            or len(mask) != int(polys.sum()) or mask.min(initial=1) < 1 or mask.max(initial=0) > ALL_NODES \
+            or code.min(initial=0) < 0 or code.max(initial=0) >= 16**12:
+        raise ValueError("counts or cells out of range")
     return part
 
 
-def _read_elements(path):
-    """A stage-2 checkpoint, checked: ``(entries, types)``, or FormatError."""
+def _read_elements(path: Path, count: int):
+    """A stage-2 checkpoint of ``count`` elements, checked: ``(entries, types)``; ValueError says why not."""
+    text = _checked_payload(path, 4096 + ELEMENT_BYTES * count).decode("utf-8")
+    data = parse_json(text, path.name)
     try:
-        return _element_chunk_from_json(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, TypeError, KeyError, AttributeError):
-        raise _damaged(path) from None
+        entries, types = data
+        entries = [ElementEntry.from_json(e) for e in entries]
+        types = {k: TypeInfo(**t) for k, t in types.items()}
+    except (ValueError, TypeError, KeyError, AttributeError) as error:
+        raise ValueError(f"not a stage-2 checkpoint ({type(error).__name__})") from None
+    if len(entries) != count:
+        raise ValueError(f"{len(entries)} entries for {count} elements")
+    for entry in entries:
+        named = [entry.type, *(piece for options in entry.options.values() for option in options for piece in option)]
+        if set(entry.options) != set(SPLIT_CRITERIA) or any(not isinstance(t, str) or t not in types for t in named):
+            raise ValueError(f"an entry of type {str(entry.type)[:40]!r} names criteria or types it does not hold")
+    return entries, types
+
+
+def _resumed(read, path: Path, count: int, damaged: list):
+    """A checkpoint's content, or ``None`` when it is missing or damaged (noted in ``damaged``)."""
+    if not path.exists():
+        return None
+    try:
+        return read(path, count)
+    except (OSError, ValueError, UnicodeDecodeError) as error:
+        damaged.append(f"{path.name} ({str(error).splitlines()[0][:80]})")
+        return None
 
 
 def _npz_bytes(arrays: dict) -> bytes:
@@ -172,7 +242,7 @@ def _tetrahedron():
 def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, checkpoints=None,
                      progress=None, chunk: int = CHUNK, scheduler: str | None = None,
                      dask_workers: int | None = None, brute_force: bool = False,
-                     examples: dict | None = None) -> dict:
+                     examples: dict | None = None, notice: Callable[[str], None] | None = None) -> dict:
     """The intersection study's summary, all criteria, in the shape of the bisection study's.
 
     Parameters
@@ -184,7 +254,9 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
         Local worker processes.
     checkpoints : path, optional
         A folder keeping each finished chunk; chunks found there are not computed
-        again, so an interrupted run resumes.
+        again, so an interrupted run resumes.  Each carries the SHA-256 of its
+        content; one whose sum, size or values fail is computed again (and
+        rewritten), never counted.
     progress : callable, optional
         ``progress(stage, n)`` as work finishes: ``cells`` in configurations,
         ``elements`` in distinct elements.
@@ -198,6 +270,8 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
         of an element of that type, or ``(node mask, code, criterion)`` of an
         element one of whose splits under that criterion has a piece of that type
         (see :func:`example_elements`).
+    notice : callable, optional
+        ``notice(line)``: one line per stage naming the damaged checkpoints computed again.
 
     Returns
     -------
@@ -221,16 +295,19 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     # Stage 1: cells.
     starts = range(0, len(reps), chunk)
     stage1: dict[int, dict] = {}
+    damaged: list[str] = []
     for i, start in enumerate(starts):
-        path = folder / f"{tag}-cells-{i:05d}.npz" if folder else None
-        if path and path.exists():
-            stage1[i] = _read_cells(path, len(reps[start:start + chunk]))
+        part = _resumed(_read_cells, folder / f"{tag}-cells-{i:05d}.npz", len(reps[start:start + chunk]),
+                        damaged) if folder else None
+        if part is not None:
+            stage1[i] = part
             report("cells", int(sizes[start:start + chunk].sum()))
+    _notice(notice, damaged)
     todo = {i: (reps[start:start + chunk],) for i, start in enumerate(starts) if i not in stage1}
     for i, part in completed(tessellate_chunk, todo, **backend):
         stage1[i] = part
         if folder:
-            atomic_write(folder / f"{tag}-cells-{i:05d}.npz", _npz_bytes(part))
+            atomic_write(folder / f"{tag}-cells-{i:05d}.npz", _checkpoint_bytes(_npz_bytes(part)))
         report("cells", int(sizes[i * chunk:(i + 1) * chunk].sum()))
     cells = {name: np.concatenate([stage1[i][name] for i in range(len(starts))]) if starts else np.zeros(0, np.int64)
              for name in ("tets", "closed", "open", "polys", "poly_mask", "poly_code")}
@@ -243,16 +320,20 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     work = [(int(mask), int(code)) for (mask, _), code in zip(distinct.tolist(), owner.tolist())]
     element_starts = range(0, len(work), ELEMENT_CHUNK)
     stage2: dict[int, tuple] = {}
-    for i in range(len(element_starts)):
-        path = folder / f"{tag}-elements-{i:05d}.json" if folder else None
-        if path and path.exists():
-            stage2[i] = _read_elements(path)
-            report("elements", len(stage2[i][0]))
+    damaged = []
+    for i, start in enumerate(element_starts):
+        part = _resumed(_read_elements, folder / f"{tag}-elements-{i:05d}.json",
+                        len(work[start:start + ELEMENT_CHUNK]), damaged) if folder else None
+        if part is not None:
+            stage2[i] = part
+            report("elements", len(part[0]))
+    _notice(notice, damaged)
     todo = {i: (work[start:start + ELEMENT_CHUNK],) for i, start in enumerate(element_starts) if i not in stage2}
     for i, part in completed(element_entries, todo, **backend):
         stage2[i] = part
         if folder:
-            atomic_write(folder / f"{tag}-elements-{i:05d}.json", _element_chunk_json(part))
+            atomic_write(folder / f"{tag}-elements-{i:05d}.json",
+                         _checkpoint_bytes(_element_chunk_json(part).encode("utf-8")))
         report("elements", len(part[0]))
     entries, types = _tetrahedron()
     for i in range(len(element_starts)):
@@ -271,6 +352,12 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
         "configurations": configurations, "orbits": len(reps),
         **statistics(sizes, cells, element_of + 1, entries, types),
     }
+
+
+def _notice(notice, damaged: list[str]) -> None:
+    if damaged and notice is not None:
+        more = f" and {len(damaged) - 1} more" if len(damaged) > 1 else ""
+        notice(f"damaged checkpoint {damaged[0]}{more}: computed again")
 
 
 def example_elements(examples: dict) -> dict[str, tuple[str, tuple[int, ...]]]:
