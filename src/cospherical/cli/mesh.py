@@ -90,7 +90,8 @@ def _levels(text: str | None) -> int:
 SUMMARY_KEYS = ("delaunay_mode", "leaves", "vertices", "elements", "types", "volume_ok", "nonconforming_faces",
                 "circumcenters_outside_leaf", "leaves_not_fvm_adequate", "boundary_circumcenters_outside",
                 "delaunay_violations", "regions_retessellated", "cells_spanning_leaves",
-                "configurations", "tessellated_on_the_fly", "paper_final_share")
+                "configurations", "configurations_from_table", "configurations_mapped", "tessellated_on_the_fly",
+                "paper_final_share")
 
 
 def _cut(args, box: Box) -> float:

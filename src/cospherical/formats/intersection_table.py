@@ -50,9 +50,11 @@ SYMMETRY_CONVENTION = (
     "One entry per orbit of the cube's 48 symmetries. The representative is the configuration "
     "whose code, read as a base-16 number, is the smallest of its images; a symmetry sends the "
     "point at t on an edge to the image edge at t or, where the edge is reversed, at 1 - t. "
-    "To use an entry for another configuration: cospherical.symmetry.orbit_keys(digits, "
-    "box_symmetries(cube)) gives its representative and the index of a symmetry taking it there; "
-    "map the representative's nodes back with that symmetry's inverse (Symmetry.node_map).")
+    "To use an entry for another configuration: cospherical.core.symmetry.orbit_representatives(codes, "
+    "box_symmetries(cube)) gives each code's representative and the index of a symmetry taking it there; "
+    "node n of the configuration is node node_map[n] of the representative under that symmetry (a "
+    "reflection also reverses a VTK cell's node order). cospherical mesh --patterns does this "
+    "(cospherical.formats.mesh.orbit_lookup).")
 # The largest resolution whose table is also written as YAML by default: at R = 4 the
 # YAML is 71 MB; at R = 8 1.9 GB, beyond the 512 MB the YAML reader accepts.
 YAML_UP_TO = 4

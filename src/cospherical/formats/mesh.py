@@ -31,8 +31,8 @@ from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
 
-__all__ = ["REPORT_SCHEMA_VERSION", "read_leaves", "report_json", "table_lookup", "vtu_arrays", "write_report",
-           "write_vtu"]
+__all__ = ["REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "vtu_arrays",
+           "write_report", "write_vtu"]
 
 REPORT_SCHEMA_VERSION = 1
 MAX_LEAF_FILE = 2 * 1024**3
@@ -148,7 +148,55 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table") -
                 return None
         return None
 
-    return lookup
+    return orbit_lookup(lookup, box)
+
+
+# Node orders that turn a VTK cell's mirror image back into a VTK cell (the first face's
+# right-hand normal pointing into the cell again): a reflection reverses every face.
+_MIRRORED_VTK = {"tetra": (0, 2, 1, 3), "pyramid": (0, 3, 2, 1, 4), "wedge": (0, 2, 1, 3, 5, 4),
+                 "hexahedron": (0, 3, 2, 1, 4, 7, 6, 5)}
+
+
+def orbit_lookup(lookup: Lookup, box: Box) -> Lookup:
+    """``lookup``, and for a configuration it lacks, its orbit representative's elements carried back.
+
+    A table of orbit representatives (the intersection store) holds one
+    configuration per orbit of the box's symmetries: the smallest image code.  A
+    leaf's configuration is sent to its representative by a symmetry
+    (:func:`cospherical.core.symmetry.orbit_representatives`), the representative
+    looked up, and each element's nodes mapped back through that symmetry's node
+    map; a reflection also reverses a VTK cell's faces, so its nodes are put back in
+    VTK order.  Mapped elements carry ``mapped_from`` (the representative's code).
+    """
+    from ..catalogue import shipped_catalogue
+    from ..core.symmetry import box_symmetries, orbit_representatives
+
+    symmetries = box_symmetries(box)
+    vtk = {entry["id"]: entry.get("vtk") for entry in shipped_catalogue().get("types", [])}
+
+    def mapped(configuration: Configuration):
+        found = lookup(configuration)
+        if found is not None:
+            return found
+        code = configuration.point_set_code
+        (representative,), (index,) = orbit_representatives([code], symmetries)
+        if representative == code:
+            return None
+        symmetry = symmetries[index]
+        found = lookup(symmetry.configuration(configuration))
+        if found is None:
+            return None
+        back = {image: node for node, image in enumerate(symmetry.node_map)}
+        elements = []
+        for element in found:
+            nodes = [back[int(n)] for n in element["nodes"]]
+            order = None if symmetry.proper else _MIRRORED_VTK.get(vtk.get(element["type"]))
+            if order is not None and len(order) == len(nodes):
+                nodes = [nodes[i] for i in order]
+            elements.append({**element, "nodes": nodes, "mapped_from": representative})
+        return elements
+
+    return mapped
 
 
 def vtu_arrays(mesh: Mesh) -> dict:

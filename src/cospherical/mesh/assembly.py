@@ -46,7 +46,8 @@ NODE_OFFSETS = np.array(
 PAPER_FINAL = ("Cuboid", "Triangular Prism", "Quadrilateral Pyramid", "Tetrahedron", "Tetrahedron Complement",
                "Deformed Prism", "Deformed Tetrahedron Complement")
 
-# lookup(configuration) -> the table's elements (dicts with ``type`` and ``nodes``), or None when it lacks them
+# lookup(configuration) -> the table's elements (dicts with ``type`` and ``nodes``, and ``mapped_from``
+# when they were carried back from another configuration of the orbit), or None when it lacks them
 Lookup = Callable[[Configuration], "list[dict] | None"]
 
 
@@ -82,6 +83,7 @@ class LocalPattern:
     scale: int
     weights: tuple[int, int, int]
     on_the_fly: bool
+    mapped_from: str | None = None  # the table's orbit representative its elements were carried back from
 
     @property
     def fvm_adequate(self) -> bool:
@@ -90,7 +92,7 @@ class LocalPattern:
 
 
 def local_pattern(configuration: Configuration, elements: Iterable[tuple[str, Iterable[int]]],
-                  on_the_fly: bool = False) -> LocalPattern:
+                  on_the_fly: bool = False, mapped_from: str | None = None) -> LocalPattern:
     """Measure a configuration's elements (type id, node ids) exactly, trusting nothing but the node lists.
 
     Examples
@@ -123,7 +125,7 @@ def local_pattern(configuration: Configuration, elements: Iterable[tuple[str, It
             type_id, element_nodes, tuple(tuple(frame.ids[i] for i in c) for c in cycles), volume, sphere,
             frame.center(sphere) if sphere is not None else None))
     return LocalPattern(configuration.point_set_code or "", configuration, tuple(measured), frame.scale,
-                        frame.weights, on_the_fly)
+                        frame.weights, on_the_fly, mapped_from)
 
 
 @dataclass(frozen=True)
@@ -414,7 +416,8 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
 def _pattern(configuration: Configuration, lookup: Lookup | None, types: dict, criterion: str) -> LocalPattern:
     elements = lookup(configuration) if lookup is not None else None
     if elements is not None:
-        return local_pattern(configuration, [(e["type"], e["nodes"]) for e in elements])
+        return local_pattern(configuration, [(e["type"], e["nodes"]) for e in elements],
+                             mapped_from=next((e["mapped_from"] for e in elements if "mapped_from" in e), None))
     tess = apply_catalogue_criterion(tessellate(configuration), criterion)
     for element in tess.elements:
         types.setdefault(element.type.id, _type_info(element.type.id, element.type))

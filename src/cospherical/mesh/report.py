@@ -107,6 +107,9 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
         report["delaunay_violations"] = None
     on_the_fly = [p for _, p, _ in mesh.groups(all_leaves=True) if p.on_the_fly]
     report["configurations"] = len(mesh.patterns)
+    mapped = sum(p.mapped_from is not None for _, p, _ in mesh.groups())
+    report["configurations_from_table"] = len(mesh.patterns) - len(on_the_fly) - mapped
+    report["configurations_mapped"] = mapped
     report["tessellated_on_the_fly"] = len(on_the_fly)
     report["leaves_tessellated_on_the_fly"] = int(sum(
         len(leaves) for _, p, leaves in mesh.groups(all_leaves=True) if p.on_the_fly))
