@@ -1,6 +1,6 @@
 """The cube's bisection study against two baselines, all timed in this one run.
 
-    python benchmarks/bench_bisection.py [--box 1 1 1]
+    python benchmarks/bench_bisection.py [--box 1 1 1] [--every 1]
 
 (a) ``qdelaunay Qz Fv`` run once per configuration over the 4096 configurations
     (Qhull's merged regions only: no classification, no statistics);
@@ -9,7 +9,9 @@
 (d) the study as ``cospherical study bisection`` runs it: (c) plus the splits of the
     internal-face and internal-edge criteria and their minimal kept sets.
 
-The figures to compare are the ratios (a)/(c), (b)/(c) and (a)/(d).
+The figures to compare are the ratios (a)/(c), (b)/(c) and (a)/(d).  ``--every N`` times
+(a) and (b) on every Nth configuration only and scales them to all of them (a quick run,
+as the test suite makes; the ratios are then estimates).
 """
 
 from __future__ import annotations
@@ -40,7 +42,11 @@ def qhull_all(box: Box, codes) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--box", nargs=3, default=["1", "1", "1"])
+    parser.add_argument("--every", type=int, default=1, metavar="N",
+                        help="time the baselines (a), (b) on every Nth configuration and scale")
     args = parser.parse_args()
+    if args.every < 1:
+        parser.error(f"--every {args.every}: must be at least 1")
     if not shutil.which("qdelaunay"):
         raise SystemExit("qdelaunay not found: install qhull-bin (scripts/setup.sh does)")
     box = Box.parse(args.box)
@@ -49,9 +55,12 @@ def main() -> None:
     tessellate(Configuration.from_code("888888888888", box))  # and the compiled walk
     study = timed(lambda: run_study("bisection", box, codes, criteria=("optimal",)))  # (c), cold caches
     full = timed(lambda: run_study("bisection", box, codes))  # (d): the split search runs cold
-    naive = timed(lambda: [tessellate(Configuration.from_code(code, box)) for code in codes])  # (b)
-    qhull = timed(lambda: qhull_all(box, codes))  # (a)
-    print(f"bisection study, box {' x '.join(box.texts)}, {len(codes)} configurations")
+    sample = codes[::args.every]
+    scale = len(codes) / len(sample)
+    naive = scale * timed(lambda: [tessellate(Configuration.from_code(code, box)) for code in sample])  # (b)
+    qhull = scale * timed(lambda: qhull_all(box, sample))  # (a)
+    print(f"bisection study, box {' x '.join(box.texts)}, {len(codes)} configurations"
+          + (f" ((a), (b): every {args.every}th, scaled)" if args.every > 1 else ""))
     print(f"  (a) qdelaunay Qz Fv per configuration   {qhull:8.2f} s")
     print(f"  (b) tessellate every configuration      {naive:8.2f} s")
     print(f"  (c) study, one tessellation per orbit   {study:8.2f} s")

@@ -45,3 +45,68 @@ def isomorphic(a, b) -> bool:
     return nx.is_isomorphic(
         incidence_graph(*a), incidence_graph(*b), node_match=lambda x, y: x["kind"] == y["kind"]
     )
+
+
+
+def _squared_distance(p, q, squared):
+    return sum(w * (x - y) ** 2 for w, x, y in zip(squared, p, q))
+
+
+def _isometry(corners, image_corners, squared):
+    """The affine map of the box taking its corners to ``image_corners``, checked to be an isometry.
+
+    Nodes are in the box's unit coordinates, corner k at its VTK position: the map is
+    ``origin + x*X + y*Y + z*Z`` with X, Y, Z the images of the three edges at corner 0.
+    It must send all eight corners where the node map says, and keep the Gram matrix of
+    those three edges in the box's metric (a linear map keeping the inner products of a
+    basis is orthogonal).
+    """
+    origin = image_corners[0]
+    columns = [tuple(b - a for a, b in zip(origin, image_corners[k])) for k in (1, 3, 4)]
+
+    def apply(p):
+        return tuple(origin[i] + sum(p[j] * columns[j][i] for j in range(3) if columns[j][i]) for i in range(3))
+
+    edges = [tuple(b - a for a, b in zip(corners[0], corners[k])) for k in (1, 3, 4)]
+    assert tuple(corners[0]) == (0, 0, 0) and edges == [(1, 0, 0), (0, 1, 0), (0, 0, 1)], "not unit coordinates"
+    for a in range(3):
+        for b in range(3):
+            assert sum(w * x * y for w, x, y in zip(squared, edges[a], edges[b])) == \
+                sum(w * x * y for w, x, y in zip(squared, columns[a], columns[b])), "not an isometry"
+    assert all(apply(corners[k]) == image_corners[k] for k in range(8)), "corners not mapped affinely"
+    return apply
+
+
+def qhull_regions_by_orbit(configurations, symmetries) -> list[set[frozenset[int]]]:
+    """Qhull's regions of every configuration of one box, running Qhull once per orbit.
+
+    The Delaunay subdivision of a point set is unique, so an isometry taking one point set
+    onto another takes its regions onto the other's: Qhull's answer for an orbit's
+    representative, carried across by the node map of a box symmetry, is Qhull's answer for
+    every member.  That the node map is such an isometry is checked here exactly rather
+    than taken from the library: it must pair the two point sets one to one, and every
+    node must land where the affine map fixed by the corners puts it, that map keeping
+    the box's metric (see :func:`_isometry`).
+    """
+    from cospherical import Configuration
+    from cospherical.core.symmetry import orbit_representatives
+
+    configurations = list(configurations)
+    reps, sym_index = orbit_representatives([cfg.code for cfg in configurations], symmetries)
+    answers: dict[str, tuple[dict, set]] = {}
+    maps: dict[int, object] = {}
+    found = []
+    for cfg, rep, index in zip(configurations, reps, sym_index):
+        if rep not in answers:
+            image = Configuration.from_code(rep, cfg.box, cfg.face_points)
+            answers[rep] = (image.nodes(), qhull_regions(image.real_nodes()))
+        image_nodes, regions = answers[rep]
+        node_map, nodes = symmetries[index].node_map, cfg.nodes()
+        if index not in maps:
+            maps[index] = _isometry([nodes[k] for k in range(8)], [image_nodes[node_map[k]] for k in range(8)],
+                                    cfg.box.squared)
+        assert sorted(node_map[n] for n in nodes) == sorted(image_nodes), (cfg.code, rep)
+        assert all(maps[index](p) == image_nodes[node_map[n]] for n, p in nodes.items()), (cfg.code, rep)
+        back = {node_map[n]: n for n in nodes}
+        found.append({frozenset(back[n] for n in region) for region in regions})
+    return found

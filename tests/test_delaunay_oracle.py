@@ -6,11 +6,13 @@ import random
 from collections import defaultdict
 
 import pytest
-from oracle import isomorphic, qhull_regions
+from oracle import isomorphic, qhull_regions, qhull_regions_by_orbit
 from strategies import random_configuration
 
-from cospherical import Configuration, tessellate
+from cospherical import Box, Configuration, tessellate
 from cospherical.core.canonical import canonical_form
+from cospherical.core.symmetry import box_symmetries
+from cospherical.studies.bisection import run_study
 
 BOXES = {
     "cube": ("1", "1", "1"),
@@ -38,15 +40,24 @@ def check_canonical_codes(samples: dict[str, list]) -> None:
                 assert not isomorphic(pa, pb), f"codes {a} and {b} differ but graphs are isomorphic"
 
 
+@pytest.mark.oracle_qhull
+@pytest.mark.oracle_networkx
 @pytest.mark.parametrize("policy", ["octree", "none"])
 @pytest.mark.parametrize("box", sorted(BOXES))
 def test_every_bisection_configuration_matches_qhull(box, policy):
+    # Every configuration is tessellated directly and compared with Qhull's regions of its
+    # own point set; Qhull runs once per orbit, its answer carried to the other members by
+    # an isometry checked exactly (oracle.qhull_regions_by_orbit).  The study's mapped
+    # tessellations must equal the direct ones too.
+    lengths = Box.parse(BOXES[box])
+    configurations = [Configuration.from_code(code, lengths, policy) for code in bisection_codes()]
+    study = run_study("bisection", lengths, [cfg.code for cfg in configurations], policy, criteria=("optimal",))
     samples: dict[str, list] = defaultdict(list)
-    for code in bisection_codes():
-        cfg = Configuration.from_code(code, BOXES[box], policy)
+    for cfg, regions in zip(configurations, qhull_regions_by_orbit(configurations, box_symmetries(lengths))):
         tess = tessellate(cfg)
         ours = {frozenset(e.nodes) for e in tess.elements}
-        assert ours == qhull_regions(cfg.real_nodes()), f"{box} {policy} {code}"
+        assert ours == regions, f"{box} {policy} {cfg.code}"
+        assert study.tessellation(cfg.code) == tess, f"{box} {policy} {cfg.code}"
         for e in tess.elements:
             poly = e.polyhedron
             if len(samples[e.type.code]) < 3:
@@ -54,6 +65,8 @@ def test_every_bisection_configuration_matches_qhull(box, policy):
     check_canonical_codes(samples)
 
 
+@pytest.mark.oracle_qhull
+@pytest.mark.oracle_networkx
 def test_random_configurations_match_qhull():
     rng = random.Random(20261123)
     samples: dict[str, list] = defaultdict(list)
@@ -68,6 +81,7 @@ def test_random_configurations_match_qhull():
     check_canonical_codes(samples)
 
 
+@pytest.mark.oracle_qhull
 @pytest.mark.parametrize("order", ["edge", "rank", "reverse"])
 def test_random_intersection_configurations_match_qhull(order):
     from cospherical.studies.intersection import intersection_codes
@@ -80,6 +94,7 @@ def test_random_intersection_configurations_match_qhull(order):
         assert ours == qhull_regions(cfg.real_nodes()), cfg.code
 
 
+@pytest.mark.oracle_qhull
 def test_the_python_walk_matches_qhull():
     # tessellate() takes the compiled walk whenever it provably fits in int64; the
     # Python walk (any frame) is checked against the oracle on its own here.

@@ -6,6 +6,7 @@ from collections import Counter
 from fractions import Fraction
 
 import networkx as nx
+import pytest
 from hypothesis import HealthCheck, given, settings
 from strategies import configurations
 
@@ -67,6 +68,7 @@ def test_cells_meet_face_to_face(cfg):
                 assert all((face[(i + 1) % len(face)], face[i]) in directed for i in range(len(face)))
 
 
+@pytest.mark.oracle_networkx
 @SETTINGS
 @given(configurations())
 def test_euler_formula_and_planar_embedding(cfg):

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import meshio
 import numpy as np
+import pytest
 from matplotlib.image import imread
 
 from cospherical import Configuration, tessellate
@@ -24,6 +25,7 @@ def cospherical(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "cospherical", *args], capture_output=True, text=True, cwd=cwd)
 
 
+@pytest.mark.oracle_pdflatex
 def test_full_document_compiles_and_page_one_is_not_blank(tmp_path):
     assert shutil.which("pdflatex") and shutil.which("pdftoppm"), "install texlive and poppler-utils (scripts/setup.sh)"
     result = cospherical("render", "--summary", *map(str, SUMMARIES), "--out", str(tmp_path), "--pdf")
@@ -70,6 +72,7 @@ def test_render_refuses_bad_summaries(tmp_path):
     assert len(result.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.oracle_meshio
 def test_vtu_reads_back(tmp_path):
     for code, expect_polyhedra in (("888800000000", False), ("880000000000", True)):
         tess = tessellate(Configuration.from_code(code, ("1", "2", "4") if not expect_polyhedra else ("1", "1", "1")))
@@ -83,6 +86,7 @@ def test_vtu_reads_back(tmp_path):
         assert hashes == sorted(int(e.type.id.rsplit("-", 1)[1], 16) for e in tess.elements)
 
 
+@pytest.mark.oracle_meshio
 def test_tessellate_cli_writes_vtu(tmp_path):
     path = tmp_path / "out.vtu"
     result = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--vtu", str(path))

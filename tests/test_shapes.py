@@ -23,6 +23,7 @@ SHAPES = sorted(STANDARD_SHAPES)
 BOXES = {"cube": ("1", "1", "1"), "aspect4": ("1", "2", "4"), "sqrt2-exact": ("1", "sqrt(2)", "sqrt(2)")}
 
 
+@pytest.mark.oracle_qhull
 @pytest.mark.parametrize("name", SHAPES)
 def test_every_bisection_configuration_matches_qhull(name):
     """Every edge mask with midpoints (512, 256, 64 configurations) on the cube against
@@ -39,6 +40,7 @@ def test_every_bisection_configuration_matches_qhull(name):
     check_canonical_codes(samples)
 
 
+@pytest.mark.oracle_qhull
 @pytest.mark.parametrize("box", ["aspect4", "sqrt2-exact"])
 def test_other_boxes_match_qhull(box):
     for name in SHAPES:
@@ -166,6 +168,7 @@ def test_cli_element_and_shape_file(tmp_path):
         assert result.returncode == 2 and result.stdout == "" and len(result.stderr.strip().splitlines()) == 1, args
 
 
+@pytest.mark.oracle_qhull
 def test_general_quadrilateral_face_point():
     # A trapezoid face: the face point is where the two cut lines cross, not the corners' mean.
     corners = [(0, 0, 0), (4, 0, 0), (3, 2, 0), (1, 2, 0), (0, 0, 1), (4, 0, 1), (3, 2, 1), (1, 2, 1)]
@@ -265,6 +268,7 @@ def test_study_cli_element(tmp_path):
     assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.oracle_pdflatex
 def test_committed_shape_latex_compiles(tmp_path):
     import shutil
 

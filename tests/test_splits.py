@@ -135,6 +135,7 @@ def milp_minimum(instances) -> int:
     return round(result.fun)
 
 
+@pytest.mark.oracle_highs
 @pytest.mark.parametrize("key", ["A", "B", "C"])
 @pytest.mark.parametrize("criterion", ["internal_faces", "internal_edges_and_faces"])
 def test_kept_sets_are_minimal(studies, key, criterion):

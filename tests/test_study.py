@@ -37,13 +37,9 @@ def test_group_orders(lengths, order):
     assert all(s.inverse() in symmetries for s in symmetries)
 
 
-@pytest.mark.parametrize("lengths", [("1", "1", "1"), ("1", "2", "4")])
-def test_mapped_tessellations_equal_direct_ones(lengths):
-    box = Box.parse(lengths)
-    study = run_study("bisection", box, bisection_codes())
-    for code in bisection_codes():
-        direct = tessellate(Configuration.from_code(code, box))
-        assert study.tessellation(code) == direct, code
+# That the study's tessellations, mapped through the symmetries, equal direct ones is
+# checked for every bisection configuration of four boxes and both point policies in
+# test_delaunay_oracle, where the direct tessellations are made anyway.
 
 
 def test_symmetry_maps_configurations_and_points():
@@ -176,6 +172,7 @@ def test_committed_tables_answer_as_the_previous_format(committed_tables):
         assert digest.hexdigest() == PREVIOUS_FORMAT_DIGESTS[stem], stem
 
 
+@pytest.mark.oracle_pyyaml
 def test_a_standard_yaml_reader_reads_the_committed_files_alike(committed_tables):
     # PyYAML on a whole table takes ~15 s: read every 64th entry line with it, and the catalogue whole.
     for stem, table in committed_tables.items():

@@ -64,6 +64,7 @@ def test_grid_points_agree_with_the_ray(profiles):
         assert (direct["fvm_adequate"], direct["types"]) == (step.fvm_adequate, len(step.types)), c
 
 
+@pytest.mark.oracle_pdflatex
 def test_sweep_cli_json_and_figures(tmp_path):
     result = subprocess.run([sys.executable, "-m", "cospherical", "sweep", "--ratios", "1:2:2", "2:2:1",
                              "--format", "json", "--out", str(tmp_path), "--jobs", "2"], capture_output=True, text=True)
