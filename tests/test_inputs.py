@@ -456,3 +456,25 @@ def test_a_damaged_checkpoint_is_computed_again_never_counted(intersection_run, 
     assert json.loads(summary) == full
     assert path.read_bytes() == original  # rewritten whole, the same bytes
 
+
+
+def test_a_store_entry_with_a_bad_node_list_is_refused_like_a_yaml_one(tmp_path):
+    import sqlite3
+
+    from cospherical.formats.store import pack
+
+    path = _store(tmp_path)
+    connection = sqlite3.connect(path)
+    (dictionary,) = connection.execute("SELECT data FROM dictionary").fetchone()
+    code = connection.execute("SELECT code FROM entries ORDER BY code LIMIT 1").fetchone()[0]
+    entry = {"fvm_adequate": True, "optimal": [{"type": "v4f4-8f0284", "nodes": [0] * 300,
+                                                "circumcenter": [0.5, 0.5, 0.5]}],
+             "internal_faces": "optimal", "internal_edges_and_faces": "optimal"}
+    connection.execute("UPDATE entries SET entry = ? WHERE code = ?", (pack(json.dumps(entry), dictionary), code))
+    connection.commit()
+    connection.close()
+    one_line(*run("check", path)[::2], "27 items")
+    from cospherical.formats.patterns import load
+
+    with pytest.raises(Exception, match="27 items"):
+        load(path).elements(code)
