@@ -108,36 +108,54 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
     >>> pieces.edges[0, 1], pieces.volumes[0], len(pieces.edges), pieces.boundary[2, 0][0]
     (Fraction(1, 4), Fraction(1, 8), 12, Fraction(1, 4))
     """
+    # Integers throughout, one fraction per face and edge: coordinates times D (midpoints stay
+    # integers), squared lengths as integer weights W = lam * w, a face centre times D * S
     w = tuple(Fraction(x) for x in squared)
+    lam = math.lcm(*(x.denominator for x in w))
+    weight = tuple(int(x * lam) for x in w)
+    big = math.lcm(*weight)
+    scale = 2 * math.lcm(*(Fraction(x).denominator for p in (*points.values(), center) for x in p))
+    ip = {n: tuple(int(Fraction(x) * scale) for x in p) for n, p in points.items()}
+    ic = tuple(int(Fraction(x) * scale) for x in center)
     edges: dict[tuple[int, int], Fraction] = {}
     volumes: dict[int, Fraction] = {n: Fraction(0) for n in points}
     boundary: dict[tuple[int, Fraction], dict[int, Fraction]] = {}
     for cycle in faces:
-        p0, p1, p2 = (points[n] for n in cycle[:3])
+        p0, p1, p2 = (ip[n] for n in cycle[:3])
         normal = _cross(_sub(p1, p0), _sub(p2, p0))  # no three points of a circle are collinear
-        t = _dot(_sub(center, p0), normal) / sum(normal[k] * normal[k] / w[k] for k in range(3))
-        face_center = tuple(center[k] - t * normal[k] / w[k] for k in range(3))
+        s = sum(normal[k] * normal[k] * (big // weight[k]) for k in range(3))
+        dn = _dot(_sub(ic, p0), normal)
+        face_center = tuple(ic[k] * s - dn * normal[k] * (big // weight[k]) for k in range(3))  # times D * S
+        cs = tuple(x * s for x in ic)
         plane = [k for k in range(3) if normal[k] != 0]
         shares = None
         if len(plane) == 1:  # in a coordinate plane: it may be on the domain's boundary
             k = plane[0]
-            shares = boundary.setdefault((k, p0[k]), {})
+            shares = boundary.setdefault((k, Fraction(p0[k], scale)), {})
             outward = 1 if normal[k] > 0 else -1
+            face_area: dict[int, int] = {}
+        face_volume: dict[int, int] = {}
         for u, v in zip(cycle, (*cycle[1:], cycle[0])):
-            xu, xv = points[u], points[v]
-            mid = tuple((xu[k] + xv[k]) / 2 for k in range(3))
+            xu, xv = ip[u], ip[v]
+            mid = tuple((xu[k] + xv[k]) // 2 * s for k in range(3))
             along = _sub(xu, xv)
-            piece = _dot(along, _cross(_sub(face_center, mid), _sub(center, mid)))
-            length2 = sum(w[k] * along[k] * along[k] for k in range(3))
+            piece = _dot(along, _cross(_sub(face_center, mid), _sub(cs, mid)))  # times D^3 S^2
+            length2 = sum(weight[k] * along[k] * along[k] for k in range(3))  # times lam D^2
             key = (u, v) if u < v else (v, u)
-            edges[key] = edges.get(key, Fraction(0)) + piece / (2 * length2)
-            volumes[u] += piece / 12
-            volumes[v] += piece / 12
+            edges[key] = edges.get(key, Fraction(0)) + Fraction(piece * lam, 2 * scale * s * s * length2)
+            face_volume[u] = face_volume.get(u, 0) + piece
+            face_volume[v] = face_volume.get(v, 0) + piece
             if shares is not None:
-                # triangles (x_u, m, f) and (m, x_v, f): equal areas, half a base each
-                area = outward * _cross(_sub(mid, xu), _sub(face_center, xu))[k] / 2
-                shares[u] = shares.get(u, Fraction(0)) + area
-                shares[v] = shares.get(v, Fraction(0)) + area
+                # triangles (x_u, m, f) and (m, x_v, f): equal areas, half a base each (times D^2 S^2)
+                xs = tuple(x * s for x in xu)
+                area = outward * _cross(_sub(mid, xs), _sub(face_center, xs))[k]
+                face_area[u] = face_area.get(u, 0) + area
+                face_area[v] = face_area.get(v, 0) + area
+        for node, total in face_volume.items():
+            volumes[node] += Fraction(total, 12 * scale ** 3 * s * s)
+        if shares is not None:
+            for node, total in face_area.items():
+                shares[node] = shares.get(node, Fraction(0)) + Fraction(total, 2 * scale * scale * s * s)
     return ElementPieces(edges, volumes, boundary)
 
 
