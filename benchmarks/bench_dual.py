@@ -22,27 +22,16 @@ import sys
 import time
 from pathlib import Path
 
-from cospherical import load_patterns
-from cospherical.core.configuration import Box
-from cospherical.formats.mesh import table_lookup
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.dual import mesh_dual
-from cospherical.mesh.octree import build_octree, parse_shape
 
 
 def big(args) -> None:
-    box = Box.parse(args.domain)
-    centre = ",".join(str(float(length) / 2) for length in box.lengths)
-    clock = {}
+    from bench_mesh import sphere_tree, timer
 
-    def stage(name, function):
-        start, cpu = time.perf_counter(), time.process_time()
-        value = function()
-        clock[name] = (time.perf_counter() - start, time.process_time() - cpu)
-        return value
-
-    lookup = table_lookup(stage("load table", lambda: load_patterns(args.patterns)), "optimal", box, args.patterns)
-    tree = stage("octree", lambda: build_octree(box, args.levels, [parse_shape(f"sphere:{centre},{args.radius}")]))
+    clock: dict = {}
+    stage = timer(clock)
+    lookup, tree = sphere_tree(args, stage)
     mesh = stage("assembly", lambda: assemble(tree, lookup))
     dual = stage("dual (first: pieces per configuration)", lambda: mesh_dual(mesh))
     del dual
@@ -60,10 +49,10 @@ def big(args) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--domain", nargs=3, default=["1", "1", "1"])
-    parser.add_argument("--levels", type=int, default=9)
-    parser.add_argument("--radius", default="0.3")
-    parser.add_argument("--patterns", default="patterns/leaves-1x1x1.yaml")
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from bench_mesh import tree_arguments
+
+    tree_arguments(parser)
     parser.add_argument("--poisson", action="store_true", help="the Poisson comparison instead")
     parser.add_argument("--uniform", type=int, nargs="*", default=[2, 3, 4, 5, 6])
     parser.add_argument("--graded", type=int, nargs="*", default=[4, 5, 6, 7])

@@ -35,26 +35,42 @@ from cospherical.mesh.octree import build_octree, parse_shape
 from cospherical.mesh.statistics import mesh_statistics
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def tree_arguments(parser: argparse.ArgumentParser) -> None:
+    """The sphere tree's options (also bench_dual.py's)."""
     parser.add_argument("--domain", nargs=3, default=["1", "1", "1"])
     parser.add_argument("--levels", type=int, default=9)
     parser.add_argument("--radius", default="0.3")
     parser.add_argument("--patterns", default="patterns/leaves-1x1x1.yaml")
-    args = parser.parse_args()
-    box = Box.parse(args.domain)
-    centre = ",".join(str(float(length) / 2) for length in box.lengths)
-    clock = {}
 
+
+def timer(clock: dict):
+    """``stage(name, function)``: run it, record (wall, CPU) seconds in ``clock[name]``, return its value."""
     def stage(name, function):
         start, cpu = time.perf_counter(), time.process_time()
         value = function()
         clock[name] = (time.perf_counter() - start, time.process_time() - cpu)
         return value
 
+    return stage
+
+
+def sphere_tree(args, stage):
+    """The table's lookup and the sphere octree centred in the domain, each timed."""
+    box = Box.parse(args.domain)
+    centre = ",".join(str(float(length) / 2) for length in box.lengths)
     table = stage("load table", lambda: load_patterns(args.patterns))
     lookup = table_lookup(table, "optimal", box, args.patterns)
     tree = stage("octree", lambda: build_octree(box, args.levels, [parse_shape(f"sphere:{centre},{args.radius}")]))
+    return lookup, tree
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    tree_arguments(parser)
+    args = parser.parse_args()
+    clock: dict = {}
+    stage = timer(clock)
+    lookup, tree = sphere_tree(args, stage)
     cache: dict = {}
     stage("configurations (first assembly)", lambda: assemble(tree, lookup, cache=cache))
     mesh = stage("assembly", lambda: assemble(tree, lookup, cache=cache))
