@@ -168,7 +168,8 @@ def _run(args, out: OutputFolder | None) -> int:
         timings["assembly"] = time.perf_counter() - clock
         clock = time.perf_counter()
         bars["regions"] = (len(mesh), "Delaunay check (leaf mesh)", "element")
-        mesh, leaf_mesh = delaunay_mesh(mesh, mode, progress=(lambda n: advance("regions", n)) if large else None)
+        mesh, leaf_mesh, checked = delaunay_mesh(mesh, mode,
+                                                 progress=(lambda n: advance("regions", n)) if large else None)
         if leaf_mesh is not None:
             timings["global Delaunay"] = time.perf_counter() - clock
             clock = time.perf_counter()
@@ -186,7 +187,7 @@ def _run(args, out: OutputFolder | None) -> int:
         report = mesh_report(mesh, described, args.patterns.name if args.patterns else None, args.criterion,
                              uniform=not args.no_uniform, delaunay=not args.no_delaunay, stage=stage,
                              progress=(lambda n: advance("delaunay", n)) if large else None, violating=violating,
-                             leaf_mesh=leaf_mesh)
+                             leaf_mesh=leaf_mesh, checked=checked)
         dual = None
         if args.dual:
             from ..mesh.dual import dual_summary, mesh_dual

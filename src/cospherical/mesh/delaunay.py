@@ -304,19 +304,21 @@ def _shape(offsets: list[tuple[int, int, int]], squared, types: dict) -> tuple[C
 MODES = ("global", "leaf")
 
 
-def delaunay_mesh(mesh: Mesh, mode: str = "global", progress=None) -> tuple[Mesh, dict | None]:
+def delaunay_mesh(mesh: Mesh, mode: str = "global", progress=None) -> tuple[Mesh, dict | None, dict | None]:
     """The mesh a user asked for: ``leaf`` (the leaf mesh as assembled) or ``global`` (its exact Delaunay subdivision).
 
-    Returns the mesh and, in ``global`` mode, what the exact check found on the
-    leaf mesh (``elements``, ``delaunay_violations``, ``delaunay_ties``): the
-    elements that had to be replaced.  ``progress(n)`` is told as the check goes
-    through the leaf mesh's elements.
+    Returns the mesh; in ``global`` mode what the exact check found on the leaf mesh
+    (``elements``, ``delaunay_violations``, ``delaunay_ties``, ``elements_replaced``),
+    else ``None``; and the check itself when it also holds for the mesh returned
+    (nothing was replaced: a cube octree), so that it need not run twice, else ``None``.
+    ``progress(n)`` is told as the check goes through the leaf mesh's elements.
     """
     if mode not in MODES:
         raise InputError(f"--delaunay {mode!r}: write global or leaf")
     if mode == "leaf":
-        return mesh, None
+        return mesh, None, None
     found = check_delaunay(mesh, progress=progress)
     leaf = {"elements": len(mesh), "delaunay_violations": found["delaunay_violations"],
             "delaunay_ties": found["delaunay_ties"], "elements_replaced": int(len(found["_not_cells"]))}
-    return global_delaunay(mesh, found), leaf
+    result = global_delaunay(mesh, found)
+    return result, leaf, (found if result is mesh else None)

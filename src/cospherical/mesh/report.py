@@ -38,7 +38,7 @@ def outside_catalogue(mesh: Mesh) -> list[dict]:
 def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal", uniform: bool = True,
                 delaunay: bool = True, stage: Callable[[str], None] | None = None,
                 progress: Callable[[int], None] | None = None, violating: list | None = None,
-                leaf_mesh: dict | None = None) -> dict:
+                leaf_mesh: dict | None = None, checked: dict | None = None) -> dict:
     """Run every check on ``mesh`` and gather the report (the keys of ``schemas/mesh-report.schema.json``).
 
     ``tree`` describes where the octree came from; ``patterns`` names the table read
@@ -50,7 +50,8 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     whose sphere strictly holds a vertex (for the ``delaunay_ok`` cell data).
     ``leaf_mesh``: what :func:`~cospherical.mesh.delaunay.delaunay_mesh` found on the
     leaf mesh when ``mesh`` is its global Delaunay subdivision (``delaunay_mode`` is
-    then ``global``, else ``leaf``).
+    then ``global``, else ``leaf``); ``checked``: the result of
+    :func:`~cospherical.mesh.checks.check_delaunay` on ``mesh`` when the caller has it.
 
     Examples
     --------
@@ -93,7 +94,7 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     report.update(check_circumcenters(mesh))
     if delaunay:
         start("delaunay")
-        found = check_delaunay(mesh, progress=progress)
+        found = dict(checked) if checked is not None else check_delaunay(mesh, progress=progress)
         bad_leaves = found.pop("_leaves")
         bad_elements = found.pop("_elements")
         found.pop("_not_cells")
