@@ -249,3 +249,34 @@ def test_a_truncated_or_tampered_dual_npz_is_refused_with_one_line(dual_run, tmp
         assert main(["check", str(tmp_path / f"{name}.npz")]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and f"{name}.npz" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("name", ["sphere", "discretize points"])
+def test_tetgen_tetrahedra_of_the_same_vertices_give_the_same_dual_exactly(name):
+    """An independent tetrahedral Delaunay mesh (TetGen) of the vertices has the same dual, exactly.
+
+    meshplex (control volumes of tetrahedral meshes) now demands a licence at import; this is
+    its check: the tetrahedra split the co-spherical elements, so every control volume and
+    every coefficient is the same fraction; the tetrahedra's extra edges (diagonals of
+    polygon faces and through elements) get zero.
+    """
+    import shutil
+
+    from cospherical.mesh.dual import delaunay_tetrahedra
+
+    assert shutil.which("tetgen"), "tetgen (Debian) is a test dependency: scripts/setup.sh installs it"
+    tree = OCTREES[name]()
+    mesh = assemble(tree, cache=CACHES.setdefault(tree.box.texts, {}))
+    mixed = mesh_dual(mesh)
+    tets, tool, flat = delaunay_tetrahedra(mesh.vertices)
+    assert tool == "tetgen" and flat == 0
+    tetra = mesh_dual(mesh, (tets.astype(np.int32), np.full(len(tets), 4, dtype=np.int8)))
+
+    def exact(values, denominator):
+        return [Fraction(int(v), denominator) for v in values]
+
+    assert exact(tetra.volume_exact, tetra.volume_denominator) == exact(mixed.volume_exact, mixed.volume_denominator)
+    ours = dict(zip(map(tuple, mixed.edges.tolist()), exact(mixed.coefficient_exact, mixed.coefficient_denominator)))
+    theirs = dict(zip(map(tuple, tetra.edges.tolist()), exact(tetra.coefficient_exact, tetra.coefficient_denominator)))
+    assert set(ours) <= set(theirs) and len(theirs) > len(ours)
+    assert all(theirs[pair] == ours.get(pair, 0) for pair in theirs)

@@ -57,7 +57,8 @@ from ..core.delaunay import hull_faces
 from ..core.geometry import Frame
 from ..errors import InputError
 
-__all__ = ["Dual", "ElementPieces", "dual_summary", "element_pieces", "mesh_dual", "tetrahedral_counts"]
+__all__ = ["Dual", "ElementPieces", "delaunay_tetrahedra", "dual_summary", "element_pieces", "mesh_dual",
+           "tetrahedral_counts"]
 
 Point = tuple[Fraction, Fraction, Fraction]
 
@@ -450,14 +451,12 @@ def _spanning(frame: Frame, members: list[int]) -> tuple[int, int, int, int]:
 TETRAHEDRAL_LIMIT = 1_000_000  # vertices: above it the tetrahedral comparison is skipped (minutes and gigabytes)
 
 
-def tetrahedral_counts(grid_vertices: np.ndarray) -> dict:
-    """Elements, edges, faces and matrix nonzeros of a tetrahedral Delaunay mesh of the same vertices.
+def delaunay_tetrahedra(grid_vertices: np.ndarray) -> tuple[np.ndarray, str, int]:
+    """A tetrahedral Delaunay mesh of integer points: (tetrahedra, the tool, flat ones left out).
 
-    The paper's claim is that mixed elements need fewer of each; this is the
-    tetrahedral side of that comparison.  TetGen (``tetgen``, Debian) tetrahedralizes
-    the exact integer vertices; without it, scipy's Qhull does, and its flat
-    tetrahedra (co-spherical points it triangulates through a zero-volume sliver,
-    decided on the integers) are left out and counted (``flat``).
+    TetGen (``tetgen``, Debian; exact predicates) when it is installed; else scipy's
+    Qhull, whose flat tetrahedra (co-spherical points it triangulates through a
+    zero-volume sliver, decided on the integers) are left out and counted.
     """
     import shutil
     import subprocess
@@ -465,7 +464,6 @@ def tetrahedral_counts(grid_vertices: np.ndarray) -> dict:
 
     points = np.asarray(grid_vertices, dtype=np.int64)
     tool = shutil.which("tetgen")
-    flat = 0
     if tool:
         with tempfile.TemporaryDirectory() as folder:
             node = Path(folder) / "points.node"
@@ -475,21 +473,30 @@ def tetrahedral_counts(grid_vertices: np.ndarray) -> dict:
                 np.savetxt(handle, rows, fmt="%d")
             subprocess.run([tool, "-Q", "-F", "-N", str(node)], check=True, capture_output=True, timeout=3600)
             tets = np.loadtxt(Path(folder) / "points.1.ele", dtype=np.int64, skiprows=1, ndmin=2)[:, 1:5]
-    else:
-        from scipy.spatial import Delaunay
+        return tets, "tetgen", 0
+    from scipy.spatial import Delaunay
 
-        tets = Delaunay(points.astype(np.float64)).simplices.astype(np.int64)
-        a, b, c, d = (points[tets[:, k]] for k in range(4))
-        keep = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) != 0
-        flat = int((~keep).sum())
-        tets = tets[keep]
+    tets = Delaunay(points.astype(np.float64)).simplices.astype(np.int64)
+    a, b, c, d = (points[tets[:, k]] for k in range(4))
+    keep = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) != 0
+    return tets[keep], "qhull", int((~keep).sum())
+
+
+def tetrahedral_counts(grid_vertices: np.ndarray) -> dict:
+    """Elements, edges, faces and matrix nonzeros of a tetrahedral Delaunay mesh of the same vertices.
+
+    The paper's claim is that mixed elements need fewer of each; this is the
+    tetrahedral side of that comparison (:func:`delaunay_tetrahedra`).
+    """
+    points = np.asarray(grid_vertices, dtype=np.int64)
+    tets, tool, flat = delaunay_tetrahedra(points)
     tets = np.sort(tets, axis=1)
     n = np.int64(len(points))
     pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
     edges = np.unique(np.concatenate([tets[:, a] * n + tets[:, b] for a, b in pairs]))
     triples = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
     faces = np.unique(np.concatenate([(tets[:, a] * n + tets[:, b]) * n + tets[:, c] for a, b, c in triples]))
-    return {"tool": "tetgen" if tool else "qhull", "elements": int(len(tets)), "edges": int(len(edges)),
+    return {"tool": tool, "elements": int(len(tets)), "edges": int(len(edges)),
             "faces": int(len(faces)), "nonzeros": int(len(points) + 2 * len(edges)), "flat": flat}
 
 
