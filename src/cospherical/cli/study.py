@@ -50,6 +50,7 @@ def add_parser(commands) -> None:
         "cospherical study FAMILY --help.",
     )
     families = parser.add_subparsers(dest="family", required=True, metavar="{bisection,leaves,intersection}",
+                                     help="the family of configurations to study",
                                      parser_class=type(parser))
     for family, (summary, description) in FAMILIES.items():
         _add_family(families.add_parser(family, help=summary, description=description), family)
