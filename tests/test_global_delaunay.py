@@ -195,3 +195,13 @@ def test_cli_reports_both_modes(capsys, tmp_path):
         assert sum(c["leaves"] for c in report["configuration_frequencies"]) == report["leaves"]
     assert main(argv + ["--criterion", "internal_faces", "--delaunay", "global"]) == 2
     assert "--delaunay leaf" in capsys.readouterr().err
+
+
+def test_python_integers_give_the_same_cells(monkeypatch):
+    # large boxes or weights take the exact merge to Python integers: the same cells
+    import cospherical.mesh.delaunay as delaunay
+
+    leaf = assemble(build_octree(Box.parse(["1", "2", "4"]), 4, [parse_shape("plane:1,1,1,3")], "edge"))
+    fast = mesh_cells(global_delaunay(leaf))
+    monkeypatch.setattr(delaunay, "_object_if_large", lambda array, bound: array.astype(object))
+    assert mesh_cells(global_delaunay(leaf)) == fast

@@ -36,7 +36,10 @@ proposal is inexact.  Flat tetrahedra (exactly zero volume) are dropped; a
 tetrahedron is inside U_r when the leaf holding its centroid belongs to U_r
 (integer point location); tetrahedra with the same exact circumcenter are one
 cell (concentric empty spheres through points cannot differ, so the centre names
-the sphere).  A cell's vertices are its tetrahedra's.  The whole mesh is then
+the sphere).  Measured against CGAL's exact-predicate triangulation (pip ``cgal``) on
+50,000 points at load 11: Qhull 13.1 s in all, CGAL 2.9 s to insert but 13.4 s to
+read its cells back through the Python bindings, one object per cell; Qhull hands
+back arrays.  A cell's vertices are its tetrahedra's.  The whole mesh is then
 checked again by the report (volume, conformity, empty spheres and ties), so a
 wrong proposal cannot pass unseen.  Cube octrees, whose leaf mesh is already
 globally Delaunay, have no region: the mesh is returned as it is.
@@ -51,7 +54,7 @@ import numpy as np
 
 from ..core.geometry import Frame
 from ..core.tessellation import tessellation_elements
-from ..errors import InputError
+from ..errors import CosphericalError, InputError
 from .assembly import CellShape, Cells, Mesh, _type_info
 from .checks import _weights, check_delaunay
 
@@ -175,9 +178,11 @@ def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, region: int, region_of_leaf:
     try:
         triangulation = Delaunay(real, qhull_options="Qbb Qc Qz Q12 Qt")
     except Exception as error:  # Qhull refuses flat input: a region is a union of boxes, never flat
-        raise InputError(f"Delaunay of a region of {len(ids)} vertices failed: {error}") from None
+        raise CosphericalError(f"Qhull's Delaunay of a region of {len(ids)} vertices failed: {error}; "
+                               "--delaunay leaf meshes without it") from None
     if len(triangulation.coplanar):
-        raise InputError(f"Qhull left out {len(triangulation.coplanar)} of a region's {len(ids)} vertices")
+        raise CosphericalError(f"Qhull left out {len(triangulation.coplanar)} of a region's {len(ids)} vertices; "
+                               "--delaunay leaf meshes without it")
     simplices = triangulation.simplices.astype(np.int64)
     p = coords[simplices]  # (tets, 4, 3)
     d = p[:, 1:] - p[:, :1]
