@@ -1,4 +1,4 @@
-"""VTU files (VTK XML unstructured grids) written from numpy arrays, and a tessellation as one.
+"""VTU files (VTK XML unstructured grids) written from numpy arrays; a tessellation as one.
 
 :func:`write_grid` writes one unstructured grid, every array zlib-compressed in
 the file's appended section as raw binary (VTK's own layout: a ``UInt64``
@@ -23,10 +23,9 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..core.tessellation import Tessellation
-from ..errors import InputError
-from ..files.yamlio import atomic_open, atomic_path
+from ..files.yamlio import atomic_open
 
-__all__ = ["VTK_CELL", "to_meshio", "write_grid", "write_meshio", "write_vtu"]
+__all__ = ["VTK_CELL", "text_array", "write_grid", "write_vtu"]
 
 # VTK's cell type numbers (vtkCellType.h) of the cells an element can be.
 VTK_CELL = {"tetra": 10, "hexahedron": 12, "wedge": 13, "pyramid": 14, "polyhedron": 42}
@@ -120,38 +119,30 @@ def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, con
         handle.write(b"\n</AppendedData>\n</VTKFile>\n")
 
 
-def to_meshio(tess: Tessellation):
-    import meshio
+def write_vtu(tess: Tessellation, path: str | Path) -> None:
+    """Write one tessellation as a VTU grid, atomically: its nodes in id order, its elements in order.
 
+    Standard VTK cells when every element has one, else every element a
+    ``VTK_POLYHEDRON`` with its faces: a grid meshio reads too.  Cell data:
+    ``type_hash`` (the 6 hex digits of the element type id, as an integer) and
+    ``vertices``.
+    """
     real = tess.configuration.real_nodes()
     ids = sorted(real)
     index = {node: i for i, node in enumerate(ids)}
-    points = np.array([real[i] for i in ids], dtype=float)
     standard = all(e.type.vtk for e in tess.elements)
-    cells, type_hash, vertices = [], [], []
+    types, connectivity, offsets, faces, faceoffsets = [], [], [], [], []
     for element in tess.elements:
-        if standard:
-            cells.append(meshio.CellBlock(element.type.vtk, np.array([[index[n] for n in element.nodes]])))
-        else:
-            faces = [np.array([index[n] for n in face]) for face in element.polyhedron.faces]
-            cells.append(meshio.CellBlock(f"polyhedron{len(element.nodes)}", [faces]))
-        type_hash.append(np.array([int(element.type.id.rsplit("-", 1)[1], 16)]))
-        vertices.append(np.array([len(element.nodes)]))
-    return meshio.Mesh(points, cells, cell_data={"type_hash": type_hash, "vertices": vertices})
-
-
-def write_vtu(tess: Tessellation, path: str | Path) -> None:
-    """Write the tessellation to ``path`` atomically (see :func:`write_meshio`)."""
-    write_meshio(to_meshio(tess), path)
-
-
-def write_meshio(converted, path: str | Path) -> None:
-    """Write a :class:`meshio.Mesh` as VTU atomically (see :func:`~cospherical.files.yamlio.atomic_path`):
-    meshio wants a file name, so a temporary one, then rename."""
-    import meshio
-
-    with atomic_path(path) as tmp:
-        try:
-            meshio.write(tmp, converted, file_format="vtu")
-        except OSError as error:
-            raise InputError(f"{path}: cannot write: {error.strerror or error}") from None
+        connectivity += [index[n] for n in element.nodes]
+        offsets.append(len(connectivity))
+        types.append(VTK_CELL[element.type.vtk if standard else "polyhedron"])
+        if not standard:
+            faces.append(len(element.polyhedron.faces))
+            for face in element.polyhedron.faces:
+                faces += [len(face), *(index[n] for n in face)]
+            faceoffsets.append(len(faces))
+    cell_data = {"type_hash": np.array([int(e.type.id.rsplit("-", 1)[1], 16) for e in tess.elements], dtype=np.int64),
+                 "vertices": np.array([len(e.nodes) for e in tess.elements], dtype=np.int64)}
+    write_grid(path, np.array([real[i] for i in ids], dtype=float), np.array(types), np.array(connectivity),
+               np.array(offsets), None if standard else np.array(faces), None if standard else np.array(faceoffsets),
+               cell_data=cell_data)
