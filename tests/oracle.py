@@ -47,11 +47,6 @@ def isomorphic(a, b) -> bool:
     )
 
 
-
-def _squared_distance(p, q, squared):
-    return sum(w * (x - y) ** 2 for w, x, y in zip(squared, p, q))
-
-
 def _isometry(corners, image_corners, squared):
     """The affine map of the box taking its corners to ``image_corners``, checked to be an isometry.
 

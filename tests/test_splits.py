@@ -19,8 +19,10 @@ BOXES = {"A": ("1", "1", "1"), "B": ("1", "2", "4"), "C": ("1", "1.4142", "1.414
 
 
 @pytest.fixture(scope="module")
-def studies():
-    return {key: run_study("bisection", Box.parse(box), bisection_codes()) for key, box in BOXES.items()}
+def studies(paper_studies):
+    """Boxes A, B, C: the session's studies (conftest.py), shared with test_study."""
+    assert {key: study.box.texts for key, study in paper_studies.items()} == BOXES
+    return paper_studies
 
 
 def squared_distance(p, q, squared):

@@ -84,18 +84,9 @@ def test_a_bisection_study_loads_no_numpy():
     assert result.returncode == 0, result.stderr
 
 
-@pytest.fixture(scope="module")
-def paper_studies():
-    return {
-        key: run_study("bisection", Box.parse(box), bisection_codes())
-        for key, box in (("bisection_A", ("1", "1", "1")), ("bisection_B", ("1", "2", "4")),
-                         ("bisection_C", ("1", "1.4142", "1.4142")))
-    }
-
-
 @pytest.mark.parametrize("key", ["bisection_A", "bisection_B", "bisection_C"])
 def test_paper_optimal_tables_row_by_row(paper_studies, key):
-    study = paper_studies[key]
+    study = paper_studies[key.removeprefix("bisection_")]  # the session's studies (conftest.py)
     assert paper_study_key(study_summary(study))[0] == key
     table = paper_comparison(study_summary(study), key)
     assert table["rows"], "no rows"
