@@ -266,7 +266,7 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
     exact coordinate along an axis is ``grid_coordinates * length / grid_intervals``;
     the ``Points`` are the same as floats.
     """
-    from .vtu import text_array, write_grid
+    from .vtu import narrow, text_array, write_grid
 
     arrays = vtu_arrays(mesh)
     order = arrays["order"]
@@ -286,7 +286,7 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
         if len(values) != len(mesh):
             raise ValueError(f"cell data {name!r}: {len(values)} rows for {len(mesh)} elements")
         cells[name] = np.asarray(values)[order]
-    points = {"grid_coordinates": mesh.vertices.astype(np.int64)}
+    points = {"grid_coordinates": narrow(mesh.vertices)}
     for name, values in (point_data or {}).items():
         if name in points:
             raise ValueError(f"point data {name!r}: the writer's own")

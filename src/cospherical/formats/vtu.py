@@ -25,7 +25,7 @@ import numpy as np
 from ..core.tessellation import Tessellation
 from ..files.yamlio import atomic_open
 
-__all__ = ["VTK_CELL", "text_array", "write_grid", "write_vtu"]
+__all__ = ["VTK_CELL", "narrow", "text_array", "write_grid", "write_vtu"]
 
 # VTK's cell type numbers (vtkCellType.h) of the cells an element can be.
 VTK_CELL = {"tetra": 10, "hexahedron": 12, "wedge": 13, "pyramid": 14, "polyhedron": 42}
@@ -57,6 +57,13 @@ def _array(name: str, data: np.ndarray) -> tuple[str, np.ndarray, int]:
     return name, data, 1 if data.ndim == 1 else int(np.prod(data.shape[1:]))
 
 
+def narrow(values: np.ndarray) -> np.ndarray:
+    """Integers as ``Int32`` when they fit (half the bytes to compress and read), else as ``Int64``."""
+    values = np.asarray(values)
+    fits = not len(values) or (int(values.min()) >= -2**31 and int(values.max()) < 2**31)
+    return values.astype(np.int32 if fits else np.int64, copy=False)
+
+
 def text_array(text: str) -> np.ndarray:
     """Text as a ``UInt8`` array of its UTF-8 bytes: field data every VTU reader takes (meshio has no strings)."""
     return np.frombuffer(text.encode(), dtype=np.uint8)
@@ -79,9 +86,9 @@ def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, con
         ("PointData", [_array(k, v) for k, v in (point_data or {}).items()]),
         ("CellData", [_array(k, v) for k, v in (cell_data or {}).items()]),
         ("Points", [_array("Points", np.asarray(points, dtype=np.float64))]),
-        ("Cells", [_array("connectivity", connectivity), _array("offsets", offsets),
+        ("Cells", [_array("connectivity", narrow(connectivity)), _array("offsets", narrow(offsets)),
                    _array("types", np.asarray(cell_types, dtype=np.uint8))]
-         + ([_array("faces", faces), _array("faceoffsets", faceoffsets)] if faces is not None else [])),
+         + ([_array("faces", narrow(faces)), _array("faceoffsets", narrow(faceoffsets))] if faces is not None else [])),
     ]
     n_points, n_cells = len(points), len(cell_types)
     for section, items in arrays[1:3]:
