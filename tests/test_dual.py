@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import time
 from fractions import Fraction
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -280,3 +282,61 @@ def test_tetgen_tetrahedra_of_the_same_vertices_give_the_same_dual_exactly(name)
     theirs = dict(zip(map(tuple, tetra.edges.tolist()), exact(tetra.coefficient_exact, tetra.coefficient_denominator)))
     assert set(ours) <= set(theirs) and len(theirs) > len(ours)
     assert all(theirs[pair] == ours.get(pair, 0) for pair in theirs)
+
+
+def _resigned(good: Path, target: Path, manifest_edit=None, members: dict | None = None) -> None:
+    """A dual.npz whose manifest or members were rewritten and whose checksums were renewed to match:
+    only the reader's own bounds can refuse it."""
+    import hashlib
+    import io
+    import json
+    import zipfile
+
+    with zipfile.ZipFile(good) as source:
+        blobs = {info.filename[:-4]: source.read(info) for info in source.infolist()}
+    manifest = json.loads(np.lib.format.read_array(io.BytesIO(blobs.pop("manifest"))).tobytes().decode())
+    for name, array in (members or {}).items():
+        buffer = io.BytesIO()
+        np.lib.format.write_array(buffer, array, allow_pickle=False)
+        blobs[name] = buffer.getvalue()
+    manifest["sha256"] = {name: hashlib.sha256(blob).hexdigest() for name, blob in blobs.items()}
+    if manifest_edit:
+        manifest_edit(manifest)
+    buffer = io.BytesIO()
+    np.lib.format.write_array(buffer, np.frombuffer(json.dumps(manifest).encode(), dtype=np.uint8))
+    with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("manifest.npy", buffer.getvalue())
+        for name, blob in blobs.items():
+            archive.writestr(f"{name}.npy", blob)
+
+
+@pytest.mark.parametrize("case", ["factor 1e999999999", "factor 1e400", "grid 10**400", "integers --5",
+                                  "integers of 5000 digits"])
+def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, tmp_path, capsys, case):
+    from cospherical.cli import main
+
+    good = dual_run / "a" / "dual.npz"
+    edits = {"factor 1e999999999": lambda m: m.update(volume_factor_squared="1e999999999"),
+             "factor 1e400": lambda m: m.update(volume_factor_squared="1" + "0" * 400),
+             "grid 10**400": lambda m: m.update(grid=10**400)}
+    members = None
+    if case.startswith("integers"):
+        from cospherical.formats.dual import read_dual
+
+        count = len(read_dual(good).volume_exact)
+        members = {"volume_exact": np.array(["--5" if "--5" in case else "9" * 5000] * count)}
+    _resigned(good, tmp_path / "hostile.npz", edits.get(case), members)
+    capsys.readouterr()
+    start = time.monotonic()
+    assert main(["check", str(tmp_path / "hostile.npz")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert time.monotonic() - start < 30  # 10**999999999 would take far longer
+
+
+@pytest.mark.parametrize("domain", [["1e-12", "1e-12", "1e-12"], ["1e-12", "1", "1"], ["3e9", "1", "1"]])
+def test_the_dual_of_tiny_and_huge_domains_is_exact(domain):
+    box = Box.parse(domain)
+    dual = mesh_dual(assemble(build_octree(box, 2, [parse_shape("point:0,0,0")])))
+    assert dual.volume_sum() == 1  # the control volumes fill the domain, as a fraction of its volume
+    assert dual.negative_coefficients()["interior"] == 0

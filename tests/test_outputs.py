@@ -282,3 +282,25 @@ def test_setup_waits_for_the_dpkg_lock_instead_of_failing():
     calls = [line for line in script.splitlines() if "apt-get" in line and not line.lstrip().startswith("#")]
     assert calls and all("DPkg::Lock::Timeout=" in line or '"${apt[@]}"' in line for line in calls), calls
     assert re.search(r"apt=\(apt-get -o DPkg::Lock::Timeout=\d+\)", script)
+
+
+def test_a_link_at_the_manifest_is_refused_before_the_work_and_nothing_is_moved_in(tmp_path, capsys):
+    target = victim(tmp_path)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / MANIFEST).symlink_to(target)
+    start = time.monotonic()
+    refused(capsys, *MESH, "--out", out, needle="symbolic link")
+    assert time.monotonic() - start < 5  # before the meshing, not after it
+    assert target.read_text() == "the user's own file\n" and listing(out) == {MANIFEST: str(target)}
+
+
+def test_running_out_of_memory_is_one_line_and_exit_2(tmp_path):
+    # a tree under the leaf bound (half the machine) but over this process's address space
+    script = ("import resource, sys; resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30)); "
+              "from cospherical.cli import main; sys.exit(main(sys.argv[1:]))")
+    result = subprocess.run([sys.executable, "-c", script, "mesh", "--domain", "1", "1", "1", "--levels", "10",
+                             "--refine", "plane:1,1,1,1", "--no-uniform"], capture_output=True, text=True,
+                            timeout=600, cwd=tmp_path)
+    assert result.returncode == 2, result.stderr[-2000:]
+    assert result.stderr.count("\n") == 1 and "out of memory" in result.stderr, result.stderr

@@ -144,6 +144,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"cospherical: error: {where}{error.strerror or error}", file=sys.stderr)
         _silence_stdout()
         return 2
+    except MemoryError:  # the tree or table outgrew what this process may allocate (RLIMIT_AS, the machine)
+        _stop_workers()
+        print("cospherical: error: out of memory: the work needs more memory than this process may use "
+              "(a smaller tree or table, or --max-leaves for mesh)", file=sys.stderr)
+        _silence_stdout()
+        return 2
     except Exception:
         if _interrupted.is_set():  # an interrupt that a library turned into its own error (numpy: ImportError)
             _stop_workers()

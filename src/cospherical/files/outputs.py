@@ -203,6 +203,7 @@ class OutputFolder:
         try:
             for name in self._names:
                 self._check_name(name)
+            refuse_special(self.folder / MANIFEST)  # the manifest is written last: refuse a link there before any work
             self._remove_stale_staging()
             self.staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=self.folder))
         except BaseException:
@@ -266,7 +267,7 @@ class OutputFolder:
         missing = [name for name in self._staged if not os.path.isfile(self.staging / name)]
         if missing:
             raise InputError(f"{self.folder / missing[0]}: was not written")
-        for name in self._staged:  # every name checked before the first rename
+        for name in [*self._staged, MANIFEST]:  # every name checked before the first rename
             refuse_special(self.folder / name)
         manifest = self._read_manifest()
         ours = {name: _sha256(self.staging / name) for name in self._staged}

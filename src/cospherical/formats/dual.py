@@ -38,6 +38,7 @@ import io
 import json
 import math
 import os
+import re
 import stat
 import zipfile
 from fractions import Fraction
@@ -63,6 +64,12 @@ MEMBERS = {
 }
 _STAMP = (1980, 1, 1, 0, 0, 0)
 _MAX_DIGITS = 200
+# the manifest's exact numbers as written: plain integers and fractions of bounded length, so that a
+# hostile text such as "1e999999999" never reaches Fraction (which would compute 10**999999999)
+_INTEGER = re.compile(r"-?[0-9]{1,%d}" % _MAX_DIGITS)
+_POSITIVE = re.compile(r"[1-9][0-9]{0,999}")
+_POSITIVE_FRACTION = re.compile(r"[1-9][0-9]{0,999}(/[1-9][0-9]{0,999})?")
+MAX_GRID = 1 << 40
 
 
 def _npy(array: np.ndarray) -> bytes:
@@ -142,6 +149,8 @@ def read_dual(path: str | Path) -> Dual:
                 blob, arrays[name] = _member(archive, name, path, limit)
                 if hashlib.sha256(blob).hexdigest() != manifest["sha256"].get(name):
                     raise FormatError(f"{path}: member {name}: checksum mismatch (the file was changed or damaged)")
+    except MemoryError:
+        raise FormatError(f"{path}: cannot read: its members need more memory than this process may use") from None
     except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, OSError, ValueError) as error:
         if isinstance(error, FormatError):
             raise
@@ -169,8 +178,8 @@ def _integers(array: np.ndarray, name: str, path: Path) -> np.ndarray:
     if array.dtype.kind == "i":
         return array.astype(np.int64)
     text = array.astype(str)
-    if any(not (x.lstrip("-").isascii() and x.lstrip("-").isdigit()) for x in text.tolist()):
-        raise FormatError(f"{path}: member {name}: not integers")
+    if any(not _INTEGER.fullmatch(x) for x in text.tolist()):
+        raise FormatError(f"{path}: member {name}: not integers of at most {_MAX_DIGITS} digits")
     return np.array([int(x) for x in text.tolist()], dtype=object)
 
 
@@ -185,18 +194,23 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
     edges = arrays["edges"]
     if len(edges) and (edges.min() < 0 or edges.max() >= counts["n"] or np.any(edges[:, 0] >= edges[:, 1])):
         raise FormatError(f"{path}: member edges: a pair that is not two vertices i < j")
+    for key, pattern in (("coefficient_denominator", _POSITIVE), ("volume_denominator", _POSITIVE),
+                         ("volume_factor_squared", _POSITIVE_FRACTION)):
+        if not pattern.fullmatch(manifest[key]):
+            raise FormatError(f"{path}: manifest: {key} is not a positive integer or fraction of at most 1000 digits")
+    if not 0 < manifest["grid"] <= MAX_GRID:
+        raise FormatError(f"{path}: manifest: grid {manifest['grid']} is not in 1..{MAX_GRID}")
     try:
         box = Box.parse(manifest["domain"])
         grid = int(manifest["grid"])
         cden, vden = int(manifest["coefficient_denominator"]), int(manifest["volume_denominator"])
         factor_squared = Fraction(manifest["volume_factor_squared"])
-    except (ValueError, TypeError, ZeroDivisionError) as error:
+        factor = math.sqrt(factor_squared)
+    except (ValueError, TypeError, ZeroDivisionError, OverflowError) as error:
         raise FormatError(f"{path}: manifest: {error}") from None
-    if grid <= 0 or cden <= 0 or vden <= 0 or factor_squared <= 0:
-        raise FormatError(f"{path}: manifest: grid and denominators must be positive")
     return Dual(box, grid, arrays["grid_vertices"].astype(np.int64), arrays["vertices"], edges.astype(np.int64),
                 arrays["length"], arrays["area"], arrays["coefficient"], arrays["control_volume"],
                 arrays["boundary"], arrays["boundary_area"],
                 _integers(arrays["coefficient_exact"], "coefficient_exact", path), cden,
-                _integers(arrays["volume_exact"], "volume_exact", path), vden, math.sqrt(factor_squared),
+                _integers(arrays["volume_exact"], "volume_exact", path), vden, factor,
                 factor_squared, arrays["element_circumcenter"])

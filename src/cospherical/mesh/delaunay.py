@@ -178,7 +178,8 @@ def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, region: int, region_of_leaf:
     try:
         triangulation = Delaunay(real, qhull_options="Qbb Qc Qz Q12 Qt")
     except Exception as error:  # Qhull refuses flat input: a region is a union of boxes, never flat
-        raise CosphericalError(f"Qhull's Delaunay of a region of {len(ids)} vertices failed: {error}; "
+        first = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+        raise CosphericalError(f"Qhull's Delaunay of a region of {len(ids)} vertices failed: {first[:200]}; "
                                "--delaunay leaf meshes without it") from None
     if len(triangulation.coplanar):
         raise CosphericalError(f"Qhull left out {len(triangulation.coplanar)} of a region's {len(ids)} vertices; "

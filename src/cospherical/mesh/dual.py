@@ -299,7 +299,12 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
     vden = math.lcm(1, *(_lcm_denominator(shape.volume_q) for shape, _, _ in groups))
     bden = math.lcm(1, *(_lcm_denominator([q for _, q in shape.boundary]) for shape, _, _ in groups))
     max_size = max((int(sizes.max()) for _, _, sizes in groups if len(sizes)), default=1)
-    wide = vden * max_size ** 3 * 4096 >= 2**62 or cden * max_size * 4096 >= 2**62
+    # int64 sums while every product and sum is bounded below 2**62: the largest numerator (not just the
+    # denominator: on tiny or huge domains the pieces over a*b*c are far from 1) times the size scaling,
+    # times a bound on the pieces met by one edge or vertex
+    largest_coefficient = max((abs(int(q * cden)) for shape, _, _ in groups for q in shape.edge_q), default=0)
+    largest_volume = max((abs(int(q * vden)) for shape, _, _ in groups for q in shape.volume_q), default=0)
+    wide = largest_volume * max_size ** 3 * 4096 >= 2**62 or largest_coefficient * max_size * 4096 >= 2**62
     dtype = object if wide else np.int64
     edge_parts, coef_parts, vol_parts, vol_index, bnd_parts, bnd_index, bnd_axis = [], [], [], [], [], [], []
     for shape, vertex_ids, sizes in groups:
