@@ -54,7 +54,7 @@ import numpy as np
 
 from ..core.configuration import Box
 from ..core.delaunay import hull_faces
-from ..core.geometry import Frame
+from ..core.geometry import Frame, cross, dot, sub
 from ..errors import InputError
 
 __all__ = ["Dual", "ElementPieces", "delaunay_tetrahedra", "dual_summary", "element_pieces", "mesh_dual",
@@ -77,18 +77,6 @@ class ElementPieces:
     edges: dict[tuple[int, int], Fraction]
     volumes: dict[int, Fraction]
     boundary: dict[tuple[int, Fraction], dict[int, Fraction]]
-
-
-def _cross(p: Sequence[Fraction], q: Sequence[Fraction]) -> tuple[Fraction, Fraction, Fraction]:
-    return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
-
-
-def _sub(p, q):
-    return (p[0] - q[0], p[1] - q[1], p[2] - q[2])
-
-
-def _dot(p, q):
-    return p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
 
 
 def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], center: Point,
@@ -123,9 +111,9 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
     boundary: dict[tuple[int, Fraction], dict[int, Fraction]] = {}
     for cycle in faces:
         p0, p1, p2 = (ip[n] for n in cycle[:3])
-        normal = _cross(_sub(p1, p0), _sub(p2, p0))  # no three points of a circle are collinear
+        normal = cross(sub(p1, p0), sub(p2, p0))  # no three points of a circle are collinear
         s = sum(normal[k] * normal[k] * (big // weight[k]) for k in range(3))
-        dn = _dot(_sub(ic, p0), normal)
+        dn = dot(sub(ic, p0), normal)
         face_center = tuple(ic[k] * s - dn * normal[k] * (big // weight[k]) for k in range(3))  # times D * S
         cs = tuple(x * s for x in ic)
         plane = [k for k in range(3) if normal[k] != 0]
@@ -139,8 +127,8 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
         for u, v in zip(cycle, (*cycle[1:], cycle[0])):
             xu, xv = ip[u], ip[v]
             mid = tuple((xu[k] + xv[k]) // 2 * s for k in range(3))
-            along = _sub(xu, xv)
-            piece = _dot(along, _cross(_sub(face_center, mid), _sub(cs, mid)))  # times D^3 S^2
+            along = sub(xu, xv)
+            piece = dot(along, cross(sub(face_center, mid), sub(cs, mid)))  # times D^3 S^2
             length2 = sum(weight[k] * along[k] * along[k] for k in range(3))  # times lam D^2
             key = (u, v) if u < v else (v, u)
             edges[key] = edges.get(key, Fraction(0)) + Fraction(piece * lam, 2 * scale * s * s * length2)
@@ -149,7 +137,7 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
             if shares is not None:
                 # triangles (x_u, m, f) and (m, x_v, f): equal areas, half a base each (times D^2 S^2)
                 xs = tuple(x * s for x in xu)
-                area = outward * _cross(_sub(mid, xs), _sub(face_center, xs))[k]
+                area = outward * cross(sub(mid, xs), sub(face_center, xs))[k]
                 face_area[u] = face_area.get(u, 0) + area
                 face_area[v] = face_area.get(v, 0) + area
         for node, total in face_volume.items():
