@@ -31,8 +31,12 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     geometry.write_text(geometry.read_text() + "\nfrom ..catalogue import type_name  # wrong on purpose\n")
     check = tmp_path / "cospherical" / "cli" / "check.py"
     check.write_text(check.read_text() + "\nfrom . import diff  # wrong on purpose\n")
+    # Inside the core: a configuration needs no Delaunay cells; reaching up to them inverts the data flow.
+    configuration = tmp_path / "cospherical" / "core" / "configuration.py"
+    configuration.write_text(configuration.read_text() + "\nfrom .delaunay import delaunay_cells  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
-    assert "Contracts: 0 kept, 2 broken." in result.stdout
+    assert "Contracts: 0 kept, 3 broken." in result.stdout
+    assert "cospherical.core.configuration -> cospherical.core.delaunay" in result.stdout
     assert "cospherical.core.geometry -> cospherical.catalogue" in result.stdout
     assert "cospherical.cli.check -> cospherical.cli.diff" in result.stdout

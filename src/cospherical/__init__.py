@@ -30,7 +30,7 @@ _API = {
     "Shape": "cospherical.core.shapes",
     "ShapeConfiguration": "cospherical.core.shapes",
     "standard_shape": "cospherical.core.shapes",
-    "tessellate_shape": "cospherical.core.shapes",
+    "tessellate_shape": "cospherical.core.tessellation",
     "Tessellation": "cospherical.core.tessellation",
     "tessellate": "cospherical.core.tessellation",
     "load_catalogue": "cospherical.catalogue",

@@ -7,8 +7,8 @@ from pathlib import Path
 
 from ..catalogue import CRITERIA, apply_catalogue_criterion
 from ..core.configuration import POINT_POLICIES, Configuration
-from ..core.shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape, tessellate_shape
-from ..core.tessellation import tessellate
+from ..core.shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape
+from ..core.tessellation import tessellate, tessellate_shape
 from ..errors import FormatError, InputError, UsageError
 from ..files.yamlio import load_yaml
 from ..formats.tessellation import tessellation_data

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Mapping, Sequence
 
-__all__ = ["Frame", "Sphere", "cross", "dot", "six_volume", "sub"]
+__all__ = ["Frame", "Sphere", "cross", "dot", "six_volume", "sub", "tetra_six_volume"]
 
 Vector = tuple[int, int, int]
 
@@ -38,6 +38,12 @@ def dot(p: Sequence[int], q: Sequence[int]) -> int:
 
 def cross(p: Sequence[int], q: Sequence[int]) -> Vector:
     return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
+
+
+def tetra_six_volume(p: Sequence, q: Sequence, r: Sequence, s: Sequence):
+    """Six times the signed volume of the tetrahedron pqrs (zero: the four are coplanar), exact for
+    integers and Fractions alike."""
+    return dot(sub(q, p), cross(sub(r, p), sub(s, p)))
 
 
 def six_volume(coords, cycles) -> int:

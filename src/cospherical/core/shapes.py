@@ -20,14 +20,14 @@ its four edges are split with opposite edges at the same parameter (measured in
 the same direction); the point is where the two cut lines cross.  Triangles and
 the interior carry nothing: a refined neighbour puts nothing there.
 
+Their tessellation is :func:`cospherical.core.tessellation.tessellate_shape`,
+their isometries :func:`cospherical.core.symmetry.shape_symmetries`.
+
 Examples
 --------
 >>> prism = standard_shape("prism")
 >>> len(prism.corners), len(prism.edges), prism.quad_faces
 (6, 9, (2, 3, 4))
->>> tess = tessellate_shape(ShapeConfiguration.from_code(prism, "888888888"))
->>> sorted(e.type.name for e in tess.elements), tess.fvm_adequate
-(['Cuboid', 'Cuboid', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism'], True)
 """
 
 from __future__ import annotations
@@ -42,13 +42,9 @@ from typing import Iterable, Mapping, Sequence
 from ..errors import InputError
 from .configuration import Box, steiner_parameters
 from .exact import parse_rational
-from .geometry import six_volume
-from .polyhedron import Polyhedron
-from .symmetry import map_polyhedron
-from .tessellation import Tessellation, tessellation_elements
+from .geometry import cross, dot, six_volume, sub, tetra_six_volume
 
-__all__ = ["ELEMENTS", "STANDARD_SHAPES", "Shape", "ShapeConfiguration", "ShapeSymmetry", "ShapeTessellation",
-           "mask_codes", "shape_orbit_representatives", "standard_shape", "tessellate_shape"]
+__all__ = ["ELEMENTS", "STANDARD_SHAPES", "Shape", "ShapeConfiguration", "mask_codes", "standard_shape"]
 
 Point = tuple[Fraction, Fraction, Fraction]
 
@@ -76,23 +72,6 @@ ELEMENTS = ("cuboid", *STANDARD_SHAPES)
 # A base element of a mesh has a handful of corners; its tessellation's exact tests grow
 # with their number, so a shape file of thousands is refused before any is read.
 MAX_CORNERS = 64
-
-
-def _sub(p, q):
-    return tuple(a - b for a, b in zip(p, q))
-
-
-def _cross(p, q):
-    return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
-
-
-def _dot(p, q):
-    return sum(a * b for a, b in zip(p, q))
-
-
-def _volume6(p, q, r, s):
-    """Six times the signed volume of the tetrahedron pqrs (zero: the four are coplanar)."""
-    return _dot(_sub(q, p), _cross(_sub(r, p), _sub(s, p)))
 
 
 def _point(value, where: str) -> Point:
@@ -169,8 +148,8 @@ class Shape:
         # Coplanar in one pass, exactly: a corner off the line of corners 0 and 1 spans their
         # plane (none: all on one line); the corners are a solid iff one is off that plane.
         p, q = corners[0], corners[1]
-        r = next((c for c in corners[2:] if any(_cross(_sub(q, p), _sub(c, p)))), None)
-        if r is None or all(_volume6(p, q, r, c) == 0 for c in corners[2:]):
+        r = next((c for c in corners[2:] if any(cross(sub(q, p), sub(c, p)))), None)
+        if r is None or all(tetra_six_volume(p, q, r, c) == 0 for c in corners[2:]):
             raise InputError(f"{name}: the corners are coplanar: no solid")
         cycles = []
         for f, face in enumerate(faces):
@@ -244,13 +223,8 @@ class Shape:
     def contains(self, point: Sequence[Fraction], closed: bool = True) -> bool:
         """Whether a point (unit coordinates) lies in the closed (or open) element, exactly."""
         if closed:
-            return all(_dot(normal, point) <= offset for normal, offset in self.planes)
-        return all(_dot(normal, point) < offset for normal, offset in self.planes)
-
-    @cached_property
-    def symmetries(self) -> tuple["ShapeSymmetry", ...]:
-        """The isometries of the scaled shape, identity first (see :class:`ShapeSymmetry`)."""
-        return _symmetries(self)
+            return all(dot(normal, point) <= offset for normal, offset in self.planes)
+        return all(dot(normal, point) < offset for normal, offset in self.planes)
 
 
 def _oriented_face(corners, cycle, f, name):
@@ -263,25 +237,25 @@ def _oriented_face(corners, cycle, f, name):
         normal = (normal[0] + (p[1] - q[1]) * (p[2] + q[2]), normal[1] + (p[2] - q[2]) * (p[0] + q[0]),
                   normal[2] + (p[0] - q[0]) * (p[1] + q[1]))
     if normal == (0, 0, 0):  # a self-crossing order can cancel Newell's sum: any corner triple then
-        normal = next((n for a, b, c in combinations(pts, 3) if (n := _cross(_sub(b, a), _sub(c, a))) != (0, 0, 0)),
+        normal = next((n for a, b, c in combinations(pts, 3) if (n := cross(sub(b, a), sub(c, a))) != (0, 0, 0)),
                       normal)
     if normal == (0, 0, 0):
         raise InputError(f"{name}: face {f} {list(cycle)}: its corners are on one line")
-    offset = _dot(normal, pts[0])
-    if any(_dot(normal, p) != offset for p in pts):
+    offset = dot(normal, pts[0])
+    if any(dot(normal, p) != offset for p in pts):
         raise InputError(f"{name}: face {f} {list(cycle)}: its corners are not on one plane")
     for i in range(m):
         # Convex in the given order: every other corner strictly on the inner side of each side.
         p, q = pts[i], pts[(i + 1) % m]
-        inward = _cross(normal, _sub(q, p))
-        if any(_dot(inward, _sub(r, p)) <= 0 for j, r in enumerate(pts) if j not in (i, (i + 1) % m)):
+        inward = cross(normal, sub(q, p))
+        if any(dot(inward, sub(r, p)) <= 0 for j, r in enumerate(pts) if j not in (i, (i + 1) % m)):
             raise InputError(f"{name}: face {f} {list(cycle)}: not a convex polygon in this order "
                              "(or three corners on a line)")
     above = below = False
     for i, p in enumerate(corners):
         if i in cycle:
             continue
-        side = _dot(normal, p) - offset
+        side = dot(normal, p) - offset
         if side == 0:
             raise InputError(f"{name}: corner {i} lies in the plane of face {f} {list(cycle)} without being one "
                              "of its corners")
@@ -411,7 +385,7 @@ class ShapeConfiguration:
         u = [a + s * (b - a) for a, b in zip(c[1], c[2])]
         # p + x (q - p) = r + y (u - r): two of the three coordinate equations have
         # a nonzero determinant, because the cut lines of a convex face cross.
-        d1, d2, e = _sub(q, p), _sub(u, r), _sub(r, p)
+        d1, d2, e = sub(q, p), sub(u, r), sub(r, p)
         for i, j in combinations(range(3), 2):
             det = d1[i] * -d2[j] + d2[i] * d1[j]
             if det:
@@ -437,34 +411,6 @@ class ShapeConfiguration:
         return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}
 
 
-@dataclass(frozen=True)
-class ShapeTessellation(Tessellation):
-    """A tessellation of a shape; the FVM tests ask for circumcenters in the base element, not the box."""
-
-    @property
-    def fvm_adequate(self) -> bool:
-        """Every element's circumcenter lies in the closed base element."""
-        return all(self.configuration.shape.contains(e.polyhedron.center) for e in self.elements)
-
-    @property
-    def fvm_adequate_open(self) -> bool:
-        """Every element's circumcenter lies strictly inside the base element."""
-        return all(self.configuration.shape.contains(e.polyhedron.center, closed=False) for e in self.elements)
-
-
-def tessellate_shape(configuration: ShapeConfiguration) -> ShapeTessellation:
-    """The Delaunay tessellation of a 1-irregular element, its elements the largest co-spherical sets.
-
-    Examples
-    --------
-    >>> tess = tessellate_shape(ShapeConfiguration.from_code(standard_shape("tetrahedron"), "800000"))
-    >>> [e.type.name for e in tess.elements], sum(e.polyhedron.unit_volume for e in tess.elements)
-    (['Tetrahedron', 'Tetrahedron'], Fraction(1, 6))
-    """
-    nodes = configuration.nodes()
-    return ShapeTessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared))
-
-
 def mask_codes(edges: int) -> list[str]:
     """The bisection codes of an element with ``edges`` edges: a midpoint (``8``) or nothing on each.
 
@@ -472,129 +418,3 @@ def mask_codes(edges: int) -> list[str]:
     ['00', '80', '08', '88']
     """
     return ["".join("8" if mask >> k & 1 else "0" for k in range(edges)) for mask in range(1 << edges)]
-
-
-@dataclass(frozen=True)
-class ShapeSymmetry:
-    """An isometry of a shape: a permutation of its corners, acting on nodes, codes and points.
-
-    ``corner_map[i]`` is the image of corner i; ``linear`` and ``shift`` the
-    affine map of unit coordinates (rational: it maps rational corners to
-    rational corners); ``proper`` whether it keeps orientation.
-
-    Examples
-    --------
-    >>> swap = standard_shape("prism").symmetries[1]  # x <-> y: corners 1 and 2, 4 and 5
-    >>> swap.corner_map, swap.proper, swap.code("800000000")
-    ((0, 2, 1, 3, 5, 4), False, '008000000')
-    """
-
-    shape: Shape = field(repr=False, compare=False)
-    corner_map: tuple[int, ...]
-    linear: tuple[tuple[Fraction, ...], ...] = field(repr=False)
-    shift: tuple[Fraction, ...] = field(repr=False)
-
-    @property
-    def proper(self) -> bool:
-        m = self.linear
-        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) > 0
-
-    def point(self, p):
-        return tuple(sum(a * x for a, x in zip(row, p)) + b for row, b in zip(self.linear, self.shift))
-
-    @cached_property
-    def edge_map(self) -> tuple[tuple[int, bool], ...]:
-        """For edge k: (image edge, whether t becomes 1 - t)."""
-        shape, image = self.shape, self.corner_map
-        result = []
-        for k, (i, j) in enumerate(shape.edges):
-            target = shape.edge_index(image[i], image[j])
-            result.append((target, image[shape.edge_start(k)] != shape.edge_start(target)))
-        return tuple(result)
-
-    @cached_property
-    def node_map(self) -> dict[int, int]:
-        shape = self.shape
-        nc, ne = len(shape.corners), len(shape.edges)
-        nodes = dict(enumerate(self.corner_map))
-        nodes.update({nc + k: nc + target for k, (target, _) in enumerate(self.edge_map)})
-        face_of = {frozenset(shape.faces[f]): q for q, f in enumerate(shape.quad_faces)}
-        for q, f in enumerate(shape.quad_faces):
-            nodes[nc + ne + q] = nc + ne + face_of[frozenset(self.corner_map[i] for i in shape.faces[f])]
-        return nodes
-
-    def code(self, code: str) -> str:
-        """The image of a configuration code (digit n becomes 16 - n on a reversed edge)."""
-        digits = ["0"] * len(code)
-        for (target, reverse), digit in zip(self.edge_map, code):
-            digits[target] = "%x" % ((16 - int(digit, 16)) % 16) if reverse else digit
-        return "".join(digits)
-
-    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
-        return map_polyhedron(poly, self.node_map, self.proper, self.point)
-
-    def inverse(self) -> "ShapeSymmetry":
-        return next(s for s in self.shape.symmetries
-                    if all(s.corner_map[self.corner_map[i]] == i for i in range(len(self.corner_map))))
-
-
-def _affine(sources: Sequence[Point], targets: Sequence[Point]):
-    """The affine map of unit coordinates taking four affinely independent points to four others."""
-    # Solve M (s_i - s_0) = (t_i - t_0) for i = 1..3 by Cramer's rule, row by row.
-    u = [_sub(s, sources[0]) for s in sources[1:]]
-    v = [_sub(t, targets[0]) for t in targets[1:]]
-    det = _dot(u[0], _cross(u[1], u[2]))
-    # With U the matrix of columns u[i], the rows of det * U^-1 are these cross products.
-    inverse_t = [_cross(u[1], u[2]), _cross(u[2], u[0]), _cross(u[0], u[1])]
-    linear = tuple(tuple(sum(v[i][row] * inverse_t[i][col] for i in range(3)) / det for col in range(3))
-                   for row in range(3))
-    shift = tuple(t - sum(a * x for a, x in zip(r, sources[0])) for r, t in zip(linear, targets[0]))
-    return linear, shift
-
-
-def _symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
-    corners, weights = shape.corners, shape.box.squared
-
-    def distance(i, j):
-        return sum(w * (a - b) ** 2 for w, a, b in zip(weights, corners[i], corners[j]))
-
-    n = len(corners)
-    found = []
-
-    def extend(images: list[int]) -> None:
-        # Backtracking: a permutation keeping every squared distance is an isometry
-        # of the corners, hence of their convex hull.
-        i = len(images)
-        if i == n:
-            found.append(tuple(images))
-            return
-        for j in range(n):
-            if j not in images and all(distance(i, k) == distance(j, images[k]) for k in range(i)):
-                extend(images + [j])
-
-    extend([])
-    basis = next(b for b in combinations(range(n), 4) if _volume6(*(corners[i] for i in b)) != 0)
-    result = []
-    for images in sorted(found, key=lambda p: p != tuple(range(n))):
-        linear, shift = _affine([corners[i] for i in basis], [corners[images[i]] for i in basis])
-        result.append(ShapeSymmetry(shape, images, linear, shift))
-    return tuple(result)
-
-
-def shape_orbit_representatives(codes: Sequence[str],
-                                symmetries: Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
-    """For each code, its orbit's representative (the smallest image code, as a base-16
-    number) and the index of a symmetry taking the code to it.
-
-    >>> shape = standard_shape("tetrahedron")
-    >>> shape_orbit_representatives(["800000", "008000", "080000"], shape.symmetries)[0]
-    ['000800', '000800', '000008']
-    """
-    reps, index = [], []
-    for code in codes:
-        images = [sym.code(code) for sym in symmetries]
-        best = min(range(len(images)), key=lambda i: (int(images[i], 16), i))
-        reps.append(images[best])
-        index.append(best)
-    return reps, index

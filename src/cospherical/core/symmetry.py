@@ -1,4 +1,4 @@
-"""The symmetry group of a box acting on node ids, configurations and tessellations.
+"""The symmetry group of a box (or of another base element) acting on node ids, configurations and tessellations.
 
 A symmetry permutes the axes (only axes of equal length may be swapped) and
 reflects any of them: 48 elements for a cube, 16 when exactly two lengths
@@ -9,10 +9,10 @@ the result to every other member.
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
-from functools import lru_cache
-from itertools import permutations, product
+from functools import cached_property, lru_cache
+from itertools import combinations, permutations, product
 from operator import itemgetter
 from typing import TYPE_CHECKING, Sequence
 
@@ -33,10 +33,12 @@ from .configuration import (
     parse_point_suffix,
     point_suffix,
 )
+from .geometry import cross, dot, sub, tetra_six_volume
 from .polyhedron import Polyhedron
+from .shapes import Point, Shape, standard_shape
 
-__all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys", "orbit_point_keys",
-           "orbit_representatives"]
+__all__ = ["ShapeSymmetry", "Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
+           "orbit_point_keys", "orbit_representatives", "shape_orbit_representatives", "shape_symmetries"]
 
 
 @dataclass(frozen=True)
@@ -346,3 +348,135 @@ def _orbit_keys_python(codes, masks, group: _Group):
         image_masks.append(image_mask)
         sym_index.append(first)
     return keys, image_masks, sym_index
+
+
+@dataclass(frozen=True)
+class ShapeSymmetry:
+    """An isometry of a shape: a permutation of its corners, acting on nodes, codes and points.
+
+    ``corner_map[i]`` is the image of corner i; ``linear`` and ``shift`` the
+    affine map of unit coordinates (rational: it maps rational corners to
+    rational corners); ``proper`` whether it keeps orientation.
+
+    Examples
+    --------
+    >>> swap = shape_symmetries(standard_shape("prism"))[1]  # x <-> y: corners 1 and 2, 4 and 5
+    >>> swap.corner_map, swap.proper, swap.code("800000000")
+    ((0, 2, 1, 3, 5, 4), False, '008000000')
+    """
+
+    shape: Shape = field(repr=False, compare=False)
+    corner_map: tuple[int, ...]
+    linear: tuple[tuple[Fraction, ...], ...] = field(repr=False)
+    shift: tuple[Fraction, ...] = field(repr=False)
+
+    @property
+    def proper(self) -> bool:
+        m = self.linear
+        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) > 0
+
+    def point(self, p):
+        return tuple(sum(a * x for a, x in zip(row, p)) + b for row, b in zip(self.linear, self.shift))
+
+    @cached_property
+    def edge_map(self) -> tuple[tuple[int, bool], ...]:
+        """For edge k: (image edge, whether t becomes 1 - t)."""
+        shape, image = self.shape, self.corner_map
+        result = []
+        for k, (i, j) in enumerate(shape.edges):
+            target = shape.edge_index(image[i], image[j])
+            result.append((target, image[shape.edge_start(k)] != shape.edge_start(target)))
+        return tuple(result)
+
+    @cached_property
+    def node_map(self) -> dict[int, int]:
+        shape = self.shape
+        nc, ne = len(shape.corners), len(shape.edges)
+        nodes = dict(enumerate(self.corner_map))
+        nodes.update({nc + k: nc + target for k, (target, _) in enumerate(self.edge_map)})
+        face_of = {frozenset(shape.faces[f]): q for q, f in enumerate(shape.quad_faces)}
+        for q, f in enumerate(shape.quad_faces):
+            nodes[nc + ne + q] = nc + ne + face_of[frozenset(self.corner_map[i] for i in shape.faces[f])]
+        return nodes
+
+    def code(self, code: str) -> str:
+        """The image of a configuration code (digit n becomes 16 - n on a reversed edge)."""
+        digits = ["0"] * len(code)
+        for (target, reverse), digit in zip(self.edge_map, code):
+            digits[target] = "%x" % ((16 - int(digit, 16)) % 16) if reverse else digit
+        return "".join(digits)
+
+    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
+        return map_polyhedron(poly, self.node_map, self.proper, self.point)
+
+    def inverse(self) -> "ShapeSymmetry":
+        return next(s for s in shape_symmetries(self.shape)
+                    if all(s.corner_map[self.corner_map[i]] == i for i in range(len(self.corner_map))))
+
+
+def _affine(sources: Sequence[Point], targets: Sequence[Point]):
+    """The affine map of unit coordinates taking four affinely independent points to four others."""
+    # Solve M (s_i - s_0) = (t_i - t_0) for i = 1..3 by Cramer's rule, row by row.
+    u = [sub(s, sources[0]) for s in sources[1:]]
+    v = [sub(t, targets[0]) for t in targets[1:]]
+    det = dot(u[0], cross(u[1], u[2]))
+    # With U the matrix of columns u[i], the rows of det * U^-1 are these cross products.
+    inverse_t = [cross(u[1], u[2]), cross(u[2], u[0]), cross(u[0], u[1])]
+    linear = tuple(tuple(sum(v[i][row] * inverse_t[i][col] for i in range(3)) / det for col in range(3))
+                   for row in range(3))
+    shift = tuple(t - sum(a * x for a, x in zip(r, sources[0])) for r, t in zip(linear, targets[0]))
+    return linear, shift
+
+
+@lru_cache(maxsize=64)  # a study maps every member through its shape's symmetries
+def shape_symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
+    """The isometries of the scaled shape, identity first (see :class:`ShapeSymmetry`).
+
+    >>> [len(shape_symmetries(standard_shape(name))) for name in ("prism", "pyramid", "tetrahedron")]
+    [4, 8, 6]
+    """
+    corners, weights = shape.corners, shape.box.squared
+
+    def distance(i, j):
+        return sum(w * (a - b) ** 2 for w, a, b in zip(weights, corners[i], corners[j]))
+
+    n = len(corners)
+    found = []
+
+    def extend(images: list[int]) -> None:
+        # Backtracking: a permutation keeping every squared distance is an isometry
+        # of the corners, hence of their convex hull.
+        i = len(images)
+        if i == n:
+            found.append(tuple(images))
+            return
+        for j in range(n):
+            if j not in images and all(distance(i, k) == distance(j, images[k]) for k in range(i)):
+                extend(images + [j])
+
+    extend([])
+    basis = next(b for b in combinations(range(n), 4) if tetra_six_volume(*(corners[i] for i in b)) != 0)
+    result = []
+    for images in sorted(found, key=lambda p: p != tuple(range(n))):
+        linear, shift = _affine([corners[i] for i in basis], [corners[images[i]] for i in basis])
+        result.append(ShapeSymmetry(shape, images, linear, shift))
+    return tuple(result)
+
+
+def shape_orbit_representatives(codes: Sequence[str],
+                                symmetries: Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
+    """For each code, its orbit's representative (the smallest image code, as a base-16
+    number) and the index of a symmetry taking the code to it.
+
+    >>> shape = standard_shape("tetrahedron")
+    >>> shape_orbit_representatives(["800000", "008000", "080000"], shape_symmetries(shape))[0]
+    ['000800', '000800', '000008']
+    """
+    reps, index = [], []
+    for code in codes:
+        images = [sym.code(code) for sym in symmetries]
+        best = min(range(len(images)), key=lambda i: (int(images[i], 16), i))
+        reps.append(images[best])
+        index.append(best)
+    return reps, index

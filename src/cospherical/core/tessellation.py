@@ -1,4 +1,4 @@
-"""Tessellate a 1-irregular cuboid: Delaunay cells, classified and measured."""
+"""Tessellate a 1-irregular base element (a cuboid or another shape): Delaunay cells, classified and measured."""
 
 from __future__ import annotations
 
@@ -10,8 +10,9 @@ from .delaunay import delaunay_cells
 from .element_types import ElementType, classify
 from .geometry import Frame
 from .polyhedron import Polyhedron, polyhedron
+from .shapes import ShapeConfiguration
 
-__all__ = ["Element", "Tessellation", "tessellate", "tessellation_elements"]
+__all__ = ["Element", "ShapeTessellation", "Tessellation", "tessellate", "tessellate_shape", "tessellation_elements"]
 
 
 @dataclass(frozen=True)
@@ -94,3 +95,36 @@ def tessellation_elements(nodes, squared) -> tuple[Element, ...]:
         etype, order, mirrored = classify(poly)
         elements.append(Element(etype, order, poly, mirrored))
     return tuple(elements)
+
+
+@dataclass(frozen=True)
+class ShapeTessellation(Tessellation):
+    """A tessellation of a shape; the FVM tests ask for circumcenters in the base element, not the box."""
+
+    @property
+    def fvm_adequate(self) -> bool:
+        """Every element's circumcenter lies in the closed base element."""
+        return all(self.configuration.shape.contains(e.polyhedron.center) for e in self.elements)
+
+    @property
+    def fvm_adequate_open(self) -> bool:
+        """Every element's circumcenter lies strictly inside the base element."""
+        return all(self.configuration.shape.contains(e.polyhedron.center, closed=False) for e in self.elements)
+
+
+def tessellate_shape(configuration: ShapeConfiguration) -> ShapeTessellation:
+    """The Delaunay tessellation of a 1-irregular element, its elements the largest co-spherical sets.
+
+    Examples
+    --------
+    >>> from cospherical.core.shapes import ShapeConfiguration, standard_shape
+    >>> prism = standard_shape("prism")
+    >>> tess = tessellate_shape(ShapeConfiguration.from_code(prism, "888888888"))
+    >>> sorted(e.type.name for e in tess.elements), tess.fvm_adequate
+    (['Cuboid', 'Cuboid', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism'], True)
+    >>> tess = tessellate_shape(ShapeConfiguration.from_code(standard_shape("tetrahedron"), "800000"))
+    >>> [e.type.name for e in tess.elements], sum(e.polyhedron.unit_volume for e in tess.elements)
+    (['Tetrahedron', 'Tetrahedron'], Fraction(1, 6))
+    """
+    nodes = configuration.nodes()
+    return ShapeTessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared))

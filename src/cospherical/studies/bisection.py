@@ -19,9 +19,9 @@ from typing import Callable, NamedTuple, Sequence
 from ..catalogue import CRITERIA, Choice, choose
 from ..core.configuration import EDGES, Box, Configuration
 from ..core.element_types import ElementType, classify
-from ..core.shapes import ShapeConfiguration, mask_codes, shape_orbit_representatives, standard_shape, tessellate_shape
-from ..core.symmetry import Symmetry, box_symmetries, orbit_representatives
-from ..core.tessellation import Element, Tessellation, tessellate
+from ..core.shapes import ShapeConfiguration, mask_codes, standard_shape
+from ..core.symmetry import Symmetry, box_symmetries, orbit_representatives, shape_orbit_representatives, shape_symmetries
+from ..core.tessellation import Element, Tessellation, tessellate, tessellate_shape
 
 __all__ = ["Family", "Study", "TypeCount", "bisection_codes", "element_family", "map_tessellation", "run_study"]
 
@@ -64,7 +64,7 @@ def element_family(element: str, box: Box, face_points: str = "octree") -> Famil
         return Family(lambda code: Configuration.from_code(code, box, face_points), box_symmetries(box),
                       orbit_representatives, tessellate)
     shape = standard_shape(element, box)
-    return Family(lambda code: ShapeConfiguration.from_code(shape, code, face_points), shape.symmetries,
+    return Family(lambda code: ShapeConfiguration.from_code(shape, code, face_points), shape_symmetries(shape),
                   shape_orbit_representatives, tessellate_shape)
 
 
