@@ -9,10 +9,8 @@ its cells, as sets of vertex sets.
 from __future__ import annotations
 
 import json
-import math
 from fractions import Fraction
 
-import numpy as np
 import pytest
 import vtk
 from hypothesis import HealthCheck, given, settings
@@ -24,87 +22,8 @@ from cospherical.mesh.assembly import assemble
 from cospherical.mesh.checks import check_circumcenters, check_conformity, check_delaunay, check_volume
 from cospherical.mesh.delaunay import global_delaunay
 from cospherical.mesh.octree import build_octree, parse_shape
+from oracle import oracle_cells
 from vtk.util.numpy_support import vtk_to_numpy
-
-
-def _det3(a, b, c):
-    return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-            + a[2] * (b[0] * c[1] - b[1] * c[0]))
-
-
-def _det4(rows):
-    total = 0
-    for j in range(4):
-        minor = [[r[k] for k in range(4) if k != j] for r in rows[1:]]
-        total += (-1) ** j * rows[0][j] * _det3(*minor)
-    return total
-
-
-def oracle_cells(mesh) -> set[frozenset[int]]:
-    """Qhull's tetrahedra of every vertex, merged across faces when the fifth point is exactly on the sphere."""
-    from scipy.spatial import Delaunay
-
-    den = math.lcm(*(w.denominator for w in mesh.box.squared))
-    w = [int(x * den) for x in mesh.box.squared]
-    coords = [tuple(int(x) for x in v) for v in mesh.vertices]
-    tri = Delaunay(mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid), qhull_options="Qbb Qc Qz Q12 Qt")
-    assert len(tri.coplanar) == 0
-    simplices = tri.simplices.tolist()
-
-    def on_sphere(tet, v) -> bool:
-        o = coords[tet[0]]
-        rows = []
-        for u in (*tet[1:], v):
-            d = [coords[u][a] - o[a] for a in range(3)]
-            rows.append([*d, sum(w[a] * d[a] ** 2 for a in range(3))])
-        return _det4(rows) == 0
-
-    def flat(tet) -> bool:
-        o = coords[tet[0]]
-        return _det3(*([coords[u][a] - o[a] for a in range(3)] for u in tet[1:])) == 0
-
-    parent = list(range(len(simplices)))
-
-    def find(x):
-        while parent[x] != x:
-            parent[x] = parent[parent[x]]
-            x = parent[x]
-        return x
-
-    is_flat = [flat(t) for t in simplices]
-    for t, tet in enumerate(simplices):
-        for i, u in enumerate(tri.neighbors[t].tolist()):
-            if u < 0 or is_flat[t] or is_flat[u]:
-                continue
-            if on_sphere(tet, simplices[u][list(tri.neighbors[u]).index(t)]):
-                parent[find(t)] = find(u)
-    # through flat tetrahedra (four co-circular points): join their solid neighbours that share a sphere
-    flat_parent = {t: t for t, f in enumerate(is_flat) if f}
-
-    def flat_find(x):
-        while flat_parent[x] != x:
-            x = flat_parent[x]
-        return x
-
-    for t in flat_parent:
-        for u in tri.neighbors[t].tolist():
-            if u in flat_parent:
-                flat_parent[flat_find(t)] = flat_find(u)
-    around: dict[int, set[int]] = {}
-    for t in flat_parent:
-        around.setdefault(flat_find(t), set()).update(u for u in tri.neighbors[t].tolist()
-                                                      if u >= 0 and not is_flat[u])
-    for solid in around.values():
-        solid = sorted(solid)
-        for i, a in enumerate(solid):
-            for b in solid[i + 1:]:
-                if all(on_sphere(simplices[a], v) for v in simplices[b]):
-                    parent[find(a)] = find(b)
-    cells: dict[int, set[int]] = {}
-    for t, tet in enumerate(simplices):
-        if not is_flat[t]:
-            cells.setdefault(find(t), set()).update(tet)
-    return {frozenset(c) for c in cells.values()}
 
 
 def mesh_cells(mesh) -> set[frozenset[int]]:
