@@ -204,3 +204,22 @@ def test_the_picture_cuts_what_vtk_cuts(tmp_path):
     assert len(ours) == len(theirs) == len(types)
     assert np.allclose(np.sort(ours), theirs, rtol=1e-9, atol=1e-15)
     assert abs(ours.sum() - 1) < 1e-12
+    # the picture shows these sections: deep inside each (2 pixels from every side), its type's colour
+    from PIL import Image
+
+    from cospherical.outputs.mesh_picture import TAB20, cut_png, frame
+
+    cut_png(mesh, tmp_path / "mesh.png", at=at)
+    pixels = np.asarray(Image.open(tmp_path / "mesh.png").convert("RGB"))
+    _, _, x0, y0, scale = frame(1.0, 1.0)
+    commonest = sorted(set(types), key=lambda t: (-types.count(t), t))
+    checked = 0
+    for polygon, t in zip(polygons, types):
+        corners = np.c_[x0 + polygon[:, 0] * scale, y0 + (1 - polygon[:, 1]) * scale]  # pixel space
+        centre = corners.mean(axis=0)
+        edges = np.roll(corners, -1, axis=0) - corners
+        away = np.abs(np.cross(edges, centre - corners)) / np.hypot(*edges.T)
+        if away.min() > 2:
+            assert tuple(pixels[int(centre[1]), int(centre[0])]) == TAB20[commonest.index(t) % 20]
+            checked += 1
+    assert checked > len(polygons) / 2

@@ -2,14 +2,23 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
 
+from ..files.yamlio import atomic_open
 from ..mesh.assembly import Mesh
-from .latex import save_png
 
-__all__ = ["cut_png", "cut_polygons"]
+__all__ = ["TAB20", "cut_png", "cut_polygons", "frame"]
+
+# matplotlib's tab20 palette (its colours for the commonest types first, as the pictures always had)
+TAB20 = ((31, 119, 180), (174, 199, 232), (255, 127, 14), (255, 187, 120), (44, 160, 44), (152, 223, 138),
+         (214, 39, 40), (255, 152, 150), (148, 103, 189), (197, 176, 213), (140, 86, 75), (196, 156, 148),
+         (227, 119, 194), (247, 182, 210), (127, 127, 127), (199, 199, 199), (188, 189, 34), (219, 219, 141),
+         (23, 190, 207), (158, 218, 229))
+WHITE, BLACK, GREY = (255, 255, 255), (0, 0, 0), (204, 204, 204)
+OVER = 3  # over-sampling of the polygons: their outlines a third of a pixel wide, as thin as matplotlib's
 
 
 def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[str]]:
@@ -52,39 +61,91 @@ def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[st
 
 
 def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: int = 10) -> None:
-    """Write the cut through the mesh at z = ``at`` as PNG, elements coloured by type (legend: the commonest)."""
-    import matplotlib
+    """Write the cut through the mesh at z = ``at`` as PNG, elements coloured by type (legend: the commonest).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.collections import PolyCollection
-    from matplotlib.patches import Patch
+    Drawn with Pillow from the section polygons (a few thousand): the polygons
+    three times over-sampled and averaged down, outlined in black, in axes with
+    ticks, a title and a legend.  matplotlib would take a second to import and
+    draw the same; Pillow's own font makes the bytes the same on every machine.
+    """
+    from PIL import Image, ImageDraw, ImageFont
 
     polygons, types = cut_polygons(mesh, at)
     counts: dict[str, int] = {}
     for t in types:
         counts[t] = counts.get(t, 0) + 1
     order = sorted(counts, key=lambda t: (-counts[t], t))
-    palette = plt.get_cmap("tab20").colors
-    colour = {t: palette[i % len(palette)] for i, t in enumerate(order)}
+    colour = {t: TAB20[i % len(TAB20)] for i, t in enumerate(order)}
     a, b, _ = mesh.box.to_float()
-    fig, ax = plt.subplots(figsize=(10, 6.5 * min(2.0, max(0.6, b / a))))
-    fig.subplots_adjust(left=0.07, right=0.66, top=0.92, bottom=0.08)  # room for the legend on the right
-    ax.add_collection(PolyCollection(polygons, facecolors=[colour[t] for t in types], edgecolors="black",
-                                     linewidths=0.15))
-    ax.set_xlim(0, a)
-    ax.set_ylim(0, b)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.set_title(title or f"cut at z = {at:g} of the domain height", fontsize=8, wrap=True)
-
-    def label(t: str) -> str:
-        info = mesh.types.get(t, {})
-        return f"{info.get('name', t)} ({counts[t]})"
-
+    width, height, x0, y0, scale = frame(a, b)
+    w, h = round(scale * a), round(scale * b)
+    image = Image.new("RGB", (width, height), WHITE)
+    over = Image.new("RGB", (w * OVER, h * OVER), WHITE)
+    pen = ImageDraw.Draw(over)
+    s = scale * OVER
+    for polygon, t in zip(polygons, types):
+        pen.polygon([(x * s, (b - y) * s) for x, y in polygon.tolist()], fill=colour[t], outline=BLACK)
+    image.paste(over.reduce(OVER), (x0, y0))
+    draw = ImageDraw.Draw(image)
+    draw.rectangle((x0 - 1, y0 - 1, x0 + w, y0 + h), outline=BLACK)
+    ticks, label = ImageFont.load_default(18), ImageFont.load_default(18)
+    for value, text in _ticks(a):
+        x = x0 + value * scale
+        draw.line((x, y0 + h, x, y0 + h + 6), fill=BLACK)
+        draw.text((x, y0 + h + 9), text, font=ticks, fill=BLACK, anchor="mt")
+    for value, text in _ticks(b):
+        y = y0 + h - value * scale
+        draw.line((x0 - 7, y, x0 - 1, y), fill=BLACK)
+        draw.text((x0 - 10, y), text, font=ticks, fill=BLACK, anchor="rm")
+    draw.text((x0 + w / 2, y0 + h + 34), "x", font=label, fill=BLACK, anchor="mt")
+    draw.text((x0 - 10 - ticks.getlength(_ticks(b)[-1][1]) - 14, y0 + h / 2), "y", font=label, fill=BLACK,
+              anchor="rm")
+    small = ImageFont.load_default(14)
+    lines = _wrap(title or f"cut at z = {at:g} of the domain height", small, width - 40)
+    for i, line in enumerate(lines):
+        draw.text((x0 + w / 2, y0 - 8 - 18 * (len(lines) - 1 - i)), line, font=small, fill=BLACK, anchor="md")
     shown = order[:legend]
-    ax.legend(handles=[Patch(facecolor=colour[t], edgecolor="black", label=label(t)) for t in shown],
-              loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, title="element type (sections)",
-              title_fontsize=7)
-    save_png(fig, path, dpi=130)
+    if shown:
+        font = ImageFont.load_default(13)
+        rows = ["element type (sections)"] + [f"{mesh.types.get(t, {}).get('name', t)} ({counts[t]})" for t in shown]
+        box_width = 12 + 28 + 8 + max(int(font.getlength(r)) for r in rows) + 12
+        lx, ly = x0 + w + 12, y0
+        draw.rectangle((lx, ly, lx + box_width, ly + 10 + 20 * len(rows)), fill=WHITE, outline=GREY)
+        draw.text((lx + box_width / 2, ly + 6), rows[0], font=font, fill=BLACK, anchor="mt")
+        for i, (t, row) in enumerate(zip(shown, rows[1:]), 1):
+            y = ly + 8 + 20 * i
+            draw.rectangle((lx + 12, y + 2, lx + 40, y + 12), fill=colour[t], outline=BLACK)
+            draw.text((lx + 48, y + 7), row, font=font, fill=BLACK, anchor="lm")
+    with atomic_open(path, binary=True) as handle:
+        image.save(handle, format="png", optimize=False)
+
+
+def frame(a: float, b: float) -> tuple[int, int, int, int, float]:
+    """The picture of an ``a`` x ``b`` section: its width and height, the pixel of the section's corner (0, b), pixels per unit.
+
+    The axes have the left two thirds (the legend the rest); the section is drawn to
+    scale in them, centred.
+    """
+    width, height = 1300, round(845 * min(2.0, max(0.6, b / a)))
+    left, right, top, bottom = 0.07 * width, 0.66 * width, 0.08 * height, 0.92 * height
+    scale = min((right - left) / a, (bottom - top) / b)
+    return width, height, round((left + right - scale * a) / 2), round((top + bottom - scale * b) / 2), scale
+
+
+def _ticks(length: float) -> list[tuple[float, str]]:
+    """Round tick values from 0 to ``length``: steps of 1, 2 or 5 times a power of ten, 4 to 10 of them."""
+    power = 10.0 ** math.floor(math.log10(length))
+    step = next(m * power for m in (0.1, 0.2, 0.5, 1, 2, 5, 10) if length / (m * power) <= 8)
+    decimals = max(0, -math.floor(math.log10(step) + 1e-9))
+    return [(i * step, f"{i * step:.{decimals}f}") for i in range(int(length / step + 1e-9) + 1)]
+
+
+def _wrap(text: str, font, width: float) -> list[str]:
+    """``text`` broken at spaces into lines no wider than ``width`` pixels (a longer word stays whole)."""
+    lines: list[str] = []
+    for word in text.split(" "):
+        if lines and font.getlength(lines[-1] + " " + word) <= width:
+            lines[-1] += " " + word
+        else:
+            lines.append(word)
+    return lines
