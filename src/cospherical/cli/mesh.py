@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
@@ -63,6 +64,21 @@ def add_parser(commands) -> None:
                         help="global (default with the optimal criterion): the exact Delaunay subdivision of the "
                         "vertices, the leaves whose elements fail the exact check re-tessellated together; leaf "
                         "(default with a split criterion): each leaf's elements from its table")
+    parser.add_argument("--partitions", metavar="N",
+                        help="mesh the tree in N pieces (runs of the Morton curve: whole subtrees), as separate tasks "
+                        "on a local process pool (--jobs) or a Dask cluster; each piece checked exactly, across the "
+                        "seams too, and written as DIR/mesh-<k>.vtu with point data global_id, DIR/mesh.pvtu opening "
+                        "them as one mesh (no mesh.vtu, mesh.png or --dual)")
+    parser.add_argument("--jobs", metavar="N",
+                        help="worker processes for --partitions (default: as many as pieces, at most the cores); "
+                        "1 meshes the pieces one after another in this process")
+    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                        help="run the pieces on this Dask scheduler's workers (with --partitions; --out DIR must be "
+                        "a folder the workers share)")
+    parser.add_argument("--scheduler-timeout", type=float, default=30.0, metavar="SECONDS",
+                        help="give up connecting to --scheduler after this long (default 30)")
+    parser.add_argument("--dask-workers", type=int, metavar="N",
+                        help="run the pieces on a local Dask cluster of N processes (with --partitions)")
     parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check of the result")
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
@@ -75,6 +91,16 @@ def _max_leaves(text: str | None) -> int | None:
     value = text.strip()
     if not (value.isascii() and value.isdigit() and 0 < len(value) <= 15) or int(value) == 0:
         raise InputError(f"--max-leaves {text!r}: must be a positive integer")
+    return int(value)
+
+
+def _count(text: str | None, option: str, most: int) -> int | None:
+    """A count from 1 to ``most`` given as ``option``, or ``None`` when it was not given."""
+    if text is None:
+        return None
+    value = text.strip()
+    if not (value.isascii() and value.isdigit() and len(value) <= 15) or not 1 <= int(value) <= most:
+        raise InputError(f"{option} {text!r}: must be an integer from 1 to {most:,}")
     return int(value)
 
 
@@ -122,11 +148,38 @@ OUTPUTS = ("mesh.vtu", "report.json", "mesh.png")
 
 
 def run(args) -> int:
+    pieces = _pieces(args)
     if args.out is None:
         return _run(args, None)
-    names = OUTPUTS + (("dual.npz",) if args.dual else ())
+    if pieces is not None:
+        names = ("mesh.pvtu", "report.json", *(piece_name(k) for k in range(pieces)))
+    else:
+        names = OUTPUTS + (("dual.npz",) if args.dual else ())
     with OutputFolder(args.out, "mesh", names) as out:  # locked from the start; every file or none
         return _run(args, out)
+
+
+def piece_name(k: int) -> str:
+    return f"mesh-{k}.vtu"
+
+
+def _pieces(args) -> int | None:
+    """``--partitions`` and its backend, checked before any work; ``None`` without it."""
+    from ..mesh.partition import MAX_PARTITIONS
+    from ..studies.intersection.backends import check_backend
+
+    pieces = _count(args.partitions, "--partitions", MAX_PARTITIONS)
+    backend = [option for option, value in (("--jobs", args.jobs), ("--scheduler", args.scheduler),
+                                            ("--dask-workers", args.dask_workers)) if value is not None]
+    if pieces is None:
+        if backend:
+            raise InputError(f"{backend[0]} runs the pieces of --partitions N: give that too")
+        return None
+    if args.dual:
+        raise InputError("--dual needs the whole mesh in one process: not with --partitions")
+    check_backend("cospherical mesh", args.scheduler, args.dask_workers, args.scheduler_timeout)
+    args.jobs = _count(args.jobs, "--jobs", 4096) or min(pieces, os.cpu_count() or 1)
+    return pieces
 
 
 def _run(args, out: OutputFolder | None) -> int:
@@ -152,13 +205,17 @@ def _run(args, out: OutputFolder | None) -> int:
                      "balance": args.balance, "depth": tree.depth}
     timings = {"tree": time.perf_counter() - clock}
     clock = time.perf_counter()
-    lookup = None
+    table = lookup = None
     if args.patterns is not None:
         from ..formats.patterns import load
 
-        lookup = table_lookup(load(args.patterns), args.criterion, box, str(args.patterns))
+        table = (load(args.patterns), args.criterion, box, str(args.patterns))
+        if args.partitions is None:
+            lookup = table_lookup(*table)
         timings["table"] = time.perf_counter() - clock
         clock = time.perf_counter()
+    if args.partitions is not None:
+        return _in_pieces(args, tree, described, table, mode, out)
     large = len(tree) > 50_000  # bars on large trees only (and only on a terminal: tqdm's disable=None)
     bars = {"assembly": (len(tree), "assembling", "leaf"), "regions": (None, "Delaunay check (leaf mesh)", "element"),
             "delaunay": (None, "Delaunay check", "element")}
@@ -218,15 +275,39 @@ def _run(args, out: OutputFolder | None) -> int:
                       f"elements, {report['types']} types (cut at z = {at * float(box.c):.4g})")
         write_report(report, out.path("report.json"))
     timings["outputs"] = time.perf_counter() - clock
+    _print(args, report)
+    if dual is not None and args.format != "json":
+        negative = report["negative_coefficients"]
+        sys.stdout.write(f"dual_edges: {report['dual']['edges']:,}\n"
+                         f"negative_coefficients: {negative['interior']:,} interior, {negative['boundary']:,} "
+                         "boundary\n")
+    if sys.stderr.isatty():
+        print("cospherical mesh: seconds " + ", ".join(f"{k} {v:.2f}" for k, v in timings.items()), file=sys.stderr)
+    return 0
+
+
+def _print(args, report: dict) -> None:
     if args.format == "json":
         sys.stdout.write(report_json(report))
     else:
         sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in SUMMARY_KEYS))
-        if dual is not None:
-            negative = report["negative_coefficients"]
-            sys.stdout.write(f"dual_edges: {report['dual']['edges']:,}\n"
-                             f"negative_coefficients: {negative['interior']:,} interior, {negative['boundary']:,} "
-                             "boundary\n")
-    if sys.stderr.isatty():
-        print("cospherical mesh: seconds " + ", ".join(f"{k} {v:.2f}" for k, v in timings.items()), file=sys.stderr)
+
+
+def _in_pieces(args, tree, described: dict, table: tuple | None, mode: str, out: OutputFolder | None) -> int:
+    """``--partitions N``: the pieces meshed, checked and written by tasks, mesh.pvtu and the report here."""
+    from ..formats.mesh import write_piece, write_pvtu
+    from ..mesh.partition import mesh_in_pieces
+
+    pieces = int(args.partitions)
+    paths = [str(out.path(piece_name(k))) for k in range(pieces)] if out is not None else None
+    report = mesh_in_pieces(tree, pieces, (table_lookup, table) if table is not None else None, args.criterion,
+                            mode, described, args.patterns.name if args.patterns else None,
+                            uniform=not args.no_uniform, delaunay=not args.no_delaunay,
+                            write=write_piece if out is not None else None,
+                            path=paths.__getitem__ if paths is not None else None, jobs=args.jobs,
+                            scheduler=args.scheduler, dask_workers=args.dask_workers)
+    if out is not None:
+        write_pvtu(out.path("mesh.pvtu"), [Path(p) for p in paths])
+        write_report(report, out.path("report.json"))
+    _print(args, report)
     return 0

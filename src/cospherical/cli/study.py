@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import sys
 from pathlib import Path
 
@@ -170,6 +169,7 @@ def _report(summary: dict, args, study=None) -> int:
 
 def _intersection(args) -> int:
     from ..studies.intersection import run_intersection, set_patterns  # numpy: not for the other studies
+    from ..studies.intersection.backends import check_backend
 
     if Box.parse(args.box).squared != (1, 1, 1) or args.face_points != "octree":
         raise UsageError("cospherical study: error: the intersection study is the paper's: the cube, octree points")
@@ -181,24 +181,7 @@ def _intersection(args) -> int:
         raise UsageError("cospherical study: error: --patterns-format is the form of the --patterns table")
     if args.resume and not args.out:
         raise UsageError("cospherical study: error: --resume keeps its checkpoints in --out DIR")
-    if args.scheduler and args.dask_workers:
-        raise UsageError("cospherical study: error: give --scheduler or --dask-workers, not both")
-    if args.dask_workers is not None and args.dask_workers < 1:
-        raise UsageError(f"cospherical study: error: --dask-workers {args.dask_workers}: at least 1")
-    if args.scheduler or args.dask_workers:
-        from importlib.util import find_spec
-
-        if find_spec("distributed") is None:
-            raise UsageError("cospherical study: error: the Dask backend needs dask.distributed: "
-                             "pip install 'cospherical[dask]'")
-    if args.scheduler:
-        if not re.fullmatch(r"(tcp|tls|ucx)://[A-Za-z0-9._\[\]:-]+", args.scheduler):
-            raise UsageError(f"cospherical study: error: --scheduler {args.scheduler!r}: give tcp://HOST:PORT")
-        if not args.scheduler_timeout > 0:
-            raise UsageError(f"cospherical study: error: --scheduler-timeout {args.scheduler_timeout}: must be > 0")
-        import dask
-
-        dask.config.set({"distributed.comm.timeouts.connect": f"{args.scheduler_timeout}s"})
+    check_backend("cospherical study", args.scheduler, args.dask_workers, args.scheduler_timeout)
     checkpoints = args.out / "checkpoints" if args.out else None
     total = len(set_patterns(args.resolution, args.order)) ** 3  # one pattern per set of parallel edges
     with stage_bars({"cells": (total, f"intersection 1/{args.resolution}: cells", "cfg"),

@@ -22,6 +22,7 @@ import json
 import os
 import re
 from pathlib import Path
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -32,7 +33,7 @@ from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
 
 __all__ = ["REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "vtu_arrays",
-           "write_report", "write_vtu"]
+           "write_piece", "write_pvtu", "write_report", "write_vtu"]
 
 REPORT_SCHEMA_VERSION = 1
 MAX_LEAF_FILE = 2 * 1024**3
@@ -245,7 +246,8 @@ def vtu_arrays(mesh: Mesh) -> dict:
             "faces": faces, "faceoffsets": faceoffsets, "element_type": element_type}
 
 
-def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell_data: dict | None = None) -> None:
+def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell_data: dict | None = None,
+              leaves: np.ndarray | None = None) -> None:
     """Write the mesh as one compressed binary VTU grid, atomically (a complete new file or the old one).
 
     Standard VTK cells (tetra, pyramid, wedge, hexahedron, nodes in VTK order) for
@@ -259,7 +261,8 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
     level, then by the key ``(i * 2**level + j) * 2**level + k`` of its position, not the
     order of a ``--leaves`` file), ``fvm`` (its circumcenter lies in its
     closed leaf, decided exactly), then ``cell_data`` (one row per element, in
-    element order: written in cell order).
+    element order: written in cell order).  ``leaves``: when ``mesh`` is a piece of a
+    tree, its leaves' indices in the whole tree, which ``leaf`` then gives.
     Field data (text as UTF-8 bytes, ``bytes(array).decode()``): ``type_ids`` and
     ``type_names`` (one per line, in ``type`` order), ``domain`` (the lengths as
     given), ``domain_squared`` (their exact squares), and ``grid_intervals``: a point's
@@ -279,7 +282,7 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
         "grid_intervals": np.array([mesh.grid], dtype=np.int64),
     }
     cells = {"element": order.astype(np.int32), "type": arrays["element_type"][order].astype(np.int32),
-             "leaf": mesh.element_leaf[order].astype(np.int32), "fvm": mesh.element_fvm()[order].astype(np.uint8)}
+             "leaf": (mesh.element_leaf if leaves is None else leaves[mesh.element_leaf])[order].astype(np.int32), "fvm": mesh.element_fvm()[order].astype(np.uint8)}
     for name, values in (cell_data or {}).items():
         if name in cells:
             raise ValueError(f"cell data {name!r}: the writer's own")
@@ -304,3 +307,70 @@ def report_json(report: dict) -> str:
 
 def write_report(report: dict, path: str | Path) -> None:
     atomic_write(path, report_json(report))
+
+
+def write_piece(mesh: Mesh, path: str | Path, leaves: np.ndarray) -> None:
+    """One piece of a partitioned mesh as a VTU grid (see :func:`write_vtu`), atomically.
+
+    Only the vertices its elements use, in the order of their ids; point data
+    ``global_id`` (Int64, VTK's ``vtkIdType``) is each one's id in the whole mesh, the
+    same in every piece that holds it.  ``leaves``: the piece's leaves' indices in
+    the whole tree (cell data ``leaf``); ``element`` counts the piece's own elements,
+    and ``type`` indexes the piece's own ``type_ids``: a reader that joins the pieces
+    keeps one piece's field data, so cell data ``type_hash`` (the six hexadecimal
+    digits that end the type id, as an integer) names the type the same in every piece.
+    """
+    from dataclasses import replace
+
+    conn, _ = mesh.connectivity()
+    used = np.unique(conn[conn >= 0])
+    index = np.full(len(mesh.vertices), -1, dtype=np.int64)
+    index[used] = np.arange(len(used))
+
+    def local(ids: np.ndarray) -> np.ndarray:
+        return np.where(ids >= 0, index[np.maximum(ids, 0)], -1).astype(ids.dtype)
+
+    cells = replace(mesh.cells, nodes=local(mesh.cells.nodes)) if mesh.cells is not None else None
+    piece = replace(mesh, vertices=mesh.vertices[used], slots=local(mesh.slots), cells=cells, _groups=None)
+    ids, element_type = mesh.element_types()
+    hashes = np.array([int(t.rsplit("-", 1)[1], 16) for t in ids], dtype=np.int32)
+    write_vtu(piece, path, point_data={"global_id": used.astype(np.int64)},
+              cell_data={"type_hash": hashes[element_type] if len(ids) else np.zeros(0, dtype=np.int32)},
+              leaves=leaves)
+
+
+_DECLARED = re.compile(r"<(PointData|CellData|Points)>(.*?)</\1>", re.S)
+_DATA_ARRAY = re.compile(r'<DataArray type="(\w+)" Name=("[^"]*")(?: NumberOfComponents="(\d+)")?')
+
+
+def write_pvtu(path: str | Path, pieces: list[Path]) -> None:
+    """The ``.pvtu`` file (VTK's PUnstructuredGrid) that opens ``pieces`` (VTU files beside it) as one mesh, atomically.
+
+    The point and cell data arrays are declared as the pieces have them, read from
+    their headers; pieces that do not agree are refused.  ParaView and VTK's
+    ``vtkXMLPUnstructuredGridReader`` read it.
+    """
+    declared = None
+    for piece in pieces:
+        with open(piece, "rb") as handle:
+            head = handle.read(1 << 16).split(b"<AppendedData", 1)[0].decode()
+        mine = {section: _DATA_ARRAY.findall(body) for section, body in _DECLARED.findall(head)}
+        if declared is None:
+            declared = mine
+        elif mine != declared:
+            raise ValueError(f"{piece}: its arrays are not the first piece's")
+
+    def arrays(section: str) -> list[str]:
+        return [f'<PDataArray type="{kind}"' + (f" Name={name}" if section != "Points" else "")
+                + (f' NumberOfComponents="{components}"' if components else "") + "/>"
+                for kind, name, components in declared.get(section, [])]
+
+    xml = ['<?xml version="1.0"?>',
+           '<VTKFile type="PUnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">',
+           '<PUnstructuredGrid GhostLevel="0">',
+           "<PPointData>", *arrays("PointData"), "</PPointData>",
+           "<PCellData>", *arrays("CellData"), "</PCellData>",
+           "<PPoints>", *arrays("Points"), "</PPoints>",
+           *(f"<Piece Source={quoteattr(Path(piece).name)}/>" for piece in pieces),
+           "</PUnstructuredGrid>", "</VTKFile>"]
+    atomic_write(path, "\n".join(xml) + "\n")

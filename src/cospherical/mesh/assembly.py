@@ -35,7 +35,8 @@ from ..errors import InputError
 from ..paper import paper_class
 from .octree import Octree
 
-__all__ = ["CellShape", "Cells", "LocalElement", "LocalPattern", "Mesh", "NODE_OFFSETS", "assemble", "local_pattern"]
+__all__ = ["CellShape", "Cells", "LocalElement", "LocalPattern", "Mesh", "NODE_OFFSETS", "assemble", "local_pattern",
+           "vertex_keys"]
 
 # Twice the unit coordinates of the 27 nodes (corners, edge midpoints, face centres, body).
 NODE_OFFSETS = np.array(
@@ -338,8 +339,32 @@ def leaf_code(edges: int, faces: int) -> str:
     return digits + "+f" + "".join(str(f) for f in range(6) if faces >> f & 1)
 
 
+def vertex_keys(tree: Octree) -> tuple[int, np.ndarray]:
+    """The vertex grid of a tree: its intervals per domain side and the sorted keys of every leaf corner.
+
+    A vertex ``(x, y, z)`` of the grid has the key ``(x * (grid + 1) + y) * (grid + 1) + z``;
+    its index in the keys is its id in the mesh, so a mesh assembled from a part of the
+    tree with these keys numbers its vertices as the whole tree's mesh does.
+    """
+    levels = tree.levels.astype(np.int64)
+    grid = 1 << (tree.depth + 1)
+    size = grid >> levels
+    origin = tree.positions.astype(np.int64) * size[:, None]
+    keys = np.sort(_node_keys(origin, size // 2, grid, slice(None), slice(0, 8)), axis=None)
+    # sort and keep firsts: numpy's hash-based unique is much slower on int64 keys
+    return grid, keys[np.r_[True, keys[1:] != keys[:-1]]]
+
+
+def _node_keys(origin: np.ndarray, half: np.ndarray, grid: int, part: slice, nodes: slice) -> np.ndarray:
+    # per axis, (leaves x nodes): far cheaper than one (leaves x nodes x 3) array
+    n = np.int64(grid + 1)
+    x, y, z = (origin[part, a, None] + NODE_OFFSETS[None, nodes, a] * half[part, None] for a in range(3))
+    return (x * n + y) * n + z
+
+
 def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int], None] | None = None,
-             cache: dict | None = None, criterion: str = "optimal") -> Mesh:
+             cache: dict | None = None, criterion: str = "optimal",
+             vertices: tuple[int, np.ndarray] | None = None) -> Mesh:
     """Mesh an octree: configurations from the vertex set, elements from ``lookup`` (else tessellated).
 
     ``lookup(configuration)`` returns the pattern table's elements of that point set
@@ -347,7 +372,9 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     configuration without table elements is tessellated on the fly (and marked so), its
     elements split by the catalogue's kept types when ``criterion`` is not ``optimal``.
     ``cache`` ((code, criterion) -> :class:`LocalPattern`) may be shared between runs.
-    ``progress(n)`` is told as leaves are assembled.
+    ``progress(n)`` is told as leaves are assembled.  ``vertices``: the grid and vertex keys
+    (:func:`vertex_keys`) of a whole tree of which ``tree`` is a part: the part's
+    configurations and vertex ids are then the whole tree's.
 
     Examples
     --------
@@ -357,29 +384,19 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     (8, 27, 8)
     """
     cache = {} if cache is None else cache
-    levels = tree.levels.astype(np.int64)
-    grid = 1 << (tree.depth + 1)
-    size = grid >> levels  # leaf edge in grid units (even)
+    grid, keys_all = vertex_keys(tree) if vertices is None else vertices
+    size = grid >> tree.levels.astype(np.int64)  # leaf edge in grid units (even)
     origin = tree.positions.astype(np.int64) * size[:, None]
     half = size // 2
     n = np.int64(grid + 1)
-
-    def keys_at(part: slice, nodes: slice) -> np.ndarray:
-        # per axis, (leaves x nodes): far cheaper than one (leaves x nodes x 3) array
-        x, y, z = (origin[part, a, None] + NODE_OFFSETS[None, nodes, a] * half[part, None] for a in range(3))
-        return (x * n + y) * n + z
-
-    vertex_keys = np.sort(keys_at(slice(None), slice(0, 8)), axis=None)
-    # sort and keep firsts: numpy's hash-based unique is much slower on int64 keys
-    vertex_keys = vertex_keys[np.r_[True, vertex_keys[1:] != vertex_keys[:-1]]]
-    vertices = np.stack([vertex_keys // (n * n), (vertex_keys // n) % n, vertex_keys % n], axis=1)
+    vertices = np.stack([keys_all // (n * n), (keys_all // n) % n, keys_all % n], axis=1)
     slots = np.empty((len(tree), 27), dtype=np.int32)
     chunk = 1 << 18
     for start in range(0, len(tree), chunk):  # bounded temporaries on large trees
         part = slice(start, start + chunk)
-        keys = keys_at(part, slice(None))
-        where = np.minimum(np.searchsorted(vertex_keys, keys), len(vertex_keys) - 1)
-        slots[part] = np.where(vertex_keys[where] == keys, where, -1)
+        keys = _node_keys(origin, half, grid, part, slice(None))
+        where = np.minimum(np.searchsorted(keys_all, keys), len(keys_all) - 1)
+        slots[part] = np.where(keys_all[where] == keys, where, -1)
         if progress:
             progress(min(chunk, len(tree) - start) // 2)
     if (slots[:, 26] >= 0).any():

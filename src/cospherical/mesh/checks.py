@@ -23,7 +23,7 @@ import numpy as np
 
 from .assembly import Mesh
 
-__all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume"]
+__all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "match_seams"]
 
 
 def check_volume(mesh: Mesh) -> dict:
@@ -66,7 +66,7 @@ def _faces(mesh: Mesh) -> dict[int, list[np.ndarray]]:
     return by_size
 
 
-def check_conformity(mesh: Mesh, examples: int = 5) -> dict:
+def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -> dict:
     """Every interior face shared by exactly two elements, same vertices, opposite orientation; the rest on the boundary.
 
     A face is its cycle of global vertex ids, turned to start at its smallest id
@@ -74,6 +74,10 @@ def check_conformity(mesh: Mesh, examples: int = 5) -> dict:
     is its orientation.  A face met once must lie in one plane of the domain's
     boundary; a face met twice must be met once in each orientation; anything else
     (a hanging face, a T-junction, an overlap) counts as nonconforming.
+
+    ``seams``, a list, makes ``mesh`` one piece of a partitioned mesh: its faces met
+    once off the domain's boundary are not counted but appended to it (size, turned
+    faces, orientations), for :func:`match_seams` to pair with the other pieces'.
 
     Returns ``nonconforming_faces`` (face occurrences), ``interior_faces`` (pairs),
     ``boundary_faces`` and up to ``examples`` nonconforming faces (vertex
@@ -98,17 +102,8 @@ def check_conformity(mesh: Mesh, examples: int = 5) -> dict:
         turned = np.take_along_axis(faces, (start[:, None] + np.arange(size)[None]) % size, axis=1)
         flipped = turned[:, 1] > turned[:, -1]
         turned[flipped, 1:] = turned[flipped, :0:-1]
-        order = np.lexsort(turned.T[::-1])
-        turned, flipped = turned[order], flipped[order]
-        new = np.r_[True, np.any(turned[1:] != turned[:-1], axis=1)]
-        starts = np.flatnonzero(new)
-        counts = np.diff(np.r_[starts, len(turned)])
-        ok = np.zeros(len(turned), dtype=bool)
-        pairs = starts[counts == 2]
-        good_pairs = pairs[flipped[pairs] != flipped[pairs + 1]]
-        ok[good_pairs] = ok[good_pairs + 1] = True
-        interior += len(good_pairs)
-        single = starts[counts == 1]
+        turned, flipped, ok, pairs, single = _paired(turned, flipped)
+        interior += pairs
         points = mesh.vertices[turned[single]]  # (n, size, 3)
         on_boundary = np.zeros(len(single), dtype=bool)
         for axis in range(3):
@@ -116,12 +111,61 @@ def check_conformity(mesh: Mesh, examples: int = 5) -> dict:
                 on_boundary |= np.all(points[:, :, axis] == side, axis=1)
         ok[single[on_boundary]] = True
         boundary += int(on_boundary.sum())
+        if seams is not None:
+            seam = single[~on_boundary]
+            seams.append((size, turned[seam], flipped[seam]))
+            ok[seam] = True
         bad = np.flatnonzero(~ok)
         bad_total += len(bad)
         for row in bad[:max(0, examples - len(shown))]:
             shown.append((mesh.vertices[turned[row]] / grid).tolist())
     return {"nonconforming_faces": int(bad_total), "interior_faces": int(interior), "boundary_faces": int(boundary),
             "nonconforming_examples": shown}
+
+
+def _paired(turned: np.ndarray, flipped: np.ndarray):
+    """Sort turned faces; mark those met exactly twice in opposite orientations.
+
+    Returns the sorted faces and orientations, the mask of faces so paired, how many
+    pairs, and the indices of the faces met once.
+    """
+    order = np.lexsort(turned.T[::-1])
+    turned, flipped = turned[order], flipped[order]
+    new = np.r_[True, np.any(turned[1:] != turned[:-1], axis=1)]
+    starts = np.flatnonzero(new)
+    counts = np.diff(np.r_[starts, len(turned)])
+    ok = np.zeros(len(turned), dtype=bool)
+    pairs = starts[counts == 2]
+    good_pairs = pairs[flipped[pairs] != flipped[pairs + 1]]
+    ok[good_pairs] = ok[good_pairs + 1] = True
+    return turned, flipped, ok, len(good_pairs), starts[counts == 1]
+
+
+def match_seams(seams: list, vertices, grid: int, examples: int = 5) -> dict:
+    """Pair the faces that the pieces of a partitioned mesh left open (see :func:`check_conformity`'s ``seams``).
+
+    Why this equals the check of the whole mesh: the pieces hold disjoint sets of
+    elements, so a face's occurrences in the whole mesh are the sum of its
+    occurrences in the pieces.  A face a piece meets once off the boundary is sent
+    here; a conforming whole meets it exactly once more, in another piece, in the
+    opposite orientation, so it pairs here.  Every occurrence that does not pair is
+    nonconforming.  ``vertices(ids)`` gives grid points (for the examples).
+
+    Returns ``interior_faces`` (pairs across seams), ``nonconforming_faces`` and
+    ``nonconforming_examples``.
+    """
+    interior = bad_total = 0
+    shown: list = []
+    for size in sorted({size for size, _, _ in seams}):
+        parts = [(t, f) for s, t, f in seams if s == size]
+        turned, _, ok, pairs, _ = _paired(np.concatenate([t for t, _ in parts]),
+                                                np.concatenate([f for _, f in parts]))
+        interior += pairs
+        bad = np.flatnonzero(~ok)
+        bad_total += len(bad)
+        for row in bad[:max(0, examples - len(shown))]:
+            shown.append((vertices(turned[row]) / grid).tolist())
+    return {"interior_faces": int(interior), "nonconforming_faces": int(bad_total), "nonconforming_examples": shown}
 
 
 def check_circumcenters(mesh: Mesh) -> dict:
@@ -186,7 +230,6 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     grid = mesh.grid
     scale = np.array(mesh.box.to_float()) / grid
     points = mesh.vertices * scale
-    tree = cKDTree(points)
     levels = mesh.tree.levels.astype(np.int64)
     size = grid >> levels
     origin = mesh.tree.positions.astype(np.int64) * size[:, None]
@@ -223,6 +266,13 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     rows_pattern, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_pattern, rows_local, rows_leaf))
     centres, radii, n_nodes = np.concatenate(centres), np.concatenate(radii), np.concatenate(n_nodes)
     reach = radii * (1 + 1e-9) + 1e-12 * float(np.abs(points).max())
+    # Only vertices in the box around every reach can be within one: the rest are left out of the
+    # search (a piece of a partitioned mesh holds all the vertices but searches its surroundings).
+    low, high = (centres - reach[:, None]).min(axis=0), (centres + reach[:, None]).max(axis=0)
+    near = np.flatnonzero(((points >= low) & (points <= high)).all(axis=1))
+    tree = cKDTree(points[near] if len(near) < len(points) else points)
+    if len(near) == len(points):
+        near = None
     counts = np.empty(len(centres), dtype=np.int64)
     chunk = 1 << 18
     for start in range(0, len(centres), chunk):
@@ -238,7 +288,8 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         found = tree.query_ball_point(centres[rows], reach[rows], workers=workers)
         lengths = np.fromiter((len(x) for x in found), dtype=np.int64, count=len(found))
         pairs_row.append(np.repeat(rows, lengths))
-        pairs_vertex.append(np.fromiter((v for x in found for v in x), dtype=np.int64, count=int(lengths.sum())))
+        found_vertices = np.fromiter((v for x in found for v in x), dtype=np.int64, count=int(lengths.sum()))
+        pairs_vertex.append(found_vertices if near is None else near[found_vertices])
     pair_row = np.concatenate(pairs_row) if pairs_row else np.zeros(0, dtype=np.int64)
     pair_vertex = np.concatenate(pairs_vertex) if pairs_vertex else np.zeros(0, dtype=np.int64)
     # drop each element's own nodes: a (pattern, element) -> local node table, padded with slot 26 (never a vertex)

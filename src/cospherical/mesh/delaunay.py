@@ -58,7 +58,7 @@ from ..errors import CosphericalError, InputError
 from .assembly import CellShape, Cells, Mesh, _type_info
 from .checks import _weights, check_delaunay
 
-__all__ = ["MODES", "delaunay_mesh", "global_delaunay"]
+__all__ = ["MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
 
 def global_delaunay(mesh: Mesh, found: dict | None = None) -> Mesh:
@@ -85,6 +85,17 @@ def global_delaunay(mesh: Mesh, found: dict | None = None) -> Mesh:
         raise ValueError("the mesh already holds re-tessellated cells")
     bad = np.zeros(len(mesh.tree), dtype=bool)
     bad[mesh.element_leaf[elements]] = True
+    types = dict(mesh.types)
+    return with_cells(mesh, bad, retessellate(mesh, bad, types), types)
+
+
+def retessellate(mesh: Mesh, bad: np.ndarray, types: dict) -> Cells:
+    """The cells of the Delaunay subdivision of ``mesh``'s vertices inside the marked leaves (see the module's proof).
+
+    ``mesh`` may hold only some of a tree's leaves (with the whole tree's vertices):
+    a point outside its leaves is outside every region, as it is outside the marked
+    leaves of the whole tree.  ``types`` receives the cells' types it lacks (id -> name, class, VTK cell).
+    """
     region_of_leaf, regions = _regions(mesh, bad)
     weights = _weights(mesh)
     located = _Locator(mesh)
@@ -95,11 +106,14 @@ def global_delaunay(mesh: Mesh, found: dict | None = None) -> Mesh:
         ids = ids[ids >= 0]
         region_sizes.append(len(ids))
         tets.append(_region_tetrahedra(mesh, ids, r, region_of_leaf, located, weights))
-    tets = np.concatenate(tets)
-    types = dict(mesh.types)
-    cells = _cells(mesh, tets, weights, located, types)
-    cells = Cells(cells.shapes, cells.shape, cells.anchor, cells.nodes, cells.leaf, cells.spanning,
-                  regions=int(regions), largest_region=int(max(region_sizes)))
+    cells = _cells(mesh, np.concatenate(tets), weights, located, types)
+    return Cells(cells.shapes, cells.shape, cells.anchor, cells.nodes, cells.leaf, cells.spanning,
+                 regions=int(regions), largest_region=int(max(region_sizes)))
+
+
+def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict) -> Mesh:
+    """``mesh`` with the elements of the marked leaves replaced by ``cells`` (whose ``leaf`` indexes its leaves);
+    ``types``: the element types of the result."""
     counts = np.array([len(p.elements) for p in mesh.patterns], dtype=np.int64)[mesh.leaf_pattern]
     counts[bad] = 0
     offsets = np.zeros(len(mesh.tree) + 1, dtype=np.int64)

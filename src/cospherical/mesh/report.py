@@ -1,7 +1,14 @@
-"""The report of a meshed octree: sizes, the exact checks, and the frequency-weighted statistics."""
+"""The report of a meshed octree: sizes, the exact checks, and the frequency-weighted statistics.
+
+The report is made of figures that add up: :func:`mesh_figures` measures one mesh,
+or one piece of a partitioned mesh, and :func:`merged_report` adds the pieces' figures
+up (pairing the faces left open at the seams) into the report of the whole.  A
+mesh in one piece goes the same way (:func:`mesh_report`), so the two cannot drift apart.
+"""
 
 from __future__ import annotations
 
+from collections import Counter
 from fractions import Fraction
 from typing import Callable
 
@@ -10,10 +17,18 @@ import numpy as np
 from ..catalogue import shipped_catalogue
 from ..version import __version__
 from .assembly import Mesh
-from .checks import check_circumcenters, check_conformity, check_delaunay, check_volume
-from .statistics import level_counts, mesh_statistics, uniform_study
+from .checks import check_circumcenters, check_conformity, check_delaunay, check_volume, match_seams
+from .octree import Octree
+from .statistics import level_counts, occurrences, statistics, uniform_study
 
-__all__ = ["mesh_report", "outside_catalogue"]
+__all__ = ["merged_report", "mesh_figures", "mesh_report", "outside_catalogue"]
+
+# Figures of the pieces that the whole's report adds up.
+_SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_faces", "circumcenters_outside_leaf",
+           "leaves_not_fvm_adequate", "elements_not_cospherical", "boundary_circumcenters_outside",
+           "delaunay_violations", "delaunay_violating_pairs", "delaunay_violating_leaves", "delaunay_ties",
+           "delaunay_exact_tests", "delaunay_violating_fvm_leaves", "leaves_tessellated_on_the_fly",
+           "cells_spanning_leaves")
 
 
 def outside_catalogue(mesh: Mesh) -> list[dict]:
@@ -25,7 +40,7 @@ def outside_catalogue(mesh: Mesh) -> list[dict]:
     known = {entry["id"] for entry in shipped_catalogue()["types"]}
     found: dict[str, dict] = {}
     for rows, nodes, _, type_id in mesh.blocks():
-        if type_id in known:
+        if type_id in known or not len(rows):
             continue
         entry = found.setdefault(type_id, {"id": type_id, "name": mesh.types.get(type_id, {}).get("name", type_id),
                                            "count": 0, "example": None})
@@ -33,6 +48,125 @@ def outside_catalogue(mesh: Mesh) -> list[dict]:
         if entry["example"] is None:
             entry["example"] = [[str(Fraction(int(x), mesh.grid)) for x in mesh.vertices[v]] for v in nodes[0]]
     return sorted(found.values(), key=lambda e: (-e["count"], e["id"]))
+
+
+def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None] | None = None,
+                 progress: Callable[[int], None] | None = None, checked: dict | None = None,
+                 seams: list | None = None) -> dict:
+    """Every exact check and count of ``mesh`` (or of one piece of a partitioned mesh), as figures that add up.
+
+    ``seams``, a list, receives the faces a piece leaves open (see
+    :func:`~cospherical.mesh.checks.check_conformity`).  The figures hold
+    ``_violating``: the elements whose sphere strictly holds a vertex (an array).
+    """
+    def start(name: str) -> None:
+        if stage:
+            stage(name)
+
+    figures = {"elements": len(mesh), "types_outside_catalogue": outside_catalogue(mesh),
+               "cells_spanning_leaves": int(mesh.cells.spanning.sum()) if mesh.cells is not None else 0}
+    start("volume")
+    volume = check_volume(mesh)
+    figures.update(volume=Fraction(volume["volume"]), flat_elements=volume["flat_elements"])
+    start("conformity")
+    figures.update(check_conformity(mesh, seams=seams))
+    start("circumcenters")
+    figures.update(check_circumcenters(mesh))
+    if delaunay:
+        start("delaunay")
+        found = dict(checked) if checked is not None else check_delaunay(mesh, progress=progress)
+        bad_leaves = found.pop("_leaves")
+        figures["_violating"] = found.pop("_elements")
+        found.pop("_not_cells")
+        figures.update(found)
+        # the issue's point: a leaf can be fvm_adequate on its own and still not globally Delaunay
+        fvm = np.array([p.fvm_adequate for p in mesh.patterns], dtype=bool)[mesh.leaf_pattern[bad_leaves]]
+        figures["delaunay_violating_fvm_leaves"] = int(fvm.sum())
+    start("statistics")
+    figures["type_counts"], figures["configurations"] = occurrences(mesh)
+    kept = {p.code for _, p, _ in mesh.groups()}
+    figures["mapped"] = sorted(p.code for p in mesh.patterns if p.mapped_from is not None and p.code in kept)
+    figures["leaves_tessellated_on_the_fly"] = int(sum(
+        len(leaves) for _, p, leaves in mesh.groups(all_leaves=True) if p.on_the_fly))
+    figures["types"] = dict(mesh.types)
+    return figures
+
+
+def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dict, patterns: str | None,
+                  criterion: str = "optimal", uniform: bool = True, delaunay: bool = True,
+                  leaf_mesh: dict | None = None, cells: tuple[int, int] = (0, 0), seams: list | None = None,
+                  vertex_points: Callable | None = None, grid: int = 1) -> dict:
+    """The report of a mesh from the :func:`mesh_figures` of its pieces (one piece: the whole mesh).
+
+    ``cells``: the regions re-tessellated and the largest one's vertices; ``seams``:
+    the faces the pieces left open, paired here (``vertex_points(ids)`` gives their
+    grid points, for the examples).
+    """
+    summed = {key: sum(part[key] for part in parts) for key in _SUMMED if all(key in part for part in parts)}
+    report = {
+        "schema_version": 1,
+        "generator": f"cospherical {__version__}",
+        "domain": list(tree.box.texts),
+        "tree": described,
+        "patterns": patterns,
+        "criterion": criterion,
+        "leaves": len(tree),
+        "leaves_per_level": level_counts(tree),
+        "vertices": int(vertices),
+        "elements": sum(part["elements"] for part in parts),
+    }
+    type_counts: Counter = sum((Counter(part["type_counts"]) for part in parts), Counter())
+    outside: dict[str, dict] = {}
+    for part in parts:
+        for entry in part["types_outside_catalogue"]:
+            mine = outside.setdefault(entry["id"], {**entry, "count": 0})
+            mine["count"] += entry["count"]
+    report.update({
+        "types": len(type_counts),
+        "delaunay_mode": "leaf" if leaf_mesh is None else "global",
+        "leaf_mesh": leaf_mesh,
+        "cells_spanning_leaves": summed["cells_spanning_leaves"],
+        "regions_retessellated": cells[0],
+        "largest_region_vertices": cells[1],
+        "types_outside_catalogue": sorted(outside.values(), key=lambda e: (-e["count"], e["id"])),
+    })
+    volume = sum((part["volume"] for part in parts), Fraction(0))
+    report.update({"volume_ok": volume == 1 and summed["flat_elements"] == 0, "volume": str(volume),
+                   "flat_elements": summed["flat_elements"]})
+    examples = [e for part in parts for e in part["nonconforming_examples"]]
+    conformity = {key: summed[key] for key in ("nonconforming_faces", "interior_faces", "boundary_faces")}
+    if seams is not None:
+        matched = match_seams(seams, vertex_points, grid)
+        conformity["nonconforming_faces"] += matched["nonconforming_faces"]
+        conformity["interior_faces"] += matched["interior_faces"]
+        examples += matched["nonconforming_examples"]
+    report.update(conformity, nonconforming_examples=examples[:5])
+    report.update({key: summed[key] for key in ("circumcenters_outside_leaf", "leaves_not_fvm_adequate",
+                                                "elements_not_cospherical", "boundary_circumcenters_outside")})
+    if delaunay:
+        report.update({key: summed[key] for key in ("delaunay_violations", "delaunay_violating_pairs",
+                                                    "delaunay_violating_leaves", "delaunay_ties",
+                                                    "delaunay_exact_tests", "delaunay_violating_fvm_leaves")})
+    else:
+        report["delaunay_violations"] = None
+    configurations: dict[str, dict] = {}
+    for part in parts:
+        for code, entry in part["configurations"].items():
+            mine = configurations.setdefault(code, {**entry, "leaves": 0})
+            mine["leaves"] += entry["leaves"]
+    on_the_fly = sum(c["tessellated_on_the_fly"] for c in configurations.values())
+    mapped = len({code for part in parts for code in part["mapped"]})
+    report["configurations"] = len(configurations)
+    report["configurations_from_table"] = len(configurations) - on_the_fly - mapped
+    report["configurations_mapped"] = mapped
+    report["tessellated_on_the_fly"] = on_the_fly
+    report["leaves_tessellated_on_the_fly"] = summed["leaves_tessellated_on_the_fly"]
+    types: dict = {}
+    for part in parts:
+        types.update(part["types"])
+    report.update(statistics(type_counts, configurations, len(tree), types,
+                             uniform_study(tree.box) if uniform else None))
+    return report
 
 
 def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal", uniform: bool = True,
@@ -63,57 +197,9 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     >>> [report[k] for k in ("leaves", "elements", "volume_ok", "nonconforming_faces", "delaunay_violations")]
     [15, 48, True, 0, 0]
     """
-    def start(name: str) -> None:
-        if stage:
-            stage(name)
-
-    report = {
-        "schema_version": 1,
-        "generator": f"cospherical {__version__}",
-        "domain": list(mesh.box.texts),
-        "tree": tree,
-        "patterns": patterns,
-        "criterion": criterion,
-        "leaves": len(mesh.tree),
-        "leaves_per_level": level_counts(mesh),
-        "vertices": int(len(mesh.vertices)),
-        "elements": len(mesh),
-        "types": len(mesh.element_types()[0]),
-        "delaunay_mode": "leaf" if leaf_mesh is None else "global",
-        "leaf_mesh": leaf_mesh,
-        "cells_spanning_leaves": int(mesh.cells.spanning.sum()) if mesh.cells is not None else 0,
-        "regions_retessellated": mesh.cells.regions if mesh.cells is not None else 0,
-        "largest_region_vertices": mesh.cells.largest_region if mesh.cells is not None else 0,
-        "types_outside_catalogue": outside_catalogue(mesh),
-    }
-    start("volume")
-    report.update(check_volume(mesh))
-    start("conformity")
-    report.update(check_conformity(mesh))
-    start("circumcenters")
-    report.update(check_circumcenters(mesh))
-    if delaunay:
-        start("delaunay")
-        found = dict(checked) if checked is not None else check_delaunay(mesh, progress=progress)
-        bad_leaves = found.pop("_leaves")
-        bad_elements = found.pop("_elements")
-        found.pop("_not_cells")
-        if violating is not None:
-            violating.append(bad_elements)
-        report.update(found)
-        # the issue's point: a leaf can be fvm_adequate on its own and still not globally Delaunay
-        fvm = np.array([p.fvm_adequate for p in mesh.patterns], dtype=bool)[mesh.leaf_pattern[bad_leaves]]
-        report["delaunay_violating_fvm_leaves"] = int(fvm.sum())
-    else:
-        report["delaunay_violations"] = None
-    on_the_fly = [p for _, p, _ in mesh.groups(all_leaves=True) if p.on_the_fly]
-    report["configurations"] = len(mesh.patterns)
-    mapped = sum(p.mapped_from is not None for _, p, _ in mesh.groups())
-    report["configurations_from_table"] = len(mesh.patterns) - len(on_the_fly) - mapped
-    report["configurations_mapped"] = mapped
-    report["tessellated_on_the_fly"] = len(on_the_fly)
-    report["leaves_tessellated_on_the_fly"] = int(sum(
-        len(leaves) for _, p, leaves in mesh.groups(all_leaves=True) if p.on_the_fly))
-    start("statistics")
-    report.update(mesh_statistics(mesh, uniform_study(mesh.box) if uniform else None))
-    return report
+    figures = mesh_figures(mesh, delaunay, stage, progress, checked)
+    if violating is not None and delaunay:
+        violating.append(figures["_violating"])
+    cells = (mesh.cells.regions, mesh.cells.largest_region) if mesh.cells is not None else (0, 0)
+    return merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
+                         leaf_mesh, cells)

@@ -17,7 +17,7 @@ from ..core.configuration import Box, Configuration
 from ..studies.bisection import bisection_codes, run_study
 from .assembly import PAPER_FINAL, Mesh, _type_info
 
-__all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "uniform_study"]
+__all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "statistics", "uniform_study"]
 
 BISECTION_CONFIGURATIONS = 4096
 
@@ -53,28 +53,46 @@ def mesh_statistics(mesh: Mesh, uniform: dict | None = None) -> dict:
     (by decreasing leaf count), ``paper_final_share`` (elements whose paper class is
     one of the paper's seven final elements) and, with ``uniform``, its figures.
     """
+    type_counts, configurations = occurrences(mesh)
+    return statistics(type_counts, configurations, len(mesh.tree), mesh.types, uniform)
+
+
+def occurrences(mesh: Mesh) -> tuple[Counter, dict[str, dict]]:
+    """Elements per type id, and per configuration code its leaves (replaced ones too) and what it is.
+
+    Both add up over the pieces of a partitioned mesh (leaves summed per code).
+    """
     type_counts: Counter = Counter()
-    configurations = []
-    total_leaves = len(mesh.tree)
     for rows, _, _, type_id in mesh.blocks():
-        type_counts[type_id] += len(rows)
+        if len(rows):
+            type_counts[type_id] += len(rows)
+    configurations = {}
     for _, pattern, leaves in mesh.groups(all_leaves=True):
-        configurations.append({
+        configurations[pattern.code] = {
             "code": pattern.code,
             "leaves": int(len(leaves)),
-            "share": _share(len(leaves), total_leaves),
-            "uniform_share": (_share(1, BISECTION_CONFIGURATIONS) if in_bisection_family(pattern.configuration)
-                              else None),
+            "in_bisection_family": in_bisection_family(pattern.configuration),
             "elements_per_leaf": len(pattern.elements),
             "fvm_adequate": pattern.fvm_adequate,
             "tessellated_on_the_fly": pattern.on_the_fly,
-        })
-    configurations.sort(key=lambda c: (-c["leaves"], c["code"]))
+        }
+    return type_counts, configurations
+
+
+def statistics(type_counts: Counter, configurations: dict[str, dict], total_leaves: int, types: dict,
+               uniform: dict | None = None) -> dict:
+    """:func:`mesh_statistics` from the :func:`occurrences` of a mesh (or of all its pieces, added up)."""
+    configurations = sorted(({
+        "code": c["code"], "leaves": c["leaves"], "share": _share(c["leaves"], total_leaves),
+        "uniform_share": _share(1, BISECTION_CONFIGURATIONS) if c["in_bisection_family"] else None,
+        "elements_per_leaf": c["elements_per_leaf"], "fvm_adequate": c["fvm_adequate"],
+        "tessellated_on_the_fly": c["tessellated_on_the_fly"]} for c in configurations.values()),
+        key=lambda c: (-c["leaves"], c["code"]))
     total = sum(type_counts.values())
     uniform_counts = uniform["counts"] if uniform else {}
     uniform_total = uniform["elements"] if uniform else 0
     info = dict(uniform["types"]) if uniform else {}
-    info.update(mesh.types)
+    info.update(types)
     rows = []
     for type_id in sorted(set(type_counts) | set(uniform_counts), key=lambda t: (-type_counts[t], t)):
         entry = info.get(type_id) or _type_info(type_id, None)
@@ -98,7 +116,7 @@ def mesh_statistics(mesh: Mesh, uniform: dict | None = None) -> dict:
     return result
 
 
-def level_counts(mesh: Mesh) -> dict[str, int]:
-    """Leaves per level (levels that occur)."""
-    counts = np.bincount(mesh.tree.levels.astype(np.int64))
+def level_counts(tree) -> dict[str, int]:
+    """Leaves per level of an octree (levels that occur)."""
+    counts = np.bincount(tree.levels.astype(np.int64))
     return {str(level): int(n) for level, n in enumerate(counts.tolist()) if n}

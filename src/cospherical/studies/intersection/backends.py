@@ -5,9 +5,36 @@ from __future__ import annotations
 from contextlib import contextmanager
 from typing import Any, Callable, Hashable, Iterator
 
-from ...errors import InputError
+from ...errors import InputError, UsageError
 
-__all__ = ["completed"]
+__all__ = ["check_backend", "completed"]
+
+
+def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, timeout: float | None) -> None:
+    """Refuse a bad choice of Dask backend with one line (``prog``: the command, for the message); set the timeout.
+
+    ``scheduler`` must look like ``tcp://HOST:PORT``, ``dask_workers`` be at least 1,
+    not both given, and dask.distributed installed.
+    """
+    import re
+
+    if scheduler and dask_workers:
+        raise UsageError(f"{prog}: error: give --scheduler or --dask-workers, not both")
+    if dask_workers is not None and dask_workers < 1:
+        raise UsageError(f"{prog}: error: --dask-workers {dask_workers}: at least 1")
+    if scheduler or dask_workers:
+        from importlib.util import find_spec
+
+        if find_spec("distributed") is None:
+            raise UsageError(f"{prog}: error: the Dask backend needs dask.distributed: pip install 'cospherical[dask]'")
+    if scheduler:
+        if not re.fullmatch(r"(tcp|tls|ucx)://[A-Za-z0-9._\[\]:-]+", scheduler):
+            raise UsageError(f"{prog}: error: --scheduler {scheduler!r}: give tcp://HOST:PORT")
+        if not timeout > 0:
+            raise UsageError(f"{prog}: error: --scheduler-timeout {timeout}: must be > 0")
+        import dask
+
+        dask.config.set({"distributed.comm.timeouts.connect": f"{timeout}s"})
 
 
 def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, scheduler: str | None = None,

@@ -1,0 +1,212 @@
+"""An octree meshed in pieces: subtrees as separate tasks, on a local process pool or a Dask cluster.
+
+The leaves are cut into ``N`` runs of the Morton (Z-order) curve, as equal in
+leaves as can be: each run is a union of whole subtrees.  A task meshes one piece
+(:func:`mesh_piece`), checks it exactly and writes it; this process adds the
+pieces' figures up into the report of the whole mesh, pairs the faces the pieces
+left open at their seams, and re-tessellates the regions of the global Delaunay
+subdivision.
+
+Why a piece is the whole mesh's restriction, element for element:
+
+- **Vertices and their ids.**  Every task is given the vertex keys of the whole
+  tree (:func:`~cospherical.mesh.assembly.vertex_keys`: every leaf corner, an
+  integer grid point).  A leaf's configuration is which of its 27 slots are
+  vertices, so a piece's leaves get the configurations, elements and vertex ids
+  they have in the whole tree; a vertex's id is its rank among the keys, the same
+  in every piece and in the mesh of one process (the ``global_id`` of the files).
+- **Conformity at the seams.**  A piece's faces met once off the domain's boundary
+  are paired across pieces (:func:`~cospherical.mesh.checks.match_seams`, which
+  says why the counts are the whole mesh's).
+- **Empty spheres at the seams.**  A piece checks its elements against every
+  vertex of the whole tree that can be within reach of one of its spheres (the
+  search is limited to the box around all of them, see
+  :func:`~cospherical.mesh.checks.check_delaunay`): an element's sphere is decided
+  against exactly the vertices it would be in one process.
+- **Global Delaunay.**  In ``global`` mode a first round of tasks assembles and
+  checks the leaf mesh; the leaves holding an element that is not a cell of the
+  Delaunay subdivision (any piece's) are re-tessellated here, region by region,
+  exactly as in one process (:func:`~cospherical.mesh.delaunay.retessellate` on
+  the marked leaves alone, with the whole tree's vertices: its proof holds for
+  regions that cross seams, since nothing in it depends on the pieces).  Each new
+  cell goes to the piece that holds its first leaf (the leaf holding an interior
+  point of it, a marked one), and those pieces are meshed again with their cells,
+  checked and written.  Pieces with no marked leaf are checked and written in the
+  first round: no cell can go to them.  Cube octrees have no marked leaf.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.configuration import Box
+from ..errors import InputError
+from ..studies.intersection.backends import completed
+from .assembly import Cells, assemble, vertex_keys
+from .checks import check_delaunay
+from .delaunay import retessellate, with_cells
+from .octree import Octree
+from .report import merged_report, mesh_figures
+
+__all__ = ["MAX_PARTITIONS", "Piece", "mesh_in_pieces", "mesh_piece", "morton_pieces"]
+
+# More pieces than this is a mistake, not a plan: one file each, in one folder.
+MAX_PARTITIONS = 4096
+
+
+def morton_pieces(tree: Octree, pieces: int) -> list[np.ndarray]:
+    """The leaves (indices, increasing) of ``pieces`` runs of the Morton curve, as equal in leaves as can be.
+
+    Examples
+    --------
+    >>> from cospherical.mesh.octree import build_octree, parse_shape
+    >>> tree = build_octree(Box.parse([1, 1, 1]), 1, [parse_shape("point:0.5,0.5,0.5")])
+    >>> [part.tolist() for part in morton_pieces(tree, 3)]
+    [[0, 1], [2, 3, 4], [5, 6, 7]]
+    """
+    if not 1 <= pieces <= len(tree):
+        raise InputError(f"--partitions {pieces}: from 1 to the tree's {len(tree):,} leaves")
+    depth = tree.depth
+    corner = tree.positions.astype(np.int64) << (depth - tree.levels.astype(np.int64))[:, None]
+    code = np.zeros(len(tree), dtype=np.int64)
+    for bit in range(depth):  # interleave the bits: x, y, z from the most significant down
+        for axis in range(3):
+            code |= ((corner[:, axis] >> bit) & 1) << (3 * bit + 2 - axis)
+    order = np.argsort(code, kind="stable")
+    bounds = [len(tree) * k // pieces for k in range(pieces + 1)]
+    return [np.sort(order[bounds[k]:bounds[k + 1]]) for k in range(pieces)]
+
+
+@dataclass(frozen=True)
+class Piece:
+    """One task: a piece's leaves, what it needs of the whole tree, and where it writes.
+
+    ``leaves`` are the piece's leaf indices in the whole tree; ``grid`` and ``keys``
+    the whole tree's vertex grid; ``lookup``: ``(factory, arguments)`` that make the
+    pattern lookup in the worker (a closure does not travel); ``write(mesh, path,
+    leaves)`` writes the piece (a module-level function) to ``path``.  ``cells`` (their
+    ``leaf`` indexing the piece's leaves), ``replaced`` (a mask over them) and
+    ``types`` come with the second round of ``global`` mode.
+    """
+
+    index: int
+    box: Box
+    levels: np.ndarray
+    positions: np.ndarray
+    leaves: np.ndarray
+    grid: int
+    keys: np.ndarray
+    lookup: tuple | None
+    criterion: str
+    mode: str
+    delaunay: bool
+    write: Callable | None
+    path: str | None
+    cells: Cells | None = None
+    replaced: np.ndarray | None = None
+    types: dict | None = None
+
+
+def mesh_piece(piece: Piece) -> dict:
+    """Mesh, check and write one piece (run in a worker); see the module for why it equals its part of the whole.
+
+    Returns ``index``; in the first round of ``global`` mode, ``leaf_mesh`` (what the
+    exact check found on the piece's leaf mesh) and, if some of its elements are not
+    cells of the Delaunay subdivision, ``marked`` (those leaves, whole-tree indices)
+    and nothing more; else ``figures`` (:func:`~cospherical.mesh.report.mesh_figures`)
+    and ``seams`` (the faces it leaves open).
+    """
+    tree = Octree(piece.box, piece.levels, piece.positions)
+    lookup = piece.lookup[0](*piece.lookup[1]) if piece.lookup is not None else None
+    mesh = assemble(tree, lookup, criterion=piece.criterion, vertices=(piece.grid, piece.keys))
+    result: dict = {"index": piece.index}
+    checked = None
+    if piece.cells is not None:
+        mesh = with_cells(mesh, piece.replaced, piece.cells, {**mesh.types, **piece.types})
+    elif piece.mode == "global":
+        found = check_delaunay(mesh)
+        result["leaf_mesh"] = {"elements": len(mesh), "delaunay_violations": found["delaunay_violations"],
+                               "delaunay_ties": found["delaunay_ties"],
+                               "elements_replaced": int(len(found["_not_cells"]))}
+        if len(found["_not_cells"]):
+            result["marked"] = piece.leaves[np.unique(mesh.element_leaf[found["_not_cells"]])]
+            return result
+        checked = found
+    seams: list = []
+    figures = mesh_figures(mesh, piece.delaunay, checked=checked, seams=seams)
+    figures.pop("_violating", None)
+    result.update(figures=figures, seams=seams)
+    if piece.write is not None:
+        piece.write(mesh, piece.path, piece.leaves)
+    return result
+
+
+def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: str, mode: str,
+                   described: dict, patterns: str | None, uniform: bool = True, delaunay: bool = True,
+                   write: Callable | None = None, path: Callable[[int], str] | None = None, jobs: int = 1,
+                   scheduler: str | None = None, dask_workers: int | None = None) -> dict:
+    """Mesh ``tree`` in ``pieces`` tasks (each writing ``path(k)`` with ``write``); return the whole mesh's report.
+
+    ``lookup``: ``(factory, arguments)`` of the pattern lookup (``None``: every
+    configuration tessellated); ``jobs``, ``scheduler``, ``dask_workers``: where the
+    tasks run (:func:`~cospherical.studies.intersection.backends.completed`).
+    """
+    grid, keys = vertex_keys(tree)
+    parts = morton_pieces(tree, pieces)
+
+    def task(k: int, **more) -> tuple:
+        leaves = parts[k]
+        return (Piece(k, tree.box, tree.levels[leaves], tree.positions[leaves], leaves, grid, keys, lookup,
+                      criterion, mode, delaunay, write, path(k) if path is not None else None, **more),)
+
+    results = dict(completed(mesh_piece, {k: task(k) for k in range(pieces)}, jobs, scheduler, dask_workers))
+    leaf_mesh = None
+    regions = (0, 0)
+    if mode == "global":
+        leaf_mesh = {key: sum(results[k]["leaf_mesh"][key] for k in range(pieces))
+                     for key in ("elements", "delaunay_violations", "delaunay_ties", "elements_replaced")}
+        marked = np.sort(np.concatenate([results[k].get("marked", np.zeros(0, dtype=np.int64))
+                                         for k in range(pieces)]))
+        if len(marked):
+            again, regions = _cells_by_piece(tree, parts, marked, grid, keys, lookup, criterion)
+            results.update(completed(mesh_piece, {k: task(k, **more) for k, more in again.items()}, jobs,
+                                     scheduler, dask_workers))
+    seams = [seam for k in range(pieces) for seam in results[k]["seams"]]
+    n = np.int64(grid + 1)
+
+    def points(ids: np.ndarray) -> np.ndarray:
+        return np.stack([keys[ids] // (n * n), (keys[ids] // n) % n, keys[ids] % n], axis=-1)
+
+    return merged_report(tree, len(keys), [results[k]["figures"] for k in range(pieces)], described, patterns,
+                         criterion, uniform, delaunay, leaf_mesh, regions, seams, points, grid)
+
+
+def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, grid: int, keys: np.ndarray,
+                    lookup: tuple | None, criterion: str) -> tuple[dict[int, dict], tuple[int, int]]:
+    """Re-tessellate the marked leaves (whole-tree indices) and give each cell to the piece of its first leaf.
+
+    Returns, per piece with marked leaves, its second round's ``cells``, ``replaced``
+    and ``types``, and (regions, the largest region's vertices).
+    """
+    sub = Octree(tree.box, tree.levels[marked], tree.positions[marked])
+    mesh = assemble(sub, lookup[0](*lookup[1]) if lookup is not None else None, criterion=criterion,
+                    vertices=(grid, keys))
+    types = dict(mesh.types)
+    cells = retessellate(mesh, np.ones(len(sub), dtype=bool), types)
+    piece_of_leaf = np.empty(len(tree), dtype=np.int64)
+    for k, leaves in enumerate(parts):
+        piece_of_leaf[leaves] = k
+    first = marked[cells.leaf]  # whole-tree leaves
+    again = {}
+    for k in np.unique(piece_of_leaf[marked]).tolist():
+        rows = np.flatnonzero(piece_of_leaf[first] == k)
+        used, shape = np.unique(cells.shape[rows], return_inverse=True)
+        mine = Cells([cells.shapes[s] for s in used.tolist()], shape.astype(np.int32).reshape(-1),
+                     cells.anchor[rows], cells.nodes[rows], np.searchsorted(parts[k], first[rows]),
+                     cells.spanning[rows], cells.regions, cells.largest_region)
+        replaced = np.isin(parts[k], marked)
+        again[k] = {"cells": mine, "replaced": replaced, "types": types}
+    return again, (cells.regions, cells.largest_region)
