@@ -201,6 +201,13 @@ def intersection_table(up: str) -> str:
     rows.append("| configurations (orbits) | - | "
                 + " | ".join(f"{_n(tables[o][0]['configurations'])} ({_n(tables[o][0]['orbits'])})" for o in orders)
                 + " |")
+    rows.append("| element types (of the paper's classes) | 38 classes | " + " | ".join(
+        f"{tables[o][0]['criteria']['optimal']['types_count']} ({tables[o][0]['criteria']['optimal'].get('paper_classes_count', '-')})"
+        for o in orders) + " |")
+    for criterion in CRITERIA[1:]:
+        rows.append(f"| {criterion.replace('_', ' ')}: elements, types | - | " + " | ".join(
+            f"{_n(tables[o][0]['criteria'][criterion]['total'])}, {tables[o][0]['criteria'][criterion]['types_count']}"
+            for o in orders) + " |")
     rows.append("| FVM-adequate, closed / open | - | "
                 + " | ".join(f"{_n(tables[o][0]['fvm_adequate'])} / {_n(tables[o][0]['fvm_adequate_open'])}"
                              for o in orders) + " |")
@@ -216,6 +223,11 @@ MESH_ROWS = [("delaunay_mode", "mode (--delaunay; - : made before the choice, ea
              ("delaunay_violating_pairs", "(element, vertex) pairs"), ("delaunay_ties", "co-spherical ties"),
              ("regions_retessellated", "regions re-tessellated (global mode)"),
              ("cells_spanning_leaves", "cells spanning leaves (global mode)"),
+             ("boundary_circumcenters_outside", "circumcenters outside the domain"),
+             (lambda r: (r.get("leaf_mesh") or {}).get("elements_replaced"), "leaf elements replaced (global mode)"),
+             ("largest_region_vertices", "largest region (vertices)"),
+             (lambda r: (lambda n: n and f"{_n(n['interior'])} / {_n(n['boundary'])}")(r.get("negative_coefficients")),
+              "negative box-method coefficients, interior / boundary (--dual)"),
              ("configurations", "distinct configurations"), ("tessellated_on_the_fly", "tessellated on the fly"),
              ("paper_final_share", "share of the paper's seven final elements")]
 
@@ -227,9 +239,30 @@ def mesh_table(up: str) -> str:
         f"{' x '.join(r['domain'])}, levels {r['tree'].get('levels', r['tree'].get('depth'))}, "
         + ", ".join(f"`{s}`" for s in r["tree"].get("refine", [])) for _, r in reports) + " |")
     for key, label in MESH_ROWS:
-        rows.append(f"| {label} | " + " | ".join(_n(r.get(key)) for _, r in reports) + " |")
+        value = key if callable(key) else (lambda r, key=key: r.get(key))
+        rows.append(f"| {label} | " + " | ".join(_n(value(r)) for _, r in reports) + " |")
     pictures = [f"![{name}]({up}figures/mesh/{name}.png)" for name, _ in reports]
     return "\n".join(rows) + "\n\n" + "\n\n".join(pictures)
+
+
+def dual_table(up: str) -> str:
+    """The mixed mesh beside the tetrahedral Delaunay mesh of its vertices, per report made with --dual."""
+    reports = [(path.parent.name, json.loads(path.read_text())) for path in sorted(RESULTS.glob("mesh/*/report.json"))]
+    reports = [(name, r) for name, r in reports if r.get("dual", {}).get("tetrahedral")]
+    if not reports:
+        return "*(no report in results/mesh/ was made with --dual)*"
+    rows = ["| | " + " | ".join(f"`{name}`" for name, _ in reports) + " |", "|---|" + "---:|" * len(reports)]
+    for key in ("elements", "edges", "faces", "nonzeros"):
+        cells = []
+        for _, r in reports:
+            mixed, tetrahedral = r["dual"]["mixed"][key], r["dual"]["tetrahedral"][key]
+            cells.append(f"{mixed:,} / {tetrahedral:,} ({mixed / tetrahedral:.2f})")
+        rows.append(f"| {key}: mixed / tetrahedral | " + " | ".join(cells) + " |")
+    rows.append("| negative coefficients, interior / boundary | " + " | ".join(
+        f"{r['negative_coefficients']['interior']:,} / {r['negative_coefficients']['boundary']:,}" for _, r in reports)
+        + " |")
+    rows.append("| mode (`--delaunay`) | " + " | ".join(_n(r.get("delaunay_mode")) for _, r in reports) + " |")
+    return "\n".join(rows)
 
 
 def gallery(up: str) -> str:
@@ -326,8 +359,27 @@ def schema_fields(up: str, name: str) -> str:
     return "\n".join(rows)
 
 
+def _recorded_run(path: Path) -> list[str]:
+    """One benchmark run as its script recorded it: the command, the machine and its load, the figures."""
+    run = json.loads(path.read_text())
+    machine, load = run["machine"], run["load_average"]
+    lines = [f"Last run: `{run['command']}`, {run['date']} (commit `{run.get('commit') or '?'}`), on "
+             f"{machine['cores']} cores, {machine['memory_gib']} GiB, {machine['cpu']}; load average "
+             f"{' / '.join(map(str, load['before']))} before, {' / '.join(map(str, load['after']))} after "
+             f"(1, 5, 15 min); the script's process {run['cpu_seconds']} s CPU (its children included), "
+             f"{run['wall_seconds']} s wall, peak {run['peak_memory_gib']} GiB. From "
+             f"`results/benchmarks/{path.name}`:", ""]
+    if run["rows"]:
+        lines += ["| what | measured |", "|---|---|"]
+        lines += [f"| {_cell(what)} | {_cell(figure)} |" for what, figure in run["rows"]]
+        lines.append("")
+    lines += ['??? note "Everything it printed"', "", "    ```text"]
+    lines += [f"    {line}" for line in run["output"]] + ["    ```", ""]
+    return lines
+
+
 def benchmarks(up: str) -> str:
-    """Each benchmark script's own docstring: what it measures, against what, and how to run it."""
+    """Each benchmark script's own docstring, then its last recorded run (results/benchmarks/*.json)."""
     import ast
 
     out = []
@@ -335,6 +387,12 @@ def benchmarks(up: str) -> str:
         text = ast.get_docstring(ast.parse(path.read_text())) or ""
         first, _, rest = text.partition("\n")
         out += [f"## `benchmarks/{path.name}`", "", first, "", "```text", rest.strip("\n"), "```", ""]
+        runs = sorted((RESULTS / "benchmarks").glob(f"{path.stem}*.json"))
+        for run in runs:
+            out += _recorded_run(run)
+        if not runs:
+            out += [f"*No recorded run yet: `python benchmarks/{path.name}` writes "
+                    f"`results/benchmarks/{path.stem}.json`, and this page shows it when next built.*", ""]
     return "\n".join(out)
 
 
@@ -355,6 +413,7 @@ GENERATORS = {
     "paper": paper_tables,
     "intersection": intersection_table,
     "meshes": mesh_table,
+    "dual": dual_table,
     "gallery": gallery,
     "sweep": sweep_figures,
     "schemas": schemas_list,

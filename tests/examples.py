@@ -4,7 +4,7 @@ Shell examples are the lines of its ```sh blocks (comments stripped); heavy ones
 small size, only their size arguments rewritten (``SMALLER``). They run in a scratch clone
 of the repository, so outputs such as ``results/sweep`` never touch the checkout, with the
 few stand-in files the examples name as the reader's own (``OLD.yaml``, ``NEW.yaml``,
-``leaves.txt``, ``SRC``, ``my-element.yaml``). Python examples are its ```python blocks.
+``SRC``). Python examples are its ```python blocks.
 """
 
 from __future__ import annotations
@@ -77,9 +77,7 @@ def make_scratch(folder: Path) -> Path:
     catalogue = (folder / "catalogue" / "catalogue.yaml").read_text()
     (folder / "OLD.yaml").write_text(catalogue)
     (folder / "NEW.yaml").write_text(catalogue.replace('"name": "Tetrahedron"', '"name": "simplex"', 1))
-    (folder / "leaves.txt").write_text("# level i j k: the root cell\n0 0 0 0\n")  # "a tree you bring"
     (folder / "SRC").symlink_to(folder / "src")  # "an older src/": this one
-    (folder / "my-element.yaml").write_text((folder / "examples" / "my-element.yaml").read_text())
     return folder
 
 

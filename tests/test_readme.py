@@ -7,7 +7,7 @@ SNIPPETS = python_examples((ROOT / "README.md").read_text())
 
 
 def test_the_readme_has_python_snippets():
-    assert len(SNIPPETS) >= 2
+    assert len(SNIPPETS) >= 1  # the front door's one; the others live in docs/ (tests/test_docs.py runs them)
 
 
 @pytest.mark.parametrize("snippet", SNIPPETS, ids=[f"snippet{i}" for i in range(len(SNIPPETS))])
