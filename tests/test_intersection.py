@@ -119,12 +119,13 @@ def test_pattern_table_of_the_representatives(tmp_path):
     from cospherical.cli import main
     from cospherical.core.symmetry import key_code
     from cospherical.formats.intersection_table import write_pattern_table
+    from cospherical.studies.intersection.table import TableRun
     from cospherical.formats.patterns import load
     from cospherical.studies.intersection import orbits
 
     summary = run_intersection(2, jobs=1)
     path, store = tmp_path / "patterns.yaml", tmp_path / "patterns.sqlite"
-    write_pattern_table(summary, shipped_catalogue()["version"], yaml_path=path, store=store, jobs=2, chunk=40)
+    write_pattern_table(TableRun(summary, jobs=2, chunk=40), shipped_catalogue()["version"], yaml_path=path, store=store)
     table = load(path)
     reps, _, _ = orbits(2)
     assert sorted(table.configurations) == [key_code(k) for k in reps.tolist()]
@@ -138,8 +139,8 @@ def test_pattern_table_of_the_representatives(tmp_path):
     # the same bytes, however the work was cut and run
     again = tmp_path / "again"
     again.mkdir()
-    write_pattern_table(summary, shipped_catalogue()["version"], yaml_path=again / path.name,
-                        store=again / store.name, jobs=1, chunk=1000)
+    write_pattern_table(TableRun(summary, jobs=1, chunk=1000), shipped_catalogue()["version"],
+                        yaml_path=again / path.name, store=again / store.name)
     assert (again / path.name).read_bytes() == path.read_bytes()
     assert (again / store.name).read_bytes() == store.read_bytes()
 
@@ -151,7 +152,7 @@ def test_table_lines_joined_from_cells_are_those_of_each_tessellation(pool_run):
     from cospherical.catalogue import split_tessellation
     from cospherical.core.symmetry import key_code
     from cospherical.files.flowyaml import mapping_text
-    from cospherical.formats.intersection_table import cell_texts, distinct_cells, table_entries
+    from cospherical.studies.intersection.table import cell_texts, distinct_cells, table_entries
     from cospherical.formats.patterns import configuration_line
     from cospherical.studies.intersection import orbits
 
@@ -199,10 +200,11 @@ def r4_table(pool_run, tmp_path_factory):
     """The R = 4 pattern table, as YAML and as an indexed store."""
     from cospherical.catalogue import shipped_catalogue
     from cospherical.formats.intersection_table import write_pattern_table
+    from cospherical.studies.intersection.table import TableRun
 
     folder = tmp_path_factory.mktemp("r4")
-    write_pattern_table(pool_run, shipped_catalogue()["version"], yaml_path=folder / "r4.yaml",
-                        store=folder / "r4.sqlite", jobs=2)
+    write_pattern_table(TableRun(pool_run, jobs=2), shipped_catalogue()["version"], yaml_path=folder / "r4.yaml",
+                        store=folder / "r4.sqlite")
     return folder / "r4.yaml", folder / "r4.sqlite"
 
 
@@ -239,9 +241,10 @@ def small_store(tmp_path_factory):
     """
     from cospherical.catalogue import shipped_catalogue
     from cospherical.formats.intersection_table import write_pattern_table
+    from cospherical.studies.intersection.table import TableRun
 
     path = tmp_path_factory.mktemp("r2") / "r2.sqlite"
-    write_pattern_table(run_intersection(2, jobs=1), shipped_catalogue()["version"], store=path)
+    write_pattern_table(TableRun(run_intersection(2, jobs=1)), shipped_catalogue()["version"], store=path)
     return path
 
 

@@ -239,10 +239,11 @@ def representatives_store(tmp_path_factory):
     """The R = 2 intersection store: one configuration per orbit of the cube's 48 symmetries."""
     from cospherical.catalogue import shipped_catalogue
     from cospherical.formats.intersection_table import write_pattern_table
+    from cospherical.studies.intersection.table import TableRun
     from cospherical.studies.intersection import run_intersection
 
     path = tmp_path_factory.mktemp("store") / "intersection-r2.sqlite"
-    write_pattern_table(run_intersection(2, jobs=1), shipped_catalogue()["version"], store=path, jobs=1)
+    write_pattern_table(TableRun(run_intersection(2, jobs=1), jobs=1), shipped_catalogue()["version"], store=path)
     return path
 
 

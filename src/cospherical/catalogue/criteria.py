@@ -15,7 +15,6 @@ from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Sequence
 
-from ..core.element_types import classify
 from ..core.geometry import Frame
 from ..core.split import CRITERIA, SPLIT_CRITERIA, subdivisions
 from ..core.tessellation import Element, Tessellation
@@ -31,8 +30,7 @@ def element_options(tess: Tessellation, element: Element, criterion: str) -> tup
     if len(poly.nodes) == 4:
         # A tetrahedron has no split: its one option without split_options' cache key,
         # whose Fraction coordinates are slow to hash (half the elements of a study).
-        etype, order, mirrored = classify(poly)
-        return ((Element(etype, order, poly, mirrored),),)
+        return ((Element.from_polyhedron(poly),),)
     points = tuple((n, tess.nodes[n]) for n in poly.nodes)
     return split_options(points, tess.configuration.box.squared, poly, criterion)
 
@@ -53,11 +51,7 @@ def split_options(points, squared, poly, criterion) -> tuple[tuple[Element, ...]
     frame = Frame.build(dict(points), squared)
     options = []
     for split in subdivisions(frame, poly, criterion):
-        pieces = []
-        for piece in split:
-            etype, order, mirrored = classify(piece)
-            pieces.append(Element(etype, order, piece, mirrored))
-        options.append(tuple(pieces))
+        options.append(tuple(Element.from_polyhedron(piece) for piece in split))
     # Fewest pieces, then the smallest multiset of piece types: a rule a symmetry cannot change,
     # so every member of an orbit is split alike (node lists only break the remaining ties).
     options.sort(key=lambda pieces: (len(pieces), sorted(p.type.id for p in pieces), [p.polyhedron.nodes for p in pieces]))

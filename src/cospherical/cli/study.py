@@ -201,6 +201,7 @@ def _intersection(args) -> int:
                       f"Intersection study at 1/{args.resolution}, insertion order {args.order}")
         if args.patterns:
             from ..formats.intersection_table import YAML_UP_TO, write_pattern_table
+            from ..studies.intersection.table import TableRun
 
             form = args.patterns_format or "auto"
             if form == "auto":
@@ -212,9 +213,9 @@ def _intersection(args) -> int:
             with stage_bars({"cells": (summary["orbits"], "pattern table: cells", "cfg"),
                              "elements": (None, "distinct cells written", "el"),
                              "entries": (summary["orbits"], "pattern table: entries", "cfg")}) as advance:
-                write_pattern_table(summary, shipped_catalogue()["version"],
+                run = TableRun(summary, jobs=max(1, args.jobs), progress=advance, scheduler=args.scheduler,
+                               dask_workers=args.dask_workers)
+                write_pattern_table(run, shipped_catalogue()["version"],
                                     yaml_path=args.out / f"{stem}-patterns.yaml" if form != "store" else None,
-                                    store=args.out / f"{stem}-patterns.sqlite" if form != "yaml" else None,
-                                    jobs=max(1, args.jobs), progress=advance, scheduler=args.scheduler,
-                                    dask_workers=args.dask_workers)
+                                    store=args.out / f"{stem}-patterns.sqlite" if form != "yaml" else None)
     return _report(summary, args)

@@ -8,7 +8,7 @@ from pathlib import Path
 from ..catalogue import CRITERIA, apply_catalogue_criterion
 from ..core.configuration import POINT_POLICIES, Configuration
 from ..core.shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape
-from ..core.tessellation import tessellate, tessellate_shape
+from ..core.tessellation import tessellate
 from ..errors import FormatError, InputError, UsageError
 from ..files.yamlio import load_yaml
 from ..formats.tessellation import tessellation_data
@@ -84,7 +84,7 @@ def _shape_file(path: Path, box) -> Shape:
 
 
 def _configuration(args):
-    """The configuration the arguments name, and the function that tessellates it."""
+    """The configuration the arguments name: a cuboid's or another shape's."""
     policy = args.face_points or "octree"  # no default in the parser: --faces excludes it
     if args.element != "cuboid" or args.shape:
         if args.faces is not None or args.body:
@@ -92,16 +92,15 @@ def _configuration(args):
                              "puts a point on every quadrilateral face whose edges allow one (--face-points)")
         shape = _shape_file(args.shape, args.box) if args.shape else standard_shape(args.element, args.box)
         if args.code is not None:
-            return ShapeConfiguration.from_code(shape, args.code, policy), tessellate_shape
-        return ShapeConfiguration.from_steiner(shape, args.steiner, policy), tessellate_shape
+            return ShapeConfiguration.from_code(shape, args.code, policy)
+        return ShapeConfiguration.from_steiner(shape, args.steiner, policy)
     if args.code is not None:
-        return Configuration.from_code(args.code, args.box, policy, args.faces, args.body), tessellate
-    return Configuration.from_steiner(args.box, args.steiner, policy, args.faces, args.body), tessellate
+        return Configuration.from_code(args.code, args.box, policy, args.faces, args.body)
+    return Configuration.from_steiner(args.box, args.steiner, policy, args.faces, args.body)
 
 
 def run(args) -> int:
-    configuration, tessellator = _configuration(args)
-    tess = tessellator(configuration)
+    tess = tessellate(_configuration(args))
     if args.criterion != "optimal":
         tess = apply_catalogue_criterion(tess, args.criterion)
     if args.vtu:

@@ -388,6 +388,18 @@ class Configuration:
             point[EDGE_AXES[k]] = self.steiner[k]
         return tuple(point)
 
+    @property
+    def shape(self) -> None:
+        """``None``: the cuboid's numbering is this module's, not a
+        :class:`~cospherical.core.shapes.Shape` (whose configurations have one)."""
+        return None
+
+    def contains(self, point, closed: bool = True) -> bool:
+        """Whether a point (unit coordinates) lies in the closed (or open) box, exactly: the FVM test."""
+        if closed:
+            return all(0 <= x <= 1 for x in point)
+        return all(0 < x < 1 for x in point)
+
     def real_nodes(self) -> dict[int, tuple[float, float, float]]:
         """Node id -> float coordinates in the real box (for output and plotting)."""
         scale = self.box.to_float()

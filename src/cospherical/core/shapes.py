@@ -20,7 +20,7 @@ its four edges are split with opposite edges at the same parameter (measured in
 the same direction); the point is where the two cut lines cross.  Triangles and
 the interior carry nothing: a refined neighbour puts nothing there.
 
-Their tessellation is :func:`cospherical.core.tessellation.tessellate_shape`,
+Their tessellation is :func:`cospherical.core.tessellation.tessellate`, as a cuboid's;
 their isometries :func:`cospherical.core.symmetry.shape_symmetries`.
 
 Examples
@@ -405,6 +405,10 @@ class ShapeConfiguration:
             if f in self.point_faces:
                 nodes[first + q] = self._face_point(f)
         return nodes
+
+    def contains(self, point, closed: bool = True) -> bool:
+        """Whether a point (unit coordinates) lies in the closed (or open) base element, exactly: the FVM test."""
+        return self.shape.contains(point, closed)
 
     def real_nodes(self) -> dict[int, tuple[float, float, float]]:
         scale = self.box.to_float()

@@ -35,7 +35,7 @@ from .configuration import (
 )
 from .geometry import cross, dot, sub, tetra_six_volume
 from .polyhedron import Polyhedron
-from .shapes import Point, Shape, standard_shape
+from .shapes import Point, Shape
 
 __all__ = ["ShapeSymmetry", "Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
            "orbit_point_keys", "orbit_representatives", "shape_orbit_representatives", "shape_symmetries"]
@@ -360,6 +360,7 @@ class ShapeSymmetry:
 
     Examples
     --------
+    >>> from cospherical.core.shapes import standard_shape
     >>> swap = shape_symmetries(standard_shape("prism"))[1]  # x <-> y: corners 1 and 2, 4 and 5
     >>> swap.corner_map, swap.proper, swap.code("800000000")
     ((0, 2, 1, 3, 5, 4), False, '008000000')
@@ -433,6 +434,7 @@ def _affine(sources: Sequence[Point], targets: Sequence[Point]):
 def shape_symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
     """The isometries of the scaled shape, identity first (see :class:`ShapeSymmetry`).
 
+    >>> from cospherical.core.shapes import standard_shape
     >>> [len(shape_symmetries(standard_shape(name))) for name in ("prism", "pyramid", "tetrahedron")]
     [4, 8, 6]
     """
@@ -469,6 +471,7 @@ def shape_orbit_representatives(codes: Sequence[str],
     """For each code, its orbit's representative (the smallest image code, as a base-16
     number) and the index of a symmetry taking the code to it.
 
+    >>> from cospherical.core.shapes import standard_shape
     >>> shape = standard_shape("tetrahedron")
     >>> shape_orbit_representatives(["800000", "008000", "080000"], shape_symmetries(shape))[0]
     ['000800', '000800', '000008']

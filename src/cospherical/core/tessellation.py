@@ -12,7 +12,7 @@ from .geometry import Frame
 from .polyhedron import Polyhedron, polyhedron
 from .shapes import ShapeConfiguration
 
-__all__ = ["Element", "ShapeTessellation", "Tessellation", "tessellate", "tessellate_shape", "tessellation_elements"]
+__all__ = ["Element", "Tessellation", "element_entry", "tessellate", "tessellate_shape", "tessellation_elements"]
 
 
 @dataclass(frozen=True)
@@ -28,24 +28,41 @@ class Element:
     polyhedron: Polyhedron
     mirrored: bool = False
 
+    @classmethod
+    def from_polyhedron(cls, poly: Polyhedron) -> "Element":
+        """The element a polyhedron is: its type by canonical code, its nodes in the type's reference order."""
+        etype, order, mirrored = classify(poly)
+        return cls(etype, order, poly, mirrored)
+
+
+def element_entry(element: Element, scale) -> dict:
+    """An element as pattern-table data: type id, nodes in reference order, circumcenter in a
+    box of edge lengths ``scale`` (floats), and ``mirror`` where it is its type's mirror image."""
+    entry = {"type": element.type.id, "nodes": list(element.nodes),
+             "circumcenter": [float(x) * s for x, s in zip(element.polyhedron.center, scale)]}
+    if element.mirrored:
+        entry["mirror"] = True
+    return entry
+
 
 @dataclass(frozen=True)
 class Tessellation:
-    """The Delaunay tessellation of one configuration, elements sorted by node ids."""
+    """The Delaunay tessellation of one configuration (of a cuboid or another shape), elements sorted by node ids."""
 
-    configuration: Configuration
+    configuration: Configuration | ShapeConfiguration
     nodes: dict[int, tuple[Fraction, Fraction, Fraction]]
     elements: tuple[Element, ...]
 
     @property
     def fvm_adequate(self) -> bool:
-        """Every element's circumcenter lies in the closed box (the paper's FVM test)."""
-        return all(e.polyhedron.center_in_box(closed=True) for e in self.elements)
+        """Every element's circumcenter lies in the closed box, or the closed base element of another
+        shape (the paper's FVM test)."""
+        return all(self.configuration.contains(e.polyhedron.center) for e in self.elements)
 
     @property
     def fvm_adequate_open(self) -> bool:
-        """Every element's circumcenter lies strictly inside the box."""
-        return all(e.polyhedron.center_in_box(closed=False) for e in self.elements)
+        """Every element's circumcenter lies strictly inside the box (or the base element)."""
+        return all(self.configuration.contains(e.polyhedron.center, closed=False) for e in self.elements)
 
     def circumcenter(self, element: Element) -> tuple[float, float, float]:
         """Float circumcenter of an element in the real box."""
@@ -53,7 +70,7 @@ class Tessellation:
         return tuple(float(x) * s for x, s in zip(element.polyhedron.center, scale))
 
 
-def tessellate(configuration: Configuration) -> Tessellation:
+def tessellate(configuration: Configuration | ShapeConfiguration) -> Tessellation:
     """The Delaunay tessellation of a configuration, its elements the largest co-spherical sets.
 
     Every cell is the convex hull of all points on one empty sphere, decided in
@@ -62,8 +79,9 @@ def tessellate(configuration: Configuration) -> Tessellation:
 
     Parameters
     ----------
-    configuration : Configuration
-        The box, its Steiner points, and its face and body points.
+    configuration : Configuration or ShapeConfiguration
+        The box, its Steiner points, and its face and body points; or another
+        shape's configuration.
 
     Returns
     -------
@@ -80,6 +98,17 @@ def tessellate(configuration: Configuration) -> Tessellation:
     ['Rectangular Pyramid', 'Rectangular Pyramid', 'Rectangular Pyramid', 'Rectangular Pyramid']
     >>> tess.fvm_adequate
     True
+
+    Another base element (:mod:`cospherical.core.shapes`) goes through the same
+    pipeline; its FVM test asks for circumcenters in that element:
+
+    >>> from cospherical.core.shapes import ShapeConfiguration, standard_shape
+    >>> tess = tessellate(ShapeConfiguration.from_code(standard_shape("prism"), "888888888"))
+    >>> sorted(e.type.name for e in tess.elements), tess.fvm_adequate
+    (['Cuboid', 'Cuboid', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism'], True)
+    >>> tess = tessellate(ShapeConfiguration.from_code(standard_shape("tetrahedron"), "800000"))
+    >>> [e.type.name for e in tess.elements], sum(e.polyhedron.unit_volume for e in tess.elements)
+    (['Tetrahedron', 'Tetrahedron'], Fraction(1, 6))
     """
     nodes = configuration.nodes()
     return Tessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared))
@@ -91,40 +120,9 @@ def tessellation_elements(nodes, squared) -> tuple[Element, ...]:
     frame = Frame.build(nodes, squared)
     elements = []
     for cell in delaunay_cells(frame):
-        poly = polyhedron(frame, cell)
-        etype, order, mirrored = classify(poly)
-        elements.append(Element(etype, order, poly, mirrored))
+        elements.append(Element.from_polyhedron(polyhedron(frame, cell)))
     return tuple(elements)
 
 
-@dataclass(frozen=True)
-class ShapeTessellation(Tessellation):
-    """A tessellation of a shape; the FVM tests ask for circumcenters in the base element, not the box."""
-
-    @property
-    def fvm_adequate(self) -> bool:
-        """Every element's circumcenter lies in the closed base element."""
-        return all(self.configuration.shape.contains(e.polyhedron.center) for e in self.elements)
-
-    @property
-    def fvm_adequate_open(self) -> bool:
-        """Every element's circumcenter lies strictly inside the base element."""
-        return all(self.configuration.shape.contains(e.polyhedron.center, closed=False) for e in self.elements)
-
-
-def tessellate_shape(configuration: ShapeConfiguration) -> ShapeTessellation:
-    """The Delaunay tessellation of a 1-irregular element, its elements the largest co-spherical sets.
-
-    Examples
-    --------
-    >>> from cospherical.core.shapes import ShapeConfiguration, standard_shape
-    >>> prism = standard_shape("prism")
-    >>> tess = tessellate_shape(ShapeConfiguration.from_code(prism, "888888888"))
-    >>> sorted(e.type.name for e in tess.elements), tess.fvm_adequate
-    (['Cuboid', 'Cuboid', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism'], True)
-    >>> tess = tessellate_shape(ShapeConfiguration.from_code(standard_shape("tetrahedron"), "800000"))
-    >>> [e.type.name for e in tess.elements], sum(e.polyhedron.unit_volume for e in tess.elements)
-    (['Tetrahedron', 'Tetrahedron'], Fraction(1, 6))
-    """
-    nodes = configuration.nodes()
-    return ShapeTessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared))
+# The name under which a shape's tessellation was first public: the same function.
+tessellate_shape = tessellate

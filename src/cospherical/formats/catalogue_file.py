@@ -10,7 +10,7 @@ from ..catalogue import SCHEMA_VERSION, option_types, split_options, split_posit
 from ..core.canonical import canonical_form
 from ..core.configuration import Configuration
 from ..core.delaunay import delaunay_cells
-from ..core.element_types import ElementType, classify
+from ..core.element_types import ElementType
 from ..core.geometry import Frame
 from ..core.polyhedron import polyhedron
 from ..core.split import SPLIT_CRITERIA
@@ -61,8 +61,7 @@ def intersection_examples(path: str | Path | None = None) -> list[dict]:
         frame = Frame.build(points, configuration.box.squared)
         (cell,) = delaunay_cells(frame)
         poly = polyhedron(frame, cell)
-        etype, order, mirrored = classify(poly)
-        element = Element(etype, order, poly, mirrored)
+        element = Element.from_polyhedron(poly)
         if element.type.id != example["type"]:
             raise FormatError(f"{path}: types/{i}: the example gives type {element.type.id}, not {example['type']}: "
                               "run scripts/intersection_examples.py again")

@@ -13,6 +13,7 @@ from collections import Counter
 from fractions import Fraction
 
 from ..catalogue import catalogue_from_text
+from ..core.base_element import base_element
 from ..core.configuration import Box
 from ..core.delaunay import hull_faces
 from ..core.element_types import classify_faces
@@ -21,7 +22,6 @@ from ..core.polyhedron import face_kind
 from ..errors import FormatError, InputError
 from ..files.flowyaml import split_section
 from ..files.yamlio import parse_yaml, read_text, validate
-from ..studies.bisection import element_family
 from .diff import document_kind
 from .patterns import entry_elements, load, table_from_data, table_from_text
 from .store import is_store
@@ -69,7 +69,7 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
         box = Box.parse(header["box"])
     except InputError as error:
         raise FormatError(f"{name}: box: {error}") from None
-    family = element_family(header.get("element", "cuboid"), box, header["face_points"])
+    family = base_element(header.get("element", "cuboid"), box, header["face_points"])
     # The same element (type, nodes, node positions) recurs in many configurations
     # and criteria of a table: its volume and faces are computed once.
     geometry: dict[tuple, tuple | None] = {}
@@ -83,7 +83,7 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
         # Positions as integer pairs: they key the geometry cache, and hashing
         # Fractions would be most of the check's time.
         positions = {n: tuple((x.numerator, x.denominator) for x in point) for n, point in nodes.items()}
-        shape = getattr(cfg, "shape", None)
+        shape = cfg.shape
         checked = []
         for criterion in header["criteria"]:
             where = f"{name}: configurations/{code}/{criterion}"
@@ -103,11 +103,10 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
                 _check_tiling(nodes, positions, box.squared, elements, types, geometry, where, shape)
         if tiling and types:
             _check_recomputed(cfg, positions, box.squared, entry, header["criteria"], f"{name}: configurations/{code}",
-                              recomputed, family.tessellate)
+                              recomputed)
 
 
-def _check_recomputed(cfg, positions: dict, squared, entry: dict, criteria, where: str, cache: dict,
-                      tessellate) -> None:
+def _check_recomputed(cfg, positions: dict, squared, entry: dict, criteria, where: str, cache: dict) -> None:
     """Recompute and compare exactly, element by element: the type label and mirror flag (from the
     convex hull of the element's points), the circumcenter (the stored float must be the float of the
     exact one), and ``fvm_adequate`` (every circumcenter of the optimal elements in the closed box;
@@ -133,10 +132,7 @@ def _check_recomputed(cfg, positions: dict, squared, entry: dict, criteria, wher
                 raise FormatError(f"{here}: circumcenter {element['circumcenter']}, recomputed {real}")
             if c == 0:
                 centers.append(center)
-    if hasattr(cfg, "shape"):  # the FVM test of another base element is in that element
-        adequate = tessellate(cfg).fvm_adequate
-    else:
-        adequate = all(0 <= x <= 1 for center in centers for x in center)
+    adequate = all(cfg.contains(center) for center in centers)
     if entry["fvm_adequate"] != adequate:
         raise FormatError(f"{where}: fvm_adequate is {entry['fvm_adequate']}, recomputed {adequate}")
 

@@ -21,16 +21,15 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterable, Protocol
 
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
-from ..core.tessellation import Tessellation
+from ..core.tessellation import Tessellation, element_entry
 from ..errors import FormatError, InputError
 from ..files.data import data_path
 from ..files.flowyaml import decode_entry, mapping_line, split_section
 from ..files.yamlio import atomic_write, parse_yaml, read_text, validate, yaml_text
-from ..studies.bisection import Study
 from ..version import __version__
 from .store import is_store, open_store
 
@@ -68,7 +67,21 @@ def pattern_name(study: str, box_texts, face_points: str = "octree", element: st
         "" if face_points in ("octree", "explicit") else f"-{face_points}")
 
 
-def patterns_text(study: Study, catalogue_version: str) -> str:
+class StudyTable(Protocol):
+    """What a pattern table is written from: a study's result (:class:`cospherical.studies.bisection.Study`)."""
+
+    name: str
+    element: str
+    box: Box
+    face_points: str
+    criteria: tuple[str, ...]
+
+    def rows(self) -> Iterable[tuple[str, bool, Mapping[str, Tessellation], Callable[[Tessellation], Tessellation]]]:
+        """Per configuration, in code order: its code, ``fvm_adequate``, the tessellations per
+        criterion, and the map from those onto the configuration (see :func:`configuration_line`)."""
+
+
+def patterns_text(study: StudyTable, catalogue_version: str) -> str:
     """The pattern table of a study as YAML text (deterministic)."""
     header = {
         "schema_version": SCHEMA_VERSION,
@@ -82,13 +95,7 @@ def patterns_text(study: Study, catalogue_version: str) -> str:
         "criteria": list(study.criteria),
     }
     lines = [yaml_text(header), "configurations:\n"]
-    for code in sorted(study.codes):
-        rep, _ = study.representative[code]
-        lines.append(configuration_line(
-            code,
-            study.tessellations[rep].fvm_adequate,  # a symmetry keeps circumcenters in the box
-            {criterion: study.choices[criterion].tessellations[rep] for criterion in study.criteria},
-            lambda tess: study.member_tessellation(code, tess)))
+    lines.extend(configuration_line(*row) for row in study.rows())
     return "".join(lines)
 
 
@@ -121,17 +128,7 @@ def element_entries(tess) -> list[dict]:
     return [element_entry(element, scale) for element in tess.elements]
 
 
-def element_entry(element, scale) -> dict:
-    """An element as pattern-table data: type id, nodes in reference order, circumcenter in a
-    box of edge lengths ``scale`` (floats), and ``mirror`` where it is its type's mirror image."""
-    entry = {"type": element.type.id, "nodes": list(element.nodes),
-             "circumcenter": [float(x) * s for x, s in zip(element.polyhedron.center, scale)]}
-    if element.mirrored:
-        entry["mirror"] = True
-    return entry
-
-
-def write_patterns(study: Study, path: str | Path, catalogue_version: str) -> None:
+def write_patterns(study: StudyTable, path: str | Path, catalogue_version: str) -> None:
     atomic_write(path, patterns_text(study, catalogue_version))
 
 

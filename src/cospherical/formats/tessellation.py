@@ -21,9 +21,8 @@ def tessellation_data(tess: Tessellation) -> dict:
     """
     cfg = tess.configuration
     real = cfg.real_nodes()
-    shape = getattr(cfg, "shape", None)
     return {
-        **({"element": shape.name} if shape is not None else {}),
+        **({"element": cfg.shape.name} if cfg.shape is not None else {}),
         "box": list(cfg.box.texts),
         "code": cfg.code,
         "point_set_code": cfg.point_set_code,  # the key of this point set in any pattern table

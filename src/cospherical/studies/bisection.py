@@ -2,7 +2,7 @@
 
 A study tessellates only one member (the smallest code) of each orbit of the
 base element's symmetry group (the box's for a cuboid; for a prism, pyramid or
-tetrahedron the isometries of that shape, :mod:`cospherical.core.shapes`).  Statistics count every configuration through the orbit
+tetrahedron the isometries of that shape, :mod:`cospherical.core.base_element`).  Statistics count every configuration through the orbit
 sizes, since a symmetry maps element types and circumcenter tests to
 themselves.  A member's own tessellation is the representative's mapped
 through the symmetry and re-classified, so that its node orders are exactly
@@ -13,17 +13,18 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass, replace
-from functools import lru_cache
-from typing import Callable, NamedTuple, Sequence
+from functools import partial
+from typing import Callable, Iterator, Sequence
 
 from ..catalogue import CRITERIA, Choice, choose
+from ..core.base_element import base_element
 from ..core.configuration import EDGES, Box, Configuration
-from ..core.element_types import ElementType, classify
-from ..core.shapes import ShapeConfiguration, mask_codes, standard_shape
-from ..core.symmetry import Symmetry, box_symmetries, orbit_representatives, shape_orbit_representatives, shape_symmetries
-from ..core.tessellation import Element, Tessellation, tessellate, tessellate_shape
+from ..core.element_types import ElementType
+from ..core.shapes import mask_codes, standard_shape
+from ..core.symmetry import Symmetry
+from ..core.tessellation import Element, Tessellation
 
-__all__ = ["Family", "Study", "TypeCount", "bisection_codes", "element_family", "map_tessellation", "run_study"]
+__all__ = ["Study", "TypeCount", "bisection_codes", "map_tessellation", "run_study"]
 
 Progress = Callable[[int], None]
 
@@ -38,45 +39,12 @@ def bisection_codes(element: str = "cuboid") -> list[str]:
     return mask_codes(len(EDGES) if element == "cuboid" else len(standard_shape(element).edges))
 
 
-class Family(NamedTuple):
-    """What a study needs of its base element: configurations from codes, the symmetries, the
-    orbit representatives of codes under them, and the tessellation."""
-
-    configuration: Callable[[str], object]
-    symmetries: tuple
-    representatives: Callable
-    tessellate: Callable
-
-
-@lru_cache(maxsize=None)  # a study maps every member through it
-def element_family(element: str, box: Box, face_points: str = "octree") -> Family:
-    """The :class:`Family` of a base element (``cuboid``, ``prism``, ``pyramid``, ``tetrahedron``) in a box.
-
-    Examples
-    --------
-    >>> family = element_family("prism", Box.parse(["1", "1", "1"]))
-    >>> len(family.symmetries), family.configuration("888888888").point_faces
-    (4, frozenset({2, 3, 4}))
-    >>> len(element_family("cuboid", Box.parse(["1", "2", "4"])).symmetries)
-    8
-    """
-    if element == "cuboid":
-        return Family(lambda code: Configuration.from_code(code, box, face_points), box_symmetries(box),
-                      orbit_representatives, tessellate)
-    shape = standard_shape(element, box)
-    return Family(lambda code: ShapeConfiguration.from_code(shape, code, face_points), shape_symmetries(shape),
-                  shape_orbit_representatives, tessellate_shape)
-
-
 def map_tessellation(tess: Tessellation, sym: Symmetry, target: Configuration) -> Tessellation:
     """The image of ``tess`` under ``sym``; ``target`` is the image configuration."""
     elements = []
     for element in tess.elements:
-        poly = sym.polyhedron(element.polyhedron)
-        etype, order, mirrored = classify(poly)
-        elements.append(Element(etype, order, poly, mirrored))
+        elements.append(Element.from_polyhedron(sym.polyhedron(element.polyhedron)))
     elements.sort(key=lambda e: e.polyhedron.nodes)
-    # replace keeps the tessellation's class: a shape's keeps its own FVM test
     return replace(tess, configuration=target, nodes=target.nodes(), elements=tuple(elements))
 
 
@@ -129,8 +97,19 @@ class Study:
         rep, sym = self.representative[code]
         if rep == code:
             return tess
-        target = element_family(self.element, self.box, self.face_points).configuration(code)
+        target = base_element(self.element, self.box, self.face_points).configuration(code)
         return map_tessellation(tess, sym.inverse(), target)
+
+    def rows(self) -> Iterator[tuple[str, bool, dict[str, Tessellation], Callable[[Tessellation], Tessellation]]]:
+        """What a pattern table holds of each configuration, in code order: its code, whether it
+        is FVM-adequate, its orbit representative's tessellation per criterion, and the map of
+        those onto the configuration itself."""
+        for code in sorted(self.codes):
+            rep, _ = self.representative[code]
+            yield (code,
+                   self.tessellations[rep].fvm_adequate,  # a symmetry keeps circumcenters in the box
+                   {criterion: self.choices[criterion].tessellations[rep] for criterion in self.criteria},
+                   partial(self.member_tessellation, code))
 
     def _count(self, predicate: Callable[[Tessellation], bool]) -> int:
         return sum(size for rep, size in self.orbit_sizes().items() if predicate(self.tessellations[rep]))
@@ -189,9 +168,9 @@ def run_study(
     >>> study.configurations, study.orbits, study.total(), study.fvm_adequate
     (64, 20, 206, 7)
     """
-    family = element_family(element, box, face_points)
+    family = base_element(element, box, face_points)
     symmetries = family.symmetries
-    reps, sym_index = family.representatives(codes, symmetries)
+    reps, sym_index = family.orbit_representatives(codes)
     representative = {code: (rep, symmetries[i]) for code, rep, i in zip(codes, reps, sym_index)}
     sizes = Counter(reps)
     tessellations = {}

@@ -1,0 +1,91 @@
+"""The base element of a study: the cuboid or another standard shape in a box.
+
+What a study, a table check or a mesher needs of its base element, in one typed
+object: configurations from codes, the symmetry group, the orbit
+representatives of codes under it (the cube's fast paths stay behind
+:func:`~cospherical.core.symmetry.orbit_representatives`), and the
+tessellation.  The cuboid is one of the standard shapes here; its
+configurations alone carry explicit face and body points (a point suffix).
+
+Examples
+--------
+>>> prism = base_element("prism", Box.parse(["1", "1", "1"]))
+>>> len(prism.symmetries), prism.configuration("888888888").point_faces
+(4, frozenset({2, 3, 4}))
+>>> len(base_element("cuboid", Box.parse(["1", "2", "4"])).symmetries)
+8
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property, lru_cache
+from typing import Sequence, Union
+
+from .configuration import EDGES, Box, Configuration
+from .shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape
+from .symmetry import (
+    ShapeSymmetry,
+    Symmetry,
+    box_symmetries,
+    orbit_representatives,
+    shape_orbit_representatives,
+    shape_symmetries,
+)
+from .tessellation import Tessellation, tessellate
+
+__all__ = ["ELEMENTS", "BaseElement", "base_element"]
+
+AnyConfiguration = Union[Configuration, ShapeConfiguration]
+
+
+@dataclass(frozen=True)
+class BaseElement:
+    """A base element (``cuboid``, ``prism``, ``pyramid``, ``tetrahedron``) in a box, under a face-point policy.
+
+    ``shape`` is the :class:`~cospherical.core.shapes.Shape` of the non-cuboid
+    elements; the cuboid's numbering is the VTK hexahedron's of
+    :mod:`cospherical.core.configuration`.
+    """
+
+    name: str
+    box: Box
+    face_points: str = "octree"
+
+    @cached_property
+    def shape(self) -> Shape | None:
+        return None if self.name == "cuboid" else standard_shape(self.name, self.box)
+
+    @property
+    def edges(self) -> int:
+        """The number of edges, hence of digits in a configuration code."""
+        return len(EDGES) if self.shape is None else len(self.shape.edges)
+
+    def configuration(self, code: str) -> AnyConfiguration:
+        """The configuration of a code (for the cuboid, optionally with a point suffix ``+f...``)."""
+        if self.shape is None:
+            return Configuration.from_code(code, self.box, self.face_points)
+        return ShapeConfiguration.from_code(self.shape, code, self.face_points)
+
+    @cached_property
+    def symmetries(self) -> tuple[Symmetry, ...] | tuple[ShapeSymmetry, ...]:
+        """The isometries of the element in its box, identity first."""
+        return box_symmetries(self.box) if self.shape is None else shape_symmetries(self.shape)
+
+    def orbit_representatives(self, codes: Sequence[str]) -> tuple[list[str], list[int]]:
+        """For each code, its orbit's representative (the smallest image) and the index in
+        :attr:`symmetries` of a symmetry taking the code to it."""
+        if self.shape is None:
+            return orbit_representatives(codes, self.symmetries)
+        return shape_orbit_representatives(codes, self.symmetries)
+
+    def tessellate(self, configuration: AnyConfiguration) -> Tessellation:
+        """The Delaunay tessellation of one of this element's configurations."""
+        return tessellate(configuration)
+
+@lru_cache(maxsize=64)  # a study maps every member's configuration through it
+def base_element(name: str, box: Box, face_points: str = "octree") -> BaseElement:
+    """The :class:`BaseElement` named ``name`` in ``box`` (one object per element, box and policy)."""
+    element = BaseElement(name, box, face_points)
+    element.shape  # a name that is no standard shape is refused here, not at first use
+    return element
