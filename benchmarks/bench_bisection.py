@@ -11,7 +11,8 @@
 
 The figures to compare are the ratios (a)/(c), (b)/(c) and (a)/(d).  ``--every N`` times
 (a) and (b) on every Nth configuration only and scales them to all of them (a quick run,
-as the test suite makes; the ratios are then estimates).
+as the test suite makes; the ratios are then estimates).  Writes
+results/benchmarks/bench_bisection.json (benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import time
 from cospherical import Box, Configuration, tessellate
 from cospherical.catalogue import known_name
 from cospherical.studies.bisection import bisection_codes, run_study
+from record import recorded
 
 
 def timed(function) -> float:
@@ -49,6 +51,11 @@ def main() -> None:
         parser.error(f"--every {args.every}: must be at least 1")
     if not shutil.which("qdelaunay"):
         raise SystemExit("qdelaunay not found: install qhull-bin (scripts/setup.sh does)")
+    with recorded(__file__) as record:
+        run(args, record)
+
+
+def run(args, record) -> None:
     box = Box.parse(args.box)
     codes = bisection_codes()
     known_name("")  # load the shipped catalogue (once per process) before the clock starts
@@ -66,6 +73,13 @@ def main() -> None:
     print(f"  (c) study, one tessellation per orbit   {study:8.2f} s")
     print(f"  (d) study with all three criteria       {full:8.2f} s")
     print(f"  (a)/(c) = {qhull / study:.1f}x   (b)/(c) = {naive / study:.1f}x   (a)/(d) = {qhull / full:.1f}x")
+    scaled = f" ((a), (b): every {args.every}th configuration, scaled)" if args.every > 1 else ""
+    what = f"box {' x '.join(box.texts)}, {len(codes)} configurations{scaled}"
+    record.add(f"(c) study, optimal, vs (a) `qdelaunay Qz Fv` per configuration; {what}",
+               f"{study:.2f} s vs {qhull:.2f} s: {qhull / study:.1f}x")
+    record.add("(c) vs (b) `tessellate` on every configuration (no symmetry)",
+               f"{study:.2f} s vs {naive:.2f} s: {naive / study:.1f}x")
+    record.add("(d) study with all three criteria vs (a)", f"{full:.2f} s vs {qhull:.2f} s: {qhull / full:.1f}x")
 
 
 if __name__ == "__main__":

@@ -11,7 +11,8 @@ Laplacian's assembly, and the process's peak resident memory.  Target: the dual
 within 10 s CPU on top of the assembly, peak within 4 GB.
 
 ``--poisson``: examples/poisson.py's table on larger trees (needs the ``compare``
-extra, discretize), with the solve times of both methods.
+extra, discretize), with the solve times of both methods.  Both write
+results/benchmarks/bench_dual.json or bench_dual-poisson.json (benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from cospherical.mesh.assembly import assemble
 from cospherical.mesh.dual import mesh_dual
 
 
-def big(args) -> None:
+def big(args, record) -> None:
     from bench_mesh import sphere_tree, timer
 
     clock: dict = {}
@@ -45,6 +46,11 @@ def big(args) -> None:
     for name, (wall, cpu) in clock.items():
         print(f"{name:42s} {wall:8.2f} s wall {cpu:8.2f} s cpu")
     print(f"peak {peak:.2f} GB")
+    record.add(f"sphere tree L {args.levels}, R {args.radius}", f"{len(tree):,} leaves, {len(dual.edges):,} edges, "
+               f"{len(mesh.patterns)} configurations")
+    for name, (wall, cpu) in clock.items():
+        record.add(name, f"{cpu:.2f} s CPU, {wall:.2f} s wall")
+    record.add("peak memory (the process)", f"{peak:.2f} GB")
 
 
 def main() -> None:
@@ -57,13 +63,17 @@ def main() -> None:
     parser.add_argument("--uniform", type=int, nargs="*", default=[2, 3, 4, 5, 6])
     parser.add_argument("--graded", type=int, nargs="*", default=[4, 5, 6, 7])
     args = parser.parse_args()
+    from record import recorded
+
     if not args.poisson:
-        big(args)
+        with recorded(__file__) as record:
+            big(args, record)
         return
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
     import poisson
 
-    poisson.main(["--uniform", *map(str, args.uniform), "--graded", *map(str, args.graded), "--times"])
+    with recorded(f"{Path(__file__).stem}-poisson.py"):  # the table is the script's output, kept whole
+        poisson.main(["--uniform", *map(str, args.uniform), "--graded", *map(str, args.graded), "--times"])
 
 
 if __name__ == "__main__":

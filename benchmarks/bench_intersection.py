@@ -15,6 +15,8 @@
     on the same sample;
 (d) one ``tessellate`` call on an intersection configuration, median after warm-up,
     with the compiled walk and with the Python walk.
+
+Writes results/benchmarks/bench_intersection.json (benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ import time
 
 from cospherical import Configuration, tessellate
 from cospherical.studies.intersection import intersection_codes, run_intersection
+from record import recorded
 
 
 def tree_pids(pid: int) -> list[int]:
@@ -145,7 +148,11 @@ def main() -> None:
     args = parser.parse_args()
     if not shutil.which("qdelaunay"):
         raise SystemExit("qdelaunay not found: install qhull-bin (scripts/setup.sh does)")
+    with recorded(__file__) as record:
+        measure(args, record)
 
+
+def measure(args, record) -> None:
     start = time.perf_counter()
     run_intersection(2, jobs=1)  # compiles (or loads) the numba kernels once, before the clock
     warm = time.perf_counter() - start
@@ -185,6 +192,16 @@ def main() -> None:
     print(f"  (b)/(a) = {naive_wall / wall:.0f}x   (c)/(a) = {qhull_wall / wall:.0f}x")
     print(f"  (d) tessellate() median: compiled walk {fast * 1e3:.3f} ms, Python walk {slow * 1e3:.3f} ms "
           f"({slow / fast:.1f}x)")
+    what = (f"intersection study at 1/{args.resolution} ({configurations:,} configurations, {summary['orbits']:,} "
+            f"orbits), order {args.order}, all three criteria, {args.jobs} processes")
+    record.add(f"(a) {what}", f"{wall:.1f} s wall, {configurations / wall:,.0f} configurations/s, "
+                              f"peak {memory.peak / 2**30:.2f} GiB (process tree)")
+    record.add(f"(b) the naive pipeline (`tessellate` + splits per configuration), estimated on {len(sample)}",
+               f"{naive_wall:.0f} s: {naive_wall / wall:.0f}x")
+    record.add("(c) `qdelaunay Qz Fv` once per configuration, estimated on the same sample",
+               f"{qhull_wall:.0f} s: {qhull_wall / wall:.0f}x")
+    record.add("(d) one `tessellate` call, 1/16-type configuration, median of 1000",
+               f"compiled walk {fast * 1e3:.3f} ms, Python walk {slow * 1e3:.3f} ms")
 
 
 if __name__ == "__main__":

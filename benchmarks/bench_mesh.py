@@ -17,6 +17,7 @@ the leaf mesh's Delaunay check + re-tessellation + checks + statistics of the
 result; their ratio is printed (target: at most 3).  Peak memory is the process's
 maximum resident set size.  Targets (issue 14): assembly >= 100,000 leaves/s,
 volume + conformity + circumcenters < 2 min, Delaunay < 5 min, peak < 4 GB.
+Writes results/benchmarks/bench_mesh.json (benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from cospherical.mesh.checks import check_circumcenters, check_conformity, check
 from cospherical.mesh.delaunay import global_delaunay
 from cospherical.mesh.octree import build_octree, parse_shape
 from cospherical.mesh.statistics import mesh_statistics
+from record import recorded
 
 
 def tree_arguments(parser: argparse.ArgumentParser) -> None:
@@ -68,6 +70,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     tree_arguments(parser)
     args = parser.parse_args()
+    with recorded(__file__) as record:
+        measure(args, record)
+
+
+def measure(args, record) -> None:
     clock: dict = {}
     stage = timer(clock)
     lookup, tree = sphere_tree(args, stage)
@@ -107,6 +114,16 @@ def main() -> None:
     print({k: v for k, v in found.items() if not k.startswith("_") and k != "nonconforming_examples"})
     print(f"leaf mode {leaf_mode:.1f} s wall, {leaf_cpu:.1f} s cpu; global mode {global_mode:.1f} s wall, "
           f"{global_cpu:.1f} s cpu: {global_mode / leaf_mode:.2f}x wall, {global_cpu / leaf_cpu:.2f}x cpu")
+    record.add(f"sphere tree {' x '.join(args.domain)}, L {args.levels}, R {args.radius}",
+               f"{len(tree):,} leaves, {len(mesh.vertices):,} vertices, {len(mesh):,} elements, "
+               f"{len(mesh.patterns)} configurations")
+    for name, (wall, cpu) in clock.items():
+        record.add(name, f"{cpu:.2f} s CPU, {wall:.2f} s wall")
+    record.add("leaf mode (assembly, checks, statistics) vs global mode", f"{leaf_cpu:.1f} s vs {global_cpu:.1f} s CPU: "
+               f"{global_cpu / leaf_cpu:.2f}x CPU, {global_mode / leaf_mode:.2f}x wall")
+    record.add("global mode's result", f"{len(whole):,} cells, {cells.regions if cells else 0} regions, "
+               f"{found.get('delaunay_violations')} Delaunay violations, {found.get('delaunay_ties')} ties")
+    record.add("peak memory (the process)", f"{peak:.2f} GB")
 
 
 if __name__ == "__main__":

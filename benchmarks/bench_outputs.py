@@ -17,7 +17,8 @@ user + system CPU, peak resident memory) and by the wall clock:
 
 The targets: (2) at most the CPU of (3); VTK read < 3 s; meshio read < 10 s; peak of
 (2) < 1.5 GB.  meshio (5.3) refuses a grid that mixes polyhedra with standard cells
-(its VTU reader raises); the script then says so instead of a time.
+(its VTU reader raises); the script then says so instead of a time.  Writes
+results/benchmarks/bench_outputs.json (benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -30,6 +31,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from record import recorded
 
 READ = """
 import sys, time
@@ -67,6 +70,11 @@ def main() -> None:
     cospherical = str(Path(sys.executable).with_name("cospherical"))
     mesh = [cospherical, "mesh", "--domain", "1", "1", "1", "--levels", str(args.levels), "--refine",
             f"sphere:0.5,0.5,0.5,{args.radius}", "--patterns", args.patterns]
+    with recorded(__file__) as record:
+        measure(args, mesh, tetgen, version, record)
+
+
+def measure(args, mesh, tetgen, version, record) -> None:
     rows = []
     with tempfile.TemporaryDirectory(prefix="bench-outputs-") as folder:
         folder = Path(folder)
@@ -93,6 +101,14 @@ def main() -> None:
     print(f"ratio: cospherical mesh --out CPU / TetGen CPU = {rows[1][2] / rows[2][2]:.2f} (target <= 1)")
     for reader, text in reads.items():
         print(f"reading mesh.vtu with {reader}: {text}")
+    record.add(f"sphere tree L {args.levels}, R {args.radius}", f"{figures.get('leaves')} leaves, "
+               f"{figures.get('vertices')} vertices, {figures.get('elements')} elements; mesh.vtu {size / 1e6:.1f} MB")
+    for name, wall, cpu, peak in rows:
+        record.add(name, f"{cpu:.2f} s CPU, {wall:.2f} s wall, peak {peak:.2f} GB")
+    record.add("`cospherical mesh --out` CPU / TetGen CPU", f"{rows[1][2] / rows[2][2]:.2f} "
+               f"(TetGen: {tetrahedra:,} tetrahedra)")
+    for reader, text in reads.items():
+        record.add(f"reading mesh.vtu with {reader}", text)
 
 
 def run_usage(command: list[str]) -> tuple[float, float, float, str]:

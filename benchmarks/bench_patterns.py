@@ -15,6 +15,8 @@
 (d) in a fresh process: open the store and look up 1000 random configurations, one at a
     time (wall time per lookup, and the process's peak memory: the store is never read
     whole).
+
+Writes results/benchmarks/bench_patterns.json (benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from record import recorded
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_intersection import tree_pss, tree_rss  # noqa: E402  (one process-tree sampler for the benchmarks)
@@ -88,26 +92,37 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--out", type=Path, help="where the tables go (default: a temporary folder)")
     args = parser.parse_args()
+    with recorded(__file__) as record:
+        measure(args, record)
+
+
+def measure(args, record) -> None:
     out = args.out or Path(tempfile.mkdtemp(prefix="bench-patterns-"))
     study = [sys.executable, "-m", "cospherical", "study", "intersection", "--resolution", str(args.resolution),
              "--order", args.order, "--jobs", str(args.jobs)]
     print(f"load average before: {os.getloadavg()[0]:.1f}")
     alone, alone_peak = run([*study, "--format", "json"])
     print(f"(a) study intersection --resolution {args.resolution}, the study alone: {alone:.0f} s wall, {alone_peak}")
+    record.add(f"(a) `study intersection --resolution {args.resolution}`, the study alone", f"{alone:.0f} s wall, {alone_peak}")
     wall, peak = run([*study, "--patterns", "--out", str(out)])
     stem = out / f"intersection-r{args.resolution}-{args.order}-patterns"
     sizes = ", ".join(f"{suffix[1:]} {Path(f'{stem}{suffix}').stat().st_size / 1e6:.0f} MB"
                       for suffix in (".sqlite", ".yaml") if Path(f"{stem}{suffix}").exists())
     print(f"(b) the same with --patterns: {wall:.0f} s wall ({wall - alone:.0f} s for the table and the other --out files), "
           f"{peak}; {sizes}")
+    record.add("(b) the same with `--patterns`", f"{wall:.0f} s wall ({wall - alone:.0f} s for the table), {peak}; {sizes}")
     summary = json.loads((out / f"intersection-r{args.resolution}-{args.order}.json").read_text())
     naive = naive_seconds(summary, args.resolution, args.order)
     print(f"(c) the table one tessellation per representative (before), estimated: {naive:.0f} s in one process, "
           f"{naive / args.jobs:.0f} s on {args.jobs}: {naive / args.jobs / max(wall - alone, 1e-9):.0f}x the table's time now")
+    record.add("(c) the table made one tessellation per representative (the old way), estimated",
+               f"{naive / args.jobs:.0f} s on {args.jobs} processes: {naive / args.jobs / max(wall - alone, 1e-9):.0f}x")
     opened, each, rss = subprocess.run([sys.executable, "-c", LOOKUPS, f"{stem}.sqlite"], check=True,
                                        capture_output=True, text=True).stdout.split()
     print(f"(d) store: opened in {float(opened) * 1000:.0f} ms, {float(each) * 1000:.2f} ms per lookup, "
           f"peak {float(rss):.0f} MB; load average after: {os.getloadavg()[0]:.1f}")
+    record.add("(d) a lookup in the store, fresh process",
+               f"opened in {float(opened) * 1000:.0f} ms, {float(each) * 1000:.2f} ms per lookup, peak {float(rss):.0f} MB")
 
 
 if __name__ == "__main__":

@@ -20,7 +20,7 @@ another checkout, e.g. ``git worktree add /tmp/before <commit>``) measures that
 version too, in the same run, with its own pattern table.  ``--every N`` runs qdelaunay on
 every Nth configuration only and scales its time to all 4096, PyYAML (4) reads every Nth
 entry only, and ``--tables`` narrows (5) to the tables matching a pattern: a quick run, as
-the test suite makes.
+the test suite makes.  Writes results/benchmarks/bench_startup.json (benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -33,6 +33,8 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+
+from record import recorded
 
 ROOT = Path(__file__).resolve().parents[1]
 COSPHERICAL = [sys.executable, "-m", "cospherical"]
@@ -84,26 +86,34 @@ def qhull_all(every: int) -> float:
     return (time.perf_counter() - start) * len(codes) / len(inputs)
 
 
-def measure(label: str, env, root: Path, runs: int, qhull: float, tables: str) -> None:
+def measure(label: str, env, root: Path, runs: int, qhull: float, tables: str, record) -> None:
     print(f"--- {label}")
     tessellate = [wall([*COSPHERICAL, "tessellate", "--box", "1", "1", "1", "--code", "800000000000"], env)
                   for _ in range(runs)]
     print(f"(1) tessellate, whole process: median {statistics.median(tessellate):.3f} s "
           f"(min {min(tessellate):.3f}, max {max(tessellate):.3f})")
+    record.add(f"{label}: (1) `cospherical tessellate --box 1 1 1 --code 800000000000`, whole process",
+               f"{statistics.median(tessellate):.3f} s wall, median of {runs}")
     study = [wall([*COSPHERICAL, "study", "bisection", "--box", "1", "1", "1", "--format", "json"], env)
              for _ in range(runs if runs < 3 else max(3, runs // 2))]
     print(f"(2) study bisection, whole process: median {statistics.median(study):.3f} s; "
           f"qdelaunay x 4096 processes: {qhull:.2f} s; ratio {qhull / statistics.median(study):.1f}x")
+    record.add(f"{label}: (2) `cospherical study bisection --box 1 1 1 --format json` vs `qdelaunay Qz Fv` x 4096",
+               f"{statistics.median(study):.3f} s vs {qhull:.2f} s wall: {qhull / statistics.median(study):.1f}x")
     table = root / "patterns" / "bisection-1x1x1.yaml"
     loads = [subprocess.run([sys.executable, "-c", LOAD, str(table)], check=True, capture_output=True, text=True,
                             env=env).stdout.split() for _ in range(max(1, runs if label == "this version" else 1))]
     seconds = statistics.median(float(s) for s, _ in loads)
     print(f"(3) load_patterns + one lookup, fresh process: median {seconds:.3f} s, "
           f"peak {max(float(m) for _, m in loads):.0f} MB ({table.stat().st_size / 2**20:.1f} MB file)")
+    record.add(f"{label}: (3) `load_patterns(\"patterns/bisection-1x1x1.yaml\")` + one lookup, fresh process",
+               f"{seconds:.3f} s wall, peak {max(float(m) for _, m in loads):.0f} MB")
     files = [root / "catalogue" / "catalogue.yaml", *sorted((root / "patterns").glob(tables))]
     seconds = wall([*COSPHERICAL, "check", *map(str, files)], env)
     print(f"(5) check catalogue/catalogue.yaml patterns/{tables} ({len(files) - 1} tables), whole process: "
           f"{seconds:.1f} s")
+    record.add(f"{label}: (5) `cospherical check catalogue/catalogue.yaml patterns/{tables}` ({len(files) - 1} tables)",
+               f"{seconds:.1f} s wall")
 
 
 def main() -> None:
@@ -123,18 +133,24 @@ def main() -> None:
         sys.exit(2)
     if not shutil.which("qdelaunay"):
         raise SystemExit("qdelaunay not found: install qhull-bin (scripts/setup.sh does)")
+    with recorded(__file__) as record:
+        run(args, record)
+
+
+def run(args, record) -> None:
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     qhull = qhull_all(args.every)
     if args.before:
         env = {**os.environ, "PYTHONPATH": str(args.before.resolve())}
         wall([*COSPHERICAL, "tessellate", "--box", "1", "1", "1", "--code", "800000000000"], env)  # numba cache
-        measure(f"before: {args.before}", env, args.before.resolve().parent, args.runs, qhull, args.tables)
-    measure("this version", None, ROOT, args.runs, qhull, args.tables)
+        measure(f"before: {args.before}", env, args.before.resolve().parent, args.runs, qhull, args.tables, record)
+    measure("this version", None, ROOT, args.runs, qhull, args.tables, record)
     table = ROOT / "patterns" / "bisection-1x1x1.yaml"
     s, m = subprocess.run([sys.executable, "-c", PYYAML, str(table), str(args.every)], check=True,
                           capture_output=True, text=True).stdout.split()
     if args.every == 1:
         print(f"(4) PyYAML (C loader) reading this version's file whole: {float(s):.2f} s, peak {float(m):.0f} MB")
+        record.add("(4) PyYAML (C loader) reading that file whole", f"{float(s):.2f} s, peak {float(m):.0f} MB")
     else:
         print(f"(4) PyYAML (C loader) reading every {args.every}th entry of this version's file: {float(s):.2f} s "
               f"(x {args.every}: {float(s) * args.every:.1f} s), peak {float(m):.0f} MB")

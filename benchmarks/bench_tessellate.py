@@ -4,7 +4,8 @@
 
 Both are timed in this one run on the same configurations (random bisection
 configurations of the paper's boxes and random 1/16 intersection
-configurations of the cube); the figure to compare is the ratio.
+configurations of the cube); the figure to compare is the ratio. Writes
+results/benchmarks/bench_tessellate.json (benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import subprocess
 import time
 
 from cospherical import Configuration, tessellate
+from record import recorded
 
 
 def qhull(points) -> None:
@@ -51,13 +53,16 @@ def main() -> None:
             for _ in range(args.samples)
         ],
     }
-    print(f"{'configurations':<20} {'tessellate ms':>14} {'qdelaunay ms':>13} {'ratio':>7}")
-    for label, configs in sets.items():
-        for cfg in configs[:20]:  # warm-up
-            tessellate(cfg)
-        ours = median_ms(tessellate, configs)
-        theirs = median_ms(lambda cfg: qhull(cfg.real_nodes()), configs)
-        print(f"{label:<20} {ours:>14.2f} {theirs:>13.2f} {theirs / ours:>6.2f}x")
+    with recorded(__file__) as record:
+        print(f"{'configurations':<20} {'tessellate ms':>14} {'qdelaunay ms':>13} {'ratio':>7}")
+        for label, configs in sets.items():
+            for cfg in configs[:20]:  # warm-up
+                tessellate(cfg)
+            ours = median_ms(tessellate, configs)
+            theirs = median_ms(lambda cfg: qhull(cfg.real_nodes()), configs)
+            print(f"{label:<20} {ours:>14.2f} {theirs:>13.2f} {theirs / ours:>6.2f}x")
+            record.add(f"one `tessellate` call, {label} configuration, median of {len(configs)}",
+                       f"{ours:.2f} ms (one `qdelaunay Qz Fv` run: {theirs:.2f} ms, {theirs / ours:.1f}x)")
 
 
 if __name__ == "__main__":
