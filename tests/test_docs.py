@@ -205,3 +205,30 @@ def test_page_renders_in_chromium_without_console_errors(site, page):
     assert _screenshot((site / f"{page}.html").as_uri(), png) == []
     data = png.read_bytes()
     assert data.startswith(b"\x89PNG") and len(data) > 50_000  # a blank page compresses to a few kB
+
+
+def test_a_benchmark_run_is_recorded_with_its_machine_and_rendered_from_its_file(tmp_path, capsys):
+    import importlib.util
+    import os
+
+    def load(name, path):
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+
+    record = load("record", ROOT / "benchmarks" / "record.py")
+    with pytest.raises(RuntimeError), record.recorded("bench_fails.py", tmp_path):
+        raise RuntimeError("a failed run")
+    assert not (tmp_path / "bench_fails.json").exists()  # a failed run leaves the previous file as it was
+    with record.recorded("bench_example.py", tmp_path) as run:
+        print("figure line")
+        run.add("one call | median", "0.85 ms")
+    data = json.loads((tmp_path / "bench_example.json").read_text())
+    assert data["output"] == ["figure line"] and data["rows"] == [["one call | median", "0.85 ms"]]
+    assert data["machine"]["cores"] == os.cpu_count() and len(data["load_average"]["before"]) == 3
+    assert data["command"].startswith("python benchmarks/bench_example.py") and data["cpu_seconds"] > 0
+    hooks = load("docs_hooks", ROOT / "scripts" / "docs_hooks.py")
+    page = "\n".join(hooks._recorded_run(tmp_path / "bench_example.json"))
+    assert data["command"] in page and f"{data['machine']['cores']} cores" in page
+    assert "| one call \\| median | 0.85 ms |" in page and "    figure line" in page
