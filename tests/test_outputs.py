@@ -174,6 +174,11 @@ def test_render_pdf_never_writes_through_links_and_keeps_the_users_files(tmp_pat
             "frequencies-bisection-1x2x4-optimal.tex"} <= names
     assert (out / "frequencies-my-notes.tex").read_text() == "notes"
     assert target.read_text() == "the user's own file\n"
+    # a PDF the manifest does not name (the user's, or an older one changed since) stays, and the run says so
+    (out / "document.pdf").write_bytes(b"%PDF the user's")
+    assert main(["render", "--summary", str(SUMMARY), "--out", str(out)]) == 0
+    assert "document.pdf was kept" in capsys.readouterr().err
+    assert (out / "document.pdf").read_bytes() == b"%PDF the user's"
 
 
 @pytest.mark.parametrize("value", ["NaN", "Infinity", "-Infinity"])

@@ -27,8 +27,11 @@ def add_parser(commands) -> None:
         "mesh",
         help="mesh a 1-irregular octree from a pattern table and check the mesh exactly",
         description="Mesh a 1-irregular octree: each leaf's true configuration, its elements from the pattern table "
-                    "(or tessellated), global vertices; exact checks (volume, conformity, circumcenters, global "
-                    "Delaunay) and the frequencies of types and configurations in the mesh.",
+                    "(or tessellated), global vertices; where leaf elements are not globally Delaunay, the exact "
+                    "Delaunay subdivision of their leaves' vertices (--delaunay global, the default); exact checks "
+                    "(volume, conformity, circumcenters, global Delaunay), the frequencies of types and "
+                    "configurations in the mesh and, with --dual, the finite-volume dual (control volumes and "
+                    "coefficients).",
     )
     parser.add_argument("--domain", nargs=3, metavar=("A", "B", "C"), required=True,
                         help="the root cell's lengths, exact: 1, 1.4142, 3/2, sqrt(2)")
@@ -45,7 +48,7 @@ def add_parser(commands) -> None:
                         f"of this machine's memory holds at {BYTES_PER_LEAF} bytes a leaf)")
     parser.add_argument("--balance", choices=BALANCES, default="vertex",
                         help="2:1 balance across faces, edges and corners (vertex, default) or faces and edges "
-                        "(edge); face alone is refused: it is not 1-irregular")
+                        "(edge); across faces alone is not offered: it is not 1-irregular")
     parser.add_argument("--patterns", type=Path, metavar="FILE",
                         help="pattern table of the domain's box (configurations it lacks are tessellated); "
                         "without it every configuration is tessellated")

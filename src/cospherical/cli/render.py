@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 from ..catalogue import shipped_catalogue
@@ -95,4 +96,9 @@ def run(args) -> int:
     print(f"wrote {len(written)} files in {args.out}")
     if args.pdf:
         print(f"wrote {args.out / 'document.pdf'}")
+    elif (args.out / "document.pdf").exists():
+        # an earlier render's PDF went with the manifest's leave; one still here is not ours to remove, and
+        # it does not show these tables
+        print(f"note: {args.out / 'document.pdf'} was kept: not written by an earlier render or changed since; "
+              "it does not show these tables (--pdf makes one that does)", file=sys.stderr)
     return 0
