@@ -1,4 +1,4 @@
-"""The layers hold: import-linter's contracts pass, and a wrong import breaks them."""
+"""The layers hold: import-linter's contracts pass, and a wrong import breaks them; ruff's rules pass."""
 
 import os
 import shutil
@@ -8,6 +8,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 LINT = Path(sys.executable).with_name("lint-imports")
+RUFF = Path(sys.executable).with_name("ruff")
 
 
 def lint(source: Path, cwd: Path) -> subprocess.CompletedProcess:
@@ -45,3 +46,19 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     assert "cospherical.core.geometry -> cospherical.catalogue" in result.stdout
     assert "cospherical.cli.check -> cospherical.cli.diff" in result.stdout
 
+
+def test_ruff_finds_nothing():
+    # The rules of [tool.ruff.lint]: undefined and unused names, syntax, ambiguous names.
+    result = subprocess.run([str(RUFF), "check", "--no-cache", "src", "tests"], cwd=ROOT, capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_ruff_reports_an_undefined_name(tmp_path):
+    # The rules are really on: a name used before any definition is reported, by file and rule.
+    (tmp_path / "wrong.py").write_text("def f():\n    return undefined_on_purpose\n")
+    result = subprocess.run([str(RUFF), "check", "--no-cache", "--output-format", "concise", "--config",
+                             str(ROOT / "pyproject.toml"), "wrong.py"],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 1
+    assert "wrong.py:2:12: F821" in result.stdout

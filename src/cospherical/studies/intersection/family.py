@@ -54,8 +54,8 @@ def _positions(levels: tuple[int, ...], order: str) -> dict[int, Fraction]:
         raise InputError(f"insertion order {order!r}: choose one of {', '.join(INSERTION_ORDERS)}")
     placed: dict[int, Fraction] = {}
     for level in sequence:
-        below = [placed[l] for l in placed if l < level]
-        above = [placed[l] for l in placed if l > level]
+        below = [t for other, t in placed.items() if other < level]
+        above = [t for other, t in placed.items() if other > level]
         low = max(below) if below else Fraction(0)
         high = min(above) if above else Fraction(1)
         placed[level] = (low + high) / 2
