@@ -214,14 +214,17 @@ def _outside_domain(mesh: Mesh) -> int:
     size = mesh.leaf_size()
     outside = 0
     for _, pattern, leaves in mesh.groups():
-        low = mesh.tree.positions[leaves].astype(object) * size[leaves, None]
+        low = mesh.tree.positions[leaves].astype(np.int64) * size[leaves, None]
         for element in pattern.elements:
             if element.center is None:
                 continue
-            # the centre in grid units is low + c * size, for c = p / q: compare q * low + p * size with 0 and q * grid
-            p = np.array([c.numerator for c in element.center], dtype=object)
-            q = np.array([c.denominator for c in element.center], dtype=object)
-            at = low * q[None] + p[None] * size[leaves, None].astype(object)
+            # the centre in grid units is low + c * size, for c = p / q: compare q * low + p * size with 0 and q * grid,
+            # in int64 when every term is below 2**62 (low and size are at most grid), else in Python integers
+            p = [c.numerator for c in element.center]
+            q = [c.denominator for c in element.center]
+            kind = np.int64 if grid * (max(q) + max(map(abs, p))) < 2**62 else object
+            p, q = np.array(p, dtype=kind), np.array(q, dtype=kind)
+            at = low.astype(kind) * q[None] + p[None] * size[leaves, None].astype(kind)
             outside += int(((at < 0) | (at > q[None] * grid)).any(axis=1).sum())
     if mesh.cells is not None:
         num, den = mesh.cell_centers()
@@ -366,10 +369,11 @@ def _morton_order(points: np.ndarray, low: np.ndarray, high: np.ndarray, bits: i
     """The order of ``points`` along the Z-order curve of a ``2**bits`` grid on the box ``low``..``high``."""
     cell = np.clip((points - low) * ((1 << bits) / np.maximum(high - low, 1e-300)), 0, (1 << bits) - 1)
     cell = cell.astype(np.int64)
-    code = np.zeros(len(points), dtype=np.int64)
+    # each coordinate's bits spread three apart by a table, the three interleaved
+    spread = np.zeros(1 << bits, dtype=np.int64)
     for bit in range(bits):
-        for axis in range(3):
-            code |= ((cell[:, axis] >> bit) & 1) << (3 * bit + 2 - axis)
+        spread |= ((np.arange(1 << bits) >> bit) & 1) << (3 * bit)
+    code = (spread[cell[:, 0]] << 2) | (spread[cell[:, 1]] << 1) | spread[cell[:, 2]]
     return np.argsort(code, kind="stable")
 
 
