@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 from fractions import Fraction
 
+import numpy as np
 import pytest
 import vtk
 from hypothesis import HealthCheck, given, settings
@@ -124,3 +125,24 @@ def test_python_integers_give_the_same_cells(monkeypatch):
     fast = mesh_cells(global_delaunay(leaf))
     monkeypatch.setattr(delaunay, "_object_if_large", lambda array, bound: array.astype(object))
     assert mesh_cells(global_delaunay(leaf)) == fast
+
+
+def test_the_final_check_skips_only_what_the_leaf_check_proved():
+    # kept leaf elements and proven cells are not tested again: they must be leaf elements that passed,
+    # and testing every cell again must find nothing the shorter check missed
+    import dataclasses
+
+    leaf = assemble(build_octree(Box.parse(["1", "2", "4"]), 4, [parse_shape("sphere:0.5,1,2,0.6")]))
+    found = check_delaunay(leaf)
+    mesh = global_delaunay(leaf, found)
+    cells = mesh.cells
+    conn, sizes = leaf.connectivity()
+    failed = {frozenset(conn[e, :sizes[e]].tolist()) for e in found["_not_cells"]}
+    proven = {frozenset(row[row >= 0].tolist()) for row in cells.nodes[cells.proven]}
+    assert proven and not proven & failed and proven <= mesh_cells(leaf)
+    assert not cells.proven.all()
+    again = dataclasses.replace(mesh, cells=dataclasses.replace(cells, proven=np.zeros(len(cells), dtype=bool)),
+                                _groups=None)
+    short, full = check_delaunay(mesh), check_delaunay(again)
+    assert (full["delaunay_violations"], full["delaunay_ties"]) == (short["delaunay_violations"],
+                                                                    short["delaunay_ties"]) == (0, 0)

@@ -158,9 +158,11 @@ class Cells:
     Cell ``i`` has shape ``shapes[shape[i]]``, its anchor at grid point ``anchor[i]``
     and its vertices ``nodes[i, :len(offsets)]`` (global ids, -1 padded) in the
     shape's order.  ``leaf[i]`` is the cell's first leaf: the leaf whose box holds
-    an interior point of it (the centroid of one of its tetrahedra); ``spanning[i]``
-    whether the cell reaches beyond that leaf.  ``regions`` and ``largest_region``
-    (in vertices) describe what was re-tessellated.
+    an interior point of it (the centroid of its vertices); ``spanning[i]``
+    whether the cell reaches beyond that leaf; ``proven[i]`` whether it is a leaf
+    element that passed the exact global check, kept as it is (the others were
+    re-tessellated).  ``regions`` and ``largest_region`` (in vertices) describe what
+    was re-tessellated.
     """
 
     shapes: list[CellShape]
@@ -169,6 +171,7 @@ class Cells:
     nodes: np.ndarray
     leaf: np.ndarray
     spanning: np.ndarray
+    proven: np.ndarray
     regions: int = 0
     largest_region: int = 0
 
@@ -258,6 +261,18 @@ class Mesh:
                 rows = order[starts[s]:starts[s + 1]]
                 yield (self.leaf_elements + rows, self.cells.nodes[rows, :len(shape.offsets)], shape.faces,
                        shape.type_id)
+
+    def element_nodes(self, elements: np.ndarray) -> np.ndarray:
+        """Global vertex ids of the given leaf elements, in their pattern's node order, padded with -1."""
+        width = max((len(e.nodes) for p in self.patterns for e in p.elements), default=1)
+        widest = max((len(p.elements) for p in self.patterns), default=1)
+        # (pattern, element) -> local nodes, padded with slot 26 (the body centre: never a vertex, so -1)
+        local = np.full((len(self.patterns), widest, width), 26, dtype=np.int64)
+        for p, pattern in enumerate(self.patterns):
+            for j, element in enumerate(pattern.elements):
+                local[p, j, :len(element.nodes)] = element.nodes
+        leaf = self.element_leaf[elements]
+        return self.slots[leaf[:, None], local[self.leaf_pattern[leaf], self.element_local[elements]]]
 
     def connectivity(self) -> tuple[np.ndarray, np.ndarray]:
         """Global vertex ids of every element: (elements x widest) int32 padded with -1, and the sizes."""

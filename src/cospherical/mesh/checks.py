@@ -242,6 +242,11 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     ``_leaves`` and ``_elements`` (the violating leaves' and elements' indices, arrays,
     for the caller) and ``_not_cells`` (the elements that violate or tie: the ones
     that are not cells of the Delaunay subdivision of the vertices).
+
+    In a mesh with re-tessellated cells (:func:`~cospherical.mesh.delaunay.global_delaunay`)
+    the leaf elements and the cells marked ``proven`` passed this check on the same
+    vertex set when they were kept, so only the other cells are tested (and counted in
+    ``delaunay_exact_tests``); ``progress`` is told of the others at once.
     """
     from scipy.spatial import cKDTree
 
@@ -252,7 +257,10 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     size = grid >> levels
     origin = mesh.tree.positions.astype(np.int64) * size[:, None]
     rows_pattern, rows_local, rows_leaf, centres, radii, n_nodes = [], [], [], [], [], []
-    for p, pattern, leaves in mesh.groups():
+    cells = mesh.cells
+    # the leaf elements kept beside re-tessellated cells, and the cells marked proven, passed this very
+    # check on the same vertex set when they were chosen: only the other cells are tested again
+    for p, pattern, leaves in (mesh.groups() if cells is None else ()):
         for j, element in enumerate(pattern.elements):
             if element.sphere is None:
                 continue  # reported by check_circumcenters as not co-spherical
@@ -264,11 +272,10 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
             centres.append(centre)
             radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(leaves), len(element.nodes), dtype=np.int64))
-    cells = mesh.cells
     if cells is not None and len(cells):
         # a cell is a row of pattern -1 whose "leaf" is its index among the cells
         for s, shape in enumerate(cells.shapes):
-            rows = np.flatnonzero(cells.shape == s)
+            rows = np.flatnonzero((cells.shape == s) & ~cells.proven)
             centre = (cells.anchor[rows] + np.array([float(x) for x in shape.center])[None]) * scale
             first = points[cells.nodes[rows, 0]]
             rows_pattern.append(np.full(len(rows), -1, dtype=np.int32))
@@ -277,7 +284,9 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
             centres.append(centre)
             radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(rows), len(shape.offsets), dtype=np.int64))
-    if not centres:
+    if progress and cells is not None:
+        progress(len(mesh) - sum(len(c) for c in centres))
+    if not sum(len(c) for c in centres):
         return {"_leaves": np.zeros(0, dtype=np.int64), "_elements": np.zeros(0, dtype=np.int64),
                 "_not_cells": np.zeros(0, dtype=np.int64), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
                 "delaunay_ties": 0, "delaunay_exact_tests": 0}
@@ -312,18 +321,12 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         pairs_vertex.append(found_vertices if near is None else near[found_vertices])
     pair_row = np.concatenate(pairs_row) if pairs_row else np.zeros(0, dtype=np.int64)
     pair_vertex = np.concatenate(pairs_vertex) if pairs_vertex else np.zeros(0, dtype=np.int64)
-    # drop each element's own nodes: a (pattern, element) -> local node table, padded with slot 26 (never a vertex)
-    width = max((len(e.nodes) for p in mesh.patterns for e in p.elements), default=1)
-    widest = max((len(p.elements) for p in mesh.patterns), default=1)
-    local = np.full((len(mesh.patterns), widest, width), 26, dtype=np.int64)
-    for p, pattern in enumerate(mesh.patterns):
-        for j, element in enumerate(pattern.elements):
-            local[p, j, :len(element.nodes)] = element.nodes
+    # drop each element's own nodes
     is_cell = rows_pattern[pair_row] < 0
     own = np.zeros(len(pair_row), dtype=bool)
     leafy = np.flatnonzero(~is_cell)
     leaf_of_pair = rows_leaf[pair_row[leafy]]
-    nodes = mesh.slots[leaf_of_pair[:, None], local[rows_pattern[pair_row[leafy]], rows_local[pair_row[leafy]]]]
+    nodes = mesh.element_nodes(mesh.element_offsets[leaf_of_pair] + rows_local[pair_row[leafy]])
     own[leafy] = (nodes == pair_vertex[leafy, None]).any(axis=1)
     celly = np.flatnonzero(is_cell)
     if len(celly):

@@ -27,7 +27,8 @@ Why a piece is the whole mesh's restriction, element for element:
   checks the leaf mesh; the leaves holding an element that is not a cell of the
   Delaunay subdivision (any piece's) are re-tessellated here, region by region,
   exactly as in one process (:func:`~cospherical.mesh.delaunay.retessellate` on
-  the marked leaves alone, with the whole tree's vertices: its proof holds for
+  the marked leaves alone, told which of their elements failed, with the whole
+  tree's vertices: its proof holds for
   regions that cross seams, since nothing in it depends on the pieces).  Each new
   cell goes to the piece that holds its first leaf (the leaf holding an interior
   point of it, a marked one), and those pieces are meshed again with their cells,
@@ -131,8 +132,10 @@ def mesh_piece(piece: Piece) -> dict:
         result["leaf_mesh"] = {"elements": len(mesh), "delaunay_violations": found["delaunay_violations"],
                                "delaunay_ties": found["delaunay_ties"],
                                "elements_replaced": int(len(found["_not_cells"]))}
-        if len(found["_not_cells"]):
-            result["marked"] = piece.leaves[np.unique(mesh.element_leaf[found["_not_cells"]])]
+        failing = found["_not_cells"]
+        if len(failing):
+            result["marked"] = piece.leaves[np.unique(mesh.element_leaf[failing])]
+            result["failing"] = (piece.leaves[mesh.element_leaf[failing]], mesh.element_local[failing])
             return result
         checked = found
     seams: list = []
@@ -171,7 +174,9 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
         marked = np.sort(np.concatenate([results[k].get("marked", np.zeros(0, dtype=np.int64))
                                          for k in range(pieces)]))
         if len(marked):
-            again, regions = _cells_by_piece(tree, parts, marked, grid, keys, lookup, criterion)
+            failing = [results[k]["failing"] for k in range(pieces) if "failing" in results[k]]
+            failing = tuple(np.concatenate([f[i] for f in failing]) for i in range(2))
+            again, regions = _cells_by_piece(tree, parts, marked, failing, grid, keys, lookup, criterion)
             results.update(completed(mesh_piece, {k: task(k, **more) for k, more in again.items()}, jobs,
                                      scheduler, dask_workers))
     seams = [seam for k in range(pieces) for seam in results[k]["seams"]]
@@ -184,9 +189,11 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
                          criterion, uniform, delaunay, leaf_mesh, regions, seams, points, grid)
 
 
-def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, grid: int, keys: np.ndarray,
-                    lookup: tuple | None, criterion: str) -> tuple[dict[int, dict], tuple[int, int]]:
+def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, failing: tuple, grid: int,
+                    keys: np.ndarray, lookup: tuple | None, criterion: str) -> tuple[dict[int, dict], tuple[int, int]]:
     """Re-tessellate the marked leaves (whole-tree indices) and give each cell to the piece of its first leaf.
+
+    ``failing``: the elements that are not Delaunay cells, as (whole-tree leaf, index in the leaf).
 
     Returns, per piece with marked leaves, its second round's ``cells``, ``replaced``
     and ``types``, and (regions, the largest region's vertices).
@@ -195,7 +202,7 @@ def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, g
     mesh = assemble(sub, lookup[0](*lookup[1]) if lookup is not None else None, criterion=criterion,
                     vertices=(grid, keys))
     types = dict(mesh.types)
-    cells = retessellate(mesh, np.ones(len(sub), dtype=bool), types)
+    cells = retessellate(mesh, mesh.element_offsets[np.searchsorted(marked, failing[0])] + failing[1], types)
     piece_of_leaf = np.empty(len(tree), dtype=np.int64)
     for k, leaves in enumerate(parts):
         piece_of_leaf[leaves] = k
@@ -206,7 +213,7 @@ def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, g
         used, shape = np.unique(cells.shape[rows], return_inverse=True)
         mine = Cells([cells.shapes[s] for s in used.tolist()], shape.astype(np.int32).reshape(-1),
                      cells.anchor[rows], cells.nodes[rows], np.searchsorted(parts[k], first[rows]),
-                     cells.spanning[rows], cells.regions, cells.largest_region)
+                     cells.spanning[rows], cells.proven[rows], cells.regions, cells.largest_region)
         replaced = np.isin(parts[k], marked)
         again[k] = {"cells": mine, "replaced": replaced, "types": types}
     return again, (cells.regions, cells.largest_region)
