@@ -9,12 +9,12 @@ hexahedron order.  Positions are kept in *unit* coordinates (s, t, u) in
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Iterable, Mapping
 
 from ..errors import InputError
+from .codes import CUBOID_CODE, digit_parameters, parameter_digits, parse_point_suffix, point_suffix
 from .exact import Length, parse_rational
 
 __all__ = [
@@ -135,10 +135,6 @@ def steiner_parameters(steiner: Mapping | Iterable | None, edges: int = 12,
 
 
 FACE_POINT_SOURCES = (*POINT_POLICIES, "explicit")
-# The whole-point-set code: 12 edge digits, then optionally "+f", the faces carrying a
-# point in increasing order, and "b" for the body point.  One point set, one code.
-_CODE = re.compile(r"^(?P<edges>[0-9a-fA-F]{12})(?:\+(?P<suffix>.*))?$", re.DOTALL)
-_SUFFIX = re.compile(r"^f(?P<faces>[0-5]*)(?P<body>b?)$")
 
 
 def _face_numbers(faces: Iterable, where: str) -> frozenset[int]:
@@ -153,41 +149,6 @@ def _face_numbers(faces: Iterable, where: str) -> frozenset[int]:
             raise InputError(f"{where}: face {int(text)} given twice")
         numbers.append(int(text))
     return frozenset(numbers)
-
-
-def parse_point_suffix(code: str, suffix: str) -> tuple[frozenset[int], bool]:
-    """The faces and body point named by a code's point suffix (the text after ``+``).
-
-    Examples
-    --------
-    >>> parse_point_suffix("888888888888+f04", "f04")
-    (frozenset({0, 4}), False)
-    >>> parse_point_suffix("888888888888+f40", "f40")
-    Traceback (most recent call last):
-    ...
-    cospherical.errors.InputError: configuration code '888888888888+f40': list the faces of the suffix in increasing order (+f04)
-    """
-    match = _SUFFIX.match(suffix)
-    if not match:
-        raise InputError(f"configuration code {code!r}: malformed point suffix {'+' + suffix!r}: write +f, then "
-                         "the faces carrying a point (0..5, increasing), then b for the body point, e.g. +f04")
-    digits = match["faces"]
-    if len(set(digits)) != len(digits):
-        raise InputError(f"configuration code {code!r}: a face is given twice in the suffix")
-    if list(digits) != sorted(digits):
-        # one point set, one code: pattern tables are looked up by the code's text
-        raise InputError(f"configuration code {code!r}: list the faces of the suffix in increasing order "
-                         f"(+f{''.join(sorted(digits))})")
-    return frozenset(int(d) for d in digits), bool(match["body"])
-
-
-def point_suffix(faces: Iterable[int], body: bool) -> str:
-    """The point suffix (without ``+``) naming a set of face points and the body point.
-
-    >>> point_suffix({4, 0}, False), point_suffix(range(6), True), point_suffix((), False)
-    ('f04', 'f012345b', 'f')
-    """
-    return "f" + "".join(str(f) for f in sorted(faces)) + ("b" if body else "")
 
 
 @dataclass(frozen=True)
@@ -278,12 +239,12 @@ class Configuration:
         bare code takes them from the policy (``octree`` or ``none``), or from
         ``faces`` and ``body``.  ``face_points="explicit"`` asks for a suffix.
         """
-        match = _CODE.match(code) if isinstance(code, str) else None
+        match = CUBOID_CODE.match(code) if isinstance(code, str) else None
         if not match:
             raise InputError(f"configuration code {code!r}: needs exactly 12 hexadecimal digits, "
                              "optionally followed by a point suffix such as +f04")
         box = box if isinstance(box, Box) else Box.parse(box)
-        params = tuple(Fraction(int(ch, 16), 16) if ch != "0" else None for ch in match["edges"])
+        params = digit_parameters(match["edges"])
         if match["suffix"] is not None:
             if faces is not None or body:
                 raise InputError(f"configuration code {code!r}: its suffix gives the face points; "
@@ -300,17 +261,6 @@ class Configuration:
             return cls(box, params, "explicit", tuple(faces or ()), body)
         return cls(box, params, face_points)
 
-    def _edge_digits(self) -> str | None:
-        digits = []
-        for t in self.steiner:
-            if t is None:
-                digits.append("0")
-            elif (t * 16).denominator == 1:
-                digits.append("%x" % int(t * 16))
-            else:
-                return None
-        return "".join(digits)
-
     @property
     def code(self) -> str | None:
         """The configuration code as its own policy reads it: 12 hex digits under ``octree``
@@ -318,12 +268,12 @@ class Configuration:
         t is not a multiple of 1/16."""
         if self.face_points == "explicit":
             return self.point_set_code
-        return self._edge_digits()
+        return parameter_digits(self.steiner)
 
     @property
     def point_set_code(self) -> str | None:
         """The code of the whole point set, the same under every policy (always suffixed)."""
-        digits = self._edge_digits()
+        digits = parameter_digits(self.steiner)
         if digits is None:
             return None
         return f"{digits}+{point_suffix(self.point_faces, self.has_body_point)}"

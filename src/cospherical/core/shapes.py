@@ -32,7 +32,6 @@ Examples
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
@@ -40,6 +39,7 @@ from itertools import combinations
 from typing import Iterable, Mapping, Sequence
 
 from ..errors import InputError
+from .codes import EDGE_DIGITS, digit_parameters, mask_codes, parameter_digits
 from .configuration import Box, steiner_parameters
 from .exact import parse_rational
 from .geometry import cross, dot, six_volume, sub, tetra_six_volume
@@ -291,9 +291,6 @@ def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
     return Shape.from_vertices(corners, edges, faces, box, name)
 
 
-_CODE = re.compile(r"^[0-9a-fA-F]+$")
-
-
 @dataclass(frozen=True)
 class ShapeConfiguration:
     """A 1-irregular element of a :class:`Shape`: at most one Steiner point per edge.
@@ -324,10 +321,10 @@ class ShapeConfiguration:
     def from_code(cls, shape: Shape, code: str, face_points: str = "octree") -> "ShapeConfiguration":
         """From one hexadecimal digit per edge (digit n: a point at t = n/16; ``0``: none)."""
         count = len(shape.edges)
-        if not isinstance(code, str) or len(code) != count or not _CODE.match(code):
+        if not isinstance(code, str) or len(code) != count or not EDGE_DIGITS.match(code):
             raise InputError(f"configuration code {code!r}: the {shape.name} needs exactly {count} hexadecimal "
                              "digits, one per edge")
-        return cls(shape, tuple(Fraction(int(ch, 16), 16) if ch != "0" else None for ch in code), face_points)
+        return cls(shape, digit_parameters(code), face_points)
 
     @classmethod
     def from_steiner(cls, shape: Shape, steiner: Mapping | Iterable | None = None,
@@ -342,9 +339,7 @@ class ShapeConfiguration:
     @property
     def code(self) -> str | None:
         """One hexadecimal digit per edge; ``None`` when some t is not a multiple of 1/16."""
-        if any(t is not None and (t * 16).denominator != 1 for t in self.steiner):
-            return None
-        return "".join("0" if t is None else "%x" % int(t * 16) for t in self.steiner)
+        return parameter_digits(self.steiner)
 
     @property
     def point_set_code(self) -> str | None:
@@ -413,12 +408,3 @@ class ShapeConfiguration:
     def real_nodes(self) -> dict[int, tuple[float, float, float]]:
         scale = self.box.to_float()
         return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}
-
-
-def mask_codes(edges: int) -> list[str]:
-    """The bisection codes of an element with ``edges`` edges: a midpoint (``8``) or nothing on each.
-
-    >>> mask_codes(2)
-    ['00', '80', '08', '88']
-    """
-    return ["".join("8" if mask >> k & 1 else "0" for k in range(edges)) for mask in range(1 << edges)]

@@ -22,17 +22,8 @@ if TYPE_CHECKING:
 # configuration maps polyhedra with these symmetries and needs no numpy (its
 # import is a third of a command's start-up).
 
-from .configuration import (
-    BODY_NODE,
-    CORNERS,
-    EDGES,
-    FACES,
-    Box,
-    Configuration,
-    edge_axis,
-    parse_point_suffix,
-    point_suffix,
-)
+from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, point_suffix
+from .configuration import BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis
 from .geometry import cross, dot, sub, tetra_six_volume
 from .polyhedron import Polyhedron
 from .shapes import Point, Shape
@@ -90,7 +81,7 @@ class Symmetry:
         edges, plus, suffix = code.partition("+")
         digits = ["0"] * 12
         for (image, reverse), digit in zip(self.edge_map, edges):
-            digits[image] = _REVERSED_DIGIT[digit] if reverse else digit
+            digits[image] = REVERSED_DIGIT[digit] if reverse else digit
         if not plus:
             return "".join(digits)
         faces, body = parse_point_suffix(code, suffix)
@@ -142,9 +133,6 @@ def _point_mask(code: str) -> int:
 
 def _mask_suffix(mask: int) -> str:
     return point_suffix((f for f in range(6) if mask >> f & 1), bool(mask & _BODY_BIT))
-
-
-_REVERSED_DIGIT = {"%x" % n: "%x" % ((16 - n) % 16) for n in range(16)}
 
 
 @lru_cache(maxsize=None)  # shared by the node maps of all symmetries
@@ -241,17 +229,6 @@ def _orbit_keys_numpy(digits, targets, reverse, masks, faces):
     return best, best_mask, best_sym
 
 
-def code_digits(codes: Sequence[str]) -> np.ndarray:
-    import numpy as np
-
-    text = np.frombuffer("".join(code[:12] for code in codes).lower().encode("ascii"), dtype=np.uint8).reshape(-1, 12)
-    return np.where(text >= ord("a"), text - ord("a") + 10, text - ord("0")).astype(np.int64)
-
-
-def key_code(key: int) -> str:
-    return "%012x" % key
-
-
 def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry]) -> tuple[list[str], list[int]]:
     """For each code, its orbit's representative (the smallest image code) and the
     index of a symmetry taking the code to it.  A code with a point suffix
@@ -315,7 +292,7 @@ def _group(symmetries: tuple[Symmetry, ...]) -> _Group | None:
     return _Group(tuple(images), tuple(sym.face_map for sym in symmetries), tuple(compose), inverse)
 
 
-_REVERSAL = str.maketrans(_REVERSED_DIGIT)
+_REVERSAL = str.maketrans(REVERSED_DIGIT)
 
 
 def _orbit_keys_python(codes, masks, group: _Group):
@@ -405,7 +382,7 @@ class ShapeSymmetry:
         """The image of a configuration code (digit n becomes 16 - n on a reversed edge)."""
         digits = ["0"] * len(code)
         for (target, reverse), digit in zip(self.edge_map, code):
-            digits[target] = "%x" % ((16 - int(digit, 16)) % 16) if reverse else digit
+            digits[target] = REVERSED_DIGIT[digit.lower()] if reverse else digit
         return "".join(digits)
 
     def polyhedron(self, poly: Polyhedron) -> Polyhedron:

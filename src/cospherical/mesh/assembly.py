@@ -26,6 +26,7 @@ from typing import Callable, Iterable
 import numpy as np
 
 from ..catalogue import apply_catalogue_criterion, shipped_catalogue
+from ..core.codes import mask_code, point_suffix
 from ..core.configuration import CORNERS, EDGES, FACES, Box, Configuration
 from ..core.delaunay import hull_faces
 from ..core.element_types import ElementType
@@ -350,8 +351,7 @@ def leaf_code(edges: int, faces: int) -> str:
     >>> leaf_code(0b1, 0), leaf_code(0xfff, 0b010001)
     ('800000000000+f', '888888888888+f04')
     """
-    digits = "".join("8" if edges >> k & 1 else "0" for k in range(12))
-    return digits + "+f" + "".join(str(f) for f in range(6) if faces >> f & 1)
+    return mask_code(edges, 12) + "+" + point_suffix((f for f in range(6) if faces >> f & 1), False)
 
 
 def vertex_keys(tree: Octree) -> tuple[int, np.ndarray]:

@@ -21,6 +21,7 @@ from itertools import combinations
 from typing import Sequence
 
 from ..catalogue import CRITERIA
+from ..core.codes import point_suffix
 from ..core.configuration import FACE_EDGES, Box
 from .bisection import Progress, Study, bisection_codes, run_study
 
@@ -44,7 +45,7 @@ def leaf_codes() -> list[str]:
     for code in bisection_codes():
         split = [f for f in range(6) if all(code[k] == "8" for k in FACE_EDGES[f])]
         for size in range(len(split) + 1):
-            codes.extend(code + "+f" + "".join(map(str, faces)) for faces in combinations(split, size))
+            codes.extend(code + "+" + point_suffix(faces, False) for faces in combinations(split, size))
     return codes
 
 
