@@ -146,3 +146,66 @@ def test_the_final_check_skips_only_what_the_leaf_check_proved():
     short, full = check_delaunay(mesh), check_delaunay(again)
     assert (full["delaunay_violations"], full["delaunay_ties"]) == (short["delaunay_violations"],
                                                                     short["delaunay_ties"]) == (0, 0)
+
+
+def _count_exact(monkeypatch) -> list:
+    """Record the regions the exact engine tetrahedralises (their vertex counts)."""
+    import cospherical.mesh.delaunay as delaunay
+
+    calls: list = []
+    engine = delaunay.delaunay_tetrahedra
+    monkeypatch.setattr(delaunay, "delaunay_tetrahedra", lambda coords, weights: calls.append(len(coords))
+                        or engine(coords, weights))
+    return calls
+
+
+@pytest.mark.parametrize("domain, levels, shapes, balance", [CASES[0], CASES[4],
+                                                            (["1", "sqrt(2)", "3"], 4, ["point:0.3,0.61,0.77"], "vertex")])
+def test_exact_engine_gives_the_qhull_paths_cells(domain, levels, shapes, balance, monkeypatch):
+    leaf = assemble(build_octree(Box.parse(domain), levels, [parse_shape(s) for s in shapes], balance))
+    calls = _count_exact(monkeypatch)
+    proposed = mesh_cells(global_delaunay(leaf))
+    assert calls == []  # ordinary boxes: Qhull's proposal passes the exact check, no fallback
+    exact = global_delaunay(leaf, engine="exact")
+    assert calls and mesh_cells(exact) == proposed and whole(exact) == WHOLE
+    with pytest.raises(ValueError, match="engine"):
+        global_delaunay(leaf, engine="cgal")
+
+
+@pytest.mark.parametrize("domain, shape", [(["1e-12", "1", "3e9"], "point:0,0.3,1e9"),
+                                           (["sqrt(2)", "1e-12", "1"], "point:0.5,0,0.7")])
+def test_extreme_boxes_mesh_exactly(domain, shape, monkeypatch, capsys):
+    # Qhull's float triangulation fails on these regions; the exact engine takes them
+    calls = _count_exact(monkeypatch)
+    argv = ["mesh", "--domain", *domain, "--levels", "4", "--refine", shape, "--format", "json", "--no-uniform"]
+    assert main(argv) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert calls and report["regions_retessellated"] >= 1 and report["leaf_mesh"]["delaunay_violations"] > 0
+    assert {k: report[k] for k in WHOLE} == WHOLE and report["elements"] > report["leaves"]
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.integers(1, 9), st.integers(1, 9)), min_size=3, max_size=3), st.booleans(),
+       st.tuples(*[st.fractions(0, 1, max_denominator=8)] * 3))
+def test_exact_engine_on_random_trees_and_boxes(lengths, root, where):
+    # rational boxes, or the first length a square root (the sqrt(2) family of the paper's case C)
+    box = _box(lengths)
+    if root:
+        box = Box.parse([f"sqrt({Fraction(*lengths[0])})", *[str(Fraction(p, q)) for p, q in lengths[1:]]])
+    point = ",".join(str(float(x) * float(length)) for x, length in zip(where, box.lengths))
+    leaf = assemble(build_octree(box, 3, [parse_shape(f"point:{point}")], "vertex"))
+    mesh = global_delaunay(leaf, engine="exact")
+    assert mesh_cells(mesh) == oracle_cells(leaf)
+    assert whole(mesh) == WHOLE
+
+
+def test_a_wrong_float_proposal_is_caught(monkeypatch):
+    # Qhull on points stretched 5x along z: a valid tiling, but not the Delaunay one of the true box
+    import scipy.spatial
+
+    leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))
+    expected = mesh_cells(global_delaunay(leaf))
+    qhull = scipy.spatial.Delaunay
+    monkeypatch.setattr(scipy.spatial, "Delaunay", lambda points, **options: qhull(points * [1, 1, 5], **options))
+    calls = _count_exact(monkeypatch)
+    assert mesh_cells(global_delaunay(leaf)) == expected and calls

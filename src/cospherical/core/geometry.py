@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Mapping, Sequence
 
-__all__ = ["Frame", "Sphere", "cross", "dot", "six_volume", "sub", "tetra_six_volume"]
+__all__ = ["Frame", "Sphere", "cross", "dot", "six_volume", "sphere_sides", "sub", "tetra_six_volume"]
 
 Vector = tuple[int, int, int]
 
@@ -44,6 +44,44 @@ def tetra_six_volume(p: Sequence, q: Sequence, r: Sequence, s: Sequence):
     """Six times the signed volume of the tetrahedron pqrs (zero: the four are coplanar), exact for
     integers and Fractions alike."""
     return dot(sub(q, p), cross(sub(r, p), sub(s, p)))
+
+
+def sphere_sides(tets, points, weights: Sequence[int]):
+    """Per row, where a point lies against a tetrahedron's circumsphere, in bulk: < 0 strictly inside, 0 on, > 0 outside.
+
+    ``tets``: integer array (n, 4, 3) of solid tetrahedra, either orientation;
+    ``points``: (n, 3); ``weights``: the frame's.  With d_k the edges from the first
+    vertex, e the point from it and L the lifted length (weights . x^2), the centre
+    c solves 2 W c . d_k = L(d_k), so W c = N / (2 det) by Cramer's rule
+    (N: the three determinants with one column replaced by L), and e is inside
+    exactly when L(e) < e . N / det.  numpy's int64 when the bound fits, else Python
+    integers (object arrays): exact either way.
+
+    >>> import numpy as np
+    >>> cube = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 2]]] * 3)
+    >>> sphere_sides(cube, np.array([[1, 1, 1], [2, 2, 2], [3, 0, 0]]), (1, 1, 1)).tolist()
+    [-1, 0, 1]
+    """
+    import numpy as np
+
+    tets, points = np.asarray(tets, dtype=np.int64), np.asarray(points, dtype=np.int64)
+    d = tets[:, 1:] - tets[:, :1]
+    e = points - tets[:, 0]
+    extent = max(int(np.abs(d).max(initial=0)), int(np.abs(e).max(initial=0)), 1)
+    if 30 * max(weights) * extent ** 5 >= 2 ** 62:
+        d, e = d.astype(object), e.astype(object)
+        w = np.array([int(x) for x in weights], dtype=object)
+    else:
+        w = np.array(weights, dtype=np.int64)
+    lifted = (d * d * w).sum(axis=2)
+    det = np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2]))
+    towards = 0
+    for axis in range(3):
+        m = d.copy()
+        m[:, :, axis] = lifted
+        towards = towards + e[:, axis] * np.einsum("ij,ij->i", m[:, 0], np.cross(m[:, 1], m[:, 2]))
+    side = (det * (e * e * w).sum(axis=1) - towards) * np.where(det < 0, -1, 1)
+    return np.sign(side).astype(np.int8)
 
 
 def six_volume(coords, cycles) -> int:

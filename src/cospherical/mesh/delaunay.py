@@ -49,7 +49,14 @@ sphere tree of 345,640 leaves, 110,695 points in 1,305 regions (largest 10,070)
 instead of 209,793 in 239 (largest 80,067), and Qhull's time 4.2 s instead of 15.7 s.  Measured against CGAL's exact-predicate triangulation (pip ``cgal``) on
 50,000 points at load 11: Qhull 13.1 s in all, CGAL 2.9 s to insert but 13.4 s to
 read its cells back through the Python bindings, one object per cell; Qhull hands
-back arrays.  A cell's vertices are its tetrahedra's.  The whole mesh is then
+back arrays.  A cell's vertices are its tetrahedra's.  Qhull's proposal is checked
+per region in integers: across every face between two solid tetrahedra, the far
+vertex is not strictly inside the near one's sphere (float rounding makes exactly
+such flips; a triangulation of the hull without one is Delaunay).  Where Qhull
+fails (boxes of extreme aspect ratio, 1e-12 x 1 x 3e9, whose first simplex is flat
+in floats) or the check does, the exact engine
+(:mod:`cospherical.core.incremental_delaunay`, Bowyer-Watson in Python integers,
+about 3.7 times Qhull's path's CPU) tetrahedralises V_r instead.  The whole mesh is then
 checked again by the report (volume, conformity, and empty spheres and ties of
 every cell not proven before), so a wrong proposal cannot pass unseen.  Cube octrees, whose leaf mesh is already
 globally Delaunay, have no region: the mesh is returned as it is.
@@ -62,19 +69,24 @@ from fractions import Fraction
 
 import numpy as np
 
-from ..core.geometry import Frame
+from ..core.geometry import Frame, sphere_sides
+from ..core.incremental_delaunay import delaunay_tetrahedra
 from ..core.tessellation import tessellation_elements
-from ..errors import CosphericalError, InputError
+from ..errors import InputError
 from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, _type_info
 from .checks import _weights, check_delaunay
 
-__all__ = ["MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
+__all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
+
+ENGINES = ("qhull", "exact")
 
 
-def global_delaunay(mesh: Mesh, found: dict | None = None) -> Mesh:
+def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull") -> Mesh:
     """The exact Delaunay subdivision of ``mesh``'s vertices, as a :class:`Mesh` (see the module's proof).
 
     ``found``: the result of :func:`check_delaunay` on ``mesh`` when the caller has it.
+    ``engine``: how regions are tetrahedralised, ``qhull`` (floats propose, integers
+    check, the exact engine where either fails) or ``exact`` (the exact engine alone).
 
     Examples
     --------
@@ -86,6 +98,8 @@ def global_delaunay(mesh: Mesh, found: dict | None = None) -> Mesh:
     >>> [check_delaunay(m)["delaunay_violations"] for m in (leaf, whole)], whole.cells.regions
     ([5, 0], 1)
     """
+    if engine not in ENGINES:
+        raise ValueError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
     if found is None:
         found = check_delaunay(mesh)
     elements = found["_not_cells"]
@@ -96,10 +110,10 @@ def global_delaunay(mesh: Mesh, found: dict | None = None) -> Mesh:
     bad = np.zeros(len(mesh.tree), dtype=bool)
     bad[mesh.element_leaf[elements]] = True
     types = dict(mesh.types)
-    return with_cells(mesh, bad, retessellate(mesh, elements, types), types)
+    return with_cells(mesh, bad, retessellate(mesh, elements, types, engine), types)
 
 
-def retessellate(mesh: Mesh, elements: np.ndarray, types: dict) -> Cells:
+def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "qhull") -> Cells:
     """The cells of the Delaunay subdivision of ``mesh``'s vertices that replace the leaves holding ``elements``.
 
     ``elements``: the leaf elements that are not cells of it (see the module's proof).
@@ -107,6 +121,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict) -> Cells:
     ``mesh`` may hold only some of a tree's leaves (with the whole tree's vertices):
     a point outside its leaves is outside every region, as it is outside the failing
     elements of the whole tree.  ``types`` receives the cells' types it lacks (id -> name, class, VTK cell).
+    ``engine``: as for :func:`global_delaunay`.
     """
     nodes = mesh.element_nodes(elements)
     part, regions = _regions(nodes, len(mesh.vertices))
@@ -120,7 +135,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict) -> Cells:
     vertices = pairs % len(mesh.vertices)
     tets, tet_region = [], []
     for r in range(regions):
-        found_tets = _region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]])
+        found_tets = _region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine)
         tets.append(found_tets)
         tet_region.append(np.full(len(found_tets), r, dtype=np.int64))
     tets, tet_region = np.concatenate(tets), np.concatenate(tet_region)
@@ -205,28 +220,55 @@ def _object_if_large(array: np.ndarray, bound: int) -> np.ndarray:
     return array.astype(object) if bound >= 2**62 else array
 
 
-def _region_tetrahedra(mesh: Mesh, ids: np.ndarray) -> np.ndarray:
-    """Qhull's tetrahedra of a region's vertices (global ids, in and out), without the flat ones."""
+def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull") -> np.ndarray:
+    """The Delaunay tetrahedra of a region's vertices (global ids, in and out), without flat ones.
+
+    ``qhull``: Qhull proposes them in floats and integers check the proposal; where
+    Qhull fails (boxes of extreme aspect ratio, 1e-12 x 1 x 3e9: its first simplex
+    is flat in floats) or the check does, the exact engine
+    (:func:`~cospherical.core.incremental_delaunay.delaunay_tetrahedra`) makes them.
+    ``exact``: the exact engine alone.
+    """
+    coords = mesh.vertices[ids].astype(np.int64)
+    if engine == "qhull":
+        simplices = _qhull_proposal(mesh, coords)
+        if simplices is not None:
+            return ids[simplices]
+    return ids[np.array(delaunay_tetrahedra(coords.tolist(), _weights(mesh)), dtype=np.int64).reshape(-1, 4)]
+
+
+def _qhull_proposal(mesh: Mesh, coords: np.ndarray) -> np.ndarray | None:
+    """Qhull's solid tetrahedra of the points (indices into ``coords``), or ``None`` when Qhull or the check fails.
+
+    The check, in integers: across every face between two solid tetrahedra the far
+    vertex is not strictly inside the near one's sphere (a tiling of the hull that
+    is not Delaunay has such a face; float rounding on thin boxes makes exactly that
+    kind of flip).  The report's global empty-sphere check decides the mesh again.
+    """
     from scipy.spatial import Delaunay
 
-    coords = mesh.vertices[ids].astype(np.int64)
     real = (coords - coords.min(axis=0)) * (np.array(mesh.box.to_float()) / mesh.grid)
     try:
         triangulation = Delaunay(real, qhull_options="Qbb Qc Qz Q12 Qt")
-    except Exception as error:  # Qhull refuses flat input: a region is a union of boxes, never flat
-        first = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
-        raise CosphericalError(f"Qhull's Delaunay of a region of {len(ids)} vertices failed: {first[:200]}; "
-                               "--delaunay leaf meshes without it") from None
+    except Exception:  # Qhull's float precision errors: the exact engine takes the region
+        return None
     if len(triangulation.coplanar):
-        raise CosphericalError(f"Qhull left out {len(triangulation.coplanar)} of a region's {len(ids)} vertices; "
-                               "--delaunay leaf meshes without it")
+        return None
     simplices = triangulation.simplices.astype(np.int64)
     p = coords[simplices]  # (tets, 4, 3)
     d = p[:, 1:] - p[:, :1]
     extent = int(np.abs(d).max()) if len(d) else 0
     d = _object_if_large(d, 6 * extent ** 3)
-    volume = np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2]))
-    return ids[simplices[volume != 0]]
+    solid = np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2])) != 0
+    # each face between two solid tetrahedra, once (near < far): the far one's vertex across it
+    near, face = np.nonzero(solid[:, None] & (triangulation.neighbors > np.arange(len(simplices))[:, None]))
+    far = triangulation.neighbors[near, face]
+    pick = solid[far]
+    near, far = near[pick], far[pick]
+    across = simplices[far, np.argmax(triangulation.neighbors[far] == near[:, None], axis=1)]
+    if len(near) and sphere_sides(p[near], coords[across], _weights(mesh)).min() < 0:
+        return None
+    return simplices[solid]
 
 
 def _inside(mesh: Mesh, tets: np.ndarray, tet_region: np.ndarray, region: np.ndarray, located: _Locator) -> np.ndarray:
@@ -288,10 +330,10 @@ def _same_sphere(mesh: Mesh, tets: np.ndarray, weights) -> np.ndarray:
     p = coords[tets]
     d = p[:, 1:] - p[:, :1]
     extent = int(np.abs(d).max())
-    w = np.array(weights, dtype=np.int64)
     bound = 24 * max(weights) * extent ** 3 * (int(coords.max()) + extent + 1)
     d = _object_if_large(d, bound)
-    w = _object_if_large(w, bound)
+    # weights of extreme boxes (1e-12 x 1 x 3e9: 43 digits) do not fit int64 at all
+    w = np.array(weights, dtype=object) if bound >= 2**62 else np.array(weights, dtype=np.int64)
     lifted = (d * d * w).sum(axis=2)  # (tets, 3): |d|^2 in the weighted metric
     # The sphere through the origin and d1, d2, d3: centre c with 2 W c . d_k = lifted_k,
     # so (W c) = M^-1 lifted / 2 for M the rows d_k: Cramer's rule in integers.
