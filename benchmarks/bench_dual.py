@@ -1,14 +1,17 @@
 """The dual of bench_mesh.py's sphere octree, timed; the box method beside discretize's finite volumes.
 
-    python benchmarks/bench_dual.py [--levels 9] [--radius 0.3] [--patterns patterns/leaves-1x1x1.yaml]
+    python benchmarks/bench_dual.py [--levels 9] [--radius 0.3] [--patterns patterns/leaves-1x1x1.yaml] [--baseline REV]
     python benchmarks/bench_dual.py --poisson [--uniform 2 3 4 5 6] [--graded 4 5 6 7]
 
 Default: the sphere octree of about 1.3 million leaves (level 9), assembled from the
 pattern table, then :func:`cospherical.mesh.dual.mesh_dual` on it: wall and CPU
 seconds of the assembly and of the dual (the first dual, which also computes each
 configuration's pieces, and a second one that finds them remembered), the
-Laplacian's assembly, and the process's peak resident memory.  Target: the dual
-within 10 s CPU on top of the assembly, peak within 4 GB.
+Laplacian's assembly, and the process's peak resident memory (after the duals, and
+after the Laplacian).  Target: the dual within 10 s CPU on top of the assembly, peak
+within 4 GB.  ``--baseline REV`` first runs the same in a process of its own with
+``mesh_dual`` as git revision ``REV`` had it (``src/cospherical/mesh/dual.py``), so that
+before and after are measured in one run, under one load.
 
 ``--poisson``: examples/poisson.py's table on larger trees (needs the ``compare``
 extra, discretize), with the solve times of both methods.  Both write
@@ -18,18 +21,37 @@ results/benchmarks/bench_dual.json or bench_dual-poisson.json (benchmarks/record
 from __future__ import annotations
 
 import argparse
+import importlib.util
+import json
 import resource
+import subprocess
 import sys
-import time
+import tempfile
 from pathlib import Path
 
 from cospherical.mesh.assembly import assemble
-from cospherical.mesh.dual import mesh_dual
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
-def big(args, record) -> None:
+def dual_function(module: str | None):
+    """``mesh_dual``: ours, or the one of the file ``module`` (a baseline's ``dual.py``)."""
+    if module is None:
+        from cospherical.mesh.dual import mesh_dual
+
+        return mesh_dual
+    spec = importlib.util.spec_from_file_location("cospherical.mesh._baseline_dual", module)
+    baseline = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = baseline  # its dataclasses look their module up
+    spec.loader.exec_module(baseline)
+    return baseline.mesh_dual
+
+
+def measure(args) -> dict:
+    """The tree, its assembly, the two duals and the Laplacian, timed; printed, and returned for the record."""
     from bench_mesh import sphere_tree, timer
 
+    mesh_dual = dual_function(args.dual_module)
     clock: dict = {}
     stage = timer(clock)
     lookup, tree = sphere_tree(args, stage)
@@ -37,6 +59,7 @@ def big(args, record) -> None:
     dual = stage("dual (first: pieces per configuration)", lambda: mesh_dual(mesh))
     del dual
     dual = stage("dual (pieces remembered)", lambda: mesh_dual(mesh))
+    dual_peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     stage("laplacian", dual.laplacian)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     negative = dual.negative_coefficients()
@@ -45,12 +68,38 @@ def big(args, record) -> None:
           f"{negative['interior']} interior, {negative['boundary']} boundary")
     for name, (wall, cpu) in clock.items():
         print(f"{name:42s} {wall:8.2f} s wall {cpu:8.2f} s cpu")
-    print(f"peak {peak:.2f} GB")
-    record.add(f"sphere tree L {args.levels}, R {args.radius}", f"{len(tree):,} leaves, {len(dual.edges):,} edges, "
-               f"{len(mesh.patterns)} configurations")
-    for name, (wall, cpu) in clock.items():
-        record.add(name, f"{cpu:.2f} s CPU, {wall:.2f} s wall")
-    record.add("peak memory (the process)", f"{peak:.2f} GB")
+    print(f"peak {dual_peak:.2f} GB after the duals, {peak:.2f} GB after the laplacian", flush=True)
+    return {"tree": f"{len(tree):,} leaves, {len(dual.edges):,} edges, {len(mesh.patterns)} configurations",
+            "clock": clock, "dual_peak": dual_peak, "peak": peak}
+
+
+def baseline(args) -> dict:
+    """:func:`measure` in a process of its own, with ``mesh_dual`` as revision ``args.baseline`` had it."""
+    source = subprocess.run(["git", "show", f"{args.baseline}:src/cospherical/mesh/dual.py"], cwd=ROOT,
+                            check=True, capture_output=True, text=True).stdout
+    with tempfile.TemporaryDirectory() as folder:
+        module, out = Path(folder) / "dual.py", Path(folder) / "figures.json"
+        module.write_text(source)
+        run = subprocess.run([sys.executable, __file__, "--domain", *args.domain, "--levels", str(args.levels),
+                              "--radius", args.radius, "--patterns", args.patterns, "--dual-module", str(module),
+                              "--figures", str(out)], check=True, capture_output=True, text=True)
+        print(f"baseline: mesh_dual of {args.baseline}, in a process of its own")
+        print(run.stdout, end="")
+        return json.loads(out.read_text())
+
+
+def big(args, record) -> None:
+    before = baseline(args) if args.baseline else None
+    if before:
+        print("now: mesh_dual of this checkout")
+    now = measure(args)
+    record.add(f"sphere tree L {args.levels}, R {args.radius}", now["tree"])
+    for name, (wall, cpu) in now["clock"].items():
+        earlier = f" (before, {args.baseline}: {before['clock'][name][1]:.2f} s CPU)" if before else ""
+        record.add(name, f"{cpu:.2f} s CPU, {wall:.2f} s wall{earlier}")
+    for key, what in (("dual_peak", "after the duals"), ("peak", "after the Laplacian")):
+        earlier = f" (before: {before[key]:.2f} GB)" if before else ""
+        record.add(f"peak memory {what}", f"{now[key]:.2f} GB{earlier}")
 
 
 def main() -> None:
@@ -60,11 +109,17 @@ def main() -> None:
 
     tree_arguments(parser)
     parser.add_argument("--poisson", action="store_true", help="the Poisson comparison instead")
+    parser.add_argument("--baseline", metavar="REV", help="first time the dual of this git revision, the same way")
+    parser.add_argument("--dual-module", help=argparse.SUPPRESS)  # a baseline's dual.py, in its own process
+    parser.add_argument("--figures", help=argparse.SUPPRESS)  # where that process leaves its figures
     parser.add_argument("--uniform", type=int, nargs="*", default=[2, 3, 4, 5, 6])
     parser.add_argument("--graded", type=int, nargs="*", default=[4, 5, 6, 7])
     args = parser.parse_args()
     from record import recorded
 
+    if args.dual_module:
+        Path(args.figures).write_text(json.dumps(measure(args)))
+        return
     if not args.poisson:
         with recorded(__file__) as record:
             big(args, record)

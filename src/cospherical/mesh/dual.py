@@ -195,10 +195,13 @@ class Dual:
         n = len(self.vertices)
         i, j = self.edges[:, 0], self.edges[:, 1]
         c = self.coefficient
-        rows = np.concatenate([i, j, i, j])
-        cols = np.concatenate([j, i, i, j])
-        data = np.concatenate([-c, -c, c, c])
-        return coo_matrix((data, (rows, cols)), shape=(n, n)).tocsr()
+        diagonal = np.bincount(i, weights=c, minlength=n) + np.bincount(j, weights=c, minlength=n)
+        # one entry per position (no duplicates to sum), 32-bit indices while they fit: a third of the memory
+        index = np.int32 if n < 2**31 else np.int64
+        every = np.arange(n, dtype=index)
+        rows = np.concatenate([i.astype(index), j.astype(index), every])
+        cols = np.concatenate([j.astype(index), i.astype(index), every])
+        return coo_matrix((np.concatenate([-c, -c, diagonal]), (rows, cols)), shape=(n, n)).tocsr()
 
     def mass(self):
         """The lumped mass matrix: the control volumes on the diagonal (scipy.sparse)."""
@@ -276,70 +279,54 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
     factor_squared = squared[0] * squared[1] * squared[2]
     verts = np.asarray(mesh.vertices, dtype=np.int64)
     n_vertices = len(verts)
-    # collected per group: global edge pairs and their integer numerators times the group's scaling
+    # per group: its pieces, the array and rows that give its members' global vertex ids, their sizes
     if elements is None:
         groups, centers = _leaf_groups(mesh, squared)
         if mesh.cells is not None:
             groups += _cell_groups(mesh, squared, centers)
     else:
         groups, centers = _element_groups(mesh, squared, *elements)
-    cden = math.lcm(1, *(_lcm_denominator(shape.edge_q) for shape, _, _ in groups))
-    vden = math.lcm(1, *(_lcm_denominator(shape.volume_q) for shape, _, _ in groups))
-    bden = math.lcm(1, *(_lcm_denominator([q for _, q in shape.boundary]) for shape, _, _ in groups))
-    max_size = max((int(sizes.max()) for _, _, sizes in groups if len(sizes)), default=1)
+    cden = math.lcm(1, *(_lcm_denominator(shape.edge_q) for shape, _, _, _ in groups))
+    vden = math.lcm(1, *(_lcm_denominator(shape.volume_q) for shape, _, _, _ in groups))
+    bden = math.lcm(1, *(_lcm_denominator([q for _, q in shape.boundary]) for shape, _, _, _ in groups))
+    max_size = max((int(sizes.max()) for _, _, _, sizes in groups if len(sizes)), default=1)
     # int64 sums while every product and sum is bounded below 2**62: the largest numerator (not just the
     # denominator: on tiny or huge domains the pieces over a*b*c are far from 1) times the size scaling,
     # times a bound on the pieces met by one edge or vertex
-    largest_coefficient = max((abs(int(q * cden)) for shape, _, _ in groups for q in shape.edge_q), default=0)
-    largest_volume = max((abs(int(q * vden)) for shape, _, _ in groups for q in shape.volume_q), default=0)
+    largest_coefficient = max((abs(int(q * cden)) for shape, _, _, _ in groups for q in shape.edge_q), default=0)
+    largest_volume = max((abs(int(q * vden)) for shape, _, _, _ in groups for q in shape.volume_q), default=0)
     wide = largest_volume * max_size ** 3 * 4096 >= 2**62 or largest_coefficient * max_size * 4096 >= 2**62
     dtype = object if wide else np.int64
-    edge_parts, coef_parts, vol_parts, vol_index, bnd_parts, bnd_index, bnd_axis = [], [], [], [], [], [], []
-    for shape, vertex_ids, sizes in groups:
-        size = sizes.astype(dtype)
-        if len(shape.edges):
-            pairs = vertex_ids[:, shape.edges]  # (k, E, 2)
-            lo, hi = np.minimum(pairs[..., 0], pairs[..., 1]), np.maximum(pairs[..., 0], pairs[..., 1])
-            edge_parts.append((lo.astype(np.int64) * n_vertices + hi).reshape(-1))
-            q = _integers(shape.edge_q, cden).astype(dtype)
-            coef_parts.append((size[:, None] * q[None, :]).reshape(-1))
+    edges, coefficient_exact = _edge_sums(groups, n_vertices, cden, dtype)
+    boundary = np.any((verts == 0) | (verts == grid), axis=1)
+    volume_exact = np.zeros(n_vertices, dtype=dtype)
+    bnd_parts, bnd_index, bnd_axis = [], [], []
+    for shape, source, rows, sizes in groups:
         q = _integers(shape.volume_q, vden).astype(dtype)
-        vol_parts.append((size[:, None] ** 3 * q[None, :]).reshape(-1))
-        vol_index.append(vertex_ids[:, shape.volume_nodes].reshape(-1))
+        touching = []  # the members with a vertex on the domain's boundary: only they have boundary areas
+        for part in _chunks(len(rows), len(shape.volume_nodes)):
+            ids = source[rows[part, None], shape.volume_nodes]
+            # integer sums, unbuffered: exact in any order
+            np.add.at(volume_exact, ids, sizes[part, None].astype(dtype) ** 3 * q)
+            if shape.boundary:
+                touching.append(part.start + np.flatnonzero(boundary[ids].any(axis=1)))
+        touching = np.concatenate(touching) if touching else np.zeros(0, dtype=np.int64)
         for (axis, value, node), q in shape.boundary:
-            ids = vertex_ids[:, node]
+            ids = source[rows[touching], node].astype(np.int64)
             on = (verts[ids, axis] == 0) | (verts[ids, axis] == grid)
             # the face lies in the vertex's plane: on the boundary where that plane is a side of the domain
-            bnd_parts.append(sizes[on].astype(object if wide else np.int64) ** 2 * int(q * bden))
+            bnd_parts.append(sizes[touching][on].astype(dtype) ** 2 * int(q * bden))
             bnd_index.append(ids[on])
             bnd_axis.append(np.full(int(on.sum()), axis, dtype=np.int64))
-    keys = np.concatenate(edge_parts) if edge_parts else np.zeros(0, dtype=np.int64)
-    coefs = np.concatenate(coef_parts) if coef_parts else np.zeros(0, dtype=dtype)
-    order = np.argsort(keys)  # integer sums: the order among equal keys does not matter
-    keys, coefs = keys[order], coefs[order]
-    first = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]]) if len(keys) else np.zeros(0, dtype=np.int64)
-    coefficient_exact = np.add.reduceat(coefs, first) if len(keys) else coefs
-    unique = keys[first]
-    edges = np.stack([unique // n_vertices, unique % n_vertices], axis=1)
-    volume_exact = np.zeros(n_vertices, dtype=dtype)
-    if vol_parts:
-        index, parts = np.concatenate(vol_index), np.concatenate(vol_parts)
-        # float64 sums of integers are exact while every partial sum stays below 2**53: bounded by the
-        # most pieces a vertex gets times the largest piece; beyond that, integer sums
-        wide_sums = dtype is object or len(parts) == 0 or \
-            int(np.bincount(index).max()) * int(np.abs(parts).max()) >= 2**53
-        if not wide_sums:
-            volume_exact = np.rint(np.bincount(index, weights=parts, minlength=n_vertices)).astype(np.int64)
-        else:
-            np.add.at(volume_exact, index, parts)
     lengths = np.array(box.to_float())
     real = verts * (lengths / grid)
     factor = math.sqrt(factor_squared)
     coefficient = coefficient_exact.astype(np.float64) * (factor / (cden * grid))
-    edge_vectors = real[edges[:, 1]] - real[edges[:, 0]]
-    length = np.sqrt((edge_vectors ** 2).sum(axis=1))
+    length = np.empty(len(edges))
+    for part in _chunks(len(edges), 1):
+        edge_vectors = real[edges[part, 1]] - real[edges[part, 0]]
+        length[part] = np.sqrt((edge_vectors ** 2).sum(axis=1))
     control_volume = volume_exact.astype(np.float64) * (factor / (vden * float(grid) ** 3))
-    boundary = np.any((verts == 0) | (verts == grid), axis=1)
     boundary_area = np.zeros(n_vertices)
     if bnd_parts:
         plane_factor = np.array([math.sqrt(squared[(k + 1) % 3] * squared[(k + 2) % 3]) for k in range(3)])
@@ -350,26 +337,111 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
                 factor_squared, centers)
 
 
+CHUNK = 1 << 21  # instances per block of work: its temporaries stay small and the allocator reuses them
+PACKED_BITS = 63  # an edge instance's key and payload share one int64 while they fit in these bits
+
+
+def _chunks(count: int, width: int):
+    """Slices of ``range(count)`` of about :data:`CHUNK` / ``width`` rows each."""
+    step = max(1, CHUNK // max(width, 1))
+    for start in range(0, count, step):
+        yield slice(start, min(start + step, count))
+
+
+def _edge_sums(groups, n_vertices: int, cden: int, dtype) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh's edges (m x 2, ``i < j``, sorted) and their summed coefficient numerators.
+
+    Every edge instance (one edge of one group member) becomes an int64 key
+    ``i * 2**v + j`` and a payload: its piece's index into the groups' numerators and
+    its member's size as a power of two (coefficients scale with the size).  While key
+    and payload fit one int64 together they are sorted as one array (a plain sort,
+    several times faster than an argsort, which needs no second array to follow it);
+    else the keys are argsorted and the payloads follow.  Equal keys are then runs,
+    summed in integers: exact in any order.
+    """
+    table, offsets, total, max_shift = [], [], 0, 0
+    for shape, _, rows, sizes in groups:
+        offsets.append(len(table))
+        table.extend(int(q * cden) for q in shape.edge_q)
+        total += len(rows) * len(shape.edges)
+        if len(sizes):
+            max_shift = max(max_shift, int(sizes.max()).bit_length() - 1)
+    shift_bits = max_shift.bit_length()
+    payload_bits = (max(len(table) - 1, 0)).bit_length() + shift_bits
+    vertex_bits = max(n_vertices - 1, 1).bit_length()
+    packed = 2 * vertex_bits + payload_bits <= PACKED_BITS
+    keys = np.empty(total, dtype=np.int64)
+    payloads = keys if packed else np.empty(total, dtype=np.int64)
+    at = 0
+    for (shape, source, rows, sizes), offset in zip(groups, offsets):
+        count = len(shape.edges)
+        if not count:
+            continue
+        shifts = np.log2(sizes).astype(np.int64)  # sizes are powers of two: exact
+        pieces = (offset + np.arange(count, dtype=np.int64)) << shift_bits
+        for part in _chunks(len(rows), count):
+            ids = rows[part, None]
+            a = source[ids, shape.edges[:, 0]].astype(np.int64)
+            b = source[ids, shape.edges[:, 1]].astype(np.int64)
+            key = (np.minimum(a, b) << vertex_bits) | np.maximum(a, b)
+            payload = pieces | shifts[part, None]
+            end = at + key.size
+            if packed:
+                keys[at:end] = ((key << payload_bits) | payload).reshape(-1)
+            else:
+                keys[at:end], payloads[at:end] = key.reshape(-1), payload.reshape(-1)
+            at = end
+    key_shift = payload_bits if packed else 0
+    if packed:
+        keys.sort()
+    else:
+        order = np.argsort(keys)
+        keys, payloads = keys[order], payloads[order]
+        del order
+    starts = np.ones(total, dtype=bool)
+    for part in _chunks(total - 1, 1):
+        starts[part.start + 1:part.stop + 1] = (keys[part.start + 1:part.stop + 1] >> key_shift) != (
+            keys[part] >> key_shift)
+    first = np.flatnonzero(starts)
+    del starts
+    unique = np.right_shift(keys[first], key_shift)
+    edges = np.empty((len(first), 2), dtype=np.int64)
+    np.right_shift(unique, vertex_bits, out=edges[:, 0])
+    np.bitwise_and(unique, (1 << vertex_bits) - 1, out=edges[:, 1])
+    del unique
+    numerators = np.array(table, dtype=dtype)
+    powers = np.array([1 << k for k in range(max_shift + 1)], dtype=dtype)
+    sums = np.empty(len(first), dtype=dtype)
+    # blocks of whole runs, so that each run is summed within one block
+    bounds = np.unique(np.r_[np.searchsorted(first, np.arange(0, total, CHUNK)), len(first)])
+    for lo, hi in zip(bounds[:-1], bounds[1:]):
+        start, stop = first[lo], first[hi] if hi < len(first) else total
+        payload = payloads[start:stop] & ((1 << payload_bits) - 1)
+        parts = numerators[payload >> shift_bits] * powers[payload & ((1 << shift_bits) - 1)]
+        sums[lo:hi] = np.add.reduceat(parts, first[lo:hi] - start)
+    return edges, sums
+
+
 def _leaf_groups(mesh, squared):
-    """Per configuration: its pieces, the global vertex ids of its leaves' slots, the leaves' sizes."""
+    """Per configuration: its pieces, the slots and its leaves (their rows of global vertex ids), their sizes."""
     sizes = mesh.leaf_size()
     lengths = np.array(mesh.box.to_float())
     origin = mesh.tree.positions.astype(np.int64) * sizes[:, None]
     centers = np.zeros((len(mesh), 3))
     groups = []
     for _, pattern, leaves in mesh.groups():
-        first = mesh.element_offsets[leaves]
+        first, low, size = mesh.element_offsets[leaves], origin[leaves], sizes[leaves, None]
         for j, element in enumerate(pattern.elements):
             if element.center is None:
                 raise InputError(f"configuration {pattern.code}: element {j} is not co-spherical: it has no dual")
-            centers[first + j] = (origin[leaves] + np.array([float(x) for x in element.center]) * sizes[leaves, None]
-                                  ) * (lengths / mesh.grid)
-        groups.append((_pattern_shape(pattern, squared), mesh.slots[leaves].astype(np.int64), sizes[leaves]))
+            centers[first + j] = (low + np.array([float(x) for x in element.center]) * size) * (lengths / mesh.grid)
+        groups.append((_pattern_shape(pattern, squared), mesh.slots, leaves, sizes[leaves]))
     return groups, centers
 
 
 def _cell_groups(mesh, squared, centers: np.ndarray):
-    """Per shape of the cells that replace leaves: its pieces (grid units, scale 1), vertex ids; fills ``centers``."""
+    """Per shape of the cells that replace leaves: its pieces (grid units, scale 1), its rows of the cells' vertex
+    ids; fills ``centers``."""
     cells = mesh.cells
     lengths = np.array(mesh.box.to_float())
     groups = []
@@ -377,8 +449,7 @@ def _cell_groups(mesh, squared, centers: np.ndarray):
         rows = np.flatnonzero(cells.shape == s)
         points = {n: tuple(Fraction(x) for x in o) for n, o in enumerate(shape.offsets)}
         pieces = _Shape([element_pieces(points, shape.faces, shape.center, squared)])
-        groups.append((pieces, cells.nodes[rows, :len(shape.offsets)].astype(np.int64),
-                       np.ones(len(rows), dtype=np.int64)))
+        groups.append((pieces, cells.nodes, rows, np.ones(len(rows), dtype=np.int64)))
         centers[mesh.leaf_elements + rows] = (cells.anchor[rows] + np.array([float(x) for x in shape.center])) * (
             lengths / mesh.grid)
     return groups
@@ -426,7 +497,7 @@ def _element_groups(mesh, squared, conn: np.ndarray, element_sizes: np.ndarray):
         entry[1].append(ids)
         entry[2].append(scale)
         centers[e] = (low + np.array([float(x) for x in entry[3]]) * scale) * (lengths / mesh.grid)
-    groups = [(shape, np.array(ids, dtype=np.int64), np.array(scales, dtype=np.int64))
+    groups = [(shape, np.array(ids, dtype=np.int64), np.arange(len(ids)), np.array(scales, dtype=np.int64))
               for shape, ids, scales, _ in by_shape.values()]
     return groups, centers
 
