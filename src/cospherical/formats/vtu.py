@@ -10,8 +10,9 @@ mesh gives the same file.
 Cells are VTK's standard ones (tetra, pyramid, wedge, hexahedron: nodes in
 VTK order) where an element is one, and ``VTK_POLYHEDRON`` with its faces
 (``faces``/``faceoffsets``, the layout VTK has always read) only for the
-others, all in the one grid.  meshio's VTU reader (5.3) refuses a grid that
-mixes polyhedra with other cells; VTK and ParaView read it.
+others, all in the one grid.  meshio's VTU reader (5.3.5) refuses a grid that
+mixes polyhedra with other cells in any layout (``_organize_cells`` raises when a
+piece holds type 42 beside another type); VTK and ParaView read it.
 """
 
 from __future__ import annotations
