@@ -20,24 +20,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
-from typing import Sequence, Union
+from typing import Sequence
 
-from .configuration import EDGES, Box, Configuration
+from .configuration import EDGES, BaseConfiguration, Box, Configuration
 from .shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape
 from .symmetry import (
     ShapeSymmetry,
     Symmetry,
     box_symmetries,
     orbit_representatives,
-    shape_orbit_representatives,
     shape_symmetries,
 )
 from .tessellation import Tessellation, tessellate
 
 __all__ = ["ELEMENTS", "BaseElement", "base_element"]
-
-AnyConfiguration = Union[Configuration, ShapeConfiguration]
-
 
 @dataclass(frozen=True)
 class BaseElement:
@@ -61,7 +57,7 @@ class BaseElement:
         """The number of edges, hence of digits in a configuration code."""
         return len(EDGES) if self.shape is None else len(self.shape.edges)
 
-    def configuration(self, code: str) -> AnyConfiguration:
+    def configuration(self, code: str) -> BaseConfiguration:
         """The configuration of a code (for the cuboid, optionally with a point suffix ``+f...``)."""
         if self.shape is None:
             return Configuration.from_code(code, self.box, self.face_points)
@@ -75,11 +71,9 @@ class BaseElement:
     def orbit_representatives(self, codes: Sequence[str]) -> tuple[list[str], list[int]]:
         """For each code, its orbit's representative (the smallest image) and the index in
         :attr:`symmetries` of a symmetry taking the code to it."""
-        if self.shape is None:
-            return orbit_representatives(codes, self.symmetries)
-        return shape_orbit_representatives(codes, self.symmetries)
+        return orbit_representatives(codes, self.symmetries)
 
-    def tessellate(self, configuration: AnyConfiguration) -> Tessellation:
+    def tessellate(self, configuration: BaseConfiguration) -> Tessellation:
         """The Delaunay tessellation of one of this element's configurations."""
         return tessellate(configuration)
 

@@ -19,6 +19,7 @@ from .exact import Length, parse_rational
 
 __all__ = [
     "BODY_NODE",
+    "BaseConfiguration",
     "Box",
     "CORNERS",
     "Configuration",
@@ -151,8 +152,24 @@ def _face_numbers(faces: Iterable, where: str) -> frozenset[int]:
     return frozenset(numbers)
 
 
+class BaseConfiguration:
+    """What every configuration of a base element is, a cuboid's or another shape's.
+
+    It has ``box``, ``steiner`` (a parameter or ``None`` per edge), ``face_points``
+    (the policy), ``code`` and ``point_set_code``, ``point_faces`` and
+    ``has_body_point``, ``shape`` (``None`` for the cuboid), ``nodes()`` (node id
+    -> exact unit coordinates) and ``contains(point)`` (the FVM test); the
+    tessellation, the studies and the writers use nothing else.
+    """
+
+    def real_nodes(self) -> dict[int, tuple[float, float, float]]:
+        """Node id -> float coordinates in the real box (for output and plotting)."""
+        scale = self.box.to_float()
+        return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}
+
+
 @dataclass(frozen=True)
-class Configuration:
+class Configuration(BaseConfiguration):
     """A 1-irregular cuboid: a box, at most one Steiner point per edge, and its face and body points.
 
     ``steiner[k]`` is the parameter t in (0, 1) of the point on edge k (measured
@@ -349,8 +366,3 @@ class Configuration:
         if closed:
             return all(0 <= x <= 1 for x in point)
         return all(0 < x < 1 for x in point)
-
-    def real_nodes(self) -> dict[int, tuple[float, float, float]]:
-        """Node id -> float coordinates in the real box (for output and plotting)."""
-        scale = self.box.to_float()
-        return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}

@@ -40,7 +40,7 @@ from typing import Iterable, Mapping, Sequence
 
 from ..errors import InputError
 from .codes import EDGE_DIGITS, digit_parameters, mask_codes, parameter_digits
-from .configuration import Box, steiner_parameters
+from .configuration import BaseConfiguration, Box, steiner_parameters
 from .exact import parse_rational
 from .geometry import cross, dot, six_volume, sub, tetra_six_volume
 
@@ -292,7 +292,7 @@ def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
 
 
 @dataclass(frozen=True)
-class ShapeConfiguration:
+class ShapeConfiguration(BaseConfiguration):
     """A 1-irregular element of a :class:`Shape`: at most one Steiner point per edge.
 
     ``steiner[k]`` is the parameter of the point on edge k from its lower end,
@@ -404,7 +404,3 @@ class ShapeConfiguration:
     def contains(self, point, closed: bool = True) -> bool:
         """Whether a point (unit coordinates) lies in the closed (or open) base element, exactly: the FVM test."""
         return self.shape.contains(point, closed)
-
-    def real_nodes(self) -> dict[int, tuple[float, float, float]]:
-        scale = self.box.to_float()
-        return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}

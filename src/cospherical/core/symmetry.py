@@ -229,10 +229,26 @@ def _orbit_keys_numpy(digits, targets, reverse, masks, faces):
     return best, best_mask, best_sym
 
 
-def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry]) -> tuple[list[str], list[int]]:
-    """For each code, its orbit's representative (the smallest image code) and the
-    index of a symmetry taking the code to it.  A code with a point suffix
-    (``+f...``) has a representative with one."""
+def orbit_representatives(codes: Sequence[str],
+                          symmetries: Sequence[Symmetry] | Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
+    """For each code, its orbit's representative (the smallest image code, as a base-16 number)
+    and the index of a symmetry taking the code to it.
+
+    The one orbit function of every base element.  Under a box's symmetries (a
+    cuboid) a code with a point suffix (``+f...``) has a representative with
+    one, and the work goes through the cube's fast paths (pure Python per orbit
+    for a few thousand codes, numpy or the compiled kernel in bulk); under
+    another shape's isometries every image of each code is compared.
+
+    >>> from cospherical.core.shapes import standard_shape
+    >>> shape = standard_shape("tetrahedron")
+    >>> orbit_representatives(["800000", "008000", "080000"], shape_symmetries(shape))[0]
+    ['000800', '000800', '000008']
+    >>> orbit_representatives(["800000000000", "000000000008"], box_symmetries(Box.parse(["1", "1", "1"])))[0]
+    ['000000000008', '000000000008']
+    """
+    if symmetries and isinstance(symmetries[0], ShapeSymmetry):
+        return _every_image_representatives(codes, symmetries)
     suffixed = ["+" in code for code in codes]
     masks = [_point_mask(code) if s else 0 for code, s in zip(codes, suffixed)]
     group = _group(tuple(symmetries))
@@ -443,16 +459,9 @@ def shape_symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
     return tuple(result)
 
 
-def shape_orbit_representatives(codes: Sequence[str],
+def _every_image_representatives(codes: Sequence[str],
                                 symmetries: Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
-    """For each code, its orbit's representative (the smallest image code, as a base-16
-    number) and the index of a symmetry taking the code to it.
-
-    >>> from cospherical.core.shapes import standard_shape
-    >>> shape = standard_shape("tetrahedron")
-    >>> shape_orbit_representatives(["800000", "008000", "080000"], shape_symmetries(shape))[0]
-    ['000800', '000800', '000008']
-    """
+    # orbit_representatives under a shape's isometries (a few, on codes of at most 512): every image
     reps, index = [], []
     for code in codes:
         images = [sym.code(code) for sym in symmetries]
@@ -460,3 +469,7 @@ def shape_orbit_representatives(codes: Sequence[str],
         reps.append(images[best])
         index.append(best)
     return reps, index
+
+
+# The name under which the orbits of other shapes were first public: the same function.
+shape_orbit_representatives = orbit_representatives

@@ -5,12 +5,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from .configuration import Configuration
+from .configuration import BaseConfiguration
 from .delaunay import delaunay_cells
 from .element_types import ElementType, classify
 from .geometry import Frame
 from .polyhedron import Polyhedron, polyhedron
-from .shapes import ShapeConfiguration
 
 __all__ = ["Element", "Tessellation", "element_entry", "tessellate", "tessellate_shape", "tessellation_elements"]
 
@@ -49,7 +48,7 @@ def element_entry(element: Element, scale) -> dict:
 class Tessellation:
     """The Delaunay tessellation of one configuration (of a cuboid or another shape), elements sorted by node ids."""
 
-    configuration: Configuration | ShapeConfiguration
+    configuration: BaseConfiguration
     nodes: dict[int, tuple[Fraction, Fraction, Fraction]]
     elements: tuple[Element, ...]
 
@@ -70,7 +69,7 @@ class Tessellation:
         return tuple(float(x) * s for x, s in zip(element.polyhedron.center, scale))
 
 
-def tessellate(configuration: Configuration | ShapeConfiguration) -> Tessellation:
+def tessellate(configuration: BaseConfiguration) -> Tessellation:
     """The Delaunay tessellation of a configuration, its elements the largest co-spherical sets.
 
     Every cell is the convex hull of all points on one empty sphere, decided in
