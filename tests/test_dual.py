@@ -85,6 +85,20 @@ def test_area_times_length_is_six_volumes_exactly(mesh):
     grid = dual.grid
     volumes = [Fraction(int(v), dual.volume_denominator) for v in dual.volume_exact]
     assert all(s / grid ** 2 == 6 * v for s, v in zip(six, volumes))
+
+
+@PROPERTY
+@given(octrees())
+def test_boundary_areas_sum_to_each_side_of_the_domain_exactly(mesh):
+    """Per axis, the exact boundary areas of the vertices in each of the two sides normal to it sum to that side."""
+    dual = mesh_dual(mesh)
+    g, exact, den = dual.grid_vertices, dual.boundary_area_exact.astype(object), dual.boundary_area_denominator
+    for k in range(3):
+        low, high = g[:, k] == 0, g[:, k] == dual.grid
+        assert sum(exact[low, k]) == den and sum(exact[high, k]) == den  # each side: one side's area
+        assert all(x == 0 for x in exact[~(low | high), k])
+    assert dual.boundary_area_sums() == (2, 2, 2)
+    assert not np.any(dual.boundary_area[~dual.boundary])
     a, b, c = mesh.box.to_float()
     assert np.isclose(dual.boundary_area.sum(), 2 * (a * b + b * c + c * a), rtol=1e-12)
 
@@ -144,7 +158,8 @@ def test_element_list_path_equals_the_configuration_path():
                for x, y in zip(fast.coefficient_exact, generic.coefficient_exact))
     assert all(Fraction(int(x), fast.volume_denominator) == Fraction(int(y), generic.volume_denominator)
                for x, y in zip(fast.volume_exact, generic.volume_exact))
-    assert np.allclose(fast.boundary_area, generic.boundary_area, rtol=1e-13, atol=0)
+    assert all(Fraction(int(x), fast.boundary_area_denominator) == Fraction(int(y), generic.boundary_area_denominator)
+               for x, y in zip(fast.boundary_area_exact.reshape(-1), generic.boundary_area_exact.reshape(-1)))
     assert np.array_equal(fast.element_circumcenter, generic.element_circumcenter)
 
 
@@ -265,6 +280,8 @@ def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
     assert report["dual"]["mixed"]["nonzeros"] == dual.laplacian().nnz
     vtu = meshio.read(a / "mesh.vtu")
     assert np.array_equal(vtu.point_data["control_volume"], dual.control_volume)
+    assert np.array_equal(vtu.point_data["boundary_area"], dual.boundary_area)
+    assert dual.boundary_area_sums() == (2, 2, 2)  # read back: the exact areas and their factors
     ok = np.concatenate(vtu.cell_data["delaunay_ok"])
     assert (ok == 0).sum() == report["delaunay_violations"] > 0
     assert np.concatenate(vtu.cell_data["circumcenter"]).shape == (report["elements"], 3)
@@ -355,14 +372,15 @@ def _resigned(good: Path, target: Path, manifest_edit=None, members: dict | None
 
 
 @pytest.mark.parametrize("case", ["factor 1e999999999", "factor 1e400", "grid 10**400", "integers --5",
-                                  "integers of 5000 digits"])
+                                  "integers of 5000 digits", "boundary factors not the domain's"])
 def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, tmp_path, capsys, case):
     from cospherical.cli import main
 
     good = dual_run / "a" / "dual.npz"
     edits = {"factor 1e999999999": lambda m: m.update(volume_factor_squared="1e999999999"),
              "factor 1e400": lambda m: m.update(volume_factor_squared="1" + "0" * 400),
-             "grid 10**400": lambda m: m.update(grid=10**400)}
+             "grid 10**400": lambda m: m.update(grid=10**400),
+             "boundary factors not the domain's": lambda m: m.update(boundary_factors_squared=["1e400", "1", "1"])}
     members = None
     if case.startswith("integers"):
         from cospherical.formats.dual import read_dual
@@ -379,8 +397,15 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
 
 
 @pytest.mark.parametrize("domain", [["1e-12", "1e-12", "1e-12"], ["1e-12", "1", "1"], ["3e9", "1", "1"]])
-def test_the_dual_of_tiny_and_huge_domains_is_exact(domain):
+def test_the_dual_of_tiny_and_huge_domains_is_exact(domain, tmp_path):
+    from cospherical.formats.dual import read_dual, write_dual
+
     box = Box.parse(domain)
     dual = mesh_dual(assemble(build_octree(box, 2, [parse_shape("point:0,0,0")])))
     assert dual.volume_sum() == 1  # the control volumes fill the domain, as a fraction of its volume
+    assert dual.boundary_area_sums() == (2, 2, 2)  # and the boundary areas its surface
     assert dual.negative_coefficients()["interior"] == 0
+    write_dual(dual, tmp_path / "dual.npz")  # integers too wide for int64 go as decimal text, and come back
+    again = read_dual(tmp_path / "dual.npz")
+    for name in ("coefficient_exact", "volume_exact", "boundary_area_exact"):
+        assert getattr(again, name).tolist() == getattr(dual, name).tolist()

@@ -14,7 +14,7 @@ def add_parser(commands) -> None:
         help="validate catalogue and pattern-table files",
         description="Validate catalogues (schema, unique ids, consistent faces, known split types) and pattern "
         "tables (schema, known types, node counts, and that every configuration's elements tile the box), and "
-        "dual.npz files of `cospherical mesh --dual` (members, checksums, control volumes summing to the domain). "
+        "dual.npz files of `cospherical mesh --dual` (members, checksums, control volumes summing to the domain, boundary areas to its surface). "
         "Exit status 0 when every file is valid, 2 at the first problem.",
     )
     parser.add_argument("files", nargs="+", type=Path, metavar="FILE",
@@ -54,7 +54,11 @@ def _check_dual(path: Path) -> None:
     total = dual.volume_sum()
     if total != 1:
         raise FormatError(f"{path}: the control volumes sum to {total} of the domain, not 1")
+    sides = dual.boundary_area_sums()
+    if sides != (2, 2, 2):
+        raise FormatError(f"{path}: the boundary areas sum to {', '.join(map(str, sides))} sides normal to x, y, z, "
+                          "not 2 each")
     negative = dual.negative_coefficients()
     print(f"{path}: ok, dual of {len(dual.vertices)} vertices and {len(dual.edges)} edges, control volumes sum "
-          f"to the domain exactly, {negative['interior']} interior and {negative['boundary']} boundary negative "
-          "coefficients")
+          f"to the domain and boundary areas to its surface exactly, {negative['interior']} interior and "
+          f"{negative['boundary']} boundary negative coefficients")

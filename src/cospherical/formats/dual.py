@@ -6,9 +6,10 @@ same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` element
 
 ===========================  ==========  ==================================================
 ``manifest``                 uint8       JSON text: ``format`` (``cospherical-dual``),
-                                         ``version``, ``domain`` (the box, exact texts),
-                                         ``grid``, the exact denominators, ``sha256`` of
-                                         every other member
+                                         ``version`` (2), ``domain`` (the box, exact
+                                         texts), ``grid``, the exact denominators and
+                                         factors (decimal texts), ``sha256`` of every
+                                         other member
 ``grid_vertices``            int64 n x3  exact vertices: integers of the grid of ``grid``
                                          intervals per domain side
 ``vertices``                 f8 n x 3    real coordinates (``grid_vertices / grid * box``)
@@ -23,12 +24,22 @@ same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` element
                                          volume_factor_squared) / volume_denominator``
 ``boundary``                 bool n      the vertex is on the domain's boundary
 ``boundary_area``            f8 n        the boundary's area in its control volume
+``boundary_area_exact``      int64 n x3  per axis k, the part in the two sides normal
+                                         to k: ``boundary_area = sum over k of
+                                         boundary_area_exact[:, k] * sqrt(
+                                         boundary_factors_squared[k]) /
+                                         boundary_area_denominator``, the factors
+                                         ``(b^2 c^2, a^2 c^2, a^2 b^2)`` for a box
+                                         ``a x b x c`` (decimal text, ``U``, when int64
+                                         is too narrow); each column sums to twice the
+                                         denominator
 ``element_circumcenter``     f8 e x 3    the real circumcenter of each element (mesh order)
 ===========================  ==========  ==================================================
 
 The reader refuses, with one line, a file that is not such a zip, lacks or adds a
 member, has an array of the wrong kind or shape, fails a checksum (a truncated or
-tampered file) or has edges that name no vertex.
+tampered file) or has edges that name no vertex.  Version 1 (no exact boundary
+areas) is refused with its version named.
 """
 
 from __future__ import annotations
@@ -41,6 +52,7 @@ import os
 import re
 import stat
 import zipfile
+import zlib
 from fractions import Fraction
 from pathlib import Path
 
@@ -53,14 +65,14 @@ from ..mesh.dual import Dual
 
 __all__ = ["DUAL_FORMAT_VERSION", "read_dual", "write_dual"]
 
-DUAL_FORMAT_VERSION = 1
+DUAL_FORMAT_VERSION = 2
 MAX_DUAL_FILE = 16 * 1024**3
 # member -> (dtype kind, columns or None, which count: n vertices, m edges, e elements)
 MEMBERS = {
     "grid_vertices": ("i", 3, "n"), "vertices": ("f", 3, "n"), "edges": ("i", 2, "m"), "length": ("f", None, "m"),
     "area": ("f", None, "m"), "coefficient": ("f", None, "m"), "coefficient_exact": ("iU", None, "m"),
     "control_volume": ("f", None, "n"), "volume_exact": ("iU", None, "n"), "boundary": ("b", None, "n"),
-    "boundary_area": ("f", None, "n"), "element_circumcenter": ("f", 3, "e"),
+    "boundary_area": ("f", None, "n"), "boundary_area_exact": ("iU", 3, "n"), "element_circumcenter": ("f", 3, "e"),
 }
 _STAMP = (1980, 1, 1, 0, 0, 0)
 _MAX_DIGITS = 200
@@ -79,7 +91,9 @@ def _npy(array: np.ndarray) -> bytes:
 
 
 def _exact(array: np.ndarray) -> np.ndarray:
-    return array if array.dtype != object else np.array([str(int(x)) for x in array], dtype=f"U{_MAX_DIGITS}")
+    if array.dtype != object:
+        return array
+    return np.array([str(int(x)) for x in array.reshape(-1)], dtype=f"U{_MAX_DIGITS}").reshape(array.shape)
 
 
 def write_dual(dual: Dual, path: str | Path) -> None:
@@ -87,11 +101,14 @@ def write_dual(dual: Dual, path: str | Path) -> None:
     arrays = {name: getattr(dual, name) for name in MEMBERS}
     arrays["coefficient_exact"] = _exact(arrays["coefficient_exact"])
     arrays["volume_exact"] = _exact(arrays["volume_exact"])
+    arrays["boundary_area_exact"] = _exact(arrays["boundary_area_exact"])
     blobs = {name: _npy(array) for name, array in arrays.items()}
     manifest = {
         "format": "cospherical-dual", "version": DUAL_FORMAT_VERSION, "domain": list(dual.box.texts),
         "grid": int(dual.grid), "coefficient_denominator": str(dual.coefficient_denominator),
         "volume_denominator": str(dual.volume_denominator), "volume_factor_squared": str(dual.volume_factor_squared),
+        "boundary_area_denominator": str(dual.boundary_area_denominator),
+        "boundary_factors_squared": [str(f) for f in dual.boundary_factors_squared],
         "sha256": {name: hashlib.sha256(blob).hexdigest() for name, blob in blobs.items()},
     }
     blobs = {"manifest": _npy(np.frombuffer(json.dumps(manifest, sort_keys=True).encode(), dtype=np.uint8)), **blobs}
@@ -151,7 +168,7 @@ def read_dual(path: str | Path) -> Dual:
                     raise FormatError(f"{path}: member {name}: checksum mismatch (the file was changed or damaged)")
     except MemoryError:
         raise FormatError(f"{path}: cannot read: its members need more memory than this process may use") from None
-    except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, OSError, ValueError) as error:
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, zlib.error, EOFError, OSError, ValueError) as error:
         if isinstance(error, FormatError):
             raise
         raise FormatError(f"{path}: not a readable dual.npz (truncated or damaged): {error}") from None
@@ -168,7 +185,8 @@ def _manifest(raw: np.ndarray, path: Path) -> dict:
     if manifest.get("version") != DUAL_FORMAT_VERSION:
         raise FormatError(f"{path}: dual format version {manifest.get('version')!r}; this reads {DUAL_FORMAT_VERSION}")
     for key, kind in (("domain", list), ("grid", int), ("coefficient_denominator", str), ("volume_denominator", str),
-                      ("volume_factor_squared", str), ("sha256", dict)):
+                      ("volume_factor_squared", str), ("boundary_area_denominator", str),
+                      ("boundary_factors_squared", list), ("sha256", dict)):
         if not isinstance(manifest.get(key), kind):
             raise FormatError(f"{path}: manifest: {key} missing or not a {kind.__name__}")
     return manifest
@@ -177,10 +195,10 @@ def _manifest(raw: np.ndarray, path: Path) -> dict:
 def _integers(array: np.ndarray, name: str, path: Path) -> np.ndarray:
     if array.dtype.kind == "i":
         return array.astype(np.int64)
-    text = array.astype(str)
-    if any(not _INTEGER.fullmatch(x) for x in text.tolist()):
+    text = array.astype(str).reshape(-1).tolist()
+    if any(not _INTEGER.fullmatch(x) for x in text):
         raise FormatError(f"{path}: member {name}: not integers of at most {_MAX_DIGITS} digits")
-    return np.array([int(x) for x in text.tolist()], dtype=object)
+    return np.array([int(x) for x in text], dtype=object).reshape(array.shape)
 
 
 def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
@@ -194,8 +212,12 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
     edges = arrays["edges"]
     if len(edges) and (edges.min() < 0 or edges.max() >= counts["n"] or np.any(edges[:, 0] >= edges[:, 1])):
         raise FormatError(f"{path}: member edges: a pair that is not two vertices i < j")
+    factors = manifest["boundary_factors_squared"]
+    if len(factors) != 3 or not all(isinstance(f, str) and _POSITIVE_FRACTION.fullmatch(f) for f in factors):
+        raise FormatError(f"{path}: manifest: boundary_factors_squared is not three positive fractions of at most "
+                          "1000 digits")
     for key, pattern in (("coefficient_denominator", _POSITIVE), ("volume_denominator", _POSITIVE),
-                         ("volume_factor_squared", _POSITIVE_FRACTION)):
+                         ("volume_factor_squared", _POSITIVE_FRACTION), ("boundary_area_denominator", _POSITIVE)):
         if not pattern.fullmatch(manifest[key]):
             raise FormatError(f"{path}: manifest: {key} is not a positive integer or fraction of at most 1000 digits")
     if not 0 < manifest["grid"] <= MAX_GRID:
@@ -204,13 +226,22 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
         box = Box.parse(manifest["domain"])
         grid = int(manifest["grid"])
         cden, vden = int(manifest["coefficient_denominator"]), int(manifest["volume_denominator"])
+        bden = int(manifest["boundary_area_denominator"])
         factor_squared = Fraction(manifest["volume_factor_squared"])
         factor = math.sqrt(factor_squared)
+        plane_squared = tuple(Fraction(f) for f in factors)
     except (ValueError, TypeError, ZeroDivisionError, OverflowError) as error:
         raise FormatError(f"{path}: manifest: {error}") from None
-    return Dual(box, grid, arrays["grid_vertices"].astype(np.int64), arrays["vertices"], edges.astype(np.int64),
-                arrays["length"], arrays["area"], arrays["coefficient"], arrays["control_volume"],
-                arrays["boundary"], arrays["boundary_area"],
-                _integers(arrays["coefficient_exact"], "coefficient_exact", path), cden,
-                _integers(arrays["volume_exact"], "volume_exact", path), vden, factor,
-                factor_squared, arrays["element_circumcenter"])
+    squared = tuple(Fraction(x) for x in box.squared)
+    if plane_squared != tuple(squared[(k + 1) % 3] * squared[(k + 2) % 3] for k in range(3)):
+        raise FormatError(f"{path}: manifest: boundary_factors_squared are not the domain's (b^2 c^2, a^2 c^2, a^2 b^2)")
+    return Dual(box=box, grid=grid, grid_vertices=arrays["grid_vertices"].astype(np.int64),
+                vertices=arrays["vertices"], edges=edges.astype(np.int64), length=arrays["length"],
+                area=arrays["area"], coefficient=arrays["coefficient"], control_volume=arrays["control_volume"],
+                boundary=arrays["boundary"], boundary_area=arrays["boundary_area"],
+                coefficient_exact=_integers(arrays["coefficient_exact"], "coefficient_exact", path),
+                coefficient_denominator=cden, volume_exact=_integers(arrays["volume_exact"], "volume_exact", path),
+                volume_denominator=vden, volume_factor=factor, volume_factor_squared=factor_squared,
+                boundary_area_exact=_integers(arrays["boundary_area_exact"], "boundary_area_exact", path),
+                boundary_area_denominator=bden, boundary_factors_squared=plane_squared,
+                element_circumcenter=arrays["element_circumcenter"])

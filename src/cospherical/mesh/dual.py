@@ -26,7 +26,8 @@ Exact: with points ``(s*a, t*b, u*c)`` in unit coordinates and the squared lengt
 ``c - (d.N / sum N_k^2/w_k) * N/w`` and a triangle's piece of ``area / length`` is
 ``a*b*c * (x_u - x_v).((f - m) x (c - m)) / (2 |e|^2)``: a rational times ``a*b*c``.
 Volumes are rationals times ``a*b*c`` too, boundary areas rationals times the
-product of the two lengths of their plane.  Signs (negative coefficients) are
+product of the two lengths of their plane (kept per axis: on a sqrt box the three
+products are different square roots).  Signs (negative coefficients) are
 therefore decided on the rationals.  The pieces of a leaf's configuration scale
 with the leaf's size (coefficients as ``h``, areas as ``h^2``, volumes as ``h^3``), so
 they are computed once per configuration, and the mesh's sums are integer sums,
@@ -57,7 +58,7 @@ from ..core.delaunay import hull_faces
 from ..core.geometry import Frame, cross, dot, sub
 from ..errors import InputError
 
-__all__ = ["Dual", "ElementPieces", "delaunay_tetrahedra", "dual_summary", "element_pieces", "mesh_dual",
+__all__ = ["Dual", "ElementPieces", "boundary_areas", "delaunay_tetrahedra", "dual_summary", "element_pieces", "mesh_dual",
            "tetrahedral_counts"]
 
 Point = tuple[Fraction, Fraction, Fraction]
@@ -160,8 +161,12 @@ class Dual:
     volume_factor / coefficient_denominator`` and ``control_volume == volume_exact *
     volume_factor / volume_denominator`` with integer numerators (int64, or Python
     integers in an object array when int64 could overflow) and ``volume_factor`` the
-    box's ``a*b*c`` (``volume_factor_squared`` exact).  ``element_circumcenter``: the
-    real circumcenter of every element, in the mesh's element order.
+    box's ``a*b*c`` (``volume_factor_squared`` exact).  Boundary areas per axis ``k``
+    (the part in the domain's two sides normal to ``k``): ``boundary_area ==
+    sum over k of boundary_area_exact[:, k] * sqrt(boundary_factors_squared[k]) /
+    boundary_area_denominator``, ``boundary_factors_squared`` the squared products of the
+    two lengths of those sides, ``(b^2 c^2, a^2 c^2, a^2 b^2)``.  ``element_circumcenter``:
+    the real circumcenter of every element, in the mesh's element order.
     """
 
     box: Box
@@ -181,6 +186,9 @@ class Dual:
     volume_denominator: int
     volume_factor: float
     volume_factor_squared: Fraction
+    boundary_area_exact: np.ndarray
+    boundary_area_denominator: int
+    boundary_factors_squared: tuple[Fraction, Fraction, Fraction]
     element_circumcenter: np.ndarray = field(repr=False)
 
     def laplacian(self):
@@ -212,6 +220,11 @@ class Dual:
     def volume_sum(self) -> Fraction:
         """The control volumes' sum as an exact fraction of the domain's volume."""
         return Fraction(int(np.sum(self.volume_exact.astype(object))), self.volume_denominator)
+
+    def boundary_area_sums(self) -> tuple[Fraction, Fraction, Fraction]:
+        """Per axis, the boundary areas' sum as an exact fraction of one side's area (2: both sides normal to it)."""
+        return tuple(Fraction(int(np.sum(self.boundary_area_exact[:, k].astype(object))), self.boundary_area_denominator)
+                     for k in range(3))
 
     def negative_coefficients(self) -> dict:
         """Edges whose coefficient is negative (decided on the exact integers), interior and boundary apart.
@@ -295,12 +308,14 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
     # times a bound on the pieces met by one edge or vertex
     largest_coefficient = max((abs(int(q * cden)) for shape, _, _, _ in groups for q in shape.edge_q), default=0)
     largest_volume = max((abs(int(q * vden)) for shape, _, _, _ in groups for q in shape.volume_q), default=0)
-    wide = largest_volume * max_size ** 3 * 4096 >= 2**62 or largest_coefficient * max_size * 4096 >= 2**62
+    largest_boundary = max((abs(int(q * bden)) for shape, _, _, _ in groups for _, q in shape.boundary), default=0)
+    wide = largest_volume * max_size ** 3 * 4096 >= 2**62 or largest_coefficient * max_size * 4096 >= 2**62 or \
+        largest_boundary * max_size ** 2 * 4096 >= 2**62
     dtype = object if wide else np.int64
     edges, coefficient_exact = _edge_sums(groups, n_vertices, cden, dtype)
     boundary = np.any((verts == 0) | (verts == grid), axis=1)
     volume_exact = np.zeros(n_vertices, dtype=dtype)
-    bnd_parts, bnd_index, bnd_axis = [], [], []
+    boundary_exact = np.zeros((n_vertices, 3), dtype=dtype)  # per axis: the area in the sides normal to it
     for shape, source, rows, sizes in groups:
         q = _integers(shape.volume_q, vden).astype(dtype)
         touching = []  # the members with a vertex on the domain's boundary: only they have boundary areas
@@ -315,9 +330,7 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
             ids = source[rows[touching], node].astype(np.int64)
             on = (verts[ids, axis] == 0) | (verts[ids, axis] == grid)
             # the face lies in the vertex's plane: on the boundary where that plane is a side of the domain
-            bnd_parts.append(sizes[touching][on].astype(dtype) ** 2 * int(q * bden))
-            bnd_index.append(ids[on])
-            bnd_axis.append(np.full(int(on.sum()), axis, dtype=np.int64))
+            np.add.at(boundary_exact[:, axis], ids[on], sizes[touching][on].astype(dtype) ** 2 * int(q * bden))
     lengths = np.array(box.to_float())
     real = verts * (lengths / grid)
     factor = math.sqrt(factor_squared)
@@ -327,14 +340,20 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
         edge_vectors = real[edges[part, 1]] - real[edges[part, 0]]
         length[part] = np.sqrt((edge_vectors ** 2).sum(axis=1))
     control_volume = volume_exact.astype(np.float64) * (factor / (vden * float(grid) ** 3))
-    boundary_area = np.zeros(n_vertices)
-    if bnd_parts:
-        plane_factor = np.array([math.sqrt(squared[(k + 1) % 3] * squared[(k + 2) % 3]) for k in range(3)])
-        pieces = np.concatenate(bnd_parts).astype(np.float64) * plane_factor[np.concatenate(bnd_axis)]
-        np.add.at(boundary_area, np.concatenate(bnd_index), pieces / (bden * float(grid) ** 2))
-    return Dual(box, grid, verts, real, edges, length, coefficient * length, coefficient, control_volume, boundary,
-                boundary_area, coefficient_exact, cden * grid, volume_exact, vden * grid ** 3, factor,
-                factor_squared, centers)
+    plane_squared = tuple(squared[(k + 1) % 3] * squared[(k + 2) % 3] for k in range(3))
+    return Dual(box=box, grid=grid, grid_vertices=verts, vertices=real, edges=edges, length=length,
+                area=coefficient * length, coefficient=coefficient, control_volume=control_volume, boundary=boundary,
+                boundary_area=boundary_areas(boundary_exact, bden * grid ** 2, plane_squared),
+                coefficient_exact=coefficient_exact, coefficient_denominator=cden * grid, volume_exact=volume_exact,
+                volume_denominator=vden * grid ** 3, volume_factor=factor, volume_factor_squared=factor_squared,
+                boundary_area_exact=boundary_exact, boundary_area_denominator=bden * grid ** 2,
+                boundary_factors_squared=plane_squared, element_circumcenter=centers)
+
+
+def boundary_areas(exact: np.ndarray, denominator: int, factors_squared) -> np.ndarray:
+    """The boundary areas as floats from their exact per-axis numerators (see :class:`Dual`)."""
+    factors = np.array([math.sqrt(f) for f in factors_squared])
+    return (exact.astype(np.float64) * factors).sum(axis=1) / denominator
 
 
 CHUNK = 1 << 21  # instances per block of work: its temporaries stay small and the allocator reuses them
