@@ -209,3 +209,15 @@ def test_a_wrong_float_proposal_is_caught(monkeypatch):
     monkeypatch.setattr(scipy.spatial, "Delaunay", lambda points, **options: qhull(points * [1, 1, 5], **options))
     calls = _count_exact(monkeypatch)
     assert mesh_cells(global_delaunay(leaf)) == expected and calls
+
+
+def test_a_scaled_cell_shape_is_the_shape_of_the_scaled_offsets():
+    # shapes are classified once up to scale; the scaled copy must be what a direct measurement gives
+    from cospherical.mesh.delaunay import _scaled, _shape
+
+    mesh = global_delaunay(assemble(build_octree(Box.parse(["1", "2", "4"]), 3, [parse_shape("point:0.1,0.1,0.1")])))
+    for shape in mesh.cells.shapes[:6]:
+        unit, _ = _shape(list(shape.offsets), mesh.box.squared, {})
+        for g in (2, 3):
+            direct, _ = _shape([tuple(g * x for x in o) for o in shape.offsets], mesh.box.squared, {})
+            assert _scaled(unit, g) == direct

@@ -69,7 +69,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from ..core.geometry import Frame, sphere_sides
+from ..core.geometry import Frame, Sphere, sphere_sides
 from ..core.incremental_delaunay import delaunay_tetrahedra
 from ..core.tessellation import tessellation_elements
 from ..errors import InputError
@@ -402,11 +402,16 @@ def _cells(mesh: Mesh, merged: np.ndarray, proven: np.ndarray, located: _Locator
     starts = np.searchsorted(shape_of_cell[by_shape], np.arange(int(shape_of_cell.max()) + 2))
     shapes = []
     nodes = np.full((n_cells, width), -1, dtype=np.int32)
+    measured: dict = {}  # shapes up to scale (the same cells at another leaf level): classified once
     for s in range(len(starts) - 1):
         rows = by_shape[starts[s]:starts[s + 1]]
         k = int(counts[rows[0]])
-        shape, order = _shape([tuple(int(x) for x in o) for o in offsets[rows[0], :k]], mesh.box.squared, types)
-        shapes.append(shape)
+        g = int(np.gcd.reduce(np.abs(offsets[rows[0], :k]).reshape(-1)))
+        unit = offsets[rows[0], :k] // g
+        if unit.tobytes() not in measured:
+            measured[unit.tobytes()] = _shape([tuple(int(x) for x in o) for o in unit], mesh.box.squared, types)
+        shape, order = measured[unit.tobytes()]
+        shapes.append(_scaled(shape, g))
         nodes[rows, :len(order)] = members[np.ix_(rows, order)]
     # first leaf: the one whose box holds the cell's vertex centroid (an interior point)
     points = coords[np.maximum(members, 0)]
@@ -449,6 +454,23 @@ def _shape(offsets: list[tuple[int, int, int]], squared, types: dict) -> tuple[C
     return CellShape(element.type.id, tuple(offsets[n] for n in order),
                      tuple(tuple(at[n] for n in cycle) for cycle in element.polyhedron.faces),
                      element.polyhedron.unit_volume, sphere, centre), order
+
+
+def _scaled(shape: CellShape, g: int) -> CellShape:
+    """``shape`` scaled by the integer ``g`` about its anchor: what :func:`_shape` gives for the scaled offsets.
+
+    Lexicographic order, the type and its node order do not change; in
+    :meth:`~cospherical.core.geometry.Frame.sphere` the coordinates scale by ``g`` and the
+    lifted one by ``g**2``, so the cofactors of the same four nodes scale by ``g**4``
+    (x, y, z) and ``g**3`` (lifted), the offset by ``g**5``.
+    """
+    if g == 1:
+        return shape
+    n0, n1, n2, n3 = shape.sphere.normal
+    return CellShape(shape.type_id, tuple(tuple(g * x for x in o) for o in shape.offsets), shape.faces,
+                     shape.grid_volume * g ** 3, Sphere((g ** 4 * n0, g ** 4 * n1, g ** 4 * n2, g ** 3 * n3),
+                                                        g ** 5 * shape.sphere.offset),
+                     tuple(g * c for c in shape.center))
 
 
 MODES = ("global", "leaf")
