@@ -127,8 +127,14 @@ def main() -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
     import poisson
 
-    with recorded(f"{Path(__file__).stem}-poisson.py"):  # the table is the script's output, kept whole
-        poisson.main(["--uniform", *map(str, args.uniform), "--graded", *map(str, args.graded), "--times"])
+    with recorded(__file__, name=f"{Path(__file__).stem}-poisson") as record:
+        rows = poisson.main(["--uniform", *map(str, args.uniform), "--graded", *map(str, args.graded), "--times"])
+        record.table(["u", "tree", "L", "method", "unknowns, nonzeros", "max error (order)", "L2 error (order)",
+                      "build s", "solve s"],
+                     [[row["solution"], row["tree"], row["level"], row["method"],
+                       f"{row['unknowns']:,}, {row['nonzeros']:,}", f"{row['max']:.2e} ({row['max_order']})",
+                       f"{row['l2']:.2e} ({row['l2_order']})", f"{row['build']:.2f}", f"{row['solve']:.2f}"]
+                      for row in rows])
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ Use::
     with recorded(__file__) as record:
         ...                      # print as before
         record.add("what", "figure")
+        record.table(["column", ...], [[cell, ...], ...])   # a whole table, when the figures are one
 
 The file is written when the block ends without an exception (a failed run leaves the
 previous file as it was), to a temporary file in the same folder and renamed.
@@ -63,8 +64,11 @@ def _process_seconds() -> float | None:
 
 
 def _commit() -> str | None:
+    """The checkout's commit, ``+changes`` when tracked files differ from it (a local commit may be rebased later)."""
     result = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=ROOT, capture_output=True, text=True)
-    return result.stdout.strip() or None
+    changed = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
+                             capture_output=True, text=True).stdout.strip()
+    return (result.stdout.strip() + ("+changes" if changed else "")) or None
 
 
 class _Tee(io.TextIOBase):
@@ -86,6 +90,7 @@ class Record:
         self.script = Path(script).name
         self.command = " ".join(["python", f"benchmarks/{self.script}", *map(shlex.quote, sys.argv[1:])])
         self.rows: list[list[str]] = []
+        self.tables: list[dict] = []
         self.date = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
         self.load_before = [round(x, 2) for x in os.getloadavg()]
         self.start = time.perf_counter() - (_process_seconds() or 0.0)
@@ -93,6 +98,10 @@ class Record:
     def add(self, what: str, figure: str) -> None:
         """One headline figure, as the page's table shows it."""
         self.rows.append([what, figure])
+
+    def table(self, columns: list[str], rows: list[list]) -> None:
+        """A table of figures (cells as the page shows them), rendered whole."""
+        self.tables.append({"columns": list(columns), "rows": [[str(cell) for cell in row] for row in rows]})
 
     def data(self, output: str) -> dict:
         own = resource.getrusage(resource.RUSAGE_SELF)
@@ -103,18 +112,18 @@ class Record:
                                                        "after": [round(x, 2) for x in os.getloadavg()]},
                 "wall_seconds": round(time.perf_counter() - self.start, 2), "cpu_seconds": round(cpu, 2),  # whole process
                 "peak_memory_gib": round(max(own.ru_maxrss, children.ru_maxrss) / 2**20, 3),
-                "rows": self.rows, "output": output.splitlines()}
+                "rows": self.rows, "tables": self.tables, "output": output.splitlines()}
 
 
 @contextlib.contextmanager
-def recorded(script: str, folder: Path = FOLDER):
-    """Run the block with its output kept; then write ``folder/<script>.json``."""
+def recorded(script: str, folder: Path = FOLDER, name: str | None = None):
+    """Run the block with its output kept; then write ``folder/<name or the script's stem>.json``."""
     record = Record(script)
     tee = _Tee(sys.stdout)
     with contextlib.redirect_stdout(tee):
         yield record
     folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{Path(script).stem}.json"
+    path = folder / f"{name or Path(script).stem}.json"
     temporary = path.with_name(f".{path.name}.tmp")
     temporary.write_text(json.dumps(record.data(tee.kept.getvalue()), indent=1) + "\n")
     os.replace(temporary, path)

@@ -135,7 +135,8 @@ def order(rows: list[dict], key: str) -> list[str]:
     return ["-"] + [f"{math.log2(a[key] / b[key]):.2f}" for a, b in zip(rows, rows[1:])]
 
 
-def main(argv=None) -> None:
+def main(argv=None) -> list[dict]:
+    """Print the table; return its rows (each a solution, tree, level and method with its figures)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--uniform", type=int, nargs="*", default=[2, 3, 4], metavar="LEVEL")
     parser.add_argument("--graded", type=int, nargs="*", default=[4, 5, 6], metavar="LEVEL")
@@ -153,6 +154,7 @@ def main(argv=None) -> None:
     if args.times:
         header += "  build s  solve s"
     print(header)
+    table = []
     for name, (exact, source) in SOLUTIONS.items():
         for kind, levels in (("uniform", args.uniform), ("graded", args.graded)):
             trees = [octree(kind, level) for level in levels]
@@ -165,6 +167,9 @@ def main(argv=None) -> None:
                     if args.times:
                         line += f"  {row['build']:7.2f}  {row['solve']:7.2f}"
                     print(line)
+                    table.append({"solution": name, "tree": kind, "level": level, "method": method, **row,
+                                  "max_order": o_max, "l2_order": o_l2})
+    return table
 
 
 if __name__ == "__main__":

@@ -373,6 +373,10 @@ def _recorded_run(path: Path) -> list[str]:
         lines += ["| what | measured |", "|---|---|"]
         lines += [f"| {_cell(what)} | {_cell(figure)} |" for what, figure in run["rows"]]
         lines.append("")
+    for table in run.get("tables", []):
+        lines += ["| " + " | ".join(map(_cell, table["columns"])) + " |", "|" + "---|" * len(table["columns"])]
+        lines += ["| " + " | ".join(map(_cell, row)) + " |" for row in table["rows"]]
+        lines.append("")
     lines += ['??? note "Everything it printed"', "", "    ```text"]
     lines += [f"    {line}" for line in run["output"]] + ["    ```", ""]
     return lines
@@ -396,6 +400,14 @@ def benchmarks(up: str) -> str:
     return "\n".join(out)
 
 
+def benchmark_run(up: str, name: str) -> str:
+    """One benchmark's last recorded run (``results/benchmarks/NAME.json``), where a page shows its figures."""
+    path = RESULTS / "benchmarks" / f"{name}.json"
+    if not path.is_file():
+        return f"*No recorded run yet: the script writes `results/benchmarks/{name}.json` when it runs.*"
+    return "\n".join(_recorded_run(path))
+
+
 def module_doc(up: str, module: str) -> str:
     """A module's docstring as it stands (the specification of its file format), verbatim."""
     import importlib
@@ -407,6 +419,7 @@ def module_doc(up: str, module: str) -> str:
 GENERATORS = {
     "module-doc": module_doc,
     "benchmarks": benchmarks,
+    "benchmark": benchmark_run,
     "schema": schema_fields,
     "cli": cli_reference,
     "studies": studies_table,

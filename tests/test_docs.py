@@ -224,6 +224,7 @@ def test_a_benchmark_run_is_recorded_with_its_machine_and_rendered_from_its_file
     with record.recorded("bench_example.py", tmp_path) as run:
         print("figure line")
         run.add("one call | median", "0.85 ms")
+        run.table(["level", "error"], [[3, "1.29e-02"]])
     data = json.loads((tmp_path / "bench_example.json").read_text())
     assert data["output"] == ["figure line"] and data["rows"] == [["one call | median", "0.85 ms"]]
     assert data["machine"]["cores"] == os.cpu_count() and len(data["load_average"]["before"]) == 3
@@ -232,3 +233,4 @@ def test_a_benchmark_run_is_recorded_with_its_machine_and_rendered_from_its_file
     page = "\n".join(hooks._recorded_run(tmp_path / "bench_example.json"))
     assert data["command"] in page and f"{data['machine']['cores']} cores" in page
     assert "| one call \\| median | 0.85 ms |" in page and "    figure line" in page
+    assert "| level | error |" in page and "| 3 | 1.29e-02 |" in page
