@@ -174,12 +174,16 @@ def test_exact_engine_gives_the_qhull_paths_cells(domain, levels, shapes, balanc
 
 @pytest.mark.parametrize("domain, shape", [(["1e-12", "1", "3e9"], "point:0,0.3,1e9"),
                                            (["sqrt(2)", "1e-12", "1"], "point:0.5,0,0.7")])
-def test_extreme_boxes_mesh_exactly(domain, shape, monkeypatch, capsys):
-    # Qhull's float triangulation fails on these regions; the exact engine takes them
+def test_extreme_boxes_mesh_exactly(domain, shape, monkeypatch, capsys, tmp_path):
+    # Qhull's float triangulation fails on these regions; the exact engine takes them; the dual's
+    # numbers pass float's range and the picture's section is one pixel wide: every output is written
     calls = _count_exact(monkeypatch)
-    argv = ["mesh", "--domain", *domain, "--levels", "4", "--refine", shape, "--format", "json", "--no-uniform"]
+    argv = ["mesh", "--domain", *domain, "--levels", "4", "--refine", shape, "--format", "json", "--no-uniform",
+            "--dual", "--out", str(tmp_path)]
     assert main(argv) == 0
     report = json.loads(capsys.readouterr().out)
+    assert {"dual.npz", "mesh.png", "mesh.vtu", "report.json"} <= {p.name for p in tmp_path.iterdir()}
+    assert report["negative_coefficients"]["interior"] == 0
     assert calls and report["regions_retessellated"] >= 1 and report["leaf_mesh"]["delaunay_violations"] > 0
     assert {k: report[k] for k in WHOLE} == WHOLE and report["elements"] > report["leaves"]
 

@@ -334,12 +334,12 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
     lengths = np.array(box.to_float())
     real = verts * (lengths / grid)
     factor = math.sqrt(factor_squared)
-    coefficient = coefficient_exact.astype(np.float64) * (factor / (cden * grid))
+    coefficient = _scaled(coefficient_exact, cden * grid, factor)
     length = np.empty(len(edges))
     for part in _chunks(len(edges), 1):
         edge_vectors = real[edges[part, 1]] - real[edges[part, 0]]
         length[part] = np.sqrt((edge_vectors ** 2).sum(axis=1))
-    control_volume = volume_exact.astype(np.float64) * (factor / (vden * float(grid) ** 3))
+    control_volume = _scaled(volume_exact, vden * grid ** 3, factor)
     plane_squared = tuple(squared[(k + 1) % 3] * squared[(k + 2) % 3] for k in range(3))
     return Dual(box=box, grid=grid, grid_vertices=verts, vertices=real, edges=edges, length=length,
                 area=coefficient * length, coefficient=coefficient, control_volume=control_volume, boundary=boundary,
@@ -353,6 +353,8 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
 def boundary_areas(exact: np.ndarray, denominator: int, factors_squared) -> np.ndarray:
     """The boundary areas as floats from their exact per-axis numerators (see :class:`Dual`)."""
     factors = np.array([math.sqrt(f) for f in factors_squared])
+    if exact.dtype == object:  # numbers past float's range (extreme boxes): divided as Python integers first
+        return (_scaled(exact.reshape(-1), denominator, 1.0).reshape(exact.shape) * factors).sum(axis=1)
     return (exact.astype(np.float64) * factors).sum(axis=1) / denominator
 
 
@@ -439,6 +441,12 @@ def _edge_sums(groups, n_vertices: int, cden: int, dtype) -> tuple[np.ndarray, n
         parts = numerators[payload >> shift_bits] * powers[payload & ((1 << shift_bits) - 1)]
         sums[lo:hi] = np.add.reduceat(parts, first[lo:hi] - start)
     return edges, sums
+def _scaled(exact: np.ndarray, den: int, factor: float) -> np.ndarray:
+    """``exact / den * factor`` as floats.  Python integers (extreme boxes: 1e-12 x 1 x 3e9 gives numerators
+    and denominators past float's range) are divided exactly first, Python's int / int rounding once."""
+    if exact.dtype != object:
+        return exact.astype(np.float64) * (factor / float(den))
+    return np.array([x / den for x in exact.tolist()], dtype=np.float64) * factor
 
 
 def _leaf_groups(mesh, squared):

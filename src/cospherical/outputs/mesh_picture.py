@@ -78,7 +78,7 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
     colour = {t: TAB20[i % len(TAB20)] for i, t in enumerate(order)}
     a, b, _ = mesh.box.to_float()
     width, height, x0, y0, scale = frame(a, b)
-    w, h = round(scale * a), round(scale * b)
+    w, h = max(1, round(scale * a)), max(1, round(scale * b))  # a 1e-12 x 1 section is one pixel wide, not empty
     image = Image.new("RGB", (width, height), WHITE)
     over = Image.new("RGB", (w * OVER, h * OVER), WHITE)
     pen = ImageDraw.Draw(over)
