@@ -299,3 +299,31 @@ def test_the_report_says_where_each_configuration_came_from(representatives_stor
     assert report["configurations_mapped"] > 0 and report["tessellated_on_the_fly"] == 0
     assert report["configurations_from_table"] + report["configurations_mapped"] + report["tessellated_on_the_fly"] \
         == report["configurations"]
+
+
+@pytest.mark.parametrize("pieces", [None, "2"])
+def test_leaf_cell_data_numbers_the_leaves_as_the_leaves_file_lists_them(tmp_path, pieces):
+    """With --leaves, each cell's ``leaf`` is a line of the file, and the cell lies inside that line's leaf."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    tree = build_octree(Box.parse(["1", "1", "1"]), 2, [parse_shape("point:0.3,0.6,0.2")])
+    listed = np.random.default_rng(5).permutation(len(tree))  # the file's order is not the tree's
+    rows = np.column_stack([tree.levels, tree.positions])[listed]
+    path = tmp_path / "leaves.txt"
+    path.write_text("".join(" ".join(map(str, row)) + "\n" for row in rows.tolist()))
+    argv = ["mesh", "--domain", "1", "1", "1", "--leaves", str(path), "--delaunay", "leaf", "--no-uniform",
+            "--out", str(tmp_path / "out"), "--format", "json"]
+    assert main(argv + (["--partitions", pieces, "--jobs", "1"] if pieces else [])) == 0
+    reader = vtk.vtkXMLPUnstructuredGridReader() if pieces else vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(tmp_path / "out" / ("mesh.pvtu" if pieces else "mesh.vtu")))
+    reader.Update()
+    grid = reader.GetOutput()
+    leaf = vtk_to_numpy(grid.GetCellData().GetArray("leaf"))
+    points = vtk_to_numpy(grid.GetPoints().GetData())
+    assert sorted(set(leaf.tolist())) == list(range(len(tree)))  # every line of the file, by its index
+    size = 0.5 ** rows[:, 0]
+    for c in range(grid.GetNumberOfCells()):
+        ids = [grid.GetCell(c).GetPointId(k) for k in range(grid.GetCell(c).GetNumberOfPoints())]
+        low = rows[leaf[c], 1:] * size[leaf[c]]
+        assert np.all(points[ids] >= low - 1e-12) and np.all(points[ids] <= low + size[leaf[c]] + 1e-12)

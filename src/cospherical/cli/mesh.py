@@ -17,7 +17,7 @@ from ..files.outputs import OutputFolder
 from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
 from ..mesh.assembly import assemble
 from ..mesh.delaunay import MODES, delaunay_mesh
-from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, build_octree, leaves_octree, parse_shape
+from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, build_octree, leaf_list_order, leaves_octree, parse_shape
 from ..mesh.report import mesh_report
 from .progress import stage_bars
 
@@ -41,7 +41,8 @@ def add_parser(commands) -> None:
                       "plane:NX,NY,NZ,D, point:X,Y,Z or box:X0,Y0,Z0,X1,Y1,Z1, in domain units (repeatable)")
     tree.add_argument("--leaves", type=Path, metavar="FILE",
                       help="the leaves as a list of 'level i j k' (text, one per line) or JSON "
-                      '{"leaves": [[level, i, j, k], ...]}; checked to tile the domain and be 1-irregular')
+                      '{"leaves": [[level, i, j, k], ...]}; checked to tile the domain and be 1-irregular; '
+                      "mesh.vtu's cell data leaf is the index in this list")
     parser.add_argument("--levels", metavar="L", help=f"refine down to level L (0..{MAX_LEVEL}); with --refine")
     parser.add_argument("--max-leaves", metavar="N",
                         help="refuse a tree of more leaves than N, estimated before it is built (default: what half "
@@ -200,8 +201,10 @@ def _run(args, out: OutputFolder | None) -> int:
         levels, positions = read_leaves(args.leaves, max_leaves)
         tree = leaves_octree(box, levels, positions, where=str(args.leaves))
         described = {"source": "leaves", "file": args.leaves.name, "depth": tree.depth}
+        listed = leaf_list_order(levels, positions)  # cell data leaf: the file's numbering
     else:
         shapes = [parse_shape(text) for text in args.refine]
+        listed = None  # cell data leaf: the tree's order
         levels = _levels(args.levels)
         tree = build_octree(box, levels, shapes, args.balance, max_leaves)
         described = {"source": "refine", "levels": levels, "refine": [s.text for s in shapes],
@@ -218,7 +221,7 @@ def _run(args, out: OutputFolder | None) -> int:
         timings["table"] = time.perf_counter() - clock
         clock = time.perf_counter()
     if args.partitions is not None:
-        return _in_pieces(args, tree, described, table, mode, out)
+        return _in_pieces(args, tree, described, table, mode, out, listed)
     large = len(tree) > 50_000  # bars on large trees only (and only on a terminal: tqdm's disable=None)
     bars = {"assembly": (len(tree), "assembling", "leaf"), "regions": (None, "Delaunay check (leaf mesh)", "element"),
             "delaunay": (None, "Delaunay check", "element")}
@@ -271,7 +274,7 @@ def _run(args, out: OutputFolder | None) -> int:
                 ok = np.ones(len(mesh), dtype=np.int8)
                 ok[violating[0]] = 0
                 cell_data["delaunay_ok"] = ok
-        write_vtu(mesh, out.path("mesh.vtu"), point_data=point_data, cell_data=cell_data)
+        write_vtu(mesh, out.path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=listed)
         shapes = ", ".join(described.get("refine", [])) or described.get("file", "")
         cut_png(mesh, out.path("mesh.png"), at=at,
                 title=f"{' x '.join(box.texts)}: {shapes}; {report['leaves']:,} leaves, {report['elements']:,} "
@@ -296,17 +299,29 @@ def _print(args, report: dict) -> None:
         sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in SUMMARY_KEYS))
 
 
-def _in_pieces(args, tree, described: dict, table: tuple | None, mode: str, out: OutputFolder | None) -> int:
+def _write_listed_piece(listed: np.ndarray, mesh, path, leaves: np.ndarray) -> None:
+    """A piece whose cell data ``leaf`` numbers the leaves as the ``--leaves`` file lists them (tasks pickle it)."""
+    from ..formats.mesh import write_piece
+
+    write_piece(mesh, path, listed[leaves])
+
+
+def _in_pieces(args, tree, described: dict, table: tuple | None, mode: str, out: OutputFolder | None,
+               listed: np.ndarray | None) -> int:
     """``--partitions N``: the pieces meshed, checked and written by tasks, mesh.pvtu and the report here."""
+    from functools import partial
+
     from ..formats.mesh import write_piece, write_pvtu
     from ..mesh.partition import mesh_in_pieces
+
+    write = write_piece if listed is None else partial(_write_listed_piece, listed)
 
     pieces = int(args.partitions)
     paths = [str(out.path(piece_name(k))) for k in range(pieces)] if out is not None else None
     report = mesh_in_pieces(tree, pieces, (table_lookup, table) if table is not None else None, args.criterion,
                             mode, described, args.patterns.name if args.patterns else None,
                             uniform=not args.no_uniform, delaunay=not args.no_delaunay,
-                            write=write_piece if out is not None else None,
+                            write=write if out is not None else None,
                             path=paths.__getitem__ if paths is not None else None, jobs=args.jobs,
                             scheduler=args.scheduler, dask_workers=args.dask_workers)
     if out is not None:

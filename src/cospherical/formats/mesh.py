@@ -258,11 +258,12 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
     then ``point_data`` (one row per vertex, in ``mesh.vertices`` order).
     Cell data: ``element`` (the element's index in the mesh), ``type`` (index into
     the field data ``type_ids``), ``leaf`` (the leaf's index in the octree's order: by
-    level, then by the key ``(i * 2**level + j) * 2**level + k`` of its position, not the
-    order of a ``--leaves`` file), ``fvm`` (its circumcenter lies in its
+    level, then by the key ``(i * 2**level + j) * 2**level + k`` of its position; or
+    ``leaves[index]`` when ``leaves`` is given), ``fvm`` (its circumcenter lies in its
     closed leaf, decided exactly), then ``cell_data`` (one row per element, in
-    element order: written in cell order).  ``leaves``: when ``mesh`` is a piece of a
-    tree, its leaves' indices in the whole tree, which ``leaf`` then gives.
+    element order: written in cell order).  ``leaves``: the number ``leaf`` gives each
+    leaf of the mesh's tree, for example its index in a whole tree when ``mesh`` is a
+    piece of it, or its line in a ``--leaves`` file.
     Field data (text as UTF-8 bytes, ``bytes(array).decode()``): ``type_ids`` and
     ``type_names`` (one per line, in ``type`` order), ``domain`` (the lengths as
     given), ``domain_squared`` (their exact squares), and ``grid_intervals``: a point's

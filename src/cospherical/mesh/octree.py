@@ -30,7 +30,7 @@ from ..core.exact import parse_rational
 from ..errors import InputError
 
 __all__ = ["BALANCES", "BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count",
-           "estimate_leaves", "leaf_bound", "leaves_octree", "parse_shape"]
+           "estimate_leaves", "leaf_bound", "leaf_list_order", "leaves_octree", "parse_shape"]
 
 MAX_LEVEL = 16  # keys (2**16)**3 and the half-spacing grid (2**17 + 1)**3 stay inside int64
 # Balance across faces alone is not among them: it is not 1-irregular (an edge can get two points).
@@ -486,3 +486,26 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
                                      "across a face or an edge: not 1-irregular (2:1 balance)")
     levels_, positions_ = _leaves_from_splits(split)
     return Octree(box, levels_, positions_)
+
+
+def leaf_list_order(levels: Sequence[int], positions: Sequence[Sequence[int]]) -> np.ndarray:
+    """For each leaf of ``leaves_octree(box, levels, positions)``, in the tree's order, its index in the list.
+
+    The tree sorts its leaves by (level, key); a list that :func:`leaves_octree`
+    accepted holds each leaf once, so sorting the list the same way pairs them.
+
+    Examples
+    --------
+    >>> levels, positions = [1] * 8, [[i >> 2, (i >> 1) & 1, i & 1] for i in range(8)][::-1]
+    >>> tree = leaves_octree(Box.parse([1, 1, 1]), levels, positions)
+    >>> order = leaf_list_order(levels, positions)
+    >>> order.tolist(), [positions[i] for i in order] == tree.positions.tolist()
+    ([7, 6, 5, 4, 3, 2, 1, 0], True)
+    """
+    levels = np.asarray(levels, dtype=np.int64).reshape(-1)
+    positions = np.asarray(positions, dtype=np.int64).reshape(-1, 3)
+    keys = np.zeros(len(levels), dtype=np.int64)
+    for level in np.unique(levels).tolist():
+        at = levels == level
+        keys[at] = keys_of(level, positions[at])
+    return np.lexsort((keys, levels))
