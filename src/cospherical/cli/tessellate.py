@@ -46,7 +46,7 @@ def add_parser(commands) -> None:
     element = parser.add_mutually_exclusive_group()
     element.add_argument("--element", choices=ELEMENTS, default="cuboid",
                          help="the base element in the box (default cuboid): prism (half the box), pyramid (on the "
-                         "bottom face, apex at the centre) or tetrahedron (at the corner); see the README's node numbering")
+                         "bottom face, apex at the centre) or tetrahedron (at the corner); node numbering: the documentation's Conventions page")
     element.add_argument("--shape", type=Path, metavar="FILE",
                          help="any convex base element: a YAML file with corners (unit coordinates, exact: 0, 1/2), "
                          "edges and faces (corner numbers), checked exactly")

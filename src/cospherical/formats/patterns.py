@@ -278,7 +278,7 @@ def load(path: str | Path) -> PatternTable:
     used; any other YAML spelling of a table is read whole by the YAML parser.  An
     indexed store (:mod:`cospherical.formats.store`, an SQLite file) is opened and
     queried one configuration at a time.
-    See the README ("Pattern tables for a mesh generator") for an example, run by the tests.
+    The documentation's "Pattern tables for a mesher" has an example, run by the tests.
     """
     if is_store(path):
         header, texts = open_store(path)
