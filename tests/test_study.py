@@ -239,7 +239,8 @@ def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypat
     corrupt = tmp_path / "corrupt-catalogue.yaml"
     corrupt.write_text("types: [unclosed\n")
     monkeypatch.setattr(store, "catalogue_path", lambda: corrupt)
-    store._read_shipped.cache_clear()
+    store.shipped_catalogue.cache_clear()
+    store._shipped_names.cache_clear()
     root = tmp_path / "root"
     (root / "catalogue").mkdir(parents=True)
     (root / "catalogue" / "catalogue.yaml").write_text("types: [unclosed\n")
@@ -249,7 +250,8 @@ def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypat
     try:
         assert main(["reproduce", "--root", str(root)]) == 0, capsys.readouterr().err
     finally:
-        store._read_shipped.cache_clear()
+        store.shipped_catalogue.cache_clear()
+        store._shipped_names.cache_clear()
     tmp_path = root
     for folder in ("catalogue", "patterns", "results"):
         # results/sweep/, results/intersection/, results/mesh/ and results/benchmarks/ come from other

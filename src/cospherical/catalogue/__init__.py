@@ -15,11 +15,11 @@ from .criteria import (
                        split_positions,
                        split_tessellation,
 )
-from .store import (SCHEMA_VERSION, catalogue_from_text, catalogue_path, known_name, load_catalogue, shipped_catalogue,
-                    type_name, type_names, use_catalogue)
+from .store import (SCHEMA_VERSION, catalogue_from_text, catalogue_names, catalogue_path, known_name, load_catalogue,
+                    shipped_catalogue, type_name, type_names)
 
-__all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "catalogue_from_text",
+__all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "catalogue_from_text", "catalogue_names",
            "catalogue_path",
            "choose", "choose_kept", "element_options", "kept_split", "known_name", "load_catalogue", "minimal_kept_sets",
            "option_types", "shipped_catalogue", "split_options", "split_positions", "split_tessellation", "type_name",
-           "type_names", "use_catalogue"]
+           "type_names"]

@@ -205,8 +205,8 @@ def split_positions(element: Element, pieces) -> tuple[tuple[str, tuple[int, ...
     return tuple(sorted((p.type.id, tuple(position[n] for n in p.nodes)) for p in pieces))
 
 
-def apply_catalogue_criterion(tess: Tessellation, criterion: str) -> Tessellation:
-    """Split a tessellation's elements by the shipped catalogue's kept types for a criterion.
+def apply_catalogue_criterion(tess: Tessellation, criterion: str, catalogue: dict | None = None) -> Tessellation:
+    """Split a tessellation's elements by the catalogue's (default: the shipped one's) kept types for a criterion.
 
     The catalogue keeps, per criterion, the union of its studies' kept sets. An
     element of a type it does not keep is split into kept types, fewest pieces
@@ -214,5 +214,6 @@ def apply_catalogue_criterion(tess: Tessellation, criterion: str) -> Tessellatio
     """
     if criterion == "optimal":
         return tess
-    kept = frozenset(shipped_catalogue().get("criteria", {}).get(criterion, {}).get("kept", []))
+    catalogue = shipped_catalogue() if catalogue is None else catalogue
+    kept = frozenset(catalogue.get("criteria", {}).get(criterion, {}).get("kept", []))
     return split_tessellation(tess, kept, criterion, strict=False)[0]

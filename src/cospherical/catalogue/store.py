@@ -22,9 +22,8 @@ from ..files.flowyaml import decode_entry, split_section
 from ..files.yamlio import parse_yaml, read_text, validate
 from ..paper import paper_class
 
-__all__ = ["SCHEMA_VERSION", "catalogue_from_text", "catalogue_path", "known_name", "load_catalogue", "shipped_catalogue",
-           "type_name", "use_catalogue",
-           "type_names"]
+__all__ = ["SCHEMA_VERSION", "catalogue_from_text", "catalogue_names", "catalogue_path", "known_name", "load_catalogue",
+           "shipped_catalogue", "type_name", "type_names"]
 
 SCHEMA_VERSION = 1
 
@@ -34,51 +33,42 @@ def catalogue_path() -> Path:
     return data_path("catalogue.yaml")
 
 
-_in_use: list[dict] = []  # set by use_catalogue(): the catalogue this process works with instead of the file
-
-
+@lru_cache(maxsize=1)  # the shipped file does not change while a process runs
 def shipped_catalogue() -> dict:
     """The shipped catalogue, read and validated once per process (empty if there is none).
+
+    Whatever works with another catalogue (``reproduce`` builds one from
+    nothing, whatever state the file is in) is given it as an argument.
 
     Examples
     --------
     >>> shipped_catalogue()["schema_version"]
     1
     """
-    return _in_use[0] if _in_use else _read_shipped()
-
-
-@lru_cache(maxsize=None)
-def _read_shipped() -> dict:
     path = catalogue_path()
     if not path.exists():
         return {"schema_version": SCHEMA_VERSION, "version": "none", "types": []}
     return load_catalogue(path)
 
 
-def use_catalogue(catalogue: dict | None) -> None:
-    """Work with ``catalogue`` (names, kept sets) instead of the shipped file; ``None``: the file again.
-
-    ``reproduce`` regenerates the catalogue from nothing: it starts from an empty
-    one, whatever state the file is in (missing, stale, corrupt), and then names
-    everything by the catalogue it has just built, so one run gives the final bytes.
-    """
-    _in_use[:] = [catalogue] if catalogue is not None else []
-    _known_names.cache_clear()
+@lru_cache(maxsize=1)
+def _shipped_names() -> dict[str, str]:
+    return catalogue_names(shipped_catalogue())
 
 
-@lru_cache(maxsize=None)
-def _known_names() -> dict[str, str]:
-    return {entry["code"]: entry["name"] for entry in shipped_catalogue()["types"]}
+def catalogue_names(catalogue: dict) -> dict[str, str]:
+    """Canonical code -> the catalogue's name of that type."""
+    return {entry["code"]: entry["name"] for entry in catalogue["types"]}
 
 
-def known_name(code: str) -> str | None:
-    """The catalogue's name of a canonical code, if the shipped catalogue has it."""
-    return _known_names().get(code)
+def known_name(code: str, catalogue: dict | None = None) -> str | None:
+    """The name of a canonical code in ``catalogue`` (default: the shipped one), if it has it."""
+    return (_shipped_names() if catalogue is None else catalogue_names(catalogue)).get(code)
 
 
-def type_name(etype: ElementType) -> str:
-    """The name of an element type: the shipped catalogue's, else its structural or systematic name.
+def type_name(etype: ElementType, catalogue: dict | None = None) -> str:
+    """The name of an element type: the catalogue's (default: the shipped one), else its structural
+    or systematic name.
 
     Examples
     --------
@@ -86,7 +76,7 @@ def type_name(etype: ElementType) -> str:
     >>> type_name(tessellate(Configuration.from_code("000000000000")).elements[0].type)
     'Cuboid'
     """
-    return known_name(etype.code) or etype.name
+    return known_name(etype.code, catalogue) or etype.name
 
 
 def type_names(types: Iterable[ElementType]) -> dict[str, tuple[str, list[str]]]:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..catalogue import SCHEMA_VERSION, use_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..files.outputs import FolderLock
 from ..files.yamlio import atomic_write
@@ -43,13 +42,9 @@ def add_parser(commands) -> None:
 
 def run(args) -> int:
     # From nothing: whatever state catalogue/ is in (missing, stale, corrupt), it is neither read
-    # nor trusted; everything is named by the catalogue this run builds.
-    use_catalogue({"schema_version": SCHEMA_VERSION, "version": "none", "types": []})
-    try:
-        with FolderLock(args.root):  # one run at a time regenerates a tree
-            return _reproduce(args.root)
-    finally:
-        use_catalogue(None)
+    # nor trusted; everything is named by the catalogue this run builds, passed to what names.
+    with FolderLock(args.root):  # one run at a time regenerates a tree
+        return _reproduce(args.root)
 
 
 def _reproduce(root: Path) -> int:
@@ -66,7 +61,6 @@ def _reproduce(root: Path) -> int:
                             element=element) for element in SHAPE_ELEMENTS]
     catalogue = build_catalogue(studies + leaves + shapes, intersection_examples())
     names = {t["id"]: (t["name"], t["aliases"]) for t in catalogue["types"]}
-    use_catalogue(catalogue)
     write_catalogue(catalogue, root / "catalogue" / "catalogue.yaml")
 
     report = ["# Results: the paper's bisection studies, reproduced", "",
@@ -86,7 +80,7 @@ def _reproduce(root: Path) -> int:
         if study.face_points == "octree":
             write_patterns(study, root / "patterns" / f"{stem}.yaml", catalogue["version"])
         report += [f"## {stem}", "", "```", text_report(summary).rstrip("\n"), "",
-                   *comparison_lines(summary, study), "```", ""]
+                   *comparison_lines(summary, study, catalogue), "```", ""]
     for study in leaves:
         stem = pattern_name(study.name, study.box.texts, study.face_points)
         summary = compared_with(study_summary(study, names), octree_summaries[study.box])

@@ -9,7 +9,7 @@ from ..studies.bisection import Study
 __all__ = ["comparison_lines", "paper_set_gaps", "study_comparison_lines", "text_report"]
 
 
-def paper_set_gaps(study: Study, key: str, criterion: str) -> list[dict]:
+def paper_set_gaps(study: Study, key: str, criterion: str, catalogue: dict | None = None) -> list[dict]:
     """Element types of the study that cannot be split into the paper's kept classes.
 
     The paper's table for a criterion names the classes it keeps; an element whose
@@ -25,8 +25,8 @@ def paper_set_gaps(study: Study, key: str, criterion: str) -> list[dict]:
             if any(all((paper_class(p.type) or {}).get("name") in kept_classes for p in o) for o in options):
                 continue
             entry = gaps.setdefault(element.type.id, {
-                "type": element.type.id, "name": type_name(element.type), "configurations": 0,
-                "splits": sorted({" + ".join(sorted(type_name(p.type) for p in o)) for o in options}),
+                "type": element.type.id, "name": type_name(element.type, catalogue), "configurations": 0,
+                "splits": sorted({" + ".join(sorted(type_name(p.type, catalogue) for p in o)) for o in options}),
             })
             entry["configurations"] += sizes[rep]
     return sorted(gaps.values(), key=lambda g: g["type"])
@@ -107,9 +107,9 @@ def study_comparison_lines(summary: dict) -> list[str]:
     return lines
 
 
-def comparison_lines(summary: dict, study: Study | None = None) -> list[str]:
+def comparison_lines(summary: dict, study: Study | None = None, catalogue: dict | None = None) -> list[str]:
     """The paper's figures beside ours; with the ``study``, also the elements the paper's kept
-    classes cannot tessellate."""
+    classes cannot tessellate, named by ``catalogue`` (default: the shipped one)."""
     key, _ = paper_study_key(summary)
     if key is None:
         return ["The paper has no study of this box to compare with."]
@@ -131,7 +131,7 @@ def comparison_lines(summary: dict, study: Study | None = None) -> list[str]:
         lines.append(f"    {'element classes':<{width}} {classes['paper']:>8} {classes['ours']:>8}"
                      f"{_mark(classes['paper'], classes['ours'])}")
         if criterion != "optimal" and study is not None:
-            gaps = paper_set_gaps(study, key, criterion)
+            gaps = paper_set_gaps(study, key, criterion, catalogue)
             if gaps:
                 lines.append("    The paper's kept classes cannot tessellate these elements (every split shown):")
                 for gap in gaps:
