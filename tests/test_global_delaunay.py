@@ -225,3 +225,13 @@ def test_a_scaled_cell_shape_is_the_shape_of_the_scaled_offsets():
         for g in (2, 3):
             direct, _ = _shape([tuple(g * x for x in o) for o in shape.offsets], mesh.box.squared, {})
             assert _scaled(unit, g) == direct
+
+
+@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.integers(-12, 12), min_size=3, max_size=3), st.tuples(*[st.fractions(0, 1, max_denominator=8)] * 3))
+def test_random_extreme_boxes_mesh_exactly(exponents, where):
+    # aspect ratios up to 1e24, where Qhull's floats fail: the exact checks alone decide (Qhull is no oracle here)
+    box = Box.parse([f"1e{k}" for k in exponents])
+    point = ",".join(str(float(x) * float(length)) for x, length in zip(where, box.lengths))
+    leaf = assemble(build_octree(box, 3, [parse_shape(f"point:{point}")], "vertex"))
+    assert whole(global_delaunay(leaf)) == WHOLE

@@ -95,3 +95,17 @@ def test_extreme_boxes_equal_the_projects_walk(domain):
     walk = {frozenset(cell.nodes) for cell in delaunay_cells(Frame.build(dict(enumerate(points)), weights))}
     assert cells_of(points, weights)[0] == walk
     assert len(walk) > 1
+
+
+def test_the_walks_guard_finds_what_the_walk_finds():
+    # the scan that bounds the walk: a finite tetrahedron holding the point, or a hull face it is beyond
+    from cospherical.core.incremental_delaunay import _Triangulation
+
+    cube = [(x, y, z) for x in (0, 2) for y in (0, 2) for z in (0, 2)]
+    for point, infinite in (((1, 1, 1), False), ((2, 1, 1), False), ((5, 1, 1), True)):
+        points = cube + [point]
+        triangulation = _Triangulation(Frame.build(dict(enumerate(points)), (1, 1, 1)))
+        triangulation.run(list(range(8)))
+        t = triangulation._scan(8)
+        assert (-1 in triangulation.vertices[t]) == infinite and triangulation._conflict(t, 8)
+        assert cells_of(points, (1, 1, 1))[0] == cells_by_definition(points, (1, 1, 1))

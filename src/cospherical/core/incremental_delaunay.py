@@ -29,7 +29,8 @@ Bowyer-Watson with CGAL's infinite vertex:
   points on one empty sphere) follow by grouping tetrahedra with equal spheres.
 * Point location: a visibility walk from the last new tetrahedron, stepping across
   a face that p lies strictly beyond, the face to try first turned by a counter
-  so that no cycle of ties can hold it (a stochastic walk made deterministic).
+  so that no cycle of ties can hold it (a stochastic walk made deterministic); should a
+  walk take more steps than there are tetrahedra, a scan of them all finds the one.
 
 Points are inserted in Morton order of their coordinates, so the walk is short.
 """
@@ -214,7 +215,7 @@ class _Triangulation:
             t = next(i for i in range(len(self.vertices) - 1, -1, -1)
                      if self.alive[i] and _INFINITE not in self.vertices[i])
         orient, vertices, neighbours = self.orient, self.vertices, self.neighbours
-        while True:
+        for _ in range(len(vertices) + 16):
             self.turn = (self.turn + 1) & 3
             here = vertices[t]
             for step in range(4):
@@ -228,6 +229,15 @@ class _Triangulation:
                 return t
             if _INFINITE in vertices[t]:
                 return t
+        return self._scan(p)
+
+    def _scan(self, p: int) -> int:
+        """What the walk finds, by looking at every tetrahedron: the walk's guard, should it ever go round in circles."""
+        for t, (here, alive) in enumerate(zip(self.vertices, self.alive)):
+            if alive and (self._conflict(t, p) if _INFINITE in here else
+                          all(self.orient(*here[:k], p, *here[k + 1:]) >= 0 for k in range(4))):
+                return t
+        raise AssertionError("no tetrahedron holds the point")
 
     def _insert(self, p: int) -> None:
         start = self._locate(p)
