@@ -308,29 +308,36 @@ class Mesh:
         return flags
 
     def cell_centers(self) -> tuple[np.ndarray, np.ndarray]:
-        """The cells' circumcenters in grid units, exact: numerators (cells x 3, object ints) and denominators."""
+        """The cells' circumcenters in grid units, exact: numerators (cells x 3) and denominators.
+
+        int64 when the numerators and what the checks compare them with (grid points up
+        to twice the grid times a denominator) stay below 2**62, else Python integers.
+        """
         cells = self.cells
-        num = np.empty((len(cells), 3), dtype=object)
-        den = np.empty(len(cells), dtype=object)
-        for s, shape in enumerate(cells.shapes):
-            rows = np.flatnonzero(cells.shape == s)
+        parts = []
+        for shape in cells.shapes:
             common = math.lcm(*(c.denominator for c in shape.center))
-            for axis in range(3):
-                c = shape.center[axis]
-                num[rows, axis] = cells.anchor[rows, axis].astype(object) * common + c.numerator * (
-                    common // c.denominator)
+            parts.append((common, [c.numerator * (common // c.denominator) for c in shape.center]))
+        bound = max((2 * self.grid * common + max(map(abs, p)) for common, p in parts), default=0)
+        kind = np.int64 if bound < 2**62 else object
+        num = np.empty((len(cells), 3), dtype=kind)
+        den = np.empty(len(cells), dtype=kind)
+        order = np.argsort(cells.shape, kind="stable")
+        starts = np.searchsorted(cells.shape[order], np.arange(len(parts) + 1))
+        for s, (common, p) in enumerate(parts):
+            rows = order[starts[s]:starts[s + 1]]
+            num[rows] = cells.anchor[rows].astype(kind) * common + np.array(p, dtype=kind)[None]
             den[rows] = common
         return num, den
 
     def cell_center_in_leaf(self) -> np.ndarray:
         """Per cell: its circumcenter lies in the closed box of its first leaf, decided exactly."""
         num, den = self.cell_centers()
-        size = self.leaf_size()[self.cells.leaf].astype(object)
-        low = self.tree.positions[self.cells.leaf].astype(object) * size[:, None]
+        size = self.leaf_size()[self.cells.leaf].astype(num.dtype)
+        low = self.tree.positions[self.cells.leaf].astype(num.dtype) * size[:, None]
         scaled = den[:, None]
         inside = (num >= low * scaled) & (num <= (low + size[:, None]) * scaled)
         return inside.all(axis=1).astype(bool)
-
 
 def _type_info(type_id: str, etype: ElementType | None) -> dict:
     """Name, paper class, VTK cell and size of a type: from the shipped catalogue, else from the type itself."""

@@ -274,8 +274,11 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
             n_nodes.append(np.full(len(leaves), len(element.nodes), dtype=np.int64))
     if cells is not None and len(cells):
         # a cell is a row of pattern -1 whose "leaf" is its index among the cells
+        fresh = np.flatnonzero(~cells.proven)
+        fresh = fresh[np.argsort(cells.shape[fresh], kind="stable")]
+        starts = np.searchsorted(cells.shape[fresh], np.arange(len(cells.shapes) + 1))
         for s, shape in enumerate(cells.shapes):
-            rows = np.flatnonzero((cells.shape == s) & ~cells.proven)
+            rows = fresh[starts[s]:starts[s + 1]]
             centre = (cells.anchor[rows] + np.array([float(x) for x in shape.center])[None]) * scale
             first = points[cells.nodes[rows, 0]]
             rows_pattern.append(np.full(len(rows), -1, dtype=np.int32))
