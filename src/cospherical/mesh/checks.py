@@ -99,7 +99,10 @@ def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -
         faces = np.concatenate(parts)
         del parts
         start = np.argmin(faces, axis=1)
-        turned = np.take_along_axis(faces, (start[:, None] + np.arange(size)[None]) % size, axis=1)
+        # column by column (np.choose), not through a (faces x size) int64 index: a fraction of the memory
+        turned = np.empty_like(faces)
+        for column in range(size):
+            turned[:, column] = np.choose((start + column) % size, faces.T)
         flipped = turned[:, 1] > turned[:, -1]
         turned[flipped, 1:] = turned[flipped, :0:-1]
         turned, flipped, ok, pairs, single = _paired(turned, flipped)
@@ -176,9 +179,10 @@ def _row_order(rows: np.ndarray, bits: int) -> np.ndarray:
     per_key = max(1, 63 // bits)
     keys = []
     for first in range(0, rows.shape[1], per_key):
-        key = np.zeros(len(rows), dtype=np.int64)
-        for column in range(first, min(first + per_key, rows.shape[1])):
-            key = (key << bits) | rows[:, column]
+        key = rows[:, first].astype(np.int64)
+        for column in range(first + 1, min(first + per_key, rows.shape[1])):
+            key <<= bits
+            key |= rows[:, column]
         keys.append(key)
     return np.argsort(keys[0], kind="stable") if len(keys) == 1 else np.lexsort(keys[::-1])
 
