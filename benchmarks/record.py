@@ -64,10 +64,11 @@ def _process_seconds() -> float | None:
 
 
 def _commit() -> str | None:
-    """The checkout's commit, ``+changes`` when tracked files differ from it (a local commit may be rebased later)."""
+    """The checkout's commit, ``+changes`` when the measured code (``src/``, ``benchmarks/``, ``examples/``)
+    differs from it; other files, such as the records themselves, do not count (a local commit may be rebased later)."""
     result = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=ROOT, capture_output=True, text=True)
-    changed = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
-                             capture_output=True, text=True).stdout.strip()
+    changed = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", "src", "benchmarks",
+                              "examples"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     return (result.stdout.strip() + ("+changes" if changed else "")) or None
 
 
