@@ -246,14 +246,21 @@ class _Triangulation:
         cavity = {start}
         stack = [start]
         boundary: list[tuple[int, int]] = []
-        neighbours = self.neighbours
+        neighbours, spheres = self.neighbours, self.spheres
+        x, y, z, w = self.frame.lifted[p]
         while stack:
             t = stack.pop()
             for k in range(4):
                 u = neighbours[t][k]
                 if u in cavity:
                     continue
-                if self._conflict(u, p):
+                sphere = spheres[u]  # the finite tetrahedra's in-sphere test, inlined: the innermost loop
+                if sphere is not None:
+                    a, b, c, d, offset = sphere
+                    conflict = a * x + b * y + c * z + d * w < offset
+                else:
+                    conflict = self._conflict(u, p)
+                if conflict:
                     cavity.add(u)
                     stack.append(u)
                 else:

@@ -56,7 +56,7 @@ such flips; a triangulation of the hull without one is Delaunay).  Where Qhull
 fails (boxes of extreme aspect ratio, 1e-12 x 1 x 3e9, whose first simplex is flat
 in floats) or the check does, the exact engine
 (:mod:`cospherical.core.incremental_delaunay`, Bowyer-Watson in Python integers,
-about 3.7 times Qhull's path's CPU) tetrahedralises V_r instead.  The whole mesh is then
+about 3.6 times Qhull's path's CPU) tetrahedralises V_r instead.  The whole mesh is then
 checked again by the report (volume, conformity, and empty spheres and ties of
 every cell not proven before), so a wrong proposal cannot pass unseen.  Cube octrees, whose leaf mesh is already
 globally Delaunay, have no region: the mesh is returned as it is.
