@@ -62,3 +62,21 @@ def test_ruff_reports_an_undefined_name(tmp_path):
                             cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert result.returncode == 1
     assert "wrong.py:2:12: F821" in result.stdout
+
+
+def test_every_cache_is_bounded_and_declared_in_one_place():
+    # cospherical.caches.cached is the one way to memoise: a bare functools cache elsewhere
+    # would grow without bound in a long process and be missing from caches()/clear_caches().
+    import re
+
+    import pytest
+
+    from cospherical.caches import cached
+
+    bare = re.compile(r"\blru_cache\b|\bfunctools\.cache\b|^@cache\b", re.M)
+    offenders = [str(path.relative_to(ROOT)) for path in sorted((ROOT / "src").rglob("*.py"))
+                 if path.name != "caches.py" and bare.search(path.read_text())]
+    assert offenders == []
+    for size in (None, 0, True):
+        with pytest.raises(ValueError, match="bounded"):
+            cached(size)

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass, replace
-from functools import lru_cache
 from typing import Sequence
 
+from ..caches import cached
 from ..core.geometry import Frame
 from ..core.split import CRITERIA, SPLIT_CRITERIA, subdivisions
 from ..core.tessellation import Element, Tessellation
@@ -36,7 +36,7 @@ def element_options(tess: Tessellation, element: Element, criterion: str) -> tup
 
 
 # The same element (same node ids at the same places) recurs across configurations.
-@lru_cache(maxsize=1 << 14)
+@cached(maxsize=1 << 14)
 def split_options(points, squared, poly, criterion) -> tuple[tuple[Element, ...], ...]:
     """Every split of the polyhedron ``poly`` with ``points`` ((node, unit coordinates) pairs)
     under a criterion, the element itself first, pieces classified."""

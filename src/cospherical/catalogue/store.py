@@ -12,10 +12,10 @@ what comparisons with the paper use.
 
 from __future__ import annotations
 
-from functools import lru_cache
 from pathlib import Path
 from typing import Iterable
 
+from ..caches import cached
 from ..core.element_types import ElementType, systematic_name
 from ..files.data import data_path
 from ..files.flowyaml import decode_entry, split_section
@@ -33,7 +33,7 @@ def catalogue_path() -> Path:
     return data_path("catalogue.yaml")
 
 
-@lru_cache(maxsize=1)  # the shipped file does not change while a process runs
+@cached(maxsize=1)  # the shipped file does not change while a process runs
 def shipped_catalogue() -> dict:
     """The shipped catalogue, read and validated once per process (empty if there is none).
 
@@ -51,7 +51,7 @@ def shipped_catalogue() -> dict:
     return load_catalogue(path)
 
 
-@lru_cache(maxsize=1)
+@cached(maxsize=1)
 def _shipped_names() -> dict[str, str]:
     return catalogue_names(shipped_catalogue())
 

@@ -19,9 +19,10 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property, lru_cache
+from functools import cached_property
 from typing import Sequence
 
+from ..caches import cached
 from .configuration import EDGES, BaseConfiguration, Box, Configuration
 from .shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape
 from .symmetry import (
@@ -77,7 +78,7 @@ class BaseElement:
         """The Delaunay tessellation of one of this element's configurations."""
         return tessellate(configuration)
 
-@lru_cache(maxsize=64)  # a study maps every member's configuration through it
+@cached(maxsize=64)  # a study maps every member's configuration through it
 def base_element(name: str, box: Box, face_points: str = "octree") -> BaseElement:
     """The :class:`BaseElement` named ``name`` in ``box`` (one object per element, box and policy)."""
     element = BaseElement(name, box, face_points)

@@ -15,8 +15,9 @@ is the type's reference vertex order.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Sequence
+
+from ..caches import cached
 
 __all__ = ["CanonicalForm", "canonical_form", "KIND_LETTERS"]
 
@@ -75,7 +76,7 @@ def canonical_form(faces: Sequence[Sequence[int]], kinds: Sequence[str]) -> Cano
 
 # The same cell (same node ids, same faces) recurs across the configurations of
 # a study, so the pure function is memoised on its exact input.
-@lru_cache(maxsize=1 << 16)
+@cached(maxsize=1 << 16)
 def _canonical_form(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]) -> CanonicalForm:
     # For a face (..., u, v, w, ...) the next neighbour of v after w, turning
     # counter-clockwise seen from outside, is u; that face lies left of v->w.

@@ -19,11 +19,11 @@ index, exactly as :func:`cospherical.delaunay.hull_faces` orders them.
 
 from __future__ import annotations
 
-from functools import lru_cache
 
 import numpy as np
 from numba import njit
 
+from ..caches import cached
 from .configuration import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
 
 __all__ = ["cube_batch", "fits", "orbit_keys", "walk"]
@@ -311,7 +311,7 @@ def buffers(points: int):
 # cell what the statistics need.
 
 
-@lru_cache(maxsize=None)  # built once per process, shared by every chunk
+@cached(maxsize=1)  # built once per process, shared by every chunk
 def cube_tables():
     """Point tables of the cube in 16ths: corner coordinates, edge start corners and axes, faces' edge pairs."""
     corners = np.array(CORNERS, dtype=np.int64) * 16

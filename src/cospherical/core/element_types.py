@@ -5,8 +5,8 @@ from __future__ import annotations
 import hashlib
 from collections import Counter
 from dataclasses import dataclass, replace
-from functools import lru_cache
 
+from ..caches import cached
 from .canonical import canonical_form
 from .polyhedron import Polyhedron
 
@@ -177,7 +177,7 @@ def classify_faces(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]):
 
 
 # A study meets the same cell (same node ids and faces) in many configurations.
-@lru_cache(maxsize=1 << 16)
+@cached(maxsize=1 << 16)
 def _classify(faces, kinds) -> tuple[ElementType, tuple[int, ...], bool]:
     # The classification only compares node ids, never reads their values, so
     # it is computed on the ids' ranks and mapped back: cells with other ids in
@@ -190,7 +190,7 @@ def _classify(faces, kinds) -> tuple[ElementType, tuple[int, ...], bool]:
     return etype, tuple(ids[i] for i in order), mirrored
 
 
-@lru_cache(maxsize=1 << 16)
+@cached(maxsize=1 << 16)
 def _classify_ranks(faces, kinds) -> tuple[ElementType, tuple[int, ...], bool]:
     form = canonical_form(faces, kinds)
     etype = element_type(form.code, faces, kinds)

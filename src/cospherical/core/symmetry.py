@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass, field
 from fractions import Fraction
-from functools import cached_property, lru_cache
+from functools import cached_property
 from itertools import combinations, permutations, product
 from operator import itemgetter
 from typing import TYPE_CHECKING, Sequence
@@ -22,6 +22,7 @@ if TYPE_CHECKING:
 # configuration maps polyhedra with these symmetries and needs no numpy (its
 # import is a third of a command's start-up).
 
+from ..caches import cached
 from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, point_suffix
 from .configuration import BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis
 from .geometry import cross, dot, sub, tetra_six_volume
@@ -135,7 +136,7 @@ def _mask_suffix(mask: int) -> str:
     return point_suffix((f for f in range(6) if mask >> f & 1), bool(mask & _BODY_BIT))
 
 
-@lru_cache(maxsize=None)  # shared by the node maps of all symmetries
+@cached(maxsize=1)  # shared by the node maps of all symmetries
 def _positions() -> dict[tuple[Fraction, ...], int]:
     half = Fraction(1, 2)
     positions = {tuple(map(Fraction, c)): i for i, c in enumerate(CORNERS)}
@@ -147,14 +148,14 @@ def _positions() -> dict[tuple[Fraction, ...], int]:
     return positions
 
 
-@lru_cache(maxsize=None)
+@cached(maxsize=64)
 def _node_map(sym: Symmetry) -> tuple[int, ...]:
     positions = _positions()
     image = {node: positions[sym.point(p)] for p, node in positions.items()}
     return tuple(image[i] for i in range(27))
 
 
-@lru_cache(maxsize=None)
+@cached(maxsize=64)
 def _edge_map(sym: Symmetry) -> tuple[tuple[int, bool], ...]:
     result = []
     for k in range(12):
@@ -280,7 +281,7 @@ class _Group:
     inverse: tuple[int, ...]
 
 
-@lru_cache(maxsize=None)
+@cached(maxsize=16)
 def _group(symmetries: tuple[Symmetry, ...]) -> _Group | None:
     """The tables of :class:`_Group`; ``None`` unless the symmetries form a group
     (those of a box always do)."""
@@ -423,7 +424,7 @@ def _affine(sources: Sequence[Point], targets: Sequence[Point]):
     return linear, shift
 
 
-@lru_cache(maxsize=64)  # a study maps every member through its shape's symmetries
+@cached(maxsize=64)  # a study maps every member through its shape's symmetries
 def shape_symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
     """The isometries of the scaled shape, identity first (see :class:`ShapeSymmetry`).
 

@@ -7,11 +7,11 @@ import json
 import os
 import re
 import stat
-from functools import lru_cache
 from pathlib import Path
 
 import yaml
 
+from ..caches import cached
 from ..errors import FormatError
 from .data import data_path
 from .outputs import atomic_open, atomic_path, atomic_write
@@ -214,7 +214,7 @@ def parse_yaml(text: str, name: str):
     return data
 
 
-@lru_cache(maxsize=None)
+@cached(maxsize=16)
 def _validator(name: str):
     # fastjsonschema compiles the schema to Python: a 4096-configuration pattern
     # table validates in a fraction of a second instead of seconds.

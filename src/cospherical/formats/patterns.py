@@ -19,10 +19,10 @@ import json
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Callable, Iterable, Protocol
 
+from ..caches import cached
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..core.tessellation import Tessellation, element_entry
@@ -201,7 +201,7 @@ class Entries(Mapping):
         return len(self._texts)
 
 
-@lru_cache(maxsize=None)
+@cached(maxsize=1)
 def _code_syntax() -> re.Pattern:
     """The schema's pattern of configuration codes (its one home), to match whole."""
     schema = json.loads(data_path("schemas/patterns.schema.json").read_text(encoding="utf-8"))

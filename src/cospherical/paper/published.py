@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from functools import lru_cache
 
+from ..caches import cached
 from ..core.element_types import ElementType
 from ..files.data import data_path
 from ..files.yamlio import load_yaml
@@ -11,7 +11,7 @@ from ..files.yamlio import load_yaml
 __all__ = ["paper_class", "paper_classes", "paper_notes", "paper_studies"]
 
 
-@lru_cache(maxsize=None)
+@cached(maxsize=1)
 def _data() -> dict:
     return load_yaml(data_path("paper.yaml"))  # the package's reader: the C parser, 5x faster than yaml.safe_load
 

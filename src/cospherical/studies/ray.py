@@ -17,9 +17,9 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 from fractions import Fraction
-from functools import lru_cache
 from itertools import combinations
 
+from ..caches import cached
 from ..core.configuration import Box, Configuration
 from ..core.exact import Length
 from ..core.geometry import Frame
@@ -125,7 +125,7 @@ def _state_at(code: str, ray: Ray, u: Fraction) -> tuple:
     return tess.fvm_adequate, frozenset(e.type.id for e in tess.elements)
 
 
-@lru_cache(maxsize=None)
+@cached(maxsize=1 << 14)
 def code_pieces(code: str, ray: Ray, u_lo: Fraction, u_hi: Fraction) -> tuple:
     """The configuration's state on [u_lo, u_hi] as pieces ``(u_from, u_to, state)``.
 

@@ -19,12 +19,12 @@ import io
 import json
 import re
 from dataclasses import asdict, dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
+from ...caches import cached
 from ...catalogue import option_types, split_options
 from ...core.configuration import Configuration
 from ...core.delaunay import delaunay_cells
@@ -62,7 +62,7 @@ class ElementEntry:
         return cls(data["type"], {c: tuple(map(tuple, o)) for c, o in data["options"].items()})
 
 
-@lru_cache(maxsize=None)
+@cached(maxsize=1)
 def _cube_tables():
     # The compiled kernel (numba) is imported only where bulk work needs it: the
     # command line starts without it.
