@@ -85,10 +85,10 @@ def morton_pieces(tree: Octree, pieces: int) -> list[np.ndarray]:
 class Piece:
     """One task: a piece's leaves, what it needs of the whole tree, and where it writes.
 
-    ``leaves`` are the piece's leaf indices in the whole tree; ``grid`` and ``keys``
-    the whole tree's vertex grid; ``lookup``: ``(factory, arguments)`` that make the
-    pattern lookup in the worker (a closure does not travel); ``write(mesh, path,
-    leaves)`` writes the piece (a module-level function) to ``path``.  ``cells`` (their
+    ``leaves`` are the piece's leaf indices in the whole tree; ``grid`` the whole
+    tree's vertex grid; ``write(mesh, path, leaves)`` writes the piece (a module-level
+    function) to ``path``.  What every piece shares, the vertex keys and the lookup,
+    travels beside it (see :func:`mesh_piece`).  ``cells`` (their
     ``leaf`` indexing the piece's leaves), ``replaced`` (a mask over them) and
     ``types`` come with the second round of ``global`` mode.
     """
@@ -99,8 +99,6 @@ class Piece:
     positions: np.ndarray
     leaves: np.ndarray
     grid: int
-    keys: np.ndarray
-    lookup: tuple | None
     criterion: str
     mode: str
     delaunay: bool
@@ -111,8 +109,12 @@ class Piece:
     types: dict | None = None
 
 
-def mesh_piece(piece: Piece) -> dict:
+def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None) -> dict:
     """Mesh, check and write one piece (run in a worker); see the module for why it equals its part of the whole.
+
+    ``keys``: the whole tree's vertex keys; ``lookup``: ``(factory, arguments)`` that make
+    the pattern lookup in the worker (a closure does not travel), or ``None``.  Both are
+    the same for every piece: on Dask they reach each worker once.
 
     Returns ``index``; in the first round of ``global`` mode, ``leaf_mesh`` (what the
     exact check found on the piece's leaf mesh) and, if some of its elements are not
@@ -121,8 +123,8 @@ def mesh_piece(piece: Piece) -> dict:
     and ``seams`` (the faces it leaves open).
     """
     tree = Octree(piece.box, piece.levels, piece.positions)
-    lookup = piece.lookup[0](*piece.lookup[1]) if piece.lookup is not None else None
-    mesh = assemble(tree, lookup, criterion=piece.criterion, vertices=(piece.grid, piece.keys))
+    mesh = assemble(tree, lookup[0](*lookup[1]) if lookup is not None else None, criterion=piece.criterion,
+                    vertices=(piece.grid, keys))
     result: dict = {"index": piece.index}
     checked = None
     if piece.cells is not None:
@@ -162,10 +164,11 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
 
     def task(k: int, **more) -> tuple:
         leaves = parts[k]
-        return (Piece(k, tree.box, tree.levels[leaves], tree.positions[leaves], leaves, grid, keys, lookup,
-                      criterion, mode, delaunay, write, path(k) if path is not None else None, **more),)
+        return (Piece(k, tree.box, tree.levels[leaves], tree.positions[leaves], leaves, grid, criterion, mode,
+                      delaunay, write, path(k) if path is not None else None, **more),)
 
-    results = dict(completed(mesh_piece, {k: task(k) for k in range(pieces)}, jobs, scheduler, dask_workers))
+    results = dict(completed(mesh_piece, {k: task(k) for k in range(pieces)}, jobs, scheduler, dask_workers,
+                             common=(keys, lookup)))
     leaf_mesh = None
     regions = (0, 0)
     if mode == "global":
@@ -178,7 +181,7 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
             failing = tuple(np.concatenate([f[i] for f in failing]) for i in range(2))
             again, regions = _cells_by_piece(tree, parts, marked, failing, grid, keys, lookup, criterion)
             results.update(completed(mesh_piece, {k: task(k, **more) for k, more in again.items()}, jobs,
-                                     scheduler, dask_workers))
+                                     scheduler, dask_workers, common=(keys, lookup)))
     seams = [seam for k in range(pieces) for seam in results[k]["seams"]]
     n = np.int64(grid + 1)
 

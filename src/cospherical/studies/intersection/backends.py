@@ -38,7 +38,7 @@ def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, ti
 
 
 def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, scheduler: str | None = None,
-              dask_workers: int | None = None) -> Iterator[tuple[Hashable, Any]]:
+              dask_workers: int | None = None, common: tuple = ()) -> Iterator[tuple[Hashable, Any]]:
     """Yield ``(key, function(*args))`` for every task, in the order they finish, on the chosen backend.
 
     Parameters
@@ -53,6 +53,9 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
         The address of a running Dask scheduler (``tcp://SCHEDULER:8786``).
     dask_workers : int, optional
         Start a local Dask cluster of that many processes instead.
+    common : tuple
+        Arguments after each task's own, the same for every call: on Dask they are sent
+        to the workers once (scattered), not once per task in the task graph.
 
     Examples
     --------
@@ -60,17 +63,17 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
     [('a', 8), ('b', 9)]
     """
     if scheduler or dask_workers:
-        yield from _dask_completed(function, tasks, scheduler, dask_workers)
+        yield from _dask_completed(function, tasks, scheduler, dask_workers, common)
     elif jobs <= 1:
         for key, args in tasks.items():
-            yield key, function(*args)
+            yield key, function(*args, *common)
     else:
         from concurrent.futures import FIRST_COMPLETED, wait
 
         from ..pool import process_pool
 
         with process_pool(jobs) as pool:  # left by an error, Ctrl-C or SIGTERM: the workers are stopped at once
-            pending = {pool.submit(function, *args): key for key, args in tasks.items()}
+            pending = {pool.submit(function, *args, *common): key for key, args in tasks.items()}
             while pending:
                 # not as_completed, which keeps every future, and so every result, to the end
                 done, _ = wait(pending, return_when=FIRST_COMPLETED)
@@ -79,7 +82,7 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
 
 
 def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler: str | None,
-                    dask_workers: int | None) -> Iterator[tuple[Hashable, Any]]:
+                    dask_workers: int | None, common: tuple = ()) -> Iterator[tuple[Hashable, Any]]:
     """:func:`completed` on Dask: a running scheduler, or a local cluster whose scratch space
     (its lock files included) is a private temporary folder, removed at the end however the run ends."""
     import logging
@@ -121,7 +124,8 @@ def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler:
             raise InputError(f"Dask scheduler {scheduler}: cannot connect: "
                              f"{str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
         register_stop(id(client), lambda: (_kill_workers(cluster), _close_dask(client, cluster)))
-        futures = {client.submit(function, *args, pure=False): key for key, args in tasks.items()}
+        shared = client.scatter(list(common), broadcast=True) if common else []
+        futures = {client.submit(function, *args, *shared, pure=False): key for key, args in tasks.items()}
         for future in as_completed(futures):
             # dropped once yielded: a finished future keeps its result (chunks of a
             # pattern table hold megabytes each)
