@@ -1,4 +1,4 @@
-"""Hostile input, hostile file systems and hostile signals, through the real CLI (issue 18).
+"""Hostile input, hostile file systems and hostile signals, through the real CLI.
 
 Every refusal is exit 2 with exactly one line on stderr and no traceback; no
 file appears outside the output folder, and no special file is replaced.

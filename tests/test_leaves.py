@@ -1,4 +1,4 @@
-"""Face points as data, the whole-point-set code, and the octree-leaf family (issue 13)."""
+"""Face points as data, the whole-point-set code, and the octree-leaf family."""
 
 from __future__ import annotations
 

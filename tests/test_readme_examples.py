@@ -1,4 +1,4 @@
-"""Every shell example of the README runs as written (issue 18).
+"""Every shell example of the README runs as written.
 
 Heavy examples run at a small size, in a scratch clone of the repository (the
 machinery, shared with the docs site's examples, is ``examples.py``). Lines not run

@@ -1,6 +1,6 @@
 """Compiled kernels (numba), exact int64: the Delaunay walk, the cube at 1/16 in bulk, orbit keys.
 
-The Delaunay walk is the one of :mod:`cospherical.delaunay`, compiled.
+The Delaunay walk is the one of :mod:`cospherical.core.delaunay`, compiled.
 
 Same algorithm, same integer predicates, step for step: a first empty sphere
 through the lexicographically smallest point, then from cell to cell across
@@ -14,7 +14,7 @@ walk, which gives the same cells.
 
 Cells come out as bit masks over frame indices (at most 62 points), faces as
 index cycles counter-clockwise seen from outside, starting at their smallest
-index, exactly as :func:`cospherical.delaunay.hull_faces` orders them.
+index, exactly as :func:`cospherical.core.delaunay.hull_faces` orders them.
 """
 
 from __future__ import annotations

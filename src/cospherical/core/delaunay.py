@@ -6,7 +6,7 @@ pencil of spheres through the circle pqr; on the far side of the face those
 spheres' caps are nested, so one scan for the point whose sphere contains no
 other far-side point finds it.  The neighbour is then every point on that
 sphere.  A face with no point beyond it lies on the convex hull.  All tests are
-integer determinants (:mod:`cospherical.geometry`), so co-spherical points
+integer determinants (:mod:`cospherical.core.geometry`), so co-spherical points
 always end up in one cell, whatever the box or Steiner positions.
 """
 

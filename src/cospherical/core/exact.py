@@ -2,7 +2,7 @@
 
 Box lengths are square roots of positive rationals, which covers integers,
 decimals (``1.4142`` is the rational 7071/5000), fractions and ``sqrt(2)``.
-Only squared lengths ever enter a predicate (see :mod:`cospherical.geometry`),
+Only squared lengths ever enter a predicate (see :mod:`cospherical.core.geometry`),
 so every decision stays in rational arithmetic.
 """
 

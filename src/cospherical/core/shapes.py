@@ -269,7 +269,7 @@ def _oriented_face(corners, cycle, f, name):
 
 
 def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
-    """One of the issue's standard shapes in a box A x B x C.
+    """One of the standard shapes (VTK wedge, pyramid, tetra) in a box A x B x C.
 
     ``prism``: the right triangular prism (0,0,0) (A,0,0) (0,B,0) (0,0,C) (A,0,C) (0,B,C),
     half a box; ``pyramid``: the square pyramid on the box's bottom face with its

@@ -12,7 +12,7 @@ one of its boundary faces.  Two criteria:
 
 The vertices of an element are co-spherical, so every piece is again a
 Delaunay element with the same circumsphere.  The search grows a subdivision
-face to face from the first boundary face, as :mod:`cospherical.delaunay` does:
+face to face from the first boundary face, as :mod:`cospherical.core.delaunay` does:
 the piece across an open face is the hull of the face and of some vertices
 beyond it.  Each subdivision is found exactly once; it is complete when no
 face is open and the pieces' volumes add up to the element's (a closed

@@ -62,7 +62,7 @@ def check_unique(data: dict, name: str) -> None:
 
 
 def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True) -> None:
-    """Check a loaded :class:`~cospherical.patterns.PatternTable` against the catalogue and geometry."""
+    """Check a loaded :class:`~cospherical.formats.patterns.PatternTable` against the catalogue and geometry."""
     types = {t["id"]: t for t in catalogue["types"]} if catalogue else None
     header = table.header
     try:

@@ -8,7 +8,7 @@ Where a criterion gives the same elements as an earlier one, the entry is that
 criterion's name (``internal_faces: optimal``) instead of a copy.
 A mesh generator looks a configuration up like this::
 
-    table = cospherical.patterns.load("patterns/bisection-1x1x1.yaml")
+    table = cospherical.load_patterns("patterns/bisection-1x1x1.yaml")
     for element in table.elements("800000000000"):
         print(element["type"], element["nodes"])
 """

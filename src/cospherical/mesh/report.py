@@ -79,7 +79,7 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
         figures["_violating"] = found.pop("_elements")
         found.pop("_not_cells")
         figures.update(found)
-        # the point: a leaf can be fvm_adequate on its own and still not globally Delaunay
+        # the point of counting them: a leaf can be fvm_adequate on its own and still not globally Delaunay
         fvm = np.array([p.fvm_adequate for p in mesh.patterns], dtype=bool)[mesh.leaf_pattern[bad_leaves]]
         figures["delaunay_violating_fvm_leaves"] = int(fvm.sum())
     start("statistics")
