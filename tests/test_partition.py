@@ -148,11 +148,33 @@ def test_a_full_disk_leaves_no_piece(tmp_path):
     assert sorted(p.name for p in out.iterdir()) == ["mesh.pvtu"] and (out / "mesh.pvtu").read_text() == "an older run's"
 
 
+def _start(out: Path, *more: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "cospherical", "mesh", "--domain", "1", "1", "1", "--levels", "6",
+                             "--refine", "sphere:0.5,0.5,0.5,0.3", "--partitions", "2", "--out", str(out), *more],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+
+def test_a_kill_after_a_piece_is_written_leaves_none_in_place(tmp_path, capsys):
+    """SIGKILL once the first piece is written (the pieces one after another): nothing in the folder but the
+    run's hidden staging folder, which the next run removes."""
+    out = tmp_path / "out"
+    process = _start(out, "--jobs", "1")
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and process.poll() is None:
+        if list(out.glob(".cospherical-staging.*/mesh-0.vtu")):
+            break
+        time.sleep(0.02)
+    assert process.poll() is None, "the run ended before it was killed"
+    process.kill()
+    process.communicate(timeout=60)
+    assert [p.name for p in out.iterdir() if not p.name.startswith(".cospherical-staging.")] == []
+    assert main(["mesh", *BRICK, "--out", str(out), "--partitions", "2", "--jobs", "1"]) == 0
+    assert not list(out.glob(".cospherical-staging.*"))
+
+
 def test_sigterm_stops_the_workers_and_leaves_nothing(tmp_path):
     out = tmp_path / "out"
-    process = subprocess.Popen([sys.executable, "-m", "cospherical", "mesh", "--domain", "1", "1", "1", "--levels", "6",
-                                "--refine", "sphere:0.5,0.5,0.5,0.3", "--partitions", "2", "--out", str(out)],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    process = _start(out)
     deadline = time.monotonic() + 60
     workers: list[int] = []
     while time.monotonic() < deadline and len(workers) < 2 and process.poll() is None:
