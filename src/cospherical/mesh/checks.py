@@ -152,7 +152,12 @@ def match_seams(seams: list, vertices, grid: int, examples: int = 5) -> dict:
     occurrences in the pieces.  A face a piece meets once off the boundary is sent
     here; a conforming whole meets it exactly once more, in another piece, in the
     opposite orientation, so it pairs here.  Every occurrence that does not pair is
-    nonconforming.  ``vertices(ids)`` gives grid points (for the examples).
+    nonconforming.  So the counts are the whole mesh's for every face met at most
+    twice in all.  A face met more often has two elements on one side of it, which
+    overlap: then either the exact volume sum exceeds the domain's, or some of the
+    domain is left uncovered, and a face of an element bordering that gap is met
+    only from one side, unpaired here or in its piece.  Either way a check fails, as
+    in one process.  ``vertices(ids)`` gives grid points (for the examples).
 
     Returns ``interior_faces`` (pairs across seams), ``nonconforming_faces`` and
     ``nonconforming_examples``.
