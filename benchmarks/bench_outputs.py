@@ -157,7 +157,7 @@ def _write_standard(vtu: Path, path: Path) -> int:
     cells = grid.GetCells()
     offsets = vtk_to_numpy(cells.GetOffsetsArray())
     connectivity = vtk_to_numpy(cells.GetConnectivityArray())
-    types = vtk_to_numpy(grid.GetCellTypesArray())
+    types = vtk_to_numpy(grid.GetCellTypes())
     keep = types != VTK_CELL["polyhedron"]
     sizes = np.diff(offsets)
     write_grid(path, vtk_to_numpy(grid.GetPoints().GetData()), types[keep], connectivity[np.repeat(keep, sizes)],
@@ -167,12 +167,13 @@ def _write_standard(vtu: Path, path: Path) -> int:
 
 def _stages(command: list[str]) -> str:
     """The command's own stage timings (it prints them on a terminal), made CPU seconds of the process."""
-    program = ("import sys, time; import cospherical.cli.mesh as m; m.time.perf_counter = time.process_time; "
-               "sys.stderr.isatty = lambda: True; from cospherical.cli import main; sys.argv = sys.argv[1:]; "
-               "sys.exit(main())")
+    program = ("import contextlib, sys, time; import cospherical.cli.mesh as m; "
+               "m.time.perf_counter = time.process_time; sys.stderr.isatty = lambda: True; "
+               "m.stage_bars = lambda bars: contextlib.nullcontext(lambda *a: None); "  # no bars: not a terminal
+               "from cospherical.cli import main; sys.argv = sys.argv[1:]; sys.exit(main())")
     result = subprocess.run([sys.executable, "-c", program, *command], capture_output=True, text=True, check=False)
-    line = next((x for x in result.stderr.splitlines() if x.startswith("cospherical mesh: seconds ")), "")
-    return line.removeprefix("cospherical mesh: seconds ") or f"not shown (exit {result.returncode})"
+    line = next((x for x in result.stderr.splitlines() if "cospherical mesh: seconds " in x), "")
+    return line.partition("cospherical mesh: seconds ")[2] or f"not shown (exit {result.returncode})"
 
 
 def _write_node(vtu: Path, node: Path) -> None:
