@@ -26,8 +26,7 @@ from ..caches import cached
 from .configuration import EDGES, BaseConfiguration, Box, Configuration
 from .shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape
 from .symmetry import (
-    ShapeSymmetry,
-    Symmetry,
+    BaseSymmetry,
     box_symmetries,
     orbit_representatives,
     shape_symmetries,
@@ -65,7 +64,7 @@ class BaseElement:
         return ShapeConfiguration.from_code(self.shape, code, self.face_points)
 
     @cached_property
-    def symmetries(self) -> tuple[Symmetry, ...] | tuple[ShapeSymmetry, ...]:
+    def symmetries(self) -> tuple[BaseSymmetry, ...]:
         """The isometries of the element in its box, identity first."""
         return box_symmetries(self.box) if self.shape is None else shape_symmetries(self.shape)
 

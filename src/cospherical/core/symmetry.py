@@ -29,13 +29,28 @@ from .geometry import cross, dot, sub, tetra_six_volume
 from .polyhedron import Polyhedron
 from .shapes import Point, Shape
 
-__all__ = ["ShapeSymmetry", "Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
+__all__ = ["BaseSymmetry", "ShapeSymmetry", "Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
            "orbit_point_keys", "orbit_representatives", "shape_orbit_representatives", "shape_symmetries"]
 
 
+class BaseSymmetry:
+    """What every isometry of a base element is, a box's (:class:`Symmetry`) or another shape's
+    (:class:`ShapeSymmetry`).
+
+    It has ``proper`` (keeps orientation), ``point(p)`` (its action on unit
+    coordinates), ``node_map`` (node id -> image), ``edge_map`` (per edge: the
+    image edge and whether t becomes 1 - t), ``code(code)`` (the image of a
+    configuration code) and ``inverse()``; studies and tables use nothing else.
+    """
+
+    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
+        """The image of a polyhedron, faces normalised as the Delaunay stage writes them."""
+        return map_polyhedron(poly, self.node_map, self.proper, self.point)
+
+
 @dataclass(frozen=True)
-class Symmetry:
-    """``point -> q`` with ``q[i] = p[perm[i]]``, reflected (``1 - x``) where ``flips[i]``."""
+class Symmetry(BaseSymmetry):
+    """A symmetry of a box: ``point -> q`` with ``q[i] = p[perm[i]]``, reflected (``1 - x``) where ``flips[i]``."""
 
     perm: tuple[int, int, int]
     flips: tuple[bool, bool, bool]
@@ -87,10 +102,6 @@ class Symmetry:
             return "".join(digits)
         faces, body = parse_point_suffix(code, suffix)
         return "".join(digits) + "+" + point_suffix({self.face_map[f] for f in faces}, body)
-
-    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
-        """The image of a polyhedron, faces normalised as the Delaunay stage writes them."""
-        return map_polyhedron(poly, self.node_map, self.proper, self.point)
 
     def inverse(self) -> "Symmetry":
         perm = [0, 0, 0]
@@ -230,8 +241,7 @@ def _orbit_keys_numpy(digits, targets, reverse, masks, faces):
     return best, best_mask, best_sym
 
 
-def orbit_representatives(codes: Sequence[str],
-                          symmetries: Sequence[Symmetry] | Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
+def orbit_representatives(codes: Sequence[str], symmetries: Sequence[BaseSymmetry]) -> tuple[list[str], list[int]]:
     """For each code, its orbit's representative (the smallest image code, as a base-16 number)
     and the index of a symmetry taking the code to it.
 
@@ -345,7 +355,7 @@ def _orbit_keys_python(codes, masks, group: _Group):
 
 
 @dataclass(frozen=True)
-class ShapeSymmetry:
+class ShapeSymmetry(BaseSymmetry):
     """An isometry of a shape: a permutation of its corners, acting on nodes, codes and points.
 
     ``corner_map[i]`` is the image of corner i; ``linear`` and ``shift`` the
@@ -401,9 +411,6 @@ class ShapeSymmetry:
         for (target, reverse), digit in zip(self.edge_map, code):
             digits[target] = REVERSED_DIGIT[digit.lower()] if reverse else digit
         return "".join(digits)
-
-    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
-        return map_polyhedron(poly, self.node_map, self.proper, self.point)
 
     def inverse(self) -> "ShapeSymmetry":
         return next(s for s in shape_symmetries(self.shape)
