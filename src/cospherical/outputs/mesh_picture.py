@@ -34,7 +34,12 @@ def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[st
     z0 = round(at * grid) + 1 / 3
     scale = np.array(mesh.box.to_float()) / grid
     polygons, types = [], []
-    for _, nodes, faces, type_id in mesh.blocks():
+    # a leaf's elements lie in its box: only the leaves the plane crosses can hold a section (a cell of
+    # the global Delaunay subdivision may reach beyond its first leaf: cells are always looked at)
+    low = mesh.tree.positions[:, 2].astype(np.int64) * mesh.leaf_size()
+    near = (low < z0) & (low + mesh.leaf_size() > z0)
+    for rows, nodes, faces, type_id in mesh.blocks():
+        nodes = nodes[near[mesh.element_leaf[rows]] | (mesh.element_local[rows] < 0)]
         z = mesh.vertices[nodes, 2]  # (elements, nodes)
         crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
         if not len(crossing):
