@@ -93,6 +93,8 @@ def point_suffix(faces: Iterable[int], body: bool) -> str:
 def mask_code(mask: int, edges: int) -> str:
     """The bisection code with a midpoint (``8``) on the edges whose bit is set in ``mask``.
 
+    Examples
+    --------
     >>> mask_code(0b101, 4)
     '8080'
     """
@@ -102,6 +104,8 @@ def mask_code(mask: int, edges: int) -> str:
 def mask_codes(edges: int) -> list[str]:
     """The bisection codes of an element with ``edges`` edges: a midpoint (``8``) or nothing on each.
 
+    Examples
+    --------
     >>> mask_codes(2)
     ['00', '80', '08', '88']
     """
@@ -111,6 +115,8 @@ def mask_codes(edges: int) -> list[str]:
 def key_code(key: int) -> str:
     """The 12 edge digits whose base-16 number is ``key`` (the intersection study's keys).
 
+    Examples
+    --------
     >>> key_code(0x48)
     '000000000048'
     """

@@ -251,6 +251,8 @@ def orbit_representatives(codes: Sequence[str], symmetries: Sequence[BaseSymmetr
     for a few thousand codes, numpy or the compiled kernel in bulk); under
     another shape's isometries every image of each code is compared.
 
+    Examples
+    --------
     >>> from cospherical.core.shapes import standard_shape
     >>> shape = standard_shape("tetrahedron")
     >>> orbit_representatives(["800000", "008000", "080000"], shape_symmetries(shape))[0]
