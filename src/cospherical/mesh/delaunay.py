@@ -73,7 +73,7 @@ from ..core.geometry import Frame, Sphere, sphere_sides
 from ..core.incremental_delaunay import delaunay_tetrahedra
 from ..core.tessellation import tessellation_elements
 from ..errors import InputError
-from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, _type_info
+from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, _type_info, distinct
 from .checks import _weights, check_delaunay
 
 __all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
@@ -129,7 +129,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     region[elements] = part
     # each region's vertices: unique (region, vertex) pairs, in region order
     valid = nodes >= 0
-    pairs = np.unique(np.repeat(part, nodes.shape[1])[valid.reshape(-1)] * np.int64(len(mesh.vertices))
+    pairs = distinct(np.repeat(part, nodes.shape[1])[valid.reshape(-1)] * np.int64(len(mesh.vertices))
                       + nodes[valid])
     bounds = np.searchsorted(pairs // len(mesh.vertices), np.arange(regions + 1))
     vertices = pairs % len(mesh.vertices)
@@ -143,7 +143,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     tets = tets[_inside(mesh, tets, tet_region, region, located)]
     cell_of_tet = _same_sphere(mesh, tets, _weights(mesh))
     # the other elements of the leaves that give up theirs: cells as they are, proven by the check
-    leaves = np.unique(mesh.element_leaf[elements])
+    leaves = distinct(mesh.element_leaf[elements])
     counts = mesh.element_offsets[leaves + 1] - mesh.element_offsets[leaves]
     given_up = np.repeat(mesh.element_offsets[leaves] - np.r_[0, np.cumsum(counts)[:-1]], counts) \
         + np.arange(int(counts.sum()))
@@ -180,8 +180,10 @@ def _regions(nodes: np.ndarray, vertices: int) -> tuple[np.ndarray, int]:
     graph = coo_matrix((np.ones(int(keep.sum()), dtype=np.int8), (row[keep], n + column[keep])),
                        shape=(n + vertices,) * 2)
     _, label = connected_components(graph, directed=False)
-    _, part = np.unique(label[:n], return_inverse=True)
-    return part.reshape(-1), int(part.max()) + 1
+    used = np.zeros(int(label.max()) + 1, dtype=bool)
+    used[label[:n]] = True
+    part = (np.cumsum(used) - 1)[label[:n]]  # the labels the rows use, numbered in order
+    return part, int(part.max()) + 1
 
 
 class _Locator:
@@ -361,7 +363,7 @@ def _same_sphere(mesh: Mesh, tets: np.ndarray, weights) -> np.ndarray:
 
 def _members(cell_of_tet: np.ndarray, tets: np.ndarray, vertices: int) -> np.ndarray:
     """A cell's vertices are its tetrahedra's: per cell its vertex ids, increasing, padded with -1."""
-    pairs = np.unique(np.repeat(cell_of_tet, 4) * np.int64(vertices) + tets.reshape(-1))
+    pairs = distinct(np.repeat(cell_of_tet, 4) * np.int64(vertices) + tets.reshape(-1))
     cell, vertex = pairs // vertices, pairs % vertices
     counts = np.bincount(cell, minlength=int(cell_of_tet.max()) + 1 if len(cell_of_tet) else 0)
     members = np.full((len(counts), int(counts.max()) if len(counts) else 1), -1, dtype=np.int64)
