@@ -308,14 +308,17 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     # Only vertices in the box around every reach can be within one: the rest are left out of the
     # search (a piece of a partitioned mesh holds all the vertices but searches its surroundings).
     low, high = (centres - reach[:, None]).min(axis=0), (centres + reach[:, None]).max(axis=0)
-    near = np.flatnonzero(((points >= low) & (points <= high)).all(axis=1))
-    tree = cKDTree(points[near] if len(near) < len(points) else points)
-    if len(near) == len(points):
-        near = None
+    lowest, highest = points.min(axis=0), points.max(axis=0)
+    near = None  # every vertex (the whole mesh's check): no mask to build
+    if (low > lowest).any() or (high < highest).any():
+        near = np.flatnonzero(((points >= low) & (points <= high)).all(axis=1))
+        if len(near) == len(points):
+            near = None
+    tree = cKDTree(points if near is None else points[near])
     counts = np.empty(len(centres), dtype=np.int64)
     chunk = 1 << 18
     # the spheres in Morton order: neighbouring queries walk the same branches of the tree (a quarter less CPU)
-    nearby = _morton_order(centres, points.min(axis=0), points.max(axis=0))
+    nearby = _morton_order(centres, lowest, highest)
     for start in range(0, len(centres), chunk):
         part = nearby[start:start + chunk]
         counts[part] = tree.query_ball_point(centres[part], reach[part], return_length=True, workers=workers)
