@@ -421,6 +421,13 @@ def test_bad_and_unreachable_schedulers_are_one_line():
     assert time.monotonic() - start < 30
 
 
+@pytest.mark.parametrize("option", [["--jobs", "100000"], ["--jobs", "-1"], ["--dask-workers", "100000"]])
+def test_worker_counts_are_bounded_before_any_process_starts(capsys, option):
+    # 100,000 local workers: each a Python with numpy; the run went on for minutes before failing
+    refused(capsys, "study", "intersection", "--resolution", "2", *option,
+            needle=f"{option[0]} {option[1]}: must be an integer from 1 to 256")
+
+
 def test_damaged_checkpoints_are_one_line(tmp_path, capsys):
     out = tmp_path / "out"
     args = ["study", "intersection", "--resolution", "2", "--jobs", "1", "--out", out, "--resume", "--chunk-size", "20"]

@@ -125,7 +125,19 @@ def test_same_input_same_bytes(tmp_path, capsys):
 
 
 def test_on_a_local_dask_cluster(brick, tmp_path, capsys):
-    run_pieces(BRICK, tmp_path, "--partitions", "2", "--dask-workers", "2")
+    import socket
+    import warnings
+
+    # the scheduler's HTTP port held by someone else (another cluster): dask moves to a free port
+    # and warned in four lines on stderr, beside the command's one
+    with socket.socket() as held, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            held.bind(("127.0.0.1", 8787))
+        except OSError:
+            pass  # already held, by another process: the same case
+        run_pieces(BRICK, tmp_path, "--partitions", "2", "--dask-workers", "2")
+    assert not [w for w in caught if "already in use" in str(w.message)], [str(w.message) for w in caught]
     assert pieces_read_by_vtk(tmp_path)[0] == brick[1]
 
 
@@ -198,7 +210,14 @@ def test_sigterm_stops_the_workers_and_leaves_nothing(tmp_path):
     (("--partitions", "4096"), "--partitions 4096: from 1 to the tree's 50 leaves"),
     (("--partitions", "2", "--scheduler", "localhost"), "give tcp://HOST:PORT"),
     (("--partitions", "2", "--scheduler", "tcp://127.0.0.1:9", "--scheduler-timeout", "0.5"), "cannot connect"),
-    (("--partitions", "2", "--dask-workers", "0"), "--dask-workers 0: at least 1"),
+    (("--partitions", "2", "--dask-workers", "0"), "--dask-workers 0: must be an integer from 1 to 256"),
+    (("--partitions", "2", "--dask-workers", "100000"), "--dask-workers 100000: must be an integer from 1 to 256"),
+    (("--partitions", "2", "--jobs", "257"), "--jobs '257': must be an integer from 1 to 256"),
+    # dask makes a timedelta of it: inf was a KeyError traceback, 1e308 a connection that never gave up
+    (("--partitions", "2", "--scheduler", "tcp://127.0.0.1:9", "--scheduler-timeout", "inf"),
+     "--scheduler-timeout inf: must be more than 0 seconds and at most 86,400"),
+    (("--partitions", "2", "--scheduler", "tcp://127.0.0.1:9", "--scheduler-timeout", "1e308"),
+     "at most 86,400"),
     (("--scheduler", "tcp://127.0.0.1:9"), "--scheduler runs the pieces of --partitions N"),
     (("--partitions", "2", "--dual"), "--dual needs the whole mesh"),
 ])

@@ -170,7 +170,7 @@ def piece_name(k: int) -> str:
 def _pieces(args) -> int | None:
     """``--partitions`` and its backend, checked before any work; ``None`` without it."""
     from ..mesh.partition import MAX_PARTITIONS
-    from ..studies.intersection.backends import check_backend
+    from ..studies.intersection.backends import MAX_WORKERS, check_backend
 
     pieces = _count(args.partitions, "--partitions", MAX_PARTITIONS)
     backend = [option for option, value in (("--jobs", args.jobs), ("--scheduler", args.scheduler),
@@ -182,7 +182,7 @@ def _pieces(args) -> int | None:
     if args.dual:
         raise InputError("--dual needs the whole mesh in one process: not with --partitions")
     check_backend("cospherical mesh", args.scheduler, args.dask_workers, args.scheduler_timeout)
-    args.jobs = _count(args.jobs, "--jobs", 4096) or min(pieces, os.cpu_count() or 1)
+    args.jobs = _count(args.jobs, "--jobs", MAX_WORKERS) or min(pieces, os.cpu_count() or 1)
     return pieces
 
 

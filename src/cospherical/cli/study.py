@@ -181,12 +181,12 @@ def _intersection(args) -> int:
         raise UsageError("cospherical study: error: --patterns-format is the form of the --patterns table")
     if args.resume and not args.out:
         raise UsageError("cospherical study: error: --resume keeps its checkpoints in --out DIR")
-    check_backend("cospherical study", args.scheduler, args.dask_workers, args.scheduler_timeout)
+    check_backend("cospherical study", args.scheduler, args.dask_workers, args.scheduler_timeout, args.jobs)
     checkpoints = args.out / "checkpoints" if args.out else None
     total = len(set_patterns(args.resolution, args.order)) ** 3  # one pattern per set of parallel edges
     with stage_bars({"cells": (total, f"intersection 1/{args.resolution}: cells", "cfg"),
                      "elements": (None, "distinct elements classified and split", "el")}) as advance:
-        summary = run_intersection(args.resolution, args.order, jobs=max(1, args.jobs),
+        summary = run_intersection(args.resolution, args.order, jobs=args.jobs,
                                    checkpoints=checkpoints if args.resume else None, progress=advance,
                                    chunk=max(1, args.chunk_size), scheduler=args.scheduler,
                                    dask_workers=args.dask_workers, brute_force=args.no_orbits,
@@ -213,7 +213,7 @@ def _intersection(args) -> int:
             with stage_bars({"cells": (summary["orbits"], "pattern table: cells", "cfg"),
                              "elements": (None, "distinct cells written", "el"),
                              "entries": (summary["orbits"], "pattern table: entries", "cfg")}) as advance:
-                run = TableRun(summary, jobs=max(1, args.jobs), progress=advance, scheduler=args.scheduler,
+                run = TableRun(summary, jobs=args.jobs, progress=advance, scheduler=args.scheduler,
                                dask_workers=args.dask_workers)
                 write_pattern_table(run, shipped_catalogue()["version"],
                                     yaml_path=args.out / f"{stem}-patterns.yaml" if form != "store" else None,

@@ -60,7 +60,7 @@ import numpy as np
 
 from ..core.configuration import Box
 from ..errors import FormatError
-from ..files.yamlio import atomic_write
+from ..files.yamlio import atomic_write, parse_json
 from ..mesh.dual import Dual
 
 __all__ = ["DUAL_FORMAT_VERSION", "read_dual", "write_dual"]
@@ -177,9 +177,12 @@ def read_dual(path: str | Path) -> Dual:
 
 def _manifest(raw: np.ndarray, path: Path) -> dict:
     try:
-        manifest = json.loads(raw.astype(np.uint8).tobytes().decode())
+        text = raw.astype(np.uint8).tobytes().decode()
     except (ValueError, UnicodeDecodeError):
         raise FormatError(f"{path}: member manifest: not JSON") from None
+    # the readers' one JSON parser: bounded nesting (100,000 brackets were a RecursionError
+    # traceback), no repeated key, no number of thousands of digits
+    manifest = parse_json(text, f"{path}: member manifest")
     if not isinstance(manifest, dict) or manifest.get("format") != "cospherical-dual":
         raise FormatError(f"{path}: not a cospherical dual (its manifest names no format cospherical-dual)")
     if manifest.get("version") != DUAL_FORMAT_VERSION:

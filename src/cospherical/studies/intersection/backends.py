@@ -10,18 +10,30 @@ from ...errors import InputError, UsageError
 __all__ = ["check_backend", "completed"]
 
 
-def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, timeout: float | None) -> None:
-    """Refuse a bad choice of Dask backend with one line (``prog``: the command, for the message); set the timeout.
+# Local worker processes (--jobs, --dask-workers) at most: each one starts a Python with numpy
+# (a third of a CPU-second and tens of MB), so 100,000 of them ran for minutes before anything
+# was refused; no machine this runs on has more cores than this.
+MAX_WORKERS = 256
+# --scheduler-timeout at most (seconds): dask turns it into a timedelta, which inf or 1e308 is not
+# (inf was a KeyError traceback, 1e308 a run that never ended).
+MAX_TIMEOUT = 86400.0
 
-    ``scheduler`` must look like ``tcp://HOST:PORT``, ``dask_workers`` be at least 1,
-    not both given, and dask.distributed installed.
+
+def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, timeout: float | None,
+                  jobs: int | None = None) -> None:
+    """Refuse a bad choice of backend with one line (``prog``: the command, for the message); set the timeout.
+
+    ``scheduler`` must look like ``tcp://HOST:PORT``, ``dask_workers`` and ``jobs`` be from 1 to
+    :data:`MAX_WORKERS`, not both Dask options given, and dask.distributed installed.
     """
+    import math
     import re
 
     if scheduler and dask_workers:
         raise UsageError(f"{prog}: error: give --scheduler or --dask-workers, not both")
-    if dask_workers is not None and dask_workers < 1:
-        raise UsageError(f"{prog}: error: --dask-workers {dask_workers}: at least 1")
+    for option, count in (("--dask-workers", dask_workers), ("--jobs", jobs)):
+        if count is not None and not 1 <= count <= MAX_WORKERS:
+            raise UsageError(f"{prog}: error: {option} {count}: must be an integer from 1 to {MAX_WORKERS}")
     if scheduler or dask_workers:
         from importlib.util import find_spec
 
@@ -30,8 +42,9 @@ def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, ti
     if scheduler:
         if not re.fullmatch(r"(tcp|tls|ucx)://[A-Za-z0-9._\[\]:-]+", scheduler):
             raise UsageError(f"{prog}: error: --scheduler {scheduler!r}: give tcp://HOST:PORT")
-        if not timeout > 0:
-            raise UsageError(f"{prog}: error: --scheduler-timeout {timeout}: must be > 0")
+        if not (math.isfinite(timeout) and 0 < timeout <= MAX_TIMEOUT):
+            raise UsageError(f"{prog}: error: --scheduler-timeout {timeout}: must be more than 0 seconds and at "
+                             f"most {MAX_TIMEOUT:,.0f}")
         import dask
 
         dask.config.set({"distributed.comm.timeouts.connect": f"{timeout}s"})
@@ -89,6 +102,7 @@ def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler:
     import shutil
     import signal
     import tempfile
+    import warnings
 
     # Imported here: dask is an optional extra, and a heavy import the other backends never need.
     import dask
@@ -114,7 +128,10 @@ def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler:
                 signal.signal(signal.SIGINT, previous)
             settings = {"temporary-directory": scratch,  # the scheduler's scratch space too
                         "distributed.worker.multiprocessing-method": "forkserver"}
-            with dask.config.set(settings), _interrupt_deferred():  # a half-made cluster cannot be closed
+            # warnings ignored: the scheduler's HTTP server, on a port another cluster holds, moves to
+            # a free one and says so in four lines on stderr, where the command promises one line
+            with dask.config.set(settings), _interrupt_deferred(), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
                 cluster = LocalCluster(n_workers=dask_workers, threads_per_worker=1, processes=True,
                                        dashboard_address=None, local_directory=scratch,
                                        silence_logs=logging.CRITICAL)
