@@ -1,5 +1,6 @@
 """The element catalogue: names of the known types, and the paper's criteria (kept sets, splits)."""
 
+from .build import build_catalogue, intersection_examples
 from .criteria import (
                        CRITERIA,
                        SPLIT_CRITERIA,
@@ -18,7 +19,8 @@ from .criteria import (
 from .store import (SCHEMA_VERSION, catalogue_from_text, catalogue_names, catalogue_path, known_name, load_catalogue,
                     shipped_catalogue, type_name, type_names)
 
-__all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "catalogue_from_text", "catalogue_names",
+__all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "build_catalogue",
+           "catalogue_from_text", "catalogue_names", "intersection_examples",
            "catalogue_path",
            "choose", "choose_kept", "element_options", "kept_split", "known_name", "load_catalogue", "minimal_kept_sets",
            "option_types", "shipped_catalogue", "split_options", "split_positions", "split_tessellation", "type_name",

@@ -2,7 +2,7 @@
 
 The catalogue is versioned data (``catalogue/catalogue.yaml``, shipped in the
 wheel as ``cospherical/data/catalogue.yaml``; built from studies by
-:mod:`cospherical.formats.catalogue_file`).  Names follow one rule, applied
+:mod:`cospherical.catalogue.build`).  Names follow one rule, applied
 when the catalogue is built: a type's structural name (tetrahedron, pyramids,
 bipyramids, Triangular Prism, Cuboid) if it has one; else its paper class's name
 when the class is not structural (numbered variants when several types share

@@ -6,12 +6,11 @@ import math
 import sys
 from pathlib import Path
 
-from ..catalogue import shipped_catalogue
+from ..catalogue import build_catalogue, shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..errors import FormatError, InputError, UsageError
 from ..files.yamlio import load_yaml, validate
-from ..formats.catalogue_file import build_catalogue
 from ..outputs.latex import render_tables
 from ..studies.bisection import bisection_codes, run_study
 from ..studies.summary import study_summary

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..catalogue import build_catalogue, intersection_examples
 from ..core.configuration import POINT_POLICIES, Box
 from ..files.outputs import FolderLock
 from ..files.yamlio import atomic_write
-from ..formats.catalogue_file import build_catalogue, intersection_examples, write_catalogue
+from ..formats.catalogue_file import write_catalogue
 from ..formats.patterns import pattern_name, write_patterns
 from ..outputs.latex import element_png, render_tables
 from ..outputs.report import comparison_lines, text_report
