@@ -22,6 +22,7 @@ from fractions import Fraction
 import numpy as np
 
 from .assembly import Mesh
+from .octree import distinct
 
 __all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "match_seams"]
 
@@ -366,7 +367,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
                 - element.sphere.offset * m * m
         sides[i] = (side > 0) - (side < 0)
     inside = sides < 0
-    bad_rows = np.unique(pair_row[inside])
+    bad_rows = distinct(pair_row[inside])
 
     def elements(rows: np.ndarray) -> np.ndarray:
         cell = rows_pattern[rows] < 0
@@ -375,9 +376,9 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
                        ).astype(np.int64)
 
     leaf_rows = bad_rows[rows_pattern[bad_rows] >= 0]
-    bad_leaves = np.unique(np.r_[rows_leaf[leaf_rows], cells.leaf[rows_leaf[bad_rows[rows_pattern[bad_rows] < 0]]]
+    bad_leaves = distinct(np.r_[rows_leaf[leaf_rows], cells.leaf[rows_leaf[bad_rows[rows_pattern[bad_rows] < 0]]]
                                  if cells is not None else np.zeros(0, dtype=np.int64)])
-    return {"_leaves": bad_leaves, "_elements": elements(bad_rows), "_not_cells": elements(np.unique(pair_row[sides <= 0])),
+    return {"_leaves": bad_leaves, "_elements": elements(bad_rows), "_not_cells": elements(distinct(pair_row[sides <= 0])),
             "delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),
             "delaunay_violating_leaves": int(len(bad_leaves)), "delaunay_ties": int((sides == 0).sum()),
             "delaunay_exact_tests": int(len(pair_row))}

@@ -29,7 +29,7 @@ from ..core.configuration import Box
 from ..core.exact import parse_rational
 from ..errors import InputError
 
-__all__ = ["BALANCES", "BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count",
+__all__ = ["BALANCES", "BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count", "distinct",
            "estimate_leaves", "leaf_bound", "leaf_list_order", "leaves_octree", "parse_shape"]
 
 MAX_LEVEL = 16  # keys (2**16)**3 and the half-spacing grid (2**17 + 1)**3 stay inside int64
@@ -259,6 +259,16 @@ def estimate_leaves(box: Box, levels: int, shapes: Sequence[Shape]) -> int:
 # Keys and neighbourhoods
 
 
+def distinct(keys: np.ndarray) -> np.ndarray:
+    """The distinct values of an integer array, increasing.
+
+    Sort and keep firsts: numpy's hash-based ``unique`` is much slower on int64 keys
+    (4 million keys spread over 10**12: 5.5 s against 0.03 s CPU, numpy 2.4).
+    """
+    keys = np.sort(keys, axis=None)
+    return keys[np.r_[True, keys[1:] != keys[:-1]]] if len(keys) else keys
+
+
 def keys_of(level: int, cells: np.ndarray) -> np.ndarray:
     """Linear keys of positions (n x 3) at ``level``."""
     n = np.int64(1 << level)
@@ -284,7 +294,7 @@ def _neighbours(level: int, cells: np.ndarray, offsets: np.ndarray) -> np.ndarra
     n = 1 << level
     near = (cells[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
     near = near[np.all((near >= 0) & (near < n), axis=1)]
-    return np.unique(keys_of(level, near))
+    return distinct(keys_of(level, near))
 
 
 def _children(level: int, keys: np.ndarray) -> np.ndarray:
@@ -392,7 +402,7 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
     for level in range(levels - 1, 0, -1):
         # every neighbour of a split cell must exist: its parent must be split
         need = _neighbours(level, cells_of(level, split[level]), offsets)
-        parents = np.unique(keys_of(level - 1, cells_of(level, need) // 2))
+        parents = distinct(keys_of(level - 1, cells_of(level, need) // 2))
         split[level - 1] = np.union1d(split[level - 1], parents)
     levels_, positions = _leaves_from_splits(split)
     check_leaf_count(len(levels_), f"--levels {levels}: balanced, the tree has", max_leaves)
@@ -450,7 +460,7 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
     split = []
     for level in range(depth):
         deeper = [keys_of(level, cells_of(d, keys[d]) >> (d - level)) for d in range(level + 1, depth + 1)]
-        split.append(np.unique(np.concatenate(deeper)) if deeper else np.zeros(0, dtype=np.int64))
+        split.append(distinct(np.concatenate(deeper)) if deeper else np.zeros(0, dtype=np.int64))
         clash = np.isin(keys[level], split[level])
         if clash.any():
             i = index[level][np.flatnonzero(clash)[0]]
