@@ -72,6 +72,15 @@ def test_render_refuses_bad_summaries(tmp_path):
     assert len(result.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("option", [["--box", "1", "2", "4"], ["--element", "prism"], ["--face-points", "none"]])
+def test_render_refuses_a_study_option_beside_a_summary(tmp_path, capsys, option):
+    # it would do nothing: the summary says its own box, element and points
+    from cospherical.cli import main
+
+    assert main(["render", "--summary", str(SUMMARIES[0]), *option, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{option[0]} goes with --study" in err and err.count("\n") == 1, err
+    assert not (tmp_path / "out").exists()
 @pytest.mark.oracle_meshio
 def test_vtu_reads_back(tmp_path):
     for code, expect_polyhedra in (("888800000000", False), ("880000000000", True)):

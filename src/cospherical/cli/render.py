@@ -32,9 +32,10 @@ def add_parser(commands) -> None:
     source.add_argument("--summary", nargs="+", type=Path, metavar="FILE",
                         help="study summaries written by 'cospherical study --out' or 'reproduce'")
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), help="box of the study (with --study)")
-    parser.add_argument("--element", choices=ELEMENTS, default="cuboid",
+    # None by default so that one given with --summary (where it would do nothing) can be refused
+    parser.add_argument("--element", choices=ELEMENTS, default=None,
                         help="base element of the study (with --study; default cuboid)")
-    parser.add_argument("--face-points", choices=POINT_POLICIES, default="octree",
+    parser.add_argument("--face-points", choices=POINT_POLICIES, default=None,
                         help="with --study: " + FACE_POINTS_HELP)
     parser.add_argument("--out", type=Path, required=True, metavar="DIR",
                         help="folder for the .tex files (created; locked for the run; a file an earlier render "
@@ -80,14 +81,20 @@ def run(args) -> int:
     if args.study:
         if not args.box:
             raise UsageError("cospherical render: error: --study needs --box A B C")
-        codes = bisection_codes(args.element)
+        element = args.element or "cuboid"
+        codes = bisection_codes(element)
         with progress_bar(len(codes), args.study) as advance:
-            study = run_study(args.study, Box.parse(args.box), codes, args.face_points, progress=advance,
-                              element=args.element)
+            study = run_study(args.study, Box.parse(args.box), codes, args.face_points or "octree",
+                              progress=advance, element=element)
         catalogue = build_catalogue([study])
         names = {t["id"]: (t["name"], t["aliases"]) for t in catalogue["types"]}
         summaries = [study_summary(study, names)]
     else:
+        given = [flag for flag, value in (("--box", args.box), ("--element", args.element),
+                                          ("--face-points", args.face_points)) if value is not None]
+        if given:
+            raise UsageError(f"cospherical render: error: {given[0]} goes with --study; a summary says its own box, "
+                             "element and points")
         summaries = [_load_summary(path) for path in args.summary]
         catalogue = shipped_catalogue()
     written = render_tables(summaries, catalogue, args.out, "Delaunay tessellations of 1-irregular elements",
