@@ -37,7 +37,9 @@ _VTK_TYPE = {np.dtype(t): name for t, name in (
 # Large blocks: fewer zlib calls and headers; meshio joins a file's blocks by repeated
 # concatenation, which is quadratic in their number.
 BLOCK = 1 << 22
-LEVEL = 1  # zlib's fastest level: the arrays are small integers, level 6 saves little more
+# zlib's fastest level. Measured on the README sphere tree's 55.7 MB of arrays: level 1 12.5 MB in 0.38 s CPU,
+# VTK's default (zlib's 6) 12.3 MB in 2.4 s, level 9 12.4 MB in 11 s; run-length or Huffman-only 25 MB in 0.3 s.
+LEVEL = 1
 
 
 def _compressed(array: np.ndarray) -> bytes:
