@@ -196,6 +196,7 @@ UNBALANCED = [(1, i, j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1) if (i
     (["--leaves", "{tmp}/garbage.txt"], "line 2: 'one two' is not 'level i j k'"),
     (["--leaves", "{tmp}/missing.txt"], "cannot read"),
     (["--leaves", "{tmp}/missing.txt", "--cut", "2"], "--cut 2: must be a fraction"),
+    (["--levels", "2", "--refine", "point:0,0,0", "--cut", "1/2"], "only --out DIR without --partitions draws"),
 ])
 def test_bad_input_is_refused_with_one_line(tmp_path, capsys, argv, needle):
     (tmp_path / "overlap.txt").write_text("0 0 0 0\n0 0 0 0\n")

@@ -58,8 +58,8 @@ def add_parser(commands) -> None:
                         help="write mesh.vtu, report.json and mesh.png here (and dual.npz with --dual)")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="text (default): the main figures; json: the whole report on stdout")
-    parser.add_argument("--cut", metavar="Z", help="height of the picture's cut as a fraction of the domain height "
-                        "(default: through the first shape's centre, else 1/2)")
+    parser.add_argument("--cut", metavar="Z", help="height of mesh.png's cut as a fraction of the domain height "
+                        "(default: through the first shape's centre, else 1/2); with --out, not with --partitions")
     parser.add_argument("--dual", action="store_true",
                         help="the exact finite-volume dual: dual.npz in --out (edges, coefficients, control volumes), "
                         "point data control_volume, boundary_area and cell data circumcenter, delaunay_ok in mesh.vtu, "
@@ -130,6 +130,9 @@ def _cut(args, box: Box) -> float:
         value = parse_rational(args.cut, "--cut")
         if not 0 <= value <= 1:
             raise InputError(f"--cut {args.cut}: must be a fraction of the domain height, 0..1")
+        if args.out is None or args.partitions is not None:  # no picture is drawn: the option would do nothing
+            raise InputError(f"--cut {args.cut}: places mesh.png's cut, which only --out DIR without --partitions "
+                             "draws")
         return float(value)
     if args.refine:
         shape = parse_shape(args.refine[0])
