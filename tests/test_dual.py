@@ -404,6 +404,60 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
     assert case != "manifest with a repeated key" or "repeated key 'version'" in err, err
 
 
+def test_a_dual_npz_that_inflates_is_refused_from_its_headers(dual_run, tmp_path, capsys, monkeypatch):
+    """A member whose header claims 100 MB of zeros (deflated to 100 KB, re-signed) is refused
+    from the headers, before its data is read: the shapes disagree. Consistent claims beyond
+    half the machine's memory are refused likewise (here the machine is made small)."""
+    import hashlib
+    import io
+    import tracemalloc
+    import zipfile
+
+    from cospherical.cli import main
+    from cospherical.formats import dual as dual_format
+
+    good = dual_run / "a" / "dual.npz"
+    bomb = tmp_path / "bomb.npz"
+    count = 25 << 22  # 105 MB
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "|b1", "fortran_order": False, "shape": (count,)})
+    digest = hashlib.sha256(header.getvalue())
+    zeros = bytes(1 << 22)
+    for _ in range(count // len(zeros)):
+        digest.update(zeros)
+    with zipfile.ZipFile(good) as source, zipfile.ZipFile(bomb, "w", zipfile.ZIP_DEFLATED, compresslevel=1) as out:
+        for info in source.infolist():
+            if info.filename == "boundary.npy":
+                with out.open("boundary.npy", "w", force_zip64=True) as member:
+                    member.write(header.getvalue())
+                    for _ in range(count // len(zeros)):
+                        member.write(zeros)
+            elif info.filename == "manifest.npy":
+                manifest = json.loads(np.lib.format.read_array(io.BytesIO(source.read(info))).tobytes())
+                manifest["sha256"]["boundary"] = digest.hexdigest()  # re-signed: only the reader's bounds refuse it
+                text = np.frombuffer(json.dumps(manifest).encode(), dtype=np.uint8)
+                buffer = io.BytesIO()
+                np.lib.format.write_array(buffer, text)
+                out.writestr("manifest.npy", buffer.getvalue())
+            else:
+                out.writestr(info.filename, source.read(info))
+    assert bomb.stat().st_size < 1 << 20
+    capsys.readouterr()
+    tracemalloc.start()
+    try:
+        assert main(["check", str(bomb)]) == 2
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"member boundary: bool ({count},), expected b (" in err, err
+    assert peak < 20 * 2**20, peak  # it read the 100 MB (twice: the data and its array) before
+
+    monkeypatch.setattr(dual_format, "machine_memory", lambda: 2 * good.stat().st_size)
+    assert main(["check", str(good)]) == 2
+    assert "more than half this machine's memory" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("domain", [["1e-12", "1e-12", "1e-12"], ["1e-12", "1", "1"], ["3e9", "1", "1"]])
 def test_the_dual_of_tiny_and_huge_domains_is_exact(domain, tmp_path):
     from cospherical.formats.dual import read_dual, write_dual

@@ -62,6 +62,16 @@ MAX_DEPTH = 64
 MAX_INDENT = 256
 
 
+def machine_memory() -> int:
+    """This machine's physical memory in bytes (8 GiB where the system does not say): what the
+    readers and the mesher measure their bounds against, so that a small hostile file that
+    claims gigabytes is refused before they are allocated."""
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return 8 * 1024**3
+
+
 def yaml_text(data) -> str:
     return yaml.dump(data, Dumper=_Dumper, sort_keys=False, default_flow_style=None, width=100, allow_unicode=True)
 

@@ -17,7 +17,6 @@ from the finest level down, is the coarsest balanced tree containing the refinem
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from fractions import Fraction
 from itertools import product
@@ -28,6 +27,7 @@ import numpy as np
 from ..core.configuration import Box
 from ..core.exact import parse_rational
 from ..errors import InputError
+from ..files.yamlio import machine_memory
 
 __all__ = ["BALANCES", "BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count", "distinct",
            "estimate_leaves", "leaf_bound", "leaf_list_order", "leaves_octree", "parse_shape"]
@@ -344,11 +344,7 @@ def _leaves_from_splits(split: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray
 
 def leaf_bound() -> int:
     """The most leaves a mesh may have on this machine: half its memory at :data:`BYTES_PER_LEAF` a leaf."""
-    try:
-        memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        memory = 8 * 1024**3
-    return max(1, memory // 2 // BYTES_PER_LEAF)
+    return max(1, machine_memory() // 2 // BYTES_PER_LEAF)
 
 
 def check_leaf_count(count: int, what: str, max_leaves: int | None = None) -> None:
