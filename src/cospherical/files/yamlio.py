@@ -169,10 +169,10 @@ MAX_INTEGER_DIGITS = 40
 _LONG_NUMBER = re.compile(rf"[0-9]{{{MAX_INTEGER_DIGITS + 1},}}")
 
 
-def parse_json(text: str, name: str):
+def parse_json(text: str, name: str, max_digits: int = MAX_INTEGER_DIGITS):
     """Parse JSON text as every reader of ours does: no repeated key, no nesting deeper than
-    we write, no integer of more than :data:`MAX_INTEGER_DIGITS` digits; errors as one-line
-    :class:`FormatError`.
+    we write, no run of more than ``max_digits`` digits (:data:`MAX_INTEGER_DIGITS`, unless
+    the format writes longer exact numbers, as text); errors as one-line :class:`FormatError`.
 
     >>> parse_json('{"a": 1, "a": 2}', "demo.json")
     Traceback (most recent call last):
@@ -180,10 +180,11 @@ def parse_json(text: str, name: str):
     cospherical.errors.FormatError: demo.json: not valid JSON: repeated key 'a'
     """
     check_nesting(text, name)
-    long = _LONG_NUMBER.search(text)  # a scan of the text: a hook per number costs more than the parse
+    # a scan of the text (strings too: the cheap over-count): a hook per number costs more than the parse
+    long = (_LONG_NUMBER if max_digits == MAX_INTEGER_DIGITS else re.compile(f"[0-9]{{{max_digits + 1},}}")).search(text)
     if long:
         raise FormatError(f"{name}: not valid JSON: a number of {len(long.group(0)):,} digits "
-                          f"(at most {MAX_INTEGER_DIGITS})")
+                          f"(at most {max_digits})")
     try:
         return json.loads(text, object_pairs_hook=_unique_pairs)
     except json.JSONDecodeError as error:

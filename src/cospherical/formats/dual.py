@@ -79,8 +79,9 @@ _MAX_DIGITS = 200
 # the manifest's exact numbers as written: plain integers and fractions of bounded length, so that a
 # hostile text such as "1e999999999" never reaches Fraction (which would compute 10**999999999)
 _INTEGER = re.compile(r"-?[0-9]{1,%d}" % _MAX_DIGITS)
-_POSITIVE = re.compile(r"[1-9][0-9]{0,999}")
-_POSITIVE_FRACTION = re.compile(r"[1-9][0-9]{0,999}(/[1-9][0-9]{0,999})?")
+_MAX_TEXT_DIGITS = 1000  # the manifest's exact numbers, written as text
+_POSITIVE = re.compile(r"[1-9][0-9]{0,%d}" % (_MAX_TEXT_DIGITS - 1))
+_POSITIVE_FRACTION = re.compile(r"[1-9][0-9]{0,%d}(/[1-9][0-9]{0,%d})?" % (_MAX_TEXT_DIGITS - 1, _MAX_TEXT_DIGITS - 1))
 MAX_GRID = 1 << 40
 
 
@@ -222,7 +223,7 @@ def _manifest(raw: np.ndarray, path: Path) -> dict:
         raise FormatError(f"{path}: member manifest: not JSON") from None
     # the readers' one JSON parser: bounded nesting (100,000 brackets were a RecursionError
     # traceback), no repeated key, no number of thousands of digits
-    manifest = parse_json(text, f"{path}: member manifest")
+    manifest = parse_json(text, f"{path}: member manifest", max_digits=_MAX_TEXT_DIGITS)
     if not isinstance(manifest, dict) or manifest.get("format") != "cospherical-dual":
         raise FormatError(f"{path}: not a cospherical dual (its manifest names no format cospherical-dual)")
     if manifest.get("version") != DUAL_FORMAT_VERSION:
