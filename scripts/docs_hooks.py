@@ -359,26 +359,55 @@ def schema_fields(up: str, name: str) -> str:
     return "\n".join(rows)
 
 
+def _text(value) -> str:
+    """A recorded value as Markdown that shows it literally, whatever it holds.
+
+    A record is a file in the repository, and what it says is put into the site: every
+    character that Markdown, HTML or the snippets extension could read as markup (a
+    backtick ending a code span, ``<script>``, ``|`` splitting a table cell, ``--8<--``
+    including a file) is written as a numeric character reference, which the browser shows
+    as the character.
+    """
+    return "".join(c if (c.isascii() and c.isalnum()) or c in " .,:;/()%=+'\"" else f"&#{ord(c)};"
+                   for c in str(value).replace("\n", " "))
+
+
+# a line the snippets extension would read as an inclusion (``--8<-- "file"``), as in its own syntax
+_SNIPPET_LINE = re.compile(r"^([ \t]*)(;*-+8<-+)")
+
+
 def _recorded_run(path: Path) -> list[str]:
     """One benchmark run as its script recorded it: the command, the machine and its load, the figures."""
-    run = json.loads(path.read_text())
-    machine, load = run["machine"], run["load_average"]
-    lines = [f"Last run: `{run['command']}`, {run['date']} (commit `{run.get('commit') or '?'}`), on "
-             f"{machine['cores']} cores, {machine['memory_gib']} GiB, {machine['cpu']}; load average "
-             f"{' / '.join(map(str, load['before']))} before, {' / '.join(map(str, load['after']))} after "
-             f"(1, 5, 15 min); the script's process {run['cpu_seconds']} s CPU (its children included), "
-             f"{run['wall_seconds']} s wall, peak {run['peak_memory_gib']} GiB. From "
-             f"`results/benchmarks/{path.name}`:", ""]
-    if run["rows"]:
-        lines += ["| what | measured |", "|---|---|"]
-        lines += [f"| {_cell(what)} | {_cell(figure)} |" for what, figure in run["rows"]]
-        lines.append("")
-    for table in run.get("tables", []):
-        lines += ["| " + " | ".join(map(_cell, table["columns"])) + " |", "|" + "---|" * len(table["columns"])]
-        lines += ["| " + " | ".join(map(_cell, row)) + " |" for row in table["rows"]]
-        lines.append("")
-    lines += ['??? note "Everything it printed"', "", "    ```text"]
-    lines += [f"    {line}" for line in run["output"]] + ["    ```", ""]
+    from cospherical.files.yamlio import parse_json
+
+    # the readers' JSON parser: bounded nesting and digits, no repeated key; a record that is not
+    # one stops the build with one line naming the file and what is wrong
+    run = parse_json(path.read_text(), str(path), max_digits=1000)
+    try:
+        machine, load = run["machine"], run["load_average"]
+        lines = [f"Last run: <code>{_text(run['command'])}</code>, {_text(run['date'])} (commit "
+                 f"<code>{_text(run.get('commit') or '?')}</code>), on {_text(machine['cores'])} cores, "
+                 f"{_text(machine['memory_gib'])} GiB, {_text(machine['cpu'])}; load average "
+                 f"{' / '.join(map(_text, load['before']))} before, {' / '.join(map(_text, load['after']))} after "
+                 f"(1, 5, 15 min); the script's process {_text(run['cpu_seconds'])} s CPU (its children included), "
+                 f"{_text(run['wall_seconds'])} s wall, peak {_text(run['peak_memory_gib'])} GiB. From "
+                 f"`results/benchmarks/{path.name}`:", ""]
+        if run["rows"]:
+            lines += ["| what | measured |", "|---|---|"]
+            lines += [f"| {_text(what)} | {_text(figure)} |" for what, figure in run["rows"]]
+            lines.append("")
+        for table in run.get("tables", []):
+            lines += ["| " + " | ".join(map(_text, table["columns"])) + " |", "|" + "---|" * len(table["columns"])]
+            lines += ["| " + " | ".join(map(_text, row)) + " |" for row in table["rows"]]
+            lines.append("")
+        output = [str(line).replace("\n", " ") for line in run["output"]]
+    except (KeyError, TypeError, ValueError, AttributeError) as error:
+        raise ValueError(f"{path}: not a benchmark record as benchmarks/record.py writes it: "
+                         f"{type(error).__name__}: {error}") from None
+    # a fence longer than any run of backticks in the output, so that no line of it ends the block
+    fence = "`" * max([3] + [len(run) + 1 for line in output for run in re.findall("`+", line)])
+    lines += ['??? note "Everything it printed"', "", f"    {fence}text"]
+    lines += ["    " + _SNIPPET_LINE.sub(r"\1;\2", line) for line in output] + [f"    {fence}", ""]
     return lines
 
 

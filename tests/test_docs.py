@@ -208,8 +208,13 @@ def test_page_renders_in_chromium_without_console_errors(site, page):
 
 
 def test_a_benchmark_run_is_recorded_with_its_machine_and_rendered_from_its_file(tmp_path, capsys):
+    import html
     import importlib.util
     import os
+
+    import markdown
+
+    from cospherical.errors import FormatError
 
     def load(name, path):
         spec = importlib.util.spec_from_file_location(name, path)
@@ -231,6 +236,26 @@ def test_a_benchmark_run_is_recorded_with_its_machine_and_rendered_from_its_file
     assert data["command"].startswith("python benchmarks/bench_example.py") and data["cpu_seconds"] > 0
     hooks = load("docs_hooks", ROOT / "scripts" / "docs_hooks.py")
     page = "\n".join(hooks._recorded_run(tmp_path / "bench_example.json"))
-    assert data["command"] in page and f"{data['machine']['cores']} cores" in page
-    assert "| one call \\| median | 0.85 ms |" in page and "    figure line" in page
-    assert "| level | error |" in page and "| 3 | 1.29e-02 |" in page
+    shown = html.unescape(page)  # what the browser shows: the record's texts as numeric references
+    assert data["command"] in shown and f"{data['machine']['cores']} cores" in page
+    assert "| one call &#124; median | 0.85 ms |" in page and "    figure line" in page
+    assert "| level | error |" in page and "| 3 | 1.29e&#45;02 |" in page
+
+    # a hostile record (a file in the repository, put into the site): shown, never read as markup
+    data["command"] = "python x` <script>alert(1)</script> `"
+    data["machine"]["cpu"] = "<img src=x onerror=alert(2)>"
+    data["rows"].append(["a | b <script>alert(3)</script>", '--8<-- "pyproject.toml"'])
+    data["output"] += ["```", "<script>alert(4)</script>", '    --8<-- "pyproject.toml"']
+    hostile = tmp_path / "bench_hostile.json"
+    hostile.write_text(json.dumps(data))
+    site = markdown.markdown("\n".join(hooks._recorded_run(hostile)), extensions=[
+        "admonition", "tables", "md_in_html", "pymdownx.superfences", "pymdownx.details", "pymdownx.snippets"],
+        extension_configs={"pymdownx.snippets": {"base_path": [str(ROOT)], "check_paths": True}})
+    assert "<script>" not in site and "<img" not in site and "[project]" not in site, site
+    assert "alert(4)" in site and "<td>a &#124; b &#60;script" in site  # shown, the cell not split at its |
+    hostile.write_text('{"command": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    with pytest.raises(FormatError, match="nested too deeply"):
+        hooks._recorded_run(hostile)
+    hostile.write_text('{"command": "x"}')
+    with pytest.raises(ValueError, match="not a benchmark record as benchmarks/record.py writes it: KeyError"):
+        hooks._recorded_run(hostile)
