@@ -656,3 +656,26 @@ def test_hostile_entries_of_the_fast_table_format_are_one_line(tmp_path, capsys)
         path.write_text("\n".join(edited))
         refused(capsys, "check", path)
         refused(capsys, "diff", path, ROOT / "patterns" / "bisection-1x2x4.yaml")
+
+
+def test_sigterm_while_a_local_dask_cluster_starts_waits_for_it_to_be_made():
+    """A cluster half made when SIGTERM arrived could not be closed, and its workers made their
+    scratch space again after the command had removed it (a /tmp/cospherical-dask-* folder left
+    behind). The start is a block that holds SIGTERM and Ctrl-C back, then acts on them."""
+    from cospherical.studies.intersection.backends import _interrupt_deferred
+
+    seen = []
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: (seen.append("handler"), sys.exit(128 + signum)))
+    try:
+        with pytest.raises(SystemExit) as stopped:
+            with _interrupt_deferred():
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.05)  # delivered while the block runs: held
+                seen.append("block ended")
+        assert seen == ["block ended", "handler"] and stopped.value.code == 128 + signal.SIGTERM
+        with pytest.raises(KeyboardInterrupt), _interrupt_deferred():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert signal.getsignal(signal.SIGTERM) is previous

@@ -159,21 +159,35 @@ def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler:
 
 @contextmanager
 def _interrupt_deferred():
-    """Hold a Ctrl-C back until the block has ended, then raise it."""
+    """Hold a Ctrl-C or SIGTERM back until the block has ended, then act on it as the command would have.
+
+    A cluster half made when the signal arrived could not be closed: its workers went on
+    starting and made their scratch space again (with its lock files) after the command had
+    removed it, so SIGTERM left a /tmp/cospherical-dask-* folder behind.
+    """
     import signal
 
     held = []
+    previous = {}
     try:
-        previous = signal.signal(signal.SIGINT, lambda signum, frame: held.append(signum))
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            previous[signum] = signal.signal(signum, lambda signum, frame: held.append(signum))
     except ValueError:  # not the main thread: signals are not ours to handle
         yield
         return
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     if held:
-        raise KeyboardInterrupt
+        handler = previous[held[0]]
+        if held[0] == signal.SIGINT and not callable(handler):
+            raise KeyboardInterrupt
+        if callable(handler):
+            handler(held[0], None)  # the command's own: KeyboardInterrupt, or SystemExit(143) for SIGTERM
+        else:
+            signal.raise_signal(held[0])  # the default action, as if it had not been held
 
 
 def _kill_workers(cluster) -> None:
