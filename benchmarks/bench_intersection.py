@@ -105,7 +105,7 @@ def codes_of(digits) -> list[str]:
 def naive(code: str) -> None:
     from cospherical.catalogue import element_options
 
-    tess = tessellate(Configuration.from_code(code))
+    tess = tessellate(Configuration.from_code(code), backend="compiled")  # the walk at its fastest
     for element in tess.elements:
         for criterion in ("internal_faces", "internal_edges_and_faces"):
             element_options(tess, element, criterion)
@@ -117,24 +117,14 @@ def qhull(code: str) -> None:
     subprocess.run(["qdelaunay", "Qz", "Fv"], input=text, capture_output=True, text=True, check=True)
 
 
-def median_call(configurations, walk_compiled: bool) -> float:
-    from cospherical.core import delaunay
-
-    original = delaunay.delaunay_cells
-    delaunay_cells = (lambda frame, compiled=walk_compiled: original(frame, compiled))
-    import cospherical.core.tessellation as module
-
-    module.delaunay_cells = delaunay_cells
-    try:
-        for cfg in configurations[:50]:
-            tessellate(cfg)  # warm-up: compiled code loaded, caches filled
-        times = []
-        for cfg in configurations:
-            start = time.perf_counter()
-            tessellate(cfg)
-            times.append(time.perf_counter() - start)
-    finally:
-        module.delaunay_cells = original
+def median_call(configurations, backend: str) -> float:
+    for cfg in configurations[:50]:
+        tessellate(cfg, backend)  # warm-up: compiled code loaded, caches filled
+    times = []
+    for cfg in configurations:
+        start = time.perf_counter()
+        tessellate(cfg, backend)
+        times.append(time.perf_counter() - start)
     return statistics.median(times)
 
 
@@ -178,7 +168,7 @@ def measure(args, record) -> None:
     qhull_wall = per_qhull * configurations / args.jobs
 
     single = [Configuration.from_code(code) for code in codes_of(digits[rng.sample(range(len(digits)), 1000)])]
-    fast, slow = median_call(single, True), median_call(single, False)
+    fast, slow = median_call(single, "compiled"), median_call(single, "python")
 
     optimal = summary["criteria"]["optimal"]
     print(f"intersection study at 1/{args.resolution}, insertion order {args.order}, {args.jobs} processes")

@@ -56,7 +56,6 @@ def naive_seconds(summary: dict, resolution: int, order: str, sample: int = 2000
     """The table as it was made before, timed on ``sample`` representatives, scaled to all."""
     from cospherical import Configuration, tessellate
     from cospherical.catalogue import split_tessellation
-    from cospherical.core import compiled  # noqa: F401  (the bulk path: tessellate takes the compiled walk)
     from cospherical.core.symmetry import key_code
     from cospherical.formats.patterns import configuration_line
     from cospherical.studies.intersection import orbits
@@ -66,7 +65,7 @@ def naive_seconds(summary: dict, resolution: int, order: str, sample: int = 2000
     codes = reps[:: max(1, len(reps) // sample)].tolist()
     start = time.perf_counter()
     for code in map(key_code, codes):
-        tess = tessellate(Configuration.from_code(code))
+        tess = tessellate(Configuration.from_code(code), backend="compiled")  # the bulk path
         split = {c: split_tessellation(tess, types, c)[0] for c, types in kept.items()}
         configuration_line(code, tess.fvm_adequate, {"optimal": tess, **split})
     return (time.perf_counter() - start) / len(codes) * len(reps)

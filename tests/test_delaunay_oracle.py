@@ -96,8 +96,8 @@ def test_random_intersection_configurations_match_qhull(order):
 
 @pytest.mark.oracle_qhull
 def test_the_python_walk_matches_qhull():
-    # tessellate() takes the compiled walk whenever it provably fits in int64; the
-    # Python walk (any frame) is checked against the oracle on its own here.
+    # The Python walk (tessellate()'s default, any frame) against the oracle; the
+    # compiled walk is held to it in test_invariants.
     from cospherical.core.delaunay import delaunay_cells
     from cospherical.core.geometry import Frame
 
@@ -105,7 +105,7 @@ def test_the_python_walk_matches_qhull():
     for _ in range(150):
         cfg = random_configuration(rng)
         frame = Frame.build(cfg.nodes(), cfg.box.squared)
-        ours = {frozenset(cell.nodes) for cell in delaunay_cells(frame, compiled=False)}
+        ours = {frozenset(cell.nodes) for cell in delaunay_cells(frame, backend="python")}
         assert ours == qhull_regions(cfg.real_nodes()), (cfg.box.texts, cfg.steiner, cfg.face_points)
 
 

@@ -78,7 +78,7 @@ def test_compiled_stage_agrees_with_the_python_walk_on_a_sample():
     for i, code in enumerate(sample.tolist()):
         cfg = Configuration.from_code(key_code(code))
         frame = Frame.build(cfg.nodes(), cfg.box.squared)
-        python = [polyhedron(frame, cell) for cell in delaunay_cells(frame, compiled=False)]
+        python = [polyhedron(frame, cell) for cell in delaunay_cells(frame, backend="python")]
         assert cells["tets"][i] == sum(len(p.nodes) == 4 for p in python)
         assert cells["polys"][i] == sum(len(p.nodes) > 4 for p in python)
         assert cells["closed"][i] == all(p.center_in_box(closed=True) for p in python)
@@ -87,7 +87,7 @@ def test_compiled_stage_agrees_with_the_python_walk_on_a_sample():
     i = int(np.argmax(cells["polys"]))
     cfg = Configuration.from_code(key_code(int(sample[i])))
     frame = Frame.build(cfg.nodes(), cfg.box.squared)
-    masks = {sum(1 << n for n in cell.nodes) for cell in delaunay_cells(frame, compiled=False) if len(cell.nodes) > 4}
+    masks = {sum(1 << n for n in cell.nodes) for cell in delaunay_cells(frame, backend="python") if len(cell.nodes) > 4}
     assert set(cells["poly_mask"][offsets[i]:offsets[i + 1]].tolist()) == masks
 
 

@@ -115,7 +115,7 @@ def test_compiled_and_python_walks_give_the_same_cells(cfg):
     from cospherical.core.geometry import Frame
 
     frame = Frame.build(cfg.nodes(), cfg.box.squared)
-    assert delaunay_cells(frame, compiled=True) == delaunay_cells(frame, compiled=False)
+    assert delaunay_cells(frame, backend="compiled") == delaunay_cells(frame, backend="python")
 
 
 def test_the_compiled_walk_takes_only_frames_that_fit_in_int64():

@@ -54,8 +54,8 @@ def test_symmetry_maps_configurations_and_points():
 
 @pytest.mark.parametrize("lengths", [("1", "1", "1"), ("1", "2", "2"), ("1", "2", "4")])
 def test_orbit_representatives_without_numpy_equal_numpy_ones(lengths):
-    # Without numpy loaded, a few thousand codes take the pure-Python path, one orbit at a
-    # time: the same representatives and the same (first) symmetries as the numpy path.
+    # The pure-Python backend (one orbit at a time, no numpy) against the numpy backend:
+    # the same representatives and the same (first) symmetries.
     import random
 
     import numpy as np
@@ -72,7 +72,7 @@ def test_orbit_representatives_without_numpy_equal_numpy_ones(lengths):
     for codes in (bisection_codes(), leaf_codes(), scattered):
         masks = [symmetry._point_mask(code) if "+" in code else 0 for code in codes]
         numpy_keys = symmetry.orbit_point_keys(symmetry.code_digits(codes), np.array(masks, dtype=np.int64),
-                                               symmetries)
+                                               symmetries, backend="numpy")
         assert symmetry._orbit_keys_python(codes, masks, group) == tuple(a.tolist() for a in numpy_keys)
 
 

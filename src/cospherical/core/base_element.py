@@ -68,14 +68,16 @@ class BaseElement:
         """The isometries of the element in its box, identity first."""
         return box_symmetries(self.box) if self.shape is None else shape_symmetries(self.shape)
 
-    def orbit_representatives(self, codes: Sequence[str]) -> tuple[list[str], list[int]]:
+    def orbit_representatives(self, codes: Sequence[str], backend: str = "python") -> tuple[list[str], list[int]]:
         """For each code, its orbit's representative (the smallest image) and the index in
-        :attr:`symmetries` of a symmetry taking the code to it."""
-        return orbit_representatives(codes, self.symmetries)
+        :attr:`symmetries` of a symmetry taking the code to it (``backend``: the cube's fast
+        path, as in :func:`~cospherical.core.symmetry.orbit_representatives`)."""
+        return orbit_representatives(codes, self.symmetries, backend)
 
-    def tessellate(self, configuration: BaseConfiguration) -> Tessellation:
-        """The Delaunay tessellation of one of this element's configurations."""
-        return tessellate(configuration)
+    def tessellate(self, configuration: BaseConfiguration, backend: str = "python") -> Tessellation:
+        """The Delaunay tessellation of one of this element's configurations (``backend``: the
+        Delaunay walk's, as in :func:`~cospherical.core.tessellation.tessellate`)."""
+        return tessellate(configuration, backend)
 
 @cached(maxsize=64)  # a study maps every member's configuration through it
 def base_element(name: str, box: Box, face_points: str = "octree") -> BaseElement:

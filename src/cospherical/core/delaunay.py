@@ -12,7 +12,6 @@ always end up in one cell, whatever the box or Steiner positions.
 
 from __future__ import annotations
 
-import sys
 from collections import deque
 from dataclasses import dataclass
 from fractions import Fraction
@@ -125,20 +124,24 @@ def _first_cell(frame: Frame) -> tuple[list[int], Sphere]:
     raise ValueError("no empty sphere: the points do not span 3D")
 
 
-def delaunay_cells(frame: Frame, compiled: bool | None = None) -> list[Cell]:
+BACKENDS = ("python", "compiled")
+
+
+def delaunay_cells(frame: Frame, backend: str = "python") -> list[Cell]:
     """The Delaunay subdivision of the frame's points, cells sorted by node ids.
 
-    ``compiled``: take the compiled int64 walk (:mod:`cospherical.core.compiled`)
-    when its numbers provably fit; the Python walk below gives the same cells
-    on any frame.  ``None`` (the default): the compiled walk only if the kernel
-    is already loaded.  Loading it (numba) costs about a second and a half per
-    process, while the Python walk takes about 1 ms per bisection configuration,
-    so small work (one configuration, a bisection study: 144 orbits) is faster
-    without it; bulk work (the intersection study) loads it explicitly.
+    ``backend``: ``"python"`` (the default) walks in Python integers;
+    ``"compiled"`` takes the compiled int64 walk (:mod:`cospherical.core.compiled`)
+    where its numbers provably fit, else the Python walk: both give the same
+    cells on any frame.  Loading the compiled walk (numba) costs about a second
+    and a half per process, while the Python walk takes about 1 ms per
+    bisection configuration, so small work (one configuration, a bisection
+    study: 144 orbits) keeps the default and bulk work (the intersection study)
+    asks for ``"compiled"``.
     """
-    if compiled is None:
-        compiled = "cospherical.core.compiled" in sys.modules
-    if compiled:
+    if backend not in BACKENDS:
+        raise ValueError(f"backend {backend!r}: one of {', '.join(BACKENDS)}")
+    if backend == "compiled":
         cells = _compiled_cells(frame)
         if cells is not None:
             return cells

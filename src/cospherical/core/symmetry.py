@@ -8,7 +8,6 @@ the result to every other member.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
@@ -184,39 +183,46 @@ def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
     return tuple(Symmetry(p, f) for p in perms for f in product((False, True), repeat=3))
 
 
-def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry]) -> tuple[np.ndarray, np.ndarray]:
+KEY_BACKENDS = ("numpy", "compiled")
+
+
+def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry],
+               backend: str = "numpy") -> tuple[np.ndarray, np.ndarray]:
     """For rows of 12 hex digits: the orbit representative's code as a base-16 number (the
-    smallest image) and the index of the first symmetry taking the row to it (compiled)."""
-    keys, _, sym_index = orbit_point_keys(digits, None, symmetries)
+    smallest image) and the index of the first symmetry taking the row to it
+    (``backend`` as in :func:`orbit_point_keys`)."""
+    keys, _, sym_index = orbit_point_keys(digits, None, symmetries, backend)
     return keys, sym_index
 
 
 def orbit_point_keys(
-    digits: np.ndarray, masks: np.ndarray | None, symmetries: Sequence[Symmetry]
+    digits: np.ndarray, masks: np.ndarray | None, symmetries: Sequence[Symmetry], backend: str = "numpy"
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`orbit_keys` for whole point sets: rows of 12 hex digits with a point mask each
     (bit f: face f carries a point, bit 6: the body point; ``None``: no face points).  The smallest image compares the
     edge digits first, then the mask; returns its code as a base-16 number, its mask, and
-    the first symmetry reaching it.  A zero mask gives exactly the keys of the 12 digits."""
+    the first symmetry reaching it.  A zero mask gives exactly the keys of the 12 digits.
+
+    ``backend``: ``"numpy"`` (the default) or ``"compiled"`` (the numba kernel of
+    :mod:`cospherical.core.compiled`), the same keys either way.  Loading the
+    kernel costs ~1.5 s; numpy does 4096 rows x 48 symmetries in ~25 ms but is
+    ~15x slower per row (measured: 10 s against 0.7 s for a million rows), so
+    break-even is near 100,000 rows: bulk work (the intersection study) asks
+    for the kernel."""
     import numpy as np
 
+    if backend not in KEY_BACKENDS:
+        raise ValueError(f"backend {backend!r}: one of {', '.join(KEY_BACKENDS)}")
     digits = np.ascontiguousarray(digits).reshape(-1, 12)  # any integer type: millions of rows stay small
     masks = np.zeros(len(digits), dtype=np.int64) if masks is None else np.ascontiguousarray(masks, dtype=np.int64)
     targets = np.array([[target for target, _ in sym.edge_map] for sym in symmetries], dtype=np.int64).reshape(-1, 12)
     reverse = np.array([[rev for _, rev in sym.edge_map] for sym in symmetries], dtype=np.bool_).reshape(-1, 12)
     faces = np.array([sym.face_map for sym in symmetries], dtype=np.int64).reshape(-1, 6)
-    # Loading the compiled kernel costs ~1.5 s; numpy does 4096 rows x 48
-    # symmetries in ~25 ms but is ~15x slower per row (measured: 10 s against
-    # 0.7 s for a million rows).  Break-even is near 100,000 rows: below, numpy,
-    # unless bulk work has loaded the kernel anyway.
-    if "cospherical.core.compiled" in sys.modules or len(digits) > _NUMPY_ROWS:
+    if backend == "compiled":
         from .compiled import orbit_keys as kernel
 
         return kernel(digits, targets, reverse, masks, faces)
     return _orbit_keys_numpy(digits, targets, reverse, masks, faces)
-
-
-_NUMPY_ROWS = 100_000
 
 
 def _orbit_keys_numpy(digits, targets, reverse, masks, faces):
@@ -241,15 +247,21 @@ def _orbit_keys_numpy(digits, targets, reverse, masks, faces):
     return best, best_mask, best_sym
 
 
-def orbit_representatives(codes: Sequence[str], symmetries: Sequence[BaseSymmetry]) -> tuple[list[str], list[int]]:
+def orbit_representatives(codes: Sequence[str], symmetries: Sequence[BaseSymmetry],
+                          backend: str = "python") -> tuple[list[str], list[int]]:
     """For each code, its orbit's representative (the smallest image code, as a base-16 number)
     and the index of a symmetry taking the code to it.
 
     The one orbit function of every base element.  Under a box's symmetries (a
     cuboid) a code with a point suffix (``+f...``) has a representative with
-    one, and the work goes through the cube's fast paths (pure Python per orbit
-    for a few thousand codes, numpy or the compiled kernel in bulk); under
-    another shape's isometries every image of each code is compared.
+    one, and the work goes through the cube's fast paths, chosen by ``backend``:
+    ``"python"`` (the default: once per orbit, about 50 us a code in the worst
+    case, no numpy, whose import costs a tenth of a second: a bisection study's
+    4096 codes take 15 ms), ``"numpy"`` (about 6 us a code after its import) or
+    ``"compiled"`` (:func:`orbit_point_keys`, for hundreds of thousands of
+    codes).  ``"python"`` needs the symmetries to form a group, as a box's
+    always do; on any other set it computes with numpy.  Under another shape's
+    isometries every image of each code is compared, whatever the backend.
 
     Examples
     --------
@@ -260,27 +272,23 @@ def orbit_representatives(codes: Sequence[str], symmetries: Sequence[BaseSymmetr
     >>> orbit_representatives(["800000000000", "000000000008"], box_symmetries(Box.parse(["1", "1", "1"])))[0]
     ['000000000008', '000000000008']
     """
+    if backend not in ("python", *KEY_BACKENDS):
+        raise ValueError(f"backend {backend!r}: one of python, {', '.join(KEY_BACKENDS)}")
     if symmetries and isinstance(symmetries[0], ShapeSymmetry):
         return _every_image_representatives(codes, symmetries)
     suffixed = ["+" in code for code in codes]
     masks = [_point_mask(code) if s else 0 for code, s in zip(codes, suffixed)]
-    group = _group(tuple(symmetries))
-    # numpy costs a tenth of a second to import: a study of a few thousand codes
-    # (the bisection study: 4096 codes, 144 orbits, 15 ms) is faster without it.
-    if "numpy" not in sys.modules and len(codes) <= _PYTHON_ROWS and group is not None:
+    group = _group(tuple(symmetries)) if backend == "python" else None
+    if group is not None:
         keys, image_masks, sym_index = _orbit_keys_python(codes, masks, group)
     else:
         import numpy as np
 
         keys, image_masks, sym_index = (a.tolist() for a in orbit_point_keys(
-            code_digits(codes), np.array(masks, dtype=np.int64), symmetries))
+            code_digits(codes), np.array(masks, dtype=np.int64), symmetries,
+            "numpy" if backend == "python" else backend))
     reps = [key_code(k) + ("+" + _mask_suffix(m) if s else "") for k, m, s in zip(keys, image_masks, suffixed)]
     return reps, sym_index
-
-
-# Codes one orbit each (no symmetry relating them, the worst case) take about 50 us
-# each under 48 symmetries, against about 6 us in numpy after its import.
-_PYTHON_ROWS = 5_000
 
 
 @dataclass(frozen=True)

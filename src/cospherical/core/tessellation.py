@@ -69,7 +69,7 @@ class Tessellation:
         return tuple(float(x) * s for x, s in zip(element.polyhedron.center, scale))
 
 
-def tessellate(configuration: BaseConfiguration) -> Tessellation:
+def tessellate(configuration: BaseConfiguration, backend: str = "python") -> Tessellation:
     """The Delaunay tessellation of a configuration, its elements the largest co-spherical sets.
 
     Every cell is the convex hull of all points on one empty sphere, decided in
@@ -81,6 +81,10 @@ def tessellate(configuration: BaseConfiguration) -> Tessellation:
     configuration : Configuration or ShapeConfiguration
         The box, its Steiner points, and its face and body points; or another
         shape's configuration.
+    backend : str
+        The Delaunay walk (:func:`cospherical.core.delaunay.delaunay_cells`):
+        ``"python"`` (the default, for small work) or ``"compiled"`` (bulk work
+        that pays the compiled kernel's loading once); the same elements either way.
 
     Returns
     -------
@@ -110,15 +114,16 @@ def tessellate(configuration: BaseConfiguration) -> Tessellation:
     (['Tetrahedron', 'Tetrahedron'], Fraction(1, 6))
     """
     nodes = configuration.nodes()
-    return Tessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared))
+    return Tessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared, backend))
 
 
-def tessellation_elements(nodes, squared) -> tuple[Element, ...]:
+def tessellation_elements(nodes, squared, backend: str = "python") -> tuple[Element, ...]:
     """The classified Delaunay elements of points ``{node id: unit coordinates}`` in a box
-    with these squared lengths: the one pipeline of every base element (cuboid or other shape)."""
+    with these squared lengths: the one pipeline of every base element (cuboid or other shape).
+    ``backend``: the Delaunay walk's, as in :func:`tessellate`."""
     frame = Frame.build(nodes, squared)
     elements = []
-    for cell in delaunay_cells(frame):
+    for cell in delaunay_cells(frame, backend):
         elements.append(Element.from_polyhedron(polyhedron(frame, cell)))
     return tuple(elements)
 

@@ -99,15 +99,19 @@ def intersection_codes(resolution: int = 16, order: str = "edge") -> np.ndarray:
     return grid.reshape(-1, 12)
 
 
-def orbits(resolution: int = 16, order: str = "edge") -> tuple[np.ndarray, np.ndarray, int]:
+def orbits(resolution: int = 16, order: str = "edge", backend: str = "compiled") -> tuple[np.ndarray, np.ndarray, int]:
     """Orbit representatives (codes as base-16 numbers, sorted) with their sizes, and the configuration count.
 
     The family is not closed under the cube's symmetries (a reflected configuration
     has positions 1 - t, which the midpoint scheme does not produce), so an orbit
     here collects only the family's members that map onto each other.
+
+    ``backend``: the orbit keys' (:func:`cospherical.core.symmetry.orbit_keys`);
+    the compiled kernel by default, since the study and its tables load it for
+    their bulk work anyway (hundreds of thousands of codes from R = 4 on).
     """
     digits = intersection_codes(resolution, order)
-    keys, _ = orbit_keys(digits, box_symmetries(Box.parse(["1", "1", "1"])))
+    keys, _ = orbit_keys(digits, box_symmetries(Box.parse(["1", "1", "1"])), backend)
     reps, sizes = np.unique(keys, return_counts=True)
     return reps, sizes, len(digits)
 

@@ -98,7 +98,7 @@ def cell_polyhedron(node_mask: int, code: int):
     nodes = Configuration.from_code(key_code(code)).nodes()
     points = tuple((n, nodes[n]) for n in sorted(nodes) if node_mask >> n & 1)
     frame = Frame.build(dict(points), (1, 1, 1))
-    (cell,) = delaunay_cells(frame)  # the points are co-spherical: one cell
+    (cell,) = delaunay_cells(frame, "compiled")  # co-spherical points: one cell; the study's bulk walk
     return points, polyhedron(frame, cell)
 
 
