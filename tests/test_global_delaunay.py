@@ -235,3 +235,44 @@ def test_random_extreme_boxes_mesh_exactly(exponents, where):
     point = ",".join(str(float(x) * float(length)) for x, length in zip(where, box.lengths))
     leaf = assemble(build_octree(box, 3, [parse_shape(f"point:{point}")], "vertex"))
     assert whole(global_delaunay(leaf)) == WHOLE
+
+
+def _tampered(change):
+    """A proposal: Qhull's triangulation with its simplices changed by ``change(qhull)`` (a row mask and extra
+    rows); the faces next to a dropped or added simplex lose their neighbour, so the local check sees nothing."""
+    from types import SimpleNamespace
+
+    from scipy.spatial import Delaunay
+
+    def proposal(points):
+        qhull = Delaunay(points, qhull_options="Qbb Qc Qz Q12 Qt")
+        keep, extra = change(qhull)
+        renumber = np.where(keep, np.cumsum(keep) - 1, -1)
+        neighbors = np.where(qhull.neighbors >= 0, renumber[qhull.neighbors], -1)[keep]
+        return SimpleNamespace(simplices=np.r_[qhull.simplices[keep], extra],
+                               neighbors=np.r_[neighbors, np.full((len(extra), 4), -1)], coplanar=qhull.coplanar)
+    return proposal
+
+
+def _missing(qhull):
+    return np.arange(len(qhull.simplices)) % 3 != 0, np.zeros((0, 4), dtype=np.int64)
+
+
+def _overlapping(qhull):
+    # Qhull's tetrahedra and, per pair on a face, one of the other split of their five points: it overlaps both
+    # and has no neighbour (its sphere holds a point unless the five are co-spherical)
+    simplices = qhull.simplices
+    pair = np.flatnonzero(qhull.neighbors[:, 0] >= 0)
+    neighbour = qhull.neighbors[pair, 0]
+    far = simplices[neighbour, np.argmax(qhull.neighbors[neighbour] == pair[:, None], axis=1)]
+    return np.ones(len(simplices), dtype=bool), np.c_[simplices[pair, 0], far, simplices[pair, 1:3]]
+
+
+@pytest.mark.parametrize("change", [_missing, _overlapping])
+def test_a_wrong_proposal_the_local_check_passes_is_redone_exactly(change, monkeypatch):
+    leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))
+    calls = _count_exact(monkeypatch)
+    mesh = global_delaunay(leaf, proposal=_tampered(change))
+    assert calls  # the proof failed on the proposal's cells: the exact engine redid those regions
+    assert mesh_cells(mesh) == oracle_cells(leaf)
+    assert whole(mesh) == WHOLE

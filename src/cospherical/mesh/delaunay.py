@@ -49,16 +49,46 @@ sphere tree of 345,640 leaves, 110,695 points in 1,305 regions (largest 10,070)
 instead of 209,793 in 239 (largest 80,067), and Qhull's time 4.2 s instead of 15.7 s.  Measured against CGAL's exact-predicate triangulation (pip ``cgal``) on
 50,000 points at load 11: Qhull 13.1 s in all, CGAL 2.9 s to insert but 13.4 s to
 read its cells back through the Python bindings, one object per cell; Qhull hands
-back arrays.  A cell's vertices are its tetrahedra's.  Qhull's proposal is checked
-per region in integers: across every face between two solid tetrahedra, the far
-vertex is not strictly inside the near one's sphere (float rounding makes exactly
-such flips; a triangulation of the hull without one is Delaunay).  Where Qhull
-fails (boxes of extreme aspect ratio, 1e-12 x 1 x 3e9, whose first simplex is flat
-in floats) or the check does, the exact engine
-(:mod:`cospherical.core.incremental_delaunay`, Bowyer-Watson in Python integers,
-about 3.6 times Qhull's path's CPU) tetrahedralises V_r instead.  The whole mesh is then
-checked again by the report (volume, conformity, and empty spheres and ties of
-every cell not proven before), so a wrong proposal cannot pass unseen.  Cube octrees, whose leaf mesh is already
+back arrays.  A cell's vertices are its tetrahedra's.  Where Qhull fails (boxes of extreme aspect
+ratio, 1e-12 x 1 x 3e9, whose first simplex is flat in floats) or drops a point, the
+exact engine (:mod:`cospherical.core.incremental_delaunay`, Bowyer-Watson in Python
+integers, about 3.6 times Qhull's path's CPU) tetrahedralises V_r instead.  Qhull's
+tetrahedra are first checked per region in integers: across every face between two
+solid tetrahedra the far vertex is not strictly inside the near one's sphere (float
+rounding on thin boxes makes exactly such flips).  That check is cheap and saves a
+second pass, but it proves nothing alone: it does not see the faces next to flat or
+missing tetrahedra, nor overlaps.  What proves the cells, whatever proposed them:
+
+5. The cells made for a region r are accepted when (i) none of them holds a vertex
+   of V strictly inside its sphere or a vertex of V on it that is not its own
+   (:func:`~cospherical.mesh.checks.check_delaunay` on the mesh with the cells,
+   exact), and (ii) the exact volumes of the cells named by r (by the region of
+   their first vertex: the V_r are disjoint) sum to the exact volume of U_r's
+   elements.  Then they are the cells of D inside U_r.  By (i) each is a cell of D.
+   Each has an interior point in U_r of its own region: the centroid of one of its
+   solid tetrahedra (a tetrahedron on the cell's vertices lies in the cell, its
+   interior in the cell's interior), kept only when it lies in a closed element of
+   its tetrahedron's region; a point interior to a cell of D lies in no other
+   closed cell, so by 2 and 4 the cell is one of those tiling U_r (a cell made of
+   tetrahedra of two regions would be one of both tilings: it fails (i)).  Two
+   cells made are never the same cell of D: tetrahedra are grouped by exact
+   centre, and one centre names one empty sphere.  So the cells named by r are
+   distinct cells of the tiling of U_r, and their volumes sum to U_r's only if
+   they are all of them.
+6. Flat tetrahedra (Qhull's triangulation of co-spherical sets emits them: four
+   co-circular points) have no volume and no interior point, so they are dropped
+   before 5 and take no part in it: a cell is the convex hull of its vertices, and
+   if its solid tetrahedra missed one of its vertices that vertex would tie with
+   the cell (i); if they missed a whole cell the volume would fall short (ii).
+   Tetrahedra of one centre that are not one co-spherical cell (different radii)
+   cannot be classified: then every region is taken as failing.
+7. A failing region is tetrahedralised again by the exact engine and the whole is
+   checked again.  The exact engine's tetrahedra tile conv(V_r) and are Delaunay,
+   so its cells pass; should they not, that is a bug, and it raises rather than
+   return a mesh that is not D.  The check of 5 is the one the report runs on the
+   mesh anyway, handed on to it (the report tests only the cells not proven):
+   proving costs the volume sums, no second empty-sphere pass.
+Cube octrees, whose leaf mesh is already
 globally Delaunay, have no region: the mesh is returned as it is.
 """
 
@@ -81,12 +111,13 @@ __all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate
 ENGINES = ("qhull", "exact")
 
 
-def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull") -> Mesh:
+def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull", proposal=None) -> Mesh:
     """The exact Delaunay subdivision of ``mesh``'s vertices, as a :class:`Mesh` (see the module's proof).
 
     ``found``: the result of :func:`check_delaunay` on ``mesh`` when the caller has it.
     ``engine``: how regions are tetrahedralised, ``qhull`` (floats propose, integers
     check, the exact engine where either fails) or ``exact`` (the exact engine alone).
+    ``proposal``: what proposes a region's tetrahedra in place of Qhull (see :func:`retessellate`).
 
     Examples
     --------
@@ -98,22 +129,36 @@ def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull"
     >>> [check_delaunay(m)["delaunay_violations"] for m in (leaf, whole)], whole.cells.regions
     ([5, 0], 1)
     """
+    return _global_delaunay(mesh, found, engine, proposal)[0]
+
+
+def _global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull",
+                     proposal=None) -> tuple[Mesh, dict | None]:
+    """:func:`global_delaunay`, and :func:`check_delaunay` on the result when it ran (a region was re-tessellated)."""
     if engine not in ENGINES:
         raise ValueError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
     if found is None:
         found = check_delaunay(mesh)
     elements = found["_not_cells"]
     if not len(elements):
-        return mesh
+        return mesh, None
     if mesh.cells is not None:
         raise ValueError("the mesh already holds re-tessellated cells")
+    types = dict(mesh.types)
+    checked: list = []
+    cells = retessellate(mesh, elements, types, engine, proposal, checked)
+    return with_cells(mesh, _leaves_of(mesh, elements), cells, types), checked[0]
+
+
+def _leaves_of(mesh: Mesh, elements: np.ndarray) -> np.ndarray:
+    """Per leaf of the mesh: whether it holds one of ``elements`` (the leaves that give up their elements)."""
     bad = np.zeros(len(mesh.tree), dtype=bool)
     bad[mesh.element_leaf[elements]] = True
-    types = dict(mesh.types)
-    return with_cells(mesh, bad, retessellate(mesh, elements, types, engine), types)
+    return bad
 
 
-def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "qhull") -> Cells:
+def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "qhull", proposal=None,
+                 checked: list | None = None) -> Cells:
     """The cells of the Delaunay subdivision of ``mesh``'s vertices that replace the leaves holding ``elements``.
 
     ``elements``: the leaf elements that are not cells of it (see the module's proof).
@@ -121,7 +166,11 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     ``mesh`` may hold only some of a tree's leaves (with the whole tree's vertices):
     a point outside its leaves is outside every region, as it is outside the failing
     elements of the whole tree.  ``types`` receives the cells' types it lacks (id -> name, class, VTK cell).
-    ``engine``: as for :func:`global_delaunay`.
+    ``engine``: as for :func:`global_delaunay`.  ``proposal(real_points)``: what
+    proposes a region's tetrahedra in place of Qhull (rows of point indices; a seam
+    for tests).  The cells are proven before they are returned (the module's last
+    part): a region whose cells fail is tetrahedralised again by the exact engine.
+    ``checked`` (a list) receives :func:`check_delaunay` on the mesh with the cells.
     """
     nodes = mesh.element_nodes(elements)
     part, regions = _regions(nodes, len(mesh.vertices))
@@ -133,24 +182,83 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
                       + nodes[valid])
     bounds = np.searchsorted(pairs // len(mesh.vertices), np.arange(regions + 1))
     vertices = pairs % len(mesh.vertices)
-    tets, tet_region = [], []
-    for r in range(regions):
-        found_tets = _region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine)
-        tets.append(found_tets)
-        tet_region.append(np.full(len(found_tets), r, dtype=np.int64))
-    tets, tet_region = np.concatenate(tets), np.concatenate(tet_region)
+    # the regions' vertex sets are disjoint (a shared vertex would join them): a vertex names its region
+    vertex_region = np.full(len(mesh.vertices), -1, dtype=np.int64)
+    vertex_region[vertices] = pairs // len(mesh.vertices)
     located = _Locator(mesh)
-    tets = tets[_inside(mesh, tets, tet_region, region, located)]
-    cell_of_tet = _same_sphere(mesh, tets, _weights(mesh))
     # the other elements of the leaves that give up theirs: cells as they are, proven by the check
     leaves = distinct(mesh.element_leaf[elements])
     counts = mesh.element_offsets[leaves + 1] - mesh.element_offsets[leaves]
     given_up = np.repeat(mesh.element_offsets[leaves] - np.r_[0, np.cumsum(counts)[:-1]], counts) \
         + np.arange(int(counts.sum()))
-    proven = given_up[region[given_up] < 0]
-    cells = _cells(mesh, _members(cell_of_tet, tets, len(mesh.vertices)), mesh.element_nodes(proven), located, types)
-    return Cells(cells.shapes, cells.shape, cells.anchor, cells.nodes, cells.leaf, cells.spanning, cells.proven,
-                 regions=int(regions), largest_region=int(np.diff(bounds).max()))
+    proven = mesh.element_nodes(given_up[region[given_up] < 0])
+    bad = _leaves_of(mesh, elements)
+    wanted = _region_volumes(mesh, elements, part, regions)
+    tets = [_region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine, proposal) for r in range(regions)]
+    exact = set(range(regions)) if engine == "exact" else set()
+    while True:
+        tet_region = np.concatenate([np.full(len(t), r, dtype=np.int64) for r, t in enumerate(tets)])
+        every = np.concatenate(tets)
+        every = every[_inside(mesh, every, tet_region, region, located)]
+        try:
+            cells = _cells(mesh, _members(_same_sphere(mesh, every, _weights(mesh)), every, len(mesh.vertices)),
+                           proven, located, types)
+        except ValueError:  # tetrahedra of one centre that are not one co-spherical cell: no proof per region
+            failing = set(range(regions))
+        else:
+            cells = Cells(cells.shapes, cells.shape, cells.anchor, cells.nodes, cells.leaf, cells.spanning,
+                          cells.proven, regions=int(regions), largest_region=int(np.diff(bounds).max()))
+            trial = with_cells(mesh, bad, cells, types)
+            found = check_delaunay(trial)
+            failing = _failing_regions(trial, found, vertex_region, wanted)
+            if not failing:
+                if checked is not None:
+                    checked.append(found)
+                return cells
+        if failing <= exact:  # the exact engine's cells are Delaunay by construction: a bug, not rounding
+            raise RuntimeError(f"the exact engine's cells of regions {sorted(failing)[:5]} fail the exact checks")
+        for r in failing - exact:
+            tets[r] = _region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], "exact")
+        exact |= failing
+
+
+def _region_volumes(mesh: Mesh, elements: np.ndarray, part: np.ndarray, regions: int) -> list[Fraction]:
+    """Per region, the exact volume of its elements in grid cells."""
+    leaf = mesh.element_leaf[elements]
+    kind = mesh.leaf_pattern[leaf].astype(np.int64) * 65536 + mesh.element_local[elements]
+    size = (mesh.grid >> mesh.tree.levels[leaf].astype(np.int64)).astype(object) ** 3
+    volumes = [Fraction(0)] * regions
+    # elements of one pattern element and one region: one Fraction product per pair
+    for (r, k), total in _sums(part * (int(kind.max()) + 1) + kind, size, int(kind.max()) + 1):
+        element = mesh.patterns[k // 65536].elements[k % 65536]
+        volumes[r] += element.unit_volume * total
+    return volumes
+
+
+def _sums(key: np.ndarray, values: np.ndarray, base: int):
+    """Per distinct key, ((key // base, key % base), the sum of its values (Python integers))."""
+    order = np.argsort(key, kind="stable")
+    key, values = key[order], values[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    for start, total in zip(starts.tolist(), np.add.reduceat(values, starts).tolist() if len(starts) else []):
+        yield divmod(int(key[start]), base), total
+
+
+def _failing_regions(mesh: Mesh, found: dict, vertex_region: np.ndarray, wanted: list) -> set[int]:
+    """The regions whose re-tessellated cells are not proven cells of the Delaunay subdivision (the module's proof).
+
+    A region fails when one of its cells is not empty or ties with a vertex, or when
+    its cells' exact volumes do not sum to its elements'.
+    """
+    cells = mesh.cells
+    fresh = np.flatnonzero(~cells.proven)
+    cell_region = vertex_region[cells.nodes[:, 0]]
+    failing = set(cell_region[found["_not_cells"] - mesh.leaf_elements].tolist())
+    volumes = [Fraction(0)] * len(wanted)
+    key = cell_region[fresh] * len(cells.shapes) + cells.shape[fresh]
+    for (r, s), n in _sums(key, np.ones(len(fresh), dtype=object), len(cells.shapes)):
+        volumes[r] += cells.shapes[s].grid_volume * n
+    return failing | {r for r, (v, w) in enumerate(zip(volumes, wanted)) if v != w}
 
 
 def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict) -> Mesh:
@@ -222,7 +330,7 @@ def _object_if_large(array: np.ndarray, bound: int) -> np.ndarray:
     return array.astype(object) if bound >= 2**62 else array
 
 
-def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull") -> np.ndarray:
+def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull", proposal=None) -> np.ndarray:
     """The Delaunay tetrahedra of a region's vertices (global ids, in and out), without flat ones.
 
     ``qhull``: Qhull proposes them in floats and integers check the proposal; where
@@ -233,25 +341,27 @@ def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull") -> np
     """
     coords = mesh.vertices[ids].astype(np.int64)
     if engine == "qhull":
-        simplices = _qhull_proposal(mesh, coords)
+        simplices = _qhull_proposal(mesh, coords, proposal)
         if simplices is not None:
             return ids[simplices]
     return ids[np.array(delaunay_tetrahedra(coords.tolist(), _weights(mesh)), dtype=np.int64).reshape(-1, 4)]
 
 
-def _qhull_proposal(mesh: Mesh, coords: np.ndarray) -> np.ndarray | None:
+def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray | None:
     """Qhull's solid tetrahedra of the points (indices into ``coords``), or ``None`` when Qhull or the check fails.
 
     The check, in integers: across every face between two solid tetrahedra the far
     vertex is not strictly inside the near one's sphere (a tiling of the hull that
     is not Delaunay has such a face; float rounding on thin boxes makes exactly that
-    kind of flip).  The report's global empty-sphere check decides the mesh again.
+    kind of flip); it is cheap and saves a second pass, but it proves nothing alone:
+    :func:`retessellate` proves the cells.  ``proposal(real_points)``: a triangulation
+    with Qhull's ``simplices``, ``neighbors`` and ``coplanar`` in place of Qhull's (a seam for tests).
     """
     from scipy.spatial import Delaunay
 
     real = (coords - coords.min(axis=0)) * (np.array(mesh.box.to_float()) / mesh.grid)
     try:
-        triangulation = Delaunay(real, qhull_options="Qbb Qc Qz Q12 Qt")
+        triangulation = (proposal or (lambda points: Delaunay(points, qhull_options="Qbb Qc Qz Q12 Qt")))(real)
     except Exception:  # Qhull's float precision errors: the exact engine takes the region
         return None
     if len(triangulation.coplanar):
@@ -483,8 +593,9 @@ def delaunay_mesh(mesh: Mesh, mode: str = "global", progress=None) -> tuple[Mesh
 
     Returns the mesh; in ``global`` mode what the exact check found on the leaf mesh
     (``elements``, ``delaunay_violations``, ``delaunay_ties``, ``elements_replaced``),
-    else ``None``; and the check itself when it also holds for the mesh returned
-    (nothing was replaced: a cube octree), so that it need not run twice, else ``None``.
+    else ``None``; and :func:`check_delaunay` on the mesh returned in ``global`` mode
+    (on the leaf mesh when nothing was replaced: a cube octree; else the one that
+    proved the cells), so that it need not run twice, else ``None``.
     ``progress(n)`` is told as the check goes through the leaf mesh's elements.
     """
     if mode not in MODES:
@@ -494,5 +605,5 @@ def delaunay_mesh(mesh: Mesh, mode: str = "global", progress=None) -> tuple[Mesh
     found = check_delaunay(mesh, progress=progress)
     leaf = {"elements": len(mesh), "delaunay_violations": found["delaunay_violations"],
             "delaunay_ties": found["delaunay_ties"], "elements_replaced": int(len(found["_not_cells"]))}
-    result = global_delaunay(mesh, found)
-    return result, leaf, (found if result is mesh else None)
+    result, checked = _global_delaunay(mesh, found)
+    return result, leaf, (found if result is mesh else checked)
