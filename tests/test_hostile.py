@@ -421,6 +421,18 @@ def test_bad_and_unreachable_schedulers_are_one_line():
     assert time.monotonic() - start < 30
 
 
+def test_a_scheduler_port_that_never_answers_is_one_line_within_the_timeout(capsys):
+    # the kernel accepts the connection (the backlog), nothing answers: dask's Client waited for good
+    with socket.socket() as silent:
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(8)
+        start = time.monotonic()
+        refused(capsys, "study", "intersection", "--resolution", "2", "--scheduler",
+                f"tcp://127.0.0.1:{silent.getsockname()[1]}", "--scheduler-timeout", "1",
+                needle="cannot connect: no answer within 1 s")
+        assert time.monotonic() - start < 20
+
+
 @pytest.mark.parametrize("option", [["--jobs", "100000"], ["--jobs", "-1"], ["--dask-workers", "100000"]])
 def test_worker_counts_are_bounded_before_any_process_starts(capsys, option):
     # 100,000 local workers: each a Python with numpy; the run went on for minutes before failing

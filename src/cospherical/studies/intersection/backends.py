@@ -135,6 +135,8 @@ def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler:
                 cluster = LocalCluster(n_workers=dask_workers, threads_per_worker=1, processes=True,
                                        dashboard_address=None, local_directory=scratch,
                                        silence_logs=logging.CRITICAL)
+        if scheduler:
+            _handshake(scheduler)
         try:  # the connect timeout is dask's distributed.comm.timeouts.connect (--scheduler-timeout)
             client = Client(scheduler or cluster)
         except (OSError, TimeoutError, ValueError, TypeError) as error:
@@ -155,6 +157,34 @@ def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler:
         _close_dask(client, cluster)
         if scratch is not None:
             shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _handshake(scheduler: str) -> None:
+    """Connect to ``scheduler`` once and read its handshake, within --scheduler-timeout; else one line.
+
+    dask's Client bounds the TCP connect but not the wait for an answer: a port on
+    127.0.0.1 that accepted and said nothing kept the command waiting for good (over
+    120 s with --scheduler-timeout 3); one that sent garbage ended in "out of memory".
+    """
+    import asyncio
+
+    import dask
+    from dask.utils import parse_timedelta
+    from distributed.comm import connect
+
+    timeout = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), "s")
+
+    async def handshake() -> None:
+        comm = await asyncio.wait_for(connect(scheduler, timeout=timeout), timeout)
+        await comm.close()
+
+    try:
+        asyncio.run(handshake())
+    except (asyncio.TimeoutError, TimeoutError):
+        raise InputError(f"Dask scheduler {scheduler}: cannot connect: no answer within {timeout:g} s") from None
+    except Exception as error:  # refused, unreachable, or not a Dask scheduler's answer (MemoryError included)
+        text = str(error).splitlines()[0] if str(error) else type(error).__name__
+        raise InputError(f"Dask scheduler {scheduler}: cannot connect: {text}") from None
 
 
 @contextmanager
