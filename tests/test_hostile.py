@@ -691,3 +691,17 @@ def test_sigterm_while_a_local_dask_cluster_starts_waits_for_it_to_be_made():
     finally:
         signal.signal(signal.SIGTERM, previous)
     assert signal.getsignal(signal.SIGTERM) is previous
+
+
+def _one_gib():
+    resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))
+
+
+def test_the_exact_delaunay_check_on_a_stretched_box_is_bounded_before_its_pairs_are_made():
+    # 1e-12 x 1 x 3e9: floats cannot separate the vertices near each sphere, so nearly every vertex
+    # of its slab needed an exact test (40.6 M at level 5; level 6 passed 19.5 GB and was killed)
+    start = time.monotonic()
+    refused_subprocess("mesh", "--domain", "1e-12", "1", "3e9", "--refine", "box:0,0.1,1e8,1e-12,0.6,2e9",
+                       "--levels", "5", "--no-uniform", needle="sphere tests, above the bound of 16,777,216",
+                       preexec_fn=_one_gib, timeout=120)
+    assert time.monotonic() - start < 120

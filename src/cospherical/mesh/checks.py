@@ -21,8 +21,16 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..errors import InputError
 from .assembly import Mesh
 from .octree import distinct
+
+# Vertices found near spheres and tested exactly, at most: each test is a few microseconds of
+# Python integers and its pair ~100 bytes. A 1.38 M-leaf sphere tree needs 2.5 M; a box of
+# lengths 1e-12 x 1 x 3e9 at level 5 needed 40.6 M (floats there cannot separate the vertices
+# near a sphere), and at level 6 it passed 19.5 GB before the kernel killed it.
+MAX_EXACT_TESTS = 1 << 24
+PAIR_CHUNK = 1 << 22
 
 __all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "match_seams"]
 
@@ -327,10 +335,22 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
             progress(len(part))
     # the element's own nodes are on its sphere; anything more (or less) is looked at exactly
     suspect = np.flatnonzero(counts != n_nodes)
+    tests = int(counts[suspect].sum())
+    if tests > MAX_EXACT_TESTS:
+        raise InputError(f"the exact Delaunay check needs {tests:,} sphere tests, above the bound of "
+                         f"{MAX_EXACT_TESTS:,}: on a box this stretched, floats cannot tell which vertices "
+                         "are near each sphere (a coarser tree, or --delaunay leaf --no-delaunay)")
     pairs_row, pairs_vertex = [], []
-    for start in range(0, len(suspect), chunk):
-        rows = suspect[start:start + chunk]
+    # chunks of at most PAIR_CHUNK vertices found (a Python list of them is 36 bytes a vertex), and
+    # at least one sphere each
+    ends = np.searchsorted(np.cumsum(counts[suspect]), np.arange(1, tests // PAIR_CHUNK + 2) * PAIR_CHUNK, "right")
+    for start, end in zip(np.r_[0, ends[:-1]], ends):
+        rows = suspect[start:max(end, start + 1)]
+        if not len(rows):
+            continue
         found = tree.query_ball_point(centres[rows], reach[rows], workers=workers)
+        if any(x is None for x in found):  # a search thread that ran out of memory leaves None
+            raise MemoryError
         lengths = np.fromiter((len(x) for x in found), dtype=np.int64, count=len(found))
         pairs_row.append(np.repeat(rows, lengths))
         found_vertices = np.fromiter((v for x in found for v in x), dtype=np.int64, count=int(lengths.sum()))
