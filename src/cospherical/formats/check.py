@@ -116,20 +116,21 @@ def _check_recomputed(cfg, positions: dict, squared, entry: dict, criteria, wher
     centers = []
     for c, criterion in enumerate(criteria):
         for k, element in enumerate(entry_elements(entry, criterion)):
-            here = f"{where}/{criterion}/{k}"
             points = tuple(positions[n] for n in element["nodes"])
             if points not in cache:
-                cache[points] = _recompute(points, squared)
+                # with the float circumcenter: float() of a Fraction is slow, and the scale is the
+                # table's box, the same for every configuration that shares this cache
+                found = _recompute(points, squared)
+                cache[points] = found and (*found, [float(x) * s for x, s in zip(found[2], scale)])
             if cache[points] is None:
-                raise FormatError(f"{here}: its nodes are not the vertices of a convex element on one sphere")
-            type_id, mirrored, center = cache[points]
+                raise FormatError(f"{where}/{criterion}/{k}: its nodes are not the vertices of a convex element on one sphere")
+            type_id, mirrored, center, real = cache[points]
             if element["type"] != type_id:
-                raise FormatError(f"{here}: type {element['type']}, recomputed {type_id}")
+                raise FormatError(f"{where}/{criterion}/{k}: type {element['type']}, recomputed {type_id}")
             if bool(element.get("mirror", False)) != mirrored:
-                raise FormatError(f"{here}: mirror is {bool(element.get('mirror', False))}, recomputed {mirrored}")
-            real = [float(x) * s for x, s in zip(center, scale)]
+                raise FormatError(f"{where}/{criterion}/{k}: mirror is {bool(element.get('mirror', False))}, recomputed {mirrored}")
             if [float(x) for x in element["circumcenter"]] != real:
-                raise FormatError(f"{here}: circumcenter {element['circumcenter']}, recomputed {real}")
+                raise FormatError(f"{where}/{criterion}/{k}: circumcenter {element['circumcenter']}, recomputed {real}")
             if c == 0:
                 centers.append(center)
     adequate = all(cfg.contains(center) for center in centers)
