@@ -57,6 +57,7 @@ from ..core.configuration import Box
 from ..core.delaunay import hull_faces
 from ..core.geometry import Frame, cross, dot, sub
 from ..errors import InputError
+from .octree import distinct
 
 __all__ = ["Dual", "ElementPieces", "boundary_areas", "delaunay_tetrahedra", "dual_summary", "element_pieces", "mesh_dual",
            "tetrahedral_counts"]
@@ -584,9 +585,9 @@ def tetrahedral_counts(grid_vertices: np.ndarray) -> dict:
     tets = np.sort(tets, axis=1)
     n = np.int64(len(points))
     pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
-    edges = np.unique(np.concatenate([tets[:, a] * n + tets[:, b] for a, b in pairs]))
+    edges = distinct(np.concatenate([tets[:, a] * n + tets[:, b] for a, b in pairs]))
     triples = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
-    faces = np.unique(np.concatenate([(tets[:, a] * n + tets[:, b]) * n + tets[:, c] for a, b, c in triples]))
+    faces = distinct(np.concatenate([(tets[:, a] * n + tets[:, b]) * n + tets[:, c] for a, b, c in triples]))
     return {"tool": tool, "elements": int(len(tets)), "edges": int(len(edges)),
             "faces": int(len(faces)), "nonzeros": int(len(points) + 2 * len(edges)), "flat": flat}
 

@@ -49,7 +49,7 @@ from ..studies.intersection.backends import completed
 from .assembly import Cells, assemble, vertex_keys
 from .checks import check_delaunay
 from .delaunay import retessellate, with_cells
-from .octree import Octree
+from .octree import Octree, distinct
 from .report import merged_report, mesh_figures
 
 __all__ = ["MAX_PARTITIONS", "Piece", "mesh_in_pieces", "mesh_piece", "morton_pieces"]
@@ -136,7 +136,7 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None) -> dict:
                                "elements_replaced": int(len(found["_not_cells"]))}
         failing = found["_not_cells"]
         if len(failing):
-            result["marked"] = piece.leaves[np.unique(mesh.element_leaf[failing])]
+            result["marked"] = piece.leaves[distinct(mesh.element_leaf[failing])]
             result["failing"] = (piece.leaves[mesh.element_leaf[failing]], mesh.element_local[failing])
             return result
         checked = found
