@@ -375,7 +375,8 @@ def _resigned(good: Path, target: Path, manifest_edit=None, members: dict | None
 
 @pytest.mark.parametrize("case", ["factor 1e999999999", "factor 1e400", "grid 10**400", "integers --5",
                                   "integers of 5000 digits", "boundary factors not the domain's",
-                                  "manifest nested 100,000 deep", "manifest with a repeated key"])
+                                  "manifest nested 100,000 deep", "manifest with a repeated key",
+                                  "a grid vertex outside the grid"])
 def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, tmp_path, capsys, case):
     from cospherical.cli import main
 
@@ -394,6 +395,12 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
 
         count = len(read_dual(good).volume_exact)
         members = {"volume_exact": np.array(["--5" if "--5" in case else "9" * 5000] * count)}
+    if case == "a grid vertex outside the grid":  # re-signed: the checks' sums never read the vertices
+        from cospherical.formats.dual import read_dual
+
+        vertices = read_dual(good).grid_vertices.copy()
+        vertices[0] = [-1, 10**15, 0]
+        members = {"grid_vertices": vertices}
     _resigned(good, tmp_path / "hostile.npz", edits.get(case), members)
     capsys.readouterr()
     start = time.monotonic()

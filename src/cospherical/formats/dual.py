@@ -269,6 +269,9 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
         plane_squared = tuple(Fraction(f) for f in factors)
     except (ValueError, TypeError, ZeroDivisionError, OverflowError) as error:
         raise FormatError(f"{path}: manifest: {error}") from None
+    vertices = arrays["grid_vertices"]
+    if len(vertices) and (vertices.min() < 0 or vertices.max() > grid):
+        raise FormatError(f"{path}: member grid_vertices: a vertex outside the grid of {grid} intervals per side")
     squared = tuple(Fraction(x) for x in box.squared)
     if plane_squared != tuple(squared[(k + 1) % 3] * squared[(k + 2) % 3] for k in range(3)):
         raise FormatError(f"{path}: manifest: boundary_factors_squared are not the domain's (b^2 c^2, a^2 c^2, a^2 b^2)")
