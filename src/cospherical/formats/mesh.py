@@ -111,14 +111,19 @@ def read_leaves(path: str | Path, max_leaves: int | None = None) -> tuple[np.nda
     return array[:, 0], array[:, 1:]
 
 
-def table_lookup(table, criterion: str, box: Box, name: str = "pattern table") -> Lookup:
+def table_lookup(table, criterion: str, box: Box, name: str = "pattern table", catalogue: dict | None = None) -> Lookup:
     """A lookup for :func:`cospherical.mesh.assembly.assemble` reading a pattern table.
 
     The table is asked for the leaf's whole-point-set code (``800000000000+f``), and
     where its header names a point policy, for the bare edge code when that policy
     gives the same point set.  The table's box must have the domain's proportions
-    (every leaf is the domain scaled down).
+    (every leaf is the domain scaled down).  ``catalogue``: the element catalogue
+    naming the table's types (default: the shipped one), see :func:`orbit_lookup`.
     """
+    if catalogue is None:
+        from ..catalogue import shipped_catalogue
+
+        catalogue = shipped_catalogue()
     header = getattr(table, "header", None) or {}
     element = header.get("element", "cuboid")
     if element != "cuboid":
@@ -149,7 +154,7 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table") -
                 return None
         return None
 
-    return orbit_lookup(lookup, box)
+    return orbit_lookup(lookup, box, catalogue)
 
 
 # Node orders that turn a VTK cell's mirror image back into a VTK cell (the first face's
@@ -158,7 +163,7 @@ _MIRRORED_VTK = {"tetra": (0, 2, 1, 3), "pyramid": (0, 3, 2, 1, 4), "wedge": (0,
                  "hexahedron": (0, 3, 2, 1, 4, 7, 6, 5)}
 
 
-def orbit_lookup(lookup: Lookup, box: Box) -> Lookup:
+def orbit_lookup(lookup: Lookup, box: Box, catalogue: dict) -> Lookup:
     """``lookup``, and for a configuration it lacks, its orbit representative's elements carried back.
 
     A table of orbit representatives (the intersection store) holds one
@@ -167,13 +172,14 @@ def orbit_lookup(lookup: Lookup, box: Box) -> Lookup:
     (:func:`cospherical.core.symmetry.orbit_representatives`), the representative
     looked up, and each element's nodes mapped back through that symmetry's node
     map; a reflection also reverses a VTK cell's faces, so its nodes are put back in
-    VTK order.  Mapped elements carry ``mapped_from`` (the representative's code).
+    VTK order (the VTK cell of each type from ``catalogue``, the element catalogue
+    naming the table's types).  Mapped elements carry ``mapped_from`` (the
+    representative's code).
     """
-    from ..catalogue import shipped_catalogue
     from ..core.symmetry import box_symmetries, orbit_representatives
 
     symmetries = box_symmetries(box)
-    vtk = {entry["id"]: entry.get("vtk") for entry in shipped_catalogue().get("types", [])}
+    vtk = {entry["id"]: entry.get("vtk") for entry in catalogue.get("types", [])}
 
     def mapped(configuration: Configuration):
         found = lookup(configuration)
