@@ -175,3 +175,33 @@ def test_a_terminated_pattern_table_leaves_no_worker_and_no_table(tmp_path):
     time.sleep(0.5)
     assert not [pid for pid in workers if Path(f"/proc/{pid}").exists()], "a worker outlived the command"
     assert not list(tmp_path.glob("*patterns*")) and not list(tmp_path.glob(".*"))
+
+
+@pytest.mark.parametrize("sig, status", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_that_a_library_turns_into_its_own_error_still_ends_the_run_as_signalled(
+        monkeypatch, capsys, sig, status):
+    # numba reports an exception raised by a signal handler during a compiled call as
+    # "SystemError: CPUDispatcher(...) returned a result with an exception set": the run
+    # must still end as the signal says, with one line and no traceback.
+    import cospherical.cli as cli
+    import cospherical.cli.tessellate as tessellate
+
+    def compiled_call(args):
+        try:
+            signal.raise_signal(sig)
+        except BaseException as error:
+            raise SystemError("CPUDispatcher(<function>) returned a result with an exception set") from error
+
+    monkeypatch.setattr(tessellate, "run", compiled_call)
+    handlers = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
+    try:
+        try:
+            code = cli.main(["tessellate", "--box", "1", "1", "1", "--code", "800000000000"])
+        except SystemExit as exit:
+            code = exit.code
+    finally:
+        signal.signal(signal.SIGTERM, handlers[0])
+        signal.signal(signal.SIGINT, handlers[1])
+    assert code == status
+    assert capsys.readouterr().err.strip() == ("cospherical: terminated" if sig == signal.SIGTERM
+                                               else "cospherical: interrupted")

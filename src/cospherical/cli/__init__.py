@@ -45,24 +45,24 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
-def _terminated(signum, frame):
-    # SIGTERM unwinds like an exception, so that temporary files are removed and
-    # every output stays either the old complete file or the new complete file.
-    raise SystemExit(128 + signum)
-
-
 _interrupted = threading.Event()
+_terminated = threading.Event()
 
 
-def _interrupt(signum, frame):
-    # Remembered as well as raised: a KeyboardInterrupt raised inside a callback
-    # from compiled code can be swallowed there, and the run must not then end with 0.
-    _interrupted.set()
+def _on_signal(signum, frame):
+    # SIGINT unwinds as KeyboardInterrupt, SIGTERM as SystemExit(143), so that temporary
+    # files are removed and every output stays either the old complete file or the new
+    # complete file. Each is remembered as well as raised: raised inside a call into
+    # compiled code it can come back as that library's own error (numba: SystemError,
+    # numpy: ImportError) or be swallowed there, and the run must still end as signalled.
+    (_terminated if signum == signal.SIGTERM else _interrupted).set()
     if _in_compiler(frame):
         # Unwinding through numba's compiler or cache loader crashes the process (SIGSEGV):
         # deliver the signal again shortly, until it arrives outside.
         threading.Timer(0.1, os.kill, (os.getpid(), signum)).start()
         return
+    if signum == signal.SIGTERM:
+        raise SystemExit(128 + signum)
     raise KeyboardInterrupt
 
 
@@ -106,9 +106,10 @@ def _closed_standard_streams() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _terminated)
-        signal.signal(signal.SIGINT, _interrupt)
+        signal.signal(signal.SIGTERM, _on_signal)
+        signal.signal(signal.SIGINT, _on_signal)
     _interrupted.clear()
+    _terminated.clear()
     _closed_standard_streams()
     try:
         words = sys.argv[1:] if argv is None else argv
@@ -116,6 +117,8 @@ def main(argv: list[str] | None = None) -> int:
         args = build_parser(command if command in SUBCOMMANDS else None).parse_args(argv)
         status = args.run(args)
         sys.stdout.flush()  # a full disk or /dev/full shows here, as one line, not at exit
+        if _terminated.is_set():
+            raise SystemExit(128 + signal.SIGTERM)
         if _interrupted.is_set():
             raise KeyboardInterrupt
         if argv is None:
@@ -151,7 +154,12 @@ def main(argv: list[str] | None = None) -> int:
         _silence_stdout()
         return 2
     except Exception:
-        if _interrupted.is_set():  # an interrupt that a library turned into its own error (numpy: ImportError)
+        # A signal that a library turned into its own error (numba: SystemError, numpy: ImportError).
+        if _terminated.is_set():
+            _stop_workers()
+            print("cospherical: terminated", file=sys.stderr)
+            raise SystemExit(128 + signal.SIGTERM) from None
+        if _interrupted.is_set():
             _stop_workers()
             print("cospherical: interrupted", file=sys.stderr)
             return 130
