@@ -221,9 +221,9 @@ def test_a_scaled_cell_shape_is_the_shape_of_the_scaled_offsets():
 
     mesh = global_delaunay(assemble(build_octree(Box.parse(["1", "2", "4"]), 3, [parse_shape("point:0.1,0.1,0.1")])))
     for shape in mesh.cells.shapes[:6]:
-        unit, _ = _shape(list(shape.offsets), mesh.box.squared, {})
+        unit, _ = _shape(list(shape.offsets), mesh.box.squared, {}, mesh.catalogue)
         for g in (2, 3):
-            direct, _ = _shape([tuple(g * x for x in o) for o in shape.offsets], mesh.box.squared, {})
+            direct, _ = _shape([tuple(g * x for x in o) for o in shape.offsets], mesh.box.squared, {}, mesh.catalogue)
             assert _scaled(unit, g) == direct
 
 

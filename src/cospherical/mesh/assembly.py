@@ -207,6 +207,7 @@ class Mesh:
     types: dict[str, dict] = field(default_factory=dict)
     replaced: np.ndarray | None = None
     cells: Cells | None = None
+    catalogue: dict | None = field(default=None, repr=False, compare=False)  # names the types; from assemble
     _groups: list | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -339,9 +340,9 @@ class Mesh:
         inside = (num >= low * scaled) & (num <= (low + size[:, None]) * scaled)
         return inside.all(axis=1).astype(bool)
 
-def _type_info(type_id: str, etype: ElementType | None) -> dict:
-    """Name, paper class, VTK cell and size of a type: from the shipped catalogue, else from the type itself."""
-    for entry in shipped_catalogue()["types"]:
+def _type_info(type_id: str, etype: ElementType | None, catalogue: dict) -> dict:
+    """Name, paper class, VTK cell and size of a type: from the catalogue, else from the type itself."""
+    for entry in catalogue["types"]:
         if entry["id"] == type_id:
             return {"name": entry["name"], "paper_class": (entry.get("aliases") or [None])[0],
                     "vtk": entry.get("vtk"), "vertices": entry["vertices"], "faces": entry["faces"]}
@@ -388,7 +389,7 @@ def _node_keys(origin: np.ndarray, half: np.ndarray, grid: int, part: slice, nod
 
 def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int], None] | None = None,
              cache: dict | None = None, criterion: str = "optimal",
-             vertices: tuple[int, np.ndarray] | None = None) -> Mesh:
+             vertices: tuple[int, np.ndarray] | None = None, catalogue: dict | None = None) -> Mesh:
     """Mesh an octree: configurations from the vertex set, elements from ``lookup`` (else tessellated).
 
     ``lookup(configuration)`` returns the pattern table's elements of that point set
@@ -398,7 +399,9 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     ``cache`` ((code, criterion) -> :class:`LocalPattern`) may be shared between runs.
     ``progress(n)`` is told as leaves are assembled.  ``vertices``: the grid and vertex keys
     (:func:`vertex_keys`) of a whole tree of which ``tree`` is a part: the part's
-    configurations and vertex ids are then the whole tree's.
+    configurations and vertex ids are then the whole tree's.  ``catalogue``: the element
+    catalogue that names the types and gives the kept types of ``criterion`` (default: the
+    shipped one); the mesh keeps it (:attr:`Mesh.catalogue`) for its report.
 
     Examples
     --------
@@ -408,6 +411,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     (8, 27, 8)
     """
     cache = {} if cache is None else cache
+    catalogue = shipped_catalogue() if catalogue is None else catalogue
     grid, keys_all = vertex_keys(tree) if vertices is None else vertices
     size = grid >> tree.levels.astype(np.int64)  # leaf edge in grid units (even)
     origin = tree.positions.astype(np.int64) * size[:, None]
@@ -438,12 +442,13 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     for value in distinct.tolist():
         code = leaf_code(value & 0xFFF, value >> 12)
         if (code, criterion) not in cache:
-            cache[code, criterion] = _pattern(Configuration.from_code(code, tree.box), lookup, types, criterion)
+            cache[code, criterion] = _pattern(Configuration.from_code(code, tree.box), lookup, types, criterion,
+                                              catalogue)
         patterns.append(cache[code, criterion])
     for pattern in patterns:
         for element in pattern.elements:
             if element.type_id not in types:
-                types[element.type_id] = _type_info(element.type_id, None)
+                types[element.type_id] = _type_info(element.type_id, None, catalogue)
     counts = np.array([len(p.elements) for p in patterns], dtype=np.int64)[leaf_pattern]
     offsets = np.zeros(len(tree) + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
@@ -452,15 +457,16 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     if progress:
         progress(len(tree) - len(tree) // 2)
     return Mesh(tree, grid, vertices, slots, leaf_pattern.astype(np.int32).reshape(-1), patterns, offsets,
-                element_leaf, element_local, types)
+                element_leaf, element_local, types, catalogue=catalogue)
 
 
-def _pattern(configuration: Configuration, lookup: Lookup | None, types: dict, criterion: str) -> LocalPattern:
+def _pattern(configuration: Configuration, lookup: Lookup | None, types: dict, criterion: str,
+             catalogue: dict) -> LocalPattern:
     elements = lookup(configuration) if lookup is not None else None
     if elements is not None:
         return local_pattern(configuration, [(e["type"], e["nodes"]) for e in elements],
                              mapped_from=next((e["mapped_from"] for e in elements if "mapped_from" in e), None))
-    tess = apply_catalogue_criterion(tessellate(configuration), criterion)
+    tess = apply_catalogue_criterion(tessellate(configuration), criterion, catalogue)
     for element in tess.elements:
-        types.setdefault(element.type.id, _type_info(element.type.id, element.type))
+        types.setdefault(element.type.id, _type_info(element.type.id, element.type, catalogue))
     return local_pattern(configuration, [(e.type.id, e.nodes) for e in tess.elements], on_the_fly=True)

@@ -273,7 +273,7 @@ def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict) -> Mesh:
     return Mesh(mesh.tree, mesh.grid, mesh.vertices, mesh.slots, mesh.leaf_pattern, mesh.patterns, offsets,
                 np.r_[element_leaf, cells.leaf.astype(np.int32)], np.r_[element_local, np.full(len(cells), -1,
                                                                                               dtype=np.int16)],
-                types, replaced=bad, cells=cells)
+                types, replaced=bad, cells=cells, catalogue=mesh.catalogue)
 
 
 def _regions(nodes: np.ndarray, vertices: int) -> tuple[np.ndarray, int]:
@@ -521,7 +521,8 @@ def _cells(mesh: Mesh, merged: np.ndarray, proven: np.ndarray, located: _Locator
         g = int(np.gcd.reduce(np.abs(offsets[rows[0], :k]).reshape(-1)))
         unit = offsets[rows[0], :k] // g
         if unit.tobytes() not in measured:
-            measured[unit.tobytes()] = _shape([tuple(int(x) for x in o) for o in unit], mesh.box.squared, types)
+            measured[unit.tobytes()] = _shape([tuple(int(x) for x in o) for o in unit], mesh.box.squared, types,
+                                                   mesh.catalogue)
         shape, order = measured[unit.tobytes()]
         shapes.append(_scaled(shape, g))
         nodes[rows, :len(order)] = members[np.ix_(rows, order)]
@@ -546,7 +547,7 @@ def _row_classes(rows: np.ndarray) -> np.ndarray:
     return classes
 
 
-def _shape(offsets: list[tuple[int, int, int]], squared, types: dict) -> tuple[CellShape, list[int]]:
+def _shape(offsets: list[tuple[int, int, int]], squared, types: dict, catalogue: dict) -> tuple[CellShape, list[int]]:
     """Classify and measure one cell shape (vertex offsets from the anchor, grid units), exactly.
 
     Returns the shape and the order of ``offsets`` that is the type's reference order.
@@ -556,7 +557,7 @@ def _shape(offsets: list[tuple[int, int, int]], squared, types: dict) -> tuple[C
     if len(elements) != 1 or len(elements[0].nodes) != len(offsets):
         raise ValueError(f"merged tetrahedra are not one co-spherical cell: {offsets}")
     element = elements[0]
-    types.setdefault(element.type.id, _type_info(element.type.id, element.type))
+    types.setdefault(element.type.id, _type_info(element.type.id, element.type, catalogue))
     order = list(element.nodes)
     at = {n: i for i, n in enumerate(order)}
     frame = Frame.build({i: points[n] for i, n in enumerate(order)}, squared)

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..catalogue import shipped_catalogue
 from ..core.configuration import Box
 from ..errors import InputError
 from ..studies.intersection.backends import completed
@@ -109,12 +110,13 @@ class Piece:
     types: dict | None = None
 
 
-def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None) -> dict:
+def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: dict) -> dict:
     """Mesh, check and write one piece (run in a worker); see the module for why it equals its part of the whole.
 
     ``keys``: the whole tree's vertex keys; ``lookup``: ``(factory, arguments)`` that make
     the pattern lookup in the worker (a closure does not travel), or ``None``.  Both are
-    the same for every piece: on Dask they reach each worker once.
+    the same for every piece: on Dask they reach each worker once; so does ``catalogue``,
+    the element catalogue every piece is assembled with.
 
     Returns ``index``; in the first round of ``global`` mode, ``leaf_mesh`` (what the
     exact check found on the piece's leaf mesh) and, if some of its elements are not
@@ -124,7 +126,7 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None) -> dict:
     """
     tree = Octree(piece.box, piece.levels, piece.positions)
     mesh = assemble(tree, lookup[0](*lookup[1]) if lookup is not None else None, criterion=piece.criterion,
-                    vertices=(piece.grid, keys))
+                    vertices=(piece.grid, keys), catalogue=catalogue)
     result: dict = {"index": piece.index}
     checked = None
     if piece.cells is not None:
@@ -152,13 +154,15 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None) -> dict:
 def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: str, mode: str,
                    described: dict, patterns: str | None, uniform: bool = True, delaunay: bool = True,
                    write: Callable | None = None, path: Callable[[int], str] | None = None, jobs: int = 1,
-                   scheduler: str | None = None, dask_workers: int | None = None) -> dict:
+                   scheduler: str | None = None, dask_workers: int | None = None, catalogue: dict | None = None) -> dict:
     """Mesh ``tree`` in ``pieces`` tasks (each writing ``path(k)`` with ``write``); return the whole mesh's report.
 
     ``lookup``: ``(factory, arguments)`` of the pattern lookup (``None``: every
     configuration tessellated); ``jobs``, ``scheduler``, ``dask_workers``: where the
-    tasks run (:func:`~cospherical.studies.intersection.backends.completed`).
+    tasks run (:func:`~cospherical.studies.intersection.backends.completed`); ``catalogue``: the
+    element catalogue (default: the shipped one), as in :func:`~cospherical.mesh.assembly.assemble`.
     """
+    catalogue = shipped_catalogue() if catalogue is None else catalogue
     grid, keys = vertex_keys(tree)
     parts = morton_pieces(tree, pieces)
 
@@ -168,7 +172,7 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
                       delaunay, write, path(k) if path is not None else None, **more),)
 
     results = dict(completed(mesh_piece, {k: task(k) for k in range(pieces)}, jobs, scheduler, dask_workers,
-                             common=(keys, lookup)))
+                             common=(keys, lookup, catalogue)))
     leaf_mesh = None
     regions = (0, 0)
     if mode == "global":
@@ -179,9 +183,10 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
         if len(marked):
             failing = [results[k]["failing"] for k in range(pieces) if "failing" in results[k]]
             failing = tuple(np.concatenate([f[i] for f in failing]) for i in range(2))
-            again, regions = _cells_by_piece(tree, parts, marked, failing, grid, keys, lookup, criterion)
+            again, regions = _cells_by_piece(tree, parts, marked, failing, grid, keys, lookup, criterion,
+                                                     catalogue)
             results.update(completed(mesh_piece, {k: task(k, **more) for k, more in again.items()}, jobs,
-                                     scheduler, dask_workers, common=(keys, lookup)))
+                                     scheduler, dask_workers, common=(keys, lookup, catalogue)))
     seams = [seam for k in range(pieces) for seam in results[k]["seams"]]
     n = np.int64(grid + 1)
 
@@ -189,11 +194,12 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
         return np.stack([keys[ids] // (n * n), (keys[ids] // n) % n, keys[ids] % n], axis=-1)
 
     return merged_report(tree, len(keys), [results[k]["figures"] for k in range(pieces)], described, patterns,
-                         criterion, uniform, delaunay, leaf_mesh, regions, seams, points, grid)
+                         criterion, uniform, delaunay, leaf_mesh, regions, seams, points, grid, catalogue=catalogue)
 
 
 def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, failing: tuple, grid: int,
-                    keys: np.ndarray, lookup: tuple | None, criterion: str) -> tuple[dict[int, dict], tuple[int, int]]:
+                    keys: np.ndarray, lookup: tuple | None, criterion: str,
+                    catalogue: dict) -> tuple[dict[int, dict], tuple[int, int]]:
     """Re-tessellate the marked leaves (whole-tree indices) and give each cell to the piece of its first leaf.
 
     ``failing``: the elements that are not Delaunay cells, as (whole-tree leaf, index in the leaf).
@@ -203,7 +209,7 @@ def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, f
     """
     sub = Octree(tree.box, tree.levels[marked], tree.positions[marked])
     mesh = assemble(sub, lookup[0](*lookup[1]) if lookup is not None else None, criterion=criterion,
-                    vertices=(grid, keys))
+                    vertices=(grid, keys), catalogue=catalogue)
     types = dict(mesh.types)
     cells = retessellate(mesh, mesh.element_offsets[np.searchsorted(marked, failing[0])] + failing[1], types)
     piece_of_leaf = np.empty(len(tree), dtype=np.int64)

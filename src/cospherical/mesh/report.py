@@ -14,7 +14,6 @@ from typing import Callable
 
 import numpy as np
 
-from ..catalogue import shipped_catalogue
 from ..version import __version__
 from .assembly import Mesh
 from .checks import check_circumcenters, check_conformity, check_delaunay, check_volume, match_seams
@@ -32,12 +31,12 @@ _SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_f
 
 
 def outside_catalogue(mesh: Mesh) -> list[dict]:
-    """The element types of the mesh the shipped catalogue does not name: id, systematic name, count, one example.
+    """The element types of the mesh its catalogue (:attr:`Mesh.catalogue`) does not name: id, systematic name, count, one example.
 
     The example is one element's vertices in domain units (exact fractions of the
     domain's sides, as text).  Nothing is added to the catalogue.
     """
-    known = {entry["id"] for entry in shipped_catalogue()["types"]}
+    known = {entry["id"] for entry in mesh.catalogue["types"]}
     found: dict[str, dict] = {}
     for rows, nodes, _, type_id in mesh.blocks():
         if type_id in known or not len(rows):
@@ -95,8 +94,10 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
 def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dict, patterns: str | None,
                   criterion: str = "optimal", uniform: bool = True, delaunay: bool = True,
                   leaf_mesh: dict | None = None, cells: tuple[int, int] = (0, 0), seams: list | None = None,
-                  vertex_points: Callable | None = None, grid: int = 1) -> dict:
+                  vertex_points: Callable | None = None, grid: int = 1, *, catalogue: dict) -> dict:
     """The report of a mesh from the :func:`mesh_figures` of its pieces (one piece: the whole mesh).
+
+    ``catalogue``: the element catalogue the pieces were assembled with (it names the types).
 
     ``cells``: the regions re-tessellated and the largest one's vertices; ``seams``:
     the faces the pieces left open, paired here (``vertex_points(ids)`` gives their
@@ -164,8 +165,8 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
     types: dict = {}
     for part in parts:
         types.update(part["types"])
-    report.update(statistics(type_counts, configurations, len(tree), types,
-                             uniform_study(tree.box) if uniform else None))
+    report.update(statistics(type_counts, configurations, len(tree), types, catalogue,
+                             uniform_study(tree.box, catalogue) if uniform else None))
     return report
 
 
@@ -202,4 +203,4 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
         violating.append(figures["_violating"])
     cells = (mesh.cells.regions, mesh.cells.largest_region) if mesh.cells is not None else (0, 0)
     return merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
-                         leaf_mesh, cells)
+                         leaf_mesh, cells, catalogue=mesh.catalogue)

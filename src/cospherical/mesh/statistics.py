@@ -22,11 +22,12 @@ __all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrence
 BISECTION_CONFIGURATIONS = 4096
 
 
-def uniform_study(box: Box) -> dict:
-    """Element counts per type of the uniform-weight bisection study of ``box`` (octree policy, optimal)."""
+def uniform_study(box: Box, catalogue: dict) -> dict:
+    """Element counts per type of the uniform-weight bisection study of ``box`` (octree policy, optimal),
+    the types named by ``catalogue``."""
     study = run_study("bisection", box, bisection_codes(), "octree", criteria=("optimal",))
     counts = {tc.type.id: tc.count for tc in study.type_counts("optimal")}
-    info = {tc.type.id: _type_info(tc.type.id, tc.type) for tc in study.type_counts("optimal")}
+    info = {tc.type.id: _type_info(tc.type.id, tc.type, catalogue) for tc in study.type_counts("optimal")}
     return {"counts": counts, "types": info, "elements": study.total("optimal")}
 
 
@@ -54,7 +55,7 @@ def mesh_statistics(mesh: Mesh, uniform: dict | None = None) -> dict:
     one of the paper's seven final elements) and, with ``uniform``, its figures.
     """
     type_counts, configurations = occurrences(mesh)
-    return statistics(type_counts, configurations, len(mesh.tree), mesh.types, uniform)
+    return statistics(type_counts, configurations, len(mesh.tree), mesh.types, mesh.catalogue, uniform)
 
 
 def occurrences(mesh: Mesh) -> tuple[Counter, dict[str, dict]]:
@@ -80,8 +81,9 @@ def occurrences(mesh: Mesh) -> tuple[Counter, dict[str, dict]]:
 
 
 def statistics(type_counts: Counter, configurations: dict[str, dict], total_leaves: int, types: dict,
-               uniform: dict | None = None) -> dict:
-    """:func:`mesh_statistics` from the :func:`occurrences` of a mesh (or of all its pieces, added up)."""
+               catalogue: dict, uniform: dict | None = None) -> dict:
+    """:func:`mesh_statistics` from the :func:`occurrences` of a mesh (or of all its pieces, added up);
+    ``catalogue`` names the types met nowhere else."""
     configurations = sorted(({
         "code": c["code"], "leaves": c["leaves"], "share": _share(c["leaves"], total_leaves),
         "uniform_share": _share(1, BISECTION_CONFIGURATIONS) if c["in_bisection_family"] else None,
@@ -95,7 +97,7 @@ def statistics(type_counts: Counter, configurations: dict[str, dict], total_leav
     info.update(types)
     rows = []
     for type_id in sorted(set(type_counts) | set(uniform_counts), key=lambda t: (-type_counts[t], t)):
-        entry = info.get(type_id) or _type_info(type_id, None)
+        entry = info.get(type_id) or _type_info(type_id, None, catalogue)
         rows.append({
             "id": type_id, "name": entry["name"], "paper_class": entry["paper_class"], "vtk": entry["vtk"],
             "count": int(type_counts[type_id]), "share": _share(type_counts[type_id], total),
