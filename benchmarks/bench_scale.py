@@ -18,8 +18,8 @@ and, every half second while it runs, by the resident memory of its process tree
 the report's counts (leaves, vertices, elements, every exact check), and whether the two
 reports are the same bytes but for the generator line.
 
-At L 10 each process peaks at several GB (about 7.5 GB in one process, 3 GB in two
-pieces) and takes minutes of CPU: check ``free -g`` first, or run ``--levels 9``.
+At L 10 each process peaks at several GB and takes minutes of CPU (the last run below
+says how many): check ``free -g`` first, or run ``--levels 9``.
 Writes results/benchmarks/bench_scale.json (benchmarks/record.py).
 """
 
@@ -108,15 +108,15 @@ def main() -> None:
                 f"{report['configurations']} configurations ({report['configurations_from_table']} from the table)")
         print(f"the tree: {tree}; {checks}")
         print(f"report.json of (2) the same as (1)'s but for the generator line: {same}")
-        record.add(f"the tree (`{shown}`)", f"{tree}; {checks}")
+        record.add(f"the tree ({shown})", f"{tree}; {checks}")
         record.table(["command", "CPU (user + system)", "wall", "peak, largest process", "peak, process tree summed", "files"], [
-            ["one process, `--out DIR`", f"{a['user'] + a['system']:.1f} s ({a['user']:.1f} + {a['system']:.1f})",
+            ["one process, --out DIR", f"{a['user'] + a['system']:.1f} s ({a['user']:.1f} + {a['system']:.1f})",
              f"{a['wall']:.0f} s", f"{a['peak_gb']:.2f} GB", f"{a['tree_gb']:.2f} GB",
-             ", ".join(f"`{name}` {size(single / name)}" for name in ("mesh.vtu", "mesh.png", "report.json"))],
-            ["`--partitions 2 --jobs 1 --out DIR`", f"{b['user'] + b['system']:.1f} s ({b['user']:.1f} + {b['system']:.1f})",
+             ", ".join(f"{name} {size(single / name)}" for name in ("mesh.vtu", "mesh.png", "report.json"))],
+            ["--partitions 2 --jobs 1 --out DIR", f"{b['user'] + b['system']:.1f} s ({b['user']:.1f} + {b['system']:.1f})",
              f"{b['wall']:.0f} s", f"{b['peak_gb']:.2f} GB", f"{b['tree_gb']:.2f} GB",
-             ", ".join(f"`{name}` {size(pieces / name)}" for name in ("mesh-0.vtu", "mesh-1.vtu", "mesh.pvtu"))
-             + f"; `report.json` {'the same as the single process’s but for the generator line' if same else 'DIFFERS'}"],
+             ", ".join(f"{name} {size(pieces / name)}" for name in ("mesh-0.vtu", "mesh-1.vtu", "mesh.pvtu"))
+             + f"; report.json {'the same as the single process’s but for the generator line' if same else 'DIFFERS'}"],
         ])
 
 
