@@ -276,3 +276,29 @@ def test_a_wrong_proposal_the_local_check_passes_is_redone_exactly(change, monke
     assert calls  # the proof failed on the proposal's cells: the exact engine redid those regions
     assert mesh_cells(mesh) == oracle_cells(leaf)
     assert whole(mesh) == WHOLE
+
+
+def test_a_table_element_that_is_not_cospherical_is_replaced_by_delaunay_cells():
+    # A pattern table may hold an element that is no Delaunay element at all (here a whole
+    # leaf with its edge and face points as one element): it has no sphere to test, so it
+    # must count among the elements that are not cells, and the global mode replaces it.
+    tree = build_octree(Box.parse(["1", "1", "1"]), 2, [parse_shape("point:0.1,0.1,0.1")])
+    plain = assemble(tree)
+    some_type = next(iter(plain.types))
+    replaced = []
+
+    def lookup(configuration):
+        nodes = sorted(configuration.nodes())
+        if len(nodes) > 8 and not replaced:
+            replaced.append(configuration.code)
+            return [{"type": some_type, "nodes": nodes}]
+        return None
+
+    mesh = assemble(tree, lookup)
+    assert replaced and check_circumcenters(mesh)["elements_not_cospherical"] == 1
+    found = check_delaunay(mesh)
+    assert len(found["_not_cells"]) == 1
+    result = global_delaunay(mesh, found)
+    assert check_circumcenters(result)["elements_not_cospherical"] == 0
+    assert whole(result) == WHOLE
+    assert mesh_cells(result) == oracle_cells(result)

@@ -275,13 +275,17 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     size = grid >> levels
     origin = mesh.tree.positions.astype(np.int64) * size[:, None]
     rows_pattern, rows_local, rows_leaf, centres, radii, n_nodes = [], [], [], [], [], []
+    # A table element that is not co-spherical (a table may hold one) has no sphere to test, and
+    # is not a cell of the Delaunay subdivision: it joins the elements that are not cells.
+    without_sphere = [np.zeros(0, dtype=np.int64)]
     cells = mesh.cells
     # the leaf elements kept beside re-tessellated cells, and the cells marked proven, passed this very
     # check on the same vertex set when they were chosen: only the other cells are tested again
     for p, pattern, leaves in (mesh.groups() if cells is None else ()):
         for j, element in enumerate(pattern.elements):
-            if element.sphere is None:
-                continue  # reported by check_circumcenters as not co-spherical
+            if element.sphere is None:  # reported by check_circumcenters as not co-spherical
+                without_sphere.append(mesh.element_offsets[leaves].astype(np.int64) + j)
+                continue
             centre = (origin[leaves] + np.array([float(x) for x in element.center])[None] * size[leaves, None]) * scale
             first = points[mesh.slots[leaves, element.nodes[0]]]
             rows_pattern.append(np.full(len(leaves), p, dtype=np.int32))
@@ -309,7 +313,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         progress(len(mesh) - sum(len(c) for c in centres))
     if not sum(len(c) for c in centres):
         return {"_leaves": np.zeros(0, dtype=np.int64), "_elements": np.zeros(0, dtype=np.int64),
-                "_not_cells": np.zeros(0, dtype=np.int64), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
+                "_not_cells": np.sort(np.concatenate(without_sphere)), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
                 "delaunay_ties": 0, "delaunay_exact_tests": 0}
     rows_pattern, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_pattern, rows_local, rows_leaf))
     centres, radii, n_nodes = np.concatenate(centres), np.concatenate(radii), np.concatenate(n_nodes)
@@ -398,7 +402,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     leaf_rows = bad_rows[rows_pattern[bad_rows] >= 0]
     bad_leaves = distinct(np.r_[rows_leaf[leaf_rows], cells.leaf[rows_leaf[bad_rows[rows_pattern[bad_rows] < 0]]]
                                  if cells is not None else np.zeros(0, dtype=np.int64)])
-    return {"_leaves": bad_leaves, "_elements": elements(bad_rows), "_not_cells": elements(distinct(pair_row[sides <= 0])),
+    return {"_leaves": bad_leaves, "_elements": elements(bad_rows), "_not_cells": np.sort(np.r_[elements(distinct(pair_row[sides <= 0])), np.concatenate(without_sphere)]),
             "delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),
             "delaunay_violating_leaves": int(len(bad_leaves)), "delaunay_ties": int((sides == 0).sum()),
             "delaunay_exact_tests": int(len(pair_row))}
