@@ -47,6 +47,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
 _interrupted = threading.Event()
 _terminated = threading.Event()
+_redelivery: list[threading.Timer] = []  # signals held back while numba's compiler ran
 
 
 def _on_signal(signum, frame):
@@ -59,7 +60,11 @@ def _on_signal(signum, frame):
     if _in_compiler(frame):
         # Unwinding through numba's compiler or cache loader crashes the process (SIGSEGV):
         # deliver the signal again shortly, until it arrives outside.
-        threading.Timer(0.1, os.kill, (os.getpid(), signum)).start()
+        # A daemon, and cancelled when the run ends first: never delivered after main returns.
+        timer = threading.Timer(0.1, os.kill, (os.getpid(), signum))
+        timer.daemon = True
+        _redelivery.append(timer)
+        timer.start()
         return
     if signum == signal.SIGTERM:
         raise SystemExit(128 + signum)
@@ -169,6 +174,9 @@ def main(argv: list[str] | None = None) -> int:
             _stop_workers()
             print("cospherical: terminated", file=sys.stderr)
         raise
+    finally:
+        while _redelivery:  # the run has ended as signalled: a held-back signal is not sent again
+            _redelivery.pop().cancel()
 
 
 def _stop_workers() -> None:
