@@ -68,7 +68,9 @@ def sphere_sides(tets, points, weights: Sequence[int]):
     d = tets[:, 1:] - tets[:, :1]
     e = points - tets[:, 0]
     extent = max(int(np.abs(d).max(initial=0)), int(np.abs(e).max(initial=0)), 1)
-    if 30 * max(weights) * extent ** 5 >= 2 ** 62:
+    # |det| <= 6 E^3 and |lifted| <= 3 w E^2, so |det * L(e)| <= 18 w E^5 and |towards| <= 3 * 18 w E^5:
+    # every term and the side itself stay below 72 w E^5
+    if 72 * max(weights) * extent ** 5 >= 2 ** 63:
         d, e = d.astype(object), e.astype(object)
         w = np.array([int(x) for x in weights], dtype=object)
     else:
