@@ -137,7 +137,8 @@ class _Triangulation:
                     break
         if len(chosen) < 4:
             raise ValueError("the points are coplanar: no tetrahedralisation")
-        rest = [i for i in order if i not in set(chosen)]
+        first = set(chosen)
+        rest = [i for i in order if i not in first]
         return chosen, rest
 
     def run(self, order: list[int]) -> list[tuple[int, int, int, int]]:

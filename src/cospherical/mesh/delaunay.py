@@ -300,7 +300,6 @@ class _Locator:
     def __init__(self, mesh: Mesh) -> None:
         tree = mesh.tree
         self.levels = np.unique(tree.levels)
-        self.depth = int(tree.depth)
         self.grid = mesh.grid
         self.keys = {}
         for level in self.levels.tolist():
