@@ -302,3 +302,48 @@ def test_a_table_element_that_is_not_cospherical_is_replaced_by_delaunay_cells()
     assert check_circumcenters(result)["elements_not_cospherical"] == 0
     assert whole(result) == WHOLE
     assert mesh_cells(result) == oracle_cells(result)
+
+
+def test_only_a_wrong_proposals_own_failure_sends_every_region_to_the_exact_engine(monkeypatch):
+    # Tetrahedra of one centre that are not one cell (NotOneCell) are a proposal's fault: every region is
+    # redone exactly.  Any other error on the way is a bug and must surface, not be taken for that one.
+    import cospherical.mesh.delaunay as delaunay
+
+    leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))
+    shape = delaunay._shape
+    for error, raised in ((delaunay.NotOneCell, None), (ValueError, ValueError), (KeyError, KeyError)):
+        failed: list = []
+
+        def once(*args, error=error, failed=failed):
+            if not failed:
+                failed.append(True)
+                raise error("planted")
+            return shape(*args)
+        monkeypatch.setattr(delaunay, "_shape", once)
+        calls = _count_exact(monkeypatch)
+        if raised is None:
+            mesh = global_delaunay(leaf)
+            assert calls and mesh_cells(mesh) == oracle_cells(leaf)
+        else:
+            with pytest.raises(raised, match="planted"):
+                global_delaunay(leaf)
+        monkeypatch.undo()
+
+
+def test_a_kept_element_found_again_is_a_bug_not_a_region(monkeypatch):
+    # the final check tests only the fresh cells: a kept leaf element among its findings cannot be
+    # attributed to a region (it was once read through a negative index), so it stops the run
+    import cospherical.mesh.delaunay as delaunay
+
+    leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))
+    first = check_delaunay(leaf)
+    check = delaunay.check_delaunay
+
+    def planted(mesh, *args, **kwargs):
+        found = check(mesh, *args, **kwargs)
+        if mesh.cells is not None:
+            found["_not_cells"] = np.r_[0, found["_not_cells"]]
+        return found
+    monkeypatch.setattr(delaunay, "check_delaunay", planted)
+    with pytest.raises(RuntimeError, match="not a fresh cell"):
+        global_delaunay(leaf, first)

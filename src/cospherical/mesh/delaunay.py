@@ -6,33 +6,51 @@ hull of V).  The leaf mesh already tiles the domain with elements that are
 co-spherical polytopes.
 
 Why the leaf elements that pass the exact global check are kept, and the rest
-re-tessellated region by region:
+re-tessellated region by region.  What the leaf mesh brings: the tree is
+1-irregular (edge or vertex balance; face balance alone is refused and a leaf
+list is checked for it), so two leaves whose closed boxes share a piece of a face
+or of an edge differ by at most one level, and a leaf whose box meets another's
+in one point only meets it at a corner of both (the boxes lie on one dyadic
+grid).  Hence every vertex of V on a leaf's closed box (a corner of a leaf that
+touches it) is a corner, edge midpoint or face centre of that leaf: one of its
+points (:mod:`cospherical.mesh.assembly`).  Two leaves therefore hold the same
+points on what they share, and each leaf's elements tile its box; the report's
+``check_volume`` and ``check_conformity`` verify, exactly, that the elements tile
+the domain face to face (two closed elements that meet, meet in a common face).
 
 1. An element whose sphere holds no vertex strictly inside and no vertex of V on
    it but its own nodes is a cell of D (that is the definition of a cell).
    :func:`~cospherical.mesh.checks.check_delaunay` decides both exactly; every
    other element violates or ties.
-2. Let U be the union of the closed elements of the second kind.  Every other
-   element is a cell of D, and these cells and the elements of U tile the domain,
-   so U is exactly the union of the cells of D not kept: U is tiled by cells of D.
-3. Split U into its connected parts U_r (elements sharing a vertex: in a
-   conforming mesh two closed elements that meet share one).  A cell of D is
-   convex, so each cell in U lies in one U_r.  Let V_r be the vertices of the
-   elements of U_r.  A vertex v of a cell C of D inside U_r lies in a closed
-   element E of U_r; E is a cell of the Delaunay subdivision of its leaf's points,
-   which are the vertices on the leaf's closed box, v among them, so v is on E's
-   sphere (never strictly inside, E's ball holds E) and, being on the sphere and in
-   E, a vertex of E: v is in V_r.  So C is a cell of Del(V_r): its vertices are in
-   V_r, its sphere holds no point of V, so none of V_r, and every point of V_r on
-   it is in V, hence a vertex of C.
-4. The cells of D inside U_r tile U_r and are cells of Del(V_r); cells of Del(V_r)
-   do not overlap, so every other cell of Del(V_r) has its interior outside U_r.
-   A cell of Del(V_r) is therefore kept exactly when one interior point x lies in
-   U_r: the centroid of any of its tetrahedra.  Any leaf whose closed box holds x
-   decides it: x lies in a closed element F of that leaf, and x is in U_r exactly
-   when such an F is an element of U_r (a kept element, or one of another part,
-   would overlap the interior of the cell of D that x is inside).
-So D = the kept leaf elements plus, per region, the cells of Del(V_r) inside U_r.
+2. Let U be the union of the closed elements of the second kind.  The kept
+   elements are cells of D, and the cells of D have pairwise disjoint interiors,
+   as the elements do; both tile the domain, so the cells of D that are not kept
+   cover exactly what the kept elements leave: U is tiled by cells of D.
+3. Split U into its connected parts U_r, elements joined when they share a
+   vertex.  Two closed elements that meet share a vertex (their common face has
+   one), so distinct U_r are disjoint closed sets, and a cell of D in U, being
+   convex hence connected, lies in exactly one U_r.  Let V_r be the vertices of
+   the elements of U_r.  A vertex v of a cell C of D inside U_r lies in a closed
+   element E of U_r.  v is a node of E: v is a corner of some leaf, an extreme
+   point of its box, so a vertex of the element E' of that leaf that holds it;
+   E and E' meet in a common face that holds v, and a vertex of E' lying in a
+   face of E' is a vertex of that face, so of E.  So v is in V_r, and C is a
+   cell of Del(V_r): its vertices are in V_r, its sphere holds no point of V
+   strictly inside, so none of V_r, and every point of V_r on it is in V, hence
+   a vertex of C.
+4. The cells of D inside U_r tile U_r (2 and 3) and are cells of Del(V_r); two
+   cells of one Delaunay subdivision meet only in a common face, on both their
+   boundaries, so every other cell of Del(V_r) has its interior outside U_r.
+   A cell of Del(V_r) is therefore one of D's inside U_r exactly when one interior
+   point x lies in U_r: the centroid of any of its tetrahedra.  Any leaf whose
+   closed box holds x decides it: x lies in a closed element F of that leaf, and x
+   is in U_r exactly when such an F is an element of U_r (a kept element, or one
+   of another part, would overlap the interior of the cell of D that x is inside).
+So D = the kept leaf elements plus, per region, the cells of Del(V_r) inside U_r:
+every cell of D is a kept element (1) or lies in U (2), then in exactly one U_r
+(3), where it is one of the cells chosen (4).  These cells tile each U_r, and
+they meet the kept elements and one another face to face because all of them are
+cells of one Delaunay subdivision, D.
 The leaves that hold an element of U give up all their elements: the kept ones
 among them are listed as cells, as they are, marked proven.
 
@@ -109,6 +127,15 @@ from .checks import _weights, check_delaunay
 __all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
 ENGINES = ("qhull", "exact")
+NO_REGION = -1  # the region of a leaf element that is kept, and of a vertex of no region
+
+
+class NotOneCell(Exception):
+    """Tetrahedra of one exact centre whose vertices are not one co-spherical cell (different radii).
+
+    Only a wrong proposal makes them; :func:`retessellate` then redoes every region with
+    the exact engine.  Its own class, so that no other error is taken for this one.
+    """
 
 
 def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull", proposal=None) -> Mesh:
@@ -174,7 +201,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     """
     nodes = mesh.element_nodes(elements)
     part, regions = _regions(nodes, len(mesh.vertices))
-    region = np.full(len(mesh), -1, dtype=np.int64)
+    region = np.full(len(mesh), NO_REGION, dtype=np.int64)
     region[elements] = part
     # each region's vertices: unique (region, vertex) pairs, in region order
     valid = nodes >= 0
@@ -183,7 +210,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     bounds = np.searchsorted(pairs // len(mesh.vertices), np.arange(regions + 1))
     vertices = pairs % len(mesh.vertices)
     # the regions' vertex sets are disjoint (a shared vertex would join them): a vertex names its region
-    vertex_region = np.full(len(mesh.vertices), -1, dtype=np.int64)
+    vertex_region = np.full(len(mesh.vertices), NO_REGION, dtype=np.int64)
     vertex_region[vertices] = pairs // len(mesh.vertices)
     located = _Locator(mesh)
     # the other elements of the leaves that give up theirs: cells as they are, proven by the check
@@ -191,7 +218,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     counts = mesh.element_offsets[leaves + 1] - mesh.element_offsets[leaves]
     given_up = np.repeat(mesh.element_offsets[leaves] - np.r_[0, np.cumsum(counts)[:-1]], counts) \
         + np.arange(int(counts.sum()))
-    proven = mesh.element_nodes(given_up[region[given_up] < 0])
+    proven = mesh.element_nodes(given_up[region[given_up] == NO_REGION])
     bad = _leaves_of(mesh, elements)
     wanted = _region_volumes(mesh, elements, part, regions)
     tets = [_region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine, proposal) for r in range(regions)]
@@ -203,7 +230,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
         try:
             cells = _cells(mesh, _members(_same_sphere(mesh, every, _weights(mesh)), every, len(mesh.vertices)),
                            proven, located, types)
-        except ValueError:  # tetrahedra of one centre that are not one co-spherical cell: no proof per region
+        except NotOneCell:  # no cell to name a region by: no proof per region
             failing = set(range(regions))
         else:
             cells = Cells(cells.shapes, cells.shape, cells.anchor, cells.nodes, cells.leaf, cells.spanning,
@@ -252,8 +279,17 @@ def _failing_regions(mesh: Mesh, found: dict, vertex_region: np.ndarray, wanted:
     """
     cells = mesh.cells
     fresh = np.flatnonzero(~cells.proven)
-    cell_region = vertex_region[cells.nodes[:, 0]]
-    failing = set(cell_region[found["_not_cells"] - mesh.leaf_elements].tolist())
+    # A fresh cell's vertices are its tetrahedra's, all of one region (the regions' vertex sets are
+    # disjoint): its first vertex names the region.  The proven cells belong to no region.
+    cell_region = np.full(len(cells), NO_REGION, dtype=np.int64)
+    cell_region[fresh] = vertex_region[cells.nodes[fresh, 0]]
+    # check_delaunay tests only the fresh cells (the kept leaf elements and the proven cells passed it on
+    # the same vertex set), so every element it finds is a fresh cell: anything else is a bug, not a region.
+    not_cells = found["_not_cells"] - mesh.leaf_elements  # indices among the cells
+    if np.any(cell_region[fresh] == NO_REGION) or np.any(not_cells < 0) \
+            or np.any(cell_region[not_cells] == NO_REGION):
+        raise RuntimeError("an element that is not a fresh cell of a region was found not to be a cell")
+    failing = set(cell_region[not_cells].tolist())
     volumes = [Fraction(0)] * len(wanted)
     key = cell_region[fresh] * len(cells.shapes) + cells.shape[fresh]
     for (r, s), n in _sums(key, np.ones(len(fresh), dtype=object), len(cells.shapes)):
@@ -385,7 +421,7 @@ def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray
 def _inside(mesh: Mesh, tets: np.ndarray, tet_region: np.ndarray, region: np.ndarray, located: _Locator) -> np.ndarray:
     """Per tetrahedron: its centroid lies in a closed element of its region, of the leaf whose box holds it (exactly).
 
-    ``region``: per leaf element its region, -1 for the kept ones.  In the leaf's own
+    ``region``: per leaf element its region, ``NO_REGION`` for the kept ones.  In the leaf's own
     frame (4 x grid units from its lowest corner) node ``s`` sits at ``2 size
     NODE_OFFSETS[s]``; an element holds the point when no face plane has it on the
     side away from the element's vertex centroid.  The numbers are below 100 times
@@ -554,7 +590,7 @@ def _shape(offsets: list[tuple[int, int, int]], squared, types: dict, catalogue:
     points = {i: tuple(Fraction(x) for x in o) for i, o in enumerate(offsets)}
     elements = tessellation_elements(points, squared)
     if len(elements) != 1 or len(elements[0].nodes) != len(offsets):
-        raise ValueError(f"merged tetrahedra are not one co-spherical cell: {offsets}")
+        raise NotOneCell(f"merged tetrahedra are not one co-spherical cell: {offsets}")
     element = elements[0]
     types.setdefault(element.type.id, _type_info(element.type.id, element.type, catalogue))
     order = list(element.nodes)
