@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from oracle import qhull_regions
 from strategies import LENGTHS, PARAMETERS
-from test_delaunay_oracle import check_canonical_codes
+from tests.core.test_delaunay import check_canonical_codes
 
 from cospherical import InputError, Shape, ShapeConfiguration, standard_shape, tessellate_shape
 from cospherical.core.geometry import Frame
@@ -187,7 +187,7 @@ def test_general_quadrilateral_face_point():
 # ---------------------------------------------------------------------------
 # The bisection studies of the three shapes
 
-ROOT = __import__("pathlib").Path(__file__).resolve().parent.parent
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

@@ -189,7 +189,7 @@ def test_the_catalogue_holds_every_type_of_the_intersection_studies():
     known = {t["id"] for t in shipped_catalogue()["types"]}
     examples = {e["element"].type.id for e in intersection_examples()}
     assert examples <= known
-    results = Path(__file__).resolve().parents[1] / "results" / "intersection"
+    results = Path(__file__).resolve().parents[2] / "results" / "intersection"
     for summary in results.glob("*/intersection-r16-*.json"):
         for criterion, data in json.loads(summary.read_text())["criteria"].items():
             assert set(data["types"]) <= examples, (summary.name, criterion)

@@ -24,9 +24,9 @@ from cospherical.mesh.assembly import assemble
 from cospherical.mesh.delaunay import _regions, delaunay_mesh
 from cospherical.mesh.octree import build_octree, parse_shape
 from cospherical.mesh.partition import morton_pieces
-from test_outputs import _descendants
+from tests.test_outputs import _descendants
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 # A cube sphere tree (every element from the leaf table, no region to re-tessellate) and a 1 x 2 x 4 tree
 # whose leaf mesh is not Delaunay: its one re-tessellated region lies across the pieces' seams.
 SPHERE = ("--domain", "1", "1", "1", "--levels", "4", "--refine", "sphere:0.5,0.5,0.5,0.3",
