@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from cospherical.cli import main
+from cospherical.errors import InputError
 from cospherical.files import yamlio
 from cospherical.files.outputs import MANIFEST, OutputFolder
 
@@ -144,6 +145,35 @@ def test_a_mesh_whose_vtu_cannot_be_written_leaves_no_report(tmp_path, capsys, m
     (kept / "report.json").write_text("an older run's report")
     refused(capsys, *MESH, "--out", kept, needle="No space left")
     assert listing(kept) == {"report.json": b"an older run's report"}
+
+
+@pytest.mark.parametrize("limit", [2048, 8192])
+def test_a_full_disk_names_the_users_file_not_the_staging_one(tmp_path, limit):
+    # a real write failure (a file-size limit: EFBIG, as ENOSPC would be) in whichever output is written
+    # first past the limit: the line names that output in the folder the user gave, where it would go
+    import resource
+
+    out = tmp_path / "out"
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    result = subprocess.run([sys.executable, "-m", "cospherical", *MESH, "--out", str(out)], capture_output=True,
+                            text=True, timeout=300, preexec_fn=limited)
+    lines = result.stderr.strip().splitlines()
+    assert result.returncode == 2 and len(lines) == 1, result.stderr
+    assert re.fullmatch(rf"cospherical: error: {re.escape(str(out))}/(mesh\.vtu|report\.json|mesh\.png): "
+                        r"cannot write: File too large", lines[0]), lines[0]
+    assert not out.exists()  # nothing of the failed run is left
+
+
+def test_a_writer_failing_on_a_staged_file_names_the_users_file(tmp_path):
+    # a library that writes the staged path itself (not through atomic_open) and fails there
+    with pytest.raises(InputError) as raised:
+        with OutputFolder(tmp_path / "out", "example") as out:
+            staged = out.path("table.dat")
+            raise OSError(errno.ENOSPC, "No space left on device", str(staged))
+    assert str(raised.value) == f"{tmp_path / 'out' / 'table.dat'}: cannot write: No space left on device"
 
 
 # --- render: pdflatex in a private folder, the user's files kept ----------------------------------------------

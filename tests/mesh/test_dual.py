@@ -315,6 +315,20 @@ def test_a_truncated_or_tampered_dual_npz_is_refused_with_one_line(dual_run, tmp
         assert err.count("\n") == 1 and f"{name}.npz" in err and "Traceback" not in err
 
 
+def test_a_full_disk_under_tetgens_scratch_file_names_that_file(monkeypatch):
+    # a failed write names no file (EFBIG from a file-size limit was 'cospherical: error: File too large')
+    import errno
+
+    from cospherical.mesh.dual import delaunay_tetrahedra
+
+    def full(*args, **kwargs):
+        raise OSError(errno.EFBIG, "File too large")
+    monkeypatch.setattr(np, "savetxt", full)
+    with pytest.raises(OSError) as raised:
+        delaunay_tetrahedra(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]))
+    assert raised.value.filename.endswith("points.node") and raised.value.errno == errno.EFBIG
+
+
 @pytest.mark.parametrize("name", ["sphere", "discretize points"])
 def test_tetgen_tetrahedra_of_the_same_vertices_give_the_same_dual_exactly(name):
     """An independent tetrahedral Delaunay mesh (TetGen) of the vertices has the same dual, exactly.

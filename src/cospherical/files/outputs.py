@@ -46,8 +46,15 @@ _MAX_MANIFEST_BYTES = 1 << 20
 _PLAIN_NAME = re.compile(r"[0-9A-Za-z][0-9A-Za-z._-]*")
 
 
-def _output_error(path: Path, error: OSError) -> InputError:
-    return InputError(f"{path}: cannot write: {error.strerror or error}")
+def _user_path(path: str | Path) -> Path:
+    """The output the user asked for: a file in an :class:`OutputFolder`'s staging folder is named
+    by its place in the output folder, where it goes at the end; any other path as it is."""
+    path = Path(path)
+    return path.parent.parent / path.name if path.parent.name.startswith(_STAGING_PREFIX) else path
+
+
+def _output_error(path: str | Path, error: OSError) -> InputError:
+    return InputError(f"{_user_path(path)}: cannot write: {error.strerror or error}")
 
 
 def refuse_special(path: Path) -> None:
@@ -60,7 +67,7 @@ def refuse_special(path: Path) -> None:
         raise _output_error(path, error) from None
     if not stat.S_ISREG(mode):
         kind = "a symbolic link" if stat.S_ISLNK(mode) else "a folder" if stat.S_ISDIR(mode) else "a special file"
-        raise InputError(f"{path}: exists and is {kind}, not a regular file: not replacing it")
+        raise InputError(f"{_user_path(path)}: exists and is {kind}, not a regular file: not replacing it")
 
 
 def _remove_stale_temporaries(path: Path) -> None:
@@ -220,7 +227,11 @@ class OutputFolder:
 
     def __exit__(self, kind, value, traceback) -> None:
         if kind is not None:
+            staging = self.staging
             self._release(failed=True)
+            # a writer in the block that failed on a staged file (a full disk): name the user's file
+            if isinstance(value, OSError) and value.filename and Path(value.filename).parent == staging:
+                raise _output_error(value.filename, value) from None
             return
         try:
             self._commit()
@@ -281,7 +292,7 @@ class OutputFolder:
                 if name not in ours:
                     self._remove_if_ours(self.folder / name, digest)
         except OSError as error:
-            raise _output_error(self.folder / getattr(error, "filename", ""), error) from None
+            raise _output_error(error.filename or self.folder, error) from None
         manifest[self.writer] = dict(sorted(ours.items()))
         atomic_write(self.folder / MANIFEST, json.dumps(dict(sorted(manifest.items())), indent=1) + "\n")
 

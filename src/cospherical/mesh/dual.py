@@ -560,9 +560,12 @@ def delaunay_tetrahedra(grid_vertices: np.ndarray) -> tuple[np.ndarray, str, int
         with tempfile.TemporaryDirectory() as folder:
             node = Path(folder) / "points.node"
             rows = np.column_stack([np.arange(len(points)), points])
-            with open(node, "w") as handle:
-                handle.write(f"{len(points)} 3 0 0\n")
-                np.savetxt(handle, rows, fmt="%d")
+            try:
+                with open(node, "w") as handle:
+                    handle.write(f"{len(points)} 3 0 0\n")
+                    np.savetxt(handle, rows, fmt="%d")
+            except OSError as error:  # a write that fails (a full disk) names no file: name the scratch file
+                raise OSError(error.errno, error.strerror, str(node)) from None
             subprocess.run([tool, "-Q", "-F", "-N", str(node)], check=True, capture_output=True, timeout=3600)
             tets = np.loadtxt(Path(folder) / "points.1.ele", dtype=np.int64, skiprows=1, ndmin=2)[:, 1:5]
         return tets, "tetgen", 0
