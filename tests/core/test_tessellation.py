@@ -1,12 +1,17 @@
-"""Tessellations whose answer is known by hand, and the element types' node orders."""
+"""Tessellations whose answer is known by hand, and properties every tessellation must have, checked on
+generated configurations."""
+
+from __future__ import annotations
 
 from collections import Counter
 from fractions import Fraction
 
+import networkx as nx
 import pytest
+from hypothesis import HealthCheck, given, settings
+from strategies import configurations
 
 from cospherical import Configuration, tessellate
-from cospherical.core.element_types import type_id
 
 
 def names(code, box=("1", "1", "1"), policy="octree"):
@@ -37,34 +42,6 @@ def test_exact_sqrt2_differs_from_rounded():
     assert len(exact.elements) < len(rounded.elements)
 
 
-def orientation(points):
-    (p0, p1, p2, p3) = points
-    u, v, w = ([b - a for a, b in zip(p0, q)] for q in (p1, p2, p3))
-    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]))
-
-
-@pytest.mark.parametrize("code", ["000000000000", "800000000000", "888888888888", "880080000000", "8888a0000808", "123456789abc"])
-@pytest.mark.parametrize("box", [("1", "1", "1"), ("1", "2", "4"), ("1", "sqrt(2)", "sqrt(2)")])
-def test_vtk_orders_have_the_first_face_normal_pointing_inside(code, box):
-    tess = tessellate(Configuration.from_code(code, box))
-    xyz = {i: tuple(float(x) for x in p) for i, p in tess.nodes.items()}  # unit frame: same signs
-    for e in tess.elements:
-        n = e.nodes
-        vtk = e.type.vtk
-        if vtk == "tetra":
-            assert orientation([xyz[i] for i in n]) > 0
-        elif vtk == "pyramid":
-            assert orientation([xyz[n[0]], xyz[n[1]], xyz[n[2]], xyz[n[4]]]) > 0
-        elif vtk == "wedge":
-            assert orientation([xyz[n[0]], xyz[n[1]], xyz[n[2]], xyz[n[3]]]) > 0
-            edges = set(map(frozenset, e.polyhedron.edges))
-            assert all(frozenset((n[i], n[i + 3])) in edges for i in range(3))
-        elif vtk == "hexahedron":
-            assert orientation([xyz[n[0]], xyz[n[1]], xyz[n[3]], xyz[n[4]]]) > 0
-            edges = set(map(frozenset, e.polyhedron.edges))
-            assert all(frozenset((n[i], n[i + 4])) in edges for i in range(4))
-
-
 def test_fvm_closed_and_open_box():
     # On a 1 x 2 x 4 box with midpoints on the long edges, circumcenters leave the box.
     tess = tessellate(Configuration.from_code("000000008888", ("4", "2", "1")))
@@ -73,25 +50,97 @@ def test_fvm_closed_and_open_box():
     assert plain.fvm_adequate and plain.fvm_adequate_open
 
 
-def test_type_ids_are_stable():
-    assert type_id("v4:1t2t3t/0t3t2t/0t1t3t/0t2t1t", 4, 4) == "v4f4-8f0284"
-    tess = tessellate(Configuration.from_code("000000000000"))
-    assert tess.elements[0].type.id.startswith("v8f6-")
+SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
-def test_classification_on_id_ranks_is_the_classification_on_ids():
-    # classify works on the ranks of the node ids and maps the answer back (a cache
-    # shared by cells whose ids come in the same order): the same as on the ids.
-    from cospherical.core.element_types import _classify_ranks, classify
-    from cospherical.studies.bisection import bisection_codes
+def squared_distance(p, q, squared_lengths) -> Fraction:
+    # Independent of the integer frame: plain Fractions in real units squared.
+    return sum(w * (x - y) ** 2 for w, x, y in zip(squared_lengths, p, q))
 
-    seen = set()
-    for box in (("1", "1", "1"), ("1", "2", "3")):
-        for code in bisection_codes()[::7]:
-            for element in tessellate(Configuration.from_code(code, box)).elements:
-                poly = element.polyhedron
-                if (poly.faces, poly.face_kinds) in seen:
-                    continue
-                seen.add((poly.faces, poly.face_kinds))
-                assert classify(poly) == _classify_ranks.__wrapped__(poly.faces, poly.face_kinds)
-    assert len(seen) > 500
+
+@SETTINGS
+@given(configurations())
+def test_volumes_sum_to_the_box(cfg):
+    assert sum(e.polyhedron.unit_volume for e in tessellate(cfg).elements) == 1
+
+
+@SETTINGS
+@given(configurations())
+def test_every_sphere_is_empty_and_passes_through_its_cell(cfg):
+    tess = tessellate(cfg)
+    squared = cfg.box.squared
+    for e in tess.elements:
+        center = e.polyhedron.center
+        radius = {squared_distance(tess.nodes[v], center, squared) for v in e.polyhedron.nodes}
+        assert len(radius) == 1, "cell vertices not co-spherical"
+        (r2,) = radius
+        for node, point in tess.nodes.items():
+            d2 = squared_distance(point, center, squared)
+            assert d2 >= r2, f"node {node} strictly inside the sphere of {e.nodes}"
+            assert (d2 == r2) == (node in e.polyhedron.nodes), f"node {node} on the sphere but not in the cell"
+
+
+def _on_box_boundary(face, nodes) -> bool:
+    return any(len({nodes[v][axis] for v in face}) == 1 and nodes[face[0]][axis] in (0, 1) for axis in range(3))
+
+
+@SETTINGS
+@given(configurations())
+def test_cells_meet_face_to_face(cfg):
+    tess = tessellate(cfg)
+    uses = Counter()
+    directed = set()
+    for e in tess.elements:
+        for face in e.polyhedron.faces:
+            uses[frozenset(face)] += 1
+            directed.update((face[i], face[(i + 1) % len(face)]) for i in range(len(face)))
+    for face, count in uses.items():
+        if count == 1:
+            assert _on_box_boundary(tuple(face), tess.nodes), f"face {sorted(face)} is free inside the box"
+        else:
+            assert count == 2, f"face {sorted(face)} shared by {count} cells"
+    # A shared face is walked in opposite directions by its two cells.
+    for e in tess.elements:
+        for face in e.polyhedron.faces:
+            if uses[frozenset(face)] == 2:
+                assert all((face[(i + 1) % len(face)], face[i]) in directed for i in range(len(face)))
+
+
+@pytest.mark.oracle_networkx
+@SETTINGS
+@given(configurations())
+def test_euler_formula_and_planar_embedding(cfg):
+    for e in tessellate(cfg).elements:
+        v, edges, f = e.polyhedron.counts
+        assert v - edges + f == 2
+        assert (v, edges, f) == (e.type.vertices, e.type.edges, e.type.faces)
+        embedding_of(e.polyhedron.faces).check_structure()
+
+
+def embedding_of(faces) -> nx.PlanarEmbedding:
+    """The faces (counter-clockwise from outside) as a networkx rotation system."""
+    turn = {}
+    for face in faces:
+        n = len(face)
+        for i in range(n):
+            turn[face[i], face[(i + 1) % n]] = face[i - 1]  # next neighbour counter-clockwise
+    embedding = nx.PlanarEmbedding()
+    for node in {v for face in faces for v in face}:
+        first = next(w for (u, w) in turn if u == node)
+        embedding.add_half_edge(node, first)
+        previous, w = first, turn[node, first]
+        while w != first:
+            embedding.add_half_edge(node, w, cw=previous)
+            previous, w = w, turn[node, w]
+    return embedding
+
+
+@SETTINGS
+@given(configurations(dyadic=True))
+def test_nodes_follow_the_numbering(cfg):
+    tess = tessellate(cfg)
+    for k, t in enumerate(cfg.steiner):
+        assert (8 + k in tess.nodes) == (t is not None)
+    used = {v for e in tess.elements for v in e.nodes}
+    assert used == set(tess.nodes), "every point is a vertex of some cell"
+    assert Configuration.from_code(cfg.code, cfg.box, cfg.face_points) == cfg
