@@ -40,7 +40,7 @@ from typing import Iterable, Mapping, Sequence
 
 from ..errors import InputError
 from .codes import EDGE_DIGITS, digit_parameters, mask_codes, parameter_digits
-from .configuration import BaseConfiguration, Box, steiner_parameters
+from .configuration import CORNERS, EDGES, FACES, BaseConfiguration, Box, steiner_parameters
 from .exact import parse_rational
 from .geometry import cross, dot, six_volume, sub, tetra_six_volume
 
@@ -49,9 +49,12 @@ __all__ = ["ELEMENTS", "STANDARD_SHAPES", "Shape", "ShapeConfiguration", "mask_c
 Point = tuple[Fraction, Fraction, Fraction]
 
 _H = Fraction(1, 2)
-# The standard shapes, corners in VTK order (wedge, pyramid, tetra), edges in the
-# order of the VTK quadratic cells, faces as VTK lists them (oriented on building).
+# The standard shapes, corners in VTK order (hexahedron, wedge, pyramid, tetra), edges in the
+# order of the VTK quadratic cells, faces as VTK lists them (oriented on building).  The
+# cuboid's numbering is the one of :mod:`cospherical.core.configuration` (face f carries
+# node 20 + f: VTK's triquadratic hexahedron).
 STANDARD_SHAPES: dict[str, tuple[tuple, tuple, tuple]] = {
+    "cuboid": (CORNERS, EDGES, FACES),
     "prism": (
         ((0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (0, 1, 1)),
         ((0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 3), (0, 3), (1, 4), (2, 5)),
@@ -68,7 +71,7 @@ STANDARD_SHAPES: dict[str, tuple[tuple, tuple, tuple]] = {
         ((0, 1, 2), (0, 1, 3), (1, 2, 3), (2, 0, 3)),
     ),
 }
-ELEMENTS = ("cuboid", *STANDARD_SHAPES)
+ELEMENTS = tuple(STANDARD_SHAPES)
 # A base element of a mesh has a handful of corners; its tessellation's exact tests grow
 # with their number, so a shape file of thousands is refused before any is read.
 MAX_CORNERS = 64
@@ -269,8 +272,9 @@ def _oriented_face(corners, cycle, f, name):
 
 
 def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
-    """One of the standard shapes (VTK wedge, pyramid, tetra) in a box A x B x C.
+    """One of the standard shapes (VTK hexahedron, wedge, pyramid, tetra) in a box A x B x C.
 
+    ``cuboid``: the whole box, numbered as :mod:`cospherical.core.configuration` numbers it;
     ``prism``: the right triangular prism (0,0,0) (A,0,0) (0,B,0) (0,0,C) (A,0,C) (0,B,C),
     half a box; ``pyramid``: the square pyramid on the box's bottom face with its
     apex at the box centre, a sixth of a box; ``tetrahedron``: the corner
