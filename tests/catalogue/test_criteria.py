@@ -11,9 +11,8 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 
 from cospherical import Box
 from cospherical.catalogue import element_options, minimal_kept_sets
-from cospherical.paper import paper_class, paper_comparison
+from cospherical.paper import paper_class
 from cospherical.studies.bisection import bisection_codes, run_study
-from cospherical.studies.summary import study_summary
 
 BOXES = {"A": ("1", "1", "1"), "B": ("1", "2", "4"), "C": ("1", "1.4142", "1.4142")}
 
@@ -176,65 +175,3 @@ def test_paper_worked_examples(studies):
     assert names(element_options(tess, e, "internal_faces")) == [["Generic #6"]]
     assert ["Tetrahedron", "Tetrahedron", "Tetrahedron Complement"] in names(
         element_options(tess, e, "internal_edges_and_faces"))
-
-
-def test_paper_table_r2_row_by_row(studies):
-    table = paper_comparison(study_summary(studies["C"]), "bisection_C", "internal_faces")
-    assert all(row["paper"] == row["ours"] for row in table["rows"]), table["rows"]
-    assert table["total"] == {"paper": 43231, "ours": 43231}
-
-
-def test_internal_face_splits_are_the_internal_edge_splits_without_inner_edges(studies):
-    # split_options filters the internal-edge search for the internal-face criterion:
-    # the filter must give exactly what the criterion's own search gives.
-    from cospherical.core.geometry import Frame
-    from cospherical.core.split import subdivisions
-
-    seen = set()
-    for study in studies.values():
-        for tess in study.tessellations.values():
-            for element in tess.elements:
-                points = {n: tess.nodes[n] for n in element.polyhedron.nodes}
-                key = (tuple(sorted(points.items())), tess.configuration.box.squared)
-                if key in seen:
-                    continue
-                seen.add(key)
-                own = subdivisions(Frame.build(points, tess.configuration.box.squared), element.polyhedron,
-                                   "internal_faces")
-                filtered = element_options(tess, element, "internal_faces")
-                assert sorted(tuple(p.nodes for p in split) for split in own) == sorted(
-                    tuple(p.polyhedron.nodes for p in option) for option in filtered)
-
-
-def test_boundary_precheck_rejects_only_what_the_hull_test_rejects(studies):
-    # The split search skips the hull of a candidate that shares three or more but
-    # not all vertices of a boundary face: the hull test must reject each such one.
-    from itertools import combinations
-
-    from cospherical.core.delaunay import hull_faces
-    from cospherical.core.geometry import Frame
-    from cospherical.core.split import _Element
-
-    seen = set()
-    skipped = 0
-    for study in studies.values():
-        for tess in study.tessellations.values():
-            for element in tess.elements:
-                points = {n: tess.nodes[n] for n in element.polyhedron.nodes}
-                key = (tuple(sorted(points.items())), tess.configuration.box.squared)
-                if len(points) == 4 or key in seen:
-                    continue
-                seen.add(key)
-                own = _Element(Frame.build(points, tess.configuration.box.squared), element.polyhedron,
-                               "internal_edges_and_faces")
-                for size in range(4, len(points) + 1):
-                    for subset in combinations(own.members, size):
-                        if not own._cuts_boundary(frozenset(subset)):
-                            continue
-                        skipped += 1
-                        try:
-                            faces = hull_faces(own.frame, list(subset))
-                        except ValueError:
-                            continue
-                        assert own._check(faces) is None
-    assert skipped > 1000
