@@ -1,0 +1,150 @@
+"""Pattern tables: the committed ones validate and answer as before; broken ones are refused."""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from cospherical import Box, Configuration, tessellate
+from cospherical.catalogue import catalogue_path, load_catalogue
+from cospherical.errors import FormatError
+from cospherical.files.yamlio import dump_yaml, load_yaml
+from cospherical.formats.check import check_catalogue, check_patterns
+from cospherical.formats.patterns import load, write_patterns
+from cospherical.studies.bisection import bisection_codes, run_study
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def committed_tables():
+    """The committed pattern tables, each read once (a 4096-configuration table takes seconds)."""
+    stems = ("bisection-1x1x1", "bisection-1x2x4", "bisection-1x1.4142x1.4142", "bisection-1xsqrt2xsqrt2")
+    return {stem: load(ROOT / "patterns" / f"{stem}.yaml") for stem in stems}
+
+
+def test_committed_catalogue_and_patterns_validate(committed_tables):
+    catalogue = load_catalogue(catalogue_path())
+    check_catalogue(catalogue, "catalogue")
+    ids = [t["id"] for t in catalogue["types"]]
+    names = {t["name"] for t in catalogue["types"]}
+    assert {"Tetrahedron", "Cuboid", "Rectangular Pyramid", "Tetrahedron Complement", "Generic #8"} <= names
+    for stem, table in committed_tables.items():
+        assert table.header["catalogue_version"] == catalogue["version"]
+        assert len(table.configurations) == 4096
+        known = set(ids)
+        assert all(e["type"] in known for entry in table.configurations.values() for e in entry["optimal"])
+        check_patterns(table, catalogue, stem)  # known types, node counts, and every configuration tiles the box
+
+
+def test_pattern_lookup_equals_tessellate(committed_tables):
+    table = committed_tables["bisection-1x2x4"]
+    for code in bisection_codes()[::97]:
+        tess = tessellate(Configuration.from_code(code, ("1", "2", "4")))
+        assert table.elements(code) == [
+            {"type": e.type.id, "nodes": list(e.nodes), "circumcenter": list(tess.circumcenter(e))}
+            for e in tess.elements
+        ]
+        assert table.configurations[code]["fvm_adequate"] == tess.fvm_adequate
+
+
+# sha256 over every (code, criterion, elements) of each committed table, computed from the
+# tables as written before entries became one JSON flow line each (block YAML read by PyYAML):
+# the faster format must answer every lookup exactly as the previous one did.
+PREVIOUS_FORMAT_DIGESTS = {
+    "bisection-1x1x1": "42b2edc898170d41fa79d45812157cb8ea4836392fe3799854d3ff63a3923c0e",
+    "bisection-1x2x4": "b8c9b8dee07d0d4019be053006e5d97302dade33555eb9e173b42617791e6d7f",
+    "bisection-1x1.4142x1.4142": "7ca90c9a2bf73d9b1f792fb0fdfd9502b2a6d3ae11d75e5dfaf7801ff7317951",
+    "bisection-1xsqrt2xsqrt2": "c56408071132f626ddfcb9f66b256e3b14b4ce291667a06dc1d73f605b6113e8",
+    "leaves-1x1x1": "71f152faf11e4bd613ee7aaf9206c310a6e56166e192f6bdd4d854804a5af472",
+    "leaves-1x2x4": "09d91f2c18a5ae7663ef40d9d35175350f5464a4d6dbd885de47f06848fb4295",
+    "bisection-prism-1x1x1": "0ab5163f1d62c8474d53d88c805381c58aa25f40ff76caab6fcfa9139737b813",
+    "bisection-pyramid-1x1x1": "96140b99fffe7f30f1b51af52fa92625914043278f3168af5d12ebb70dbf99ae",
+    "bisection-tetrahedron-1x1x1": "945f8791d8f545eac0ff3771b757d5b17ae7497db171fa8bffdf6dd6a34dfbcd",
+}
+
+
+def test_committed_tables_answer_as_the_previous_format(committed_tables):
+    tables = {**committed_tables, **{stem: load(ROOT / "patterns" / f"{stem}.yaml")
+                                     for stem in PREVIOUS_FORMAT_DIGESTS if stem not in committed_tables}}
+    assert sorted(tables) == sorted(p.stem for p in (ROOT / "patterns").glob("*.yaml"))
+    for stem, table in tables.items():
+        digest = hashlib.sha256()
+        for code in table.configurations:
+            for criterion in table.header["criteria"]:
+                digest.update(json.dumps([code, criterion, table.elements(code, criterion)]).encode())
+        assert digest.hexdigest() == PREVIOUS_FORMAT_DIGESTS[stem], stem
+
+
+@pytest.mark.oracle_pyyaml
+def test_a_standard_yaml_reader_reads_the_committed_files_alike(committed_tables):
+    # PyYAML on a whole table takes ~15 s: read every 64th entry line with it, and the catalogue whole.
+    for stem, table in committed_tables.items():
+        lines = (ROOT / "patterns" / f"{stem}.yaml").read_text().split("\n")
+        start = lines.index("configurations:") + 1
+        sample = yaml.safe_load("\n".join(lines[:start] + lines[start:-1:64]))
+        assert {k: v for k, v in sample.items() if k != "configurations"} == table.header
+        assert len(sample["configurations"]) == 64
+        for code, entry in sample["configurations"].items():
+            assert entry == table.configurations[code]
+    assert yaml.safe_load(catalogue_path().read_text()) == load_catalogue(catalogue_path())
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda line: line.replace("0.5", "5e-1", 1), "not a YAML 1.1 float"),
+    (lambda line: line.replace('"fvm_adequate": true', '"fvm_adequate": true, "fvm_adequate": true'), "repeated key"),
+    (lambda line: line.replace('"type": "v', '"type": "x', 1), "type"),
+    (lambda line: line.replace('"nodes": [', '"nodes": [,', 1), "configurations/800000000000"),
+])
+def test_a_broken_entry_is_refused_when_read(tmp_path, small_table_path, edit, needle):
+    lines = small_table_path.read_text().split("\n")
+    at = next(i for i, line in enumerate(lines) if line.startswith("  '800000000000'"))
+    lines[at] = edit(lines[at])
+    path = tmp_path / "broken.yaml"
+    path.write_text("\n".join(lines))
+    table = load(path)  # only the header is read here
+    assert table.elements("000000000000")
+    with pytest.raises(FormatError, match=needle):
+        table.elements("800000000000")
+    result = subprocess.run([sys.executable, "-m", "cospherical", "check", str(path)], capture_output=True, text=True)
+    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1 and needle in result.stderr
+
+
+@pytest.fixture(scope="module")
+def small_table_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("small") / "small.yaml"
+    study = run_study("bisection", Box.parse(("1", "2", "4")), ["000000000000", "800000000000", "880000000000"])
+    write_patterns(study, path, "000000000000")
+    return path
+
+
+@pytest.fixture(scope="module")
+def small_table(small_table_path):
+    return load_yaml(small_table_path)
+
+
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        (lambda d: d.update(schema_version=7), "schema_version"),
+        (lambda d: d["configurations"].update({"xyz": copy.deepcopy(d["configurations"]["000000000000"])}),
+         "configurations"),  # a copy: a shared object is written as a YAML alias, refused as such
+        (lambda d: d["configurations"]["800000000000"]["optimal"][0].update(nodes=[1, 2]), "nodes"),
+        (lambda d: d["configurations"]["800000000000"]["optimal"][0].pop("type"), "type"),
+        (lambda d: d.pop("box"), "box"),
+    ],
+)
+def test_broken_pattern_tables_are_refused(tmp_path, small_table, edit, needle):
+    data = copy.deepcopy(small_table)
+    edit(data)
+    path = tmp_path / "broken.yaml"
+    dump_yaml(data, path)
+    with pytest.raises(FormatError, match=needle):
+        load(path)
