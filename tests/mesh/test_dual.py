@@ -425,6 +425,64 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
     assert case != "manifest with a repeated key" or "repeated key 'version'" in err, err
 
 
+def _edited(good: Path, target: Path, edit) -> None:
+    """A re-signed copy of ``good`` whose members ``edit(arrays)`` changed in place (numpy arrays by name)."""
+    import io
+    import zipfile
+
+    with zipfile.ZipFile(good) as source:
+        arrays = {info.filename[:-4]: np.lib.format.read_array(io.BytesIO(source.read(info)))
+                  for info in source.infolist() if info.filename != "manifest.npy"}
+    changed = set(edit(arrays))
+    _resigned(good, target, members={name: arrays[name] for name in changed})
+
+
+def test_a_resigned_edit_that_keeps_every_sum_is_refused_naming_the_edge(dual_run, tmp_path, capsys):
+    # +k on one coefficient and -k on another (floats made to agree): every identity check makes is a sum,
+    # so only computing the dual again from the file's elements can tell
+    from cospherical.cli import main
+    from cospherical.formats.dual import read_dual
+
+    good = dual_run / "a" / "dual.npz"
+    dual = read_dual(good)
+    interior = np.flatnonzero(~dual.boundary[dual.edges].all(axis=1))
+    a, b = int(interior[3]), int(interior[-5])
+    factor = dual.volume_factor / dual.coefficient_denominator
+
+    def balanced_coefficients(arrays):
+        arrays["coefficient_exact"][[a, b]] += [7, -7]
+        arrays["coefficient"][[a, b]] = arrays["coefficient_exact"][[a, b]] * factor
+        arrays["area"][[a, b]] = arrays["coefficient"][[a, b]] * arrays["length"][[a, b]]
+        return ["coefficient_exact", "coefficient", "area"]
+
+    def balanced_volumes(arrays):
+        arrays["volume_exact"][[0, 5]] += [3, -3]
+        return ["volume_exact"]
+
+    def a_float_alone(arrays):
+        arrays["coefficient"][b] *= 1.5
+        return ["coefficient"]
+
+    def a_vertex_twice(arrays):
+        arrays["element_nodes"][2, 1] = arrays["element_nodes"][2, 0]
+        return ["element_nodes"]
+
+    i, j = dual.edges[min(a, b)]
+    for edit, needle in ((balanced_coefficients, f"member coefficient_exact: edge {i}-{j} "),
+                         (balanced_volumes, "member volume_exact: vertex 0 "),
+                         (a_float_alone, f"member coefficient: edge {dual.edges[b, 0]}-{dual.edges[b, 1]} "),
+                         (a_vertex_twice, "member element_nodes: element 2 names a vertex twice")):
+        target = tmp_path / f"{edit.__name__}.npz"
+        _edited(good, target, edit)
+        if edit is not a_vertex_twice:  # the reader refuses that one itself
+            again = read_dual(target)
+            assert again.volume_sum() == 1 and again.boundary_area_sums() == (2, 2, 2)
+        capsys.readouterr()
+        assert main(["check", str(target)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and needle in err and "Traceback" not in err, (needle, err)
+
+
 def test_a_dual_npz_that_inflates_is_refused_from_its_headers(dual_run, tmp_path, capsys, monkeypatch):
     """A member whose header claims 100 MB of zeros (deflated to 100 KB, re-signed) is refused
     from the headers, before its data is read: the shapes disagree. Consistent claims beyond

@@ -167,7 +167,10 @@ class Dual:
     sum over k of boundary_area_exact[:, k] * sqrt(boundary_factors_squared[k]) /
     boundary_area_denominator``, ``boundary_factors_squared`` the squared products of the
     two lengths of those sides, ``(b^2 c^2, a^2 c^2, a^2 b^2)``.  ``element_circumcenter``:
-    the real circumcenter of every element, in the mesh's element order.
+    the real circumcenter of every element, in the mesh's element order; ``element_nodes``
+    and ``element_sizes``: the elements themselves (global vertex ids, padded with -1,
+    as :meth:`~cospherical.mesh.assembly.Mesh.connectivity` gives them), from which the
+    exact values can be computed again (``cospherical check`` does).
     """
 
     box: Box
@@ -191,6 +194,8 @@ class Dual:
     boundary_area_denominator: int
     boundary_factors_squared: tuple[Fraction, Fraction, Fraction]
     element_circumcenter: np.ndarray = field(repr=False)
+    element_nodes: np.ndarray = field(repr=False)
+    element_sizes: np.ndarray = field(repr=False)
 
     def laplacian(self):
         """The box method's matrix: ``K[i, j] = -coefficient``, ``K[i, i]`` the row's sum (scipy.sparse CSR).
@@ -298,6 +303,7 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
         groups, centers = _leaf_groups(mesh, squared)
         if mesh.cells is not None:
             groups += _cell_groups(mesh, squared, centers)
+        elements = mesh.connectivity()
     else:
         groups, centers = _element_groups(mesh, squared, *elements)
     cden = math.lcm(1, *(_lcm_denominator(shape.edge_q) for shape, _, _, _ in groups))
@@ -348,7 +354,8 @@ def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Du
                 coefficient_exact=coefficient_exact, coefficient_denominator=cden * grid, volume_exact=volume_exact,
                 volume_denominator=vden * grid ** 3, volume_factor=factor, volume_factor_squared=factor_squared,
                 boundary_area_exact=boundary_exact, boundary_area_denominator=bden * grid ** 2,
-                boundary_factors_squared=plane_squared, element_circumcenter=centers)
+                boundary_factors_squared=plane_squared, element_circumcenter=centers,
+                element_nodes=elements[0], element_sizes=elements[1])
 
 
 def boundary_areas(exact: np.ndarray, denominator: int, factors_squared) -> np.ndarray:
