@@ -30,7 +30,7 @@ SMALLER = [
     (re.compile(r"^(python benchmarks/bench_startup.py)"), r"\1 --runs 1 --every 64 --tables 'bisection-tetra*'"),
     (re.compile(r"^(python benchmarks/bench_bisection.py)"), r"\1 --every 64"),
     (re.compile(r"^(cospherical sweep --ratios \S+):\d+ (\S+):\d+"), r"\1:2 \2:2"),  # 2 x 2 grid values
-    # test_study and test_shapes check the bisection and shape tables deeply in-process: the
+    # formats/test_patterns.py and core/test_shapes.py check the bisection and shape tables deeply in-process: the
     # example checks the others, the leaf tables
     (re.compile(r"^(cospherical check catalogue/catalogue.yaml) patterns/\*\.yaml"), r"\1 patterns/leaves-*.yaml"),
     (re.compile(r"^(cospherical mesh .*)--levels \d+"), r"\1--levels 3"),

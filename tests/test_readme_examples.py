@@ -4,7 +4,7 @@ Heavy examples run at a small size, in a scratch clone of the repository (the
 machinery, shared with the docs site's examples, is ``examples.py``). Lines not run
 here, and why: the set-up (it made the environment these tests run in), the test
 suite itself, and ``cospherical reproduce``, which
-``test_study.test_reproduce_regenerates_committed_files_byte_for_byte`` runs and
+``outputs/test_reproduce.py::test_reproduce_regenerates_committed_files_byte_for_byte`` runs and
 compares byte for byte.
 """
 

@@ -19,7 +19,7 @@ BOXES = {"A": ("1", "1", "1"), "B": ("1", "2", "4"), "C": ("1", "1.4142", "1.414
 
 @pytest.fixture(scope="module")
 def studies(paper_studies):
-    """Boxes A, B, C: the session's studies (conftest.py), shared with test_study."""
+    """Boxes A, B, C: the session's studies (conftest.py), shared with paper/test_comparison.py."""
     assert {key: study.box.texts for key, study in paper_studies.items()} == BOXES
     return paper_studies
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import random
 from collections import defaultdict
+from fractions import Fraction
 
 import pytest
 from oracle import isomorphic, qhull_regions, qhull_regions_by_orbit
@@ -14,6 +15,7 @@ from cospherical.core.canonical import canonical_form
 from cospherical.core.symmetry import box_symmetries
 from cospherical.studies.bisection import run_study
 
+CUBE = ("1", "1", "1")
 BOXES = {
     "cube": ("1", "1", "1"),
     "aspect4": ("1", "2", "4"),
@@ -97,7 +99,7 @@ def test_random_intersection_configurations_match_qhull(order):
 @pytest.mark.oracle_qhull
 def test_the_python_walk_matches_qhull():
     # The Python walk (tessellate()'s default, any frame) against the oracle; the
-    # compiled walk is held to it in test_invariants.
+    # compiled walk is held to it in core/test_compiled.py.
     from cospherical.core.delaunay import delaunay_cells
     from cospherical.core.geometry import Frame
 
@@ -121,3 +123,29 @@ def test_code_is_invariant_under_relabelling_and_mirroring():
         shuffled = [mirrored[i] for i in order], [kinds[i] for i in order]
         assert canonical_form(renamed, kinds).code == e.type.code
         assert canonical_form(*shuffled).code == e.type.code
+
+
+@pytest.mark.oracle_qhull
+def test_random_face_subsets_at_sixteenths_match_qhull():
+    rng = random.Random(1313)
+    boxes = [CUBE, ("1", "2", "4"), ("1", "sqrt(2)", "sqrt(2)"), ("3", "1", "2")]
+    checked = 0
+    while checked < 300:
+        steiner = {}
+        for axis_edges in ((0, 2, 4, 6), (1, 3, 5, 7), (8, 9, 10, 11)):
+            t = Fraction(rng.randint(1, 15), 16)
+            for k in axis_edges:
+                roll = rng.random()
+                if roll < 0.6:
+                    steiner[k] = t  # equal parameters on parallel edges: admissible faces
+                elif roll < 0.8:
+                    steiner[k] = Fraction(rng.randint(1, 15), 16)
+        admissible = sorted(Configuration.from_steiner(CUBE, steiner).admissible_faces)
+        if not admissible:
+            continue
+        faces = [f for f in admissible if rng.random() < 0.5]
+        body = len(faces) == 6 and rng.random() < 0.5
+        cfg = Configuration.from_steiner(rng.choice(boxes), steiner, faces=faces, body=body)
+        ours = {frozenset(e.nodes) for e in tessellate(cfg).elements}
+        assert ours == qhull_regions(cfg.real_nodes()), (cfg.box.texts, cfg.point_set_code)
+        checked += 1

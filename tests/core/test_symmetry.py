@@ -5,8 +5,10 @@ from __future__ import annotations
 import pytest
 
 from cospherical import Box, Configuration
-from cospherical.core.symmetry import box_symmetries
+from cospherical.core.symmetry import box_symmetries, orbit_representatives
 from cospherical.studies.bisection import bisection_codes
+
+CUBE = ("1", "1", "1")
 
 
 @pytest.mark.parametrize("lengths, order", [(("1", "1", "1"), 48), (("1", "2", "2"), 16), (("1", "2", "4"), 8)])
@@ -56,3 +58,17 @@ def test_orbit_representatives_without_numpy_equal_numpy_ones(lengths):
         numpy_keys = symmetry.orbit_point_keys(symmetry.code_digits(codes), np.array(masks, dtype=np.int64),
                                                symmetries, backend="numpy")
         assert symmetry._orbit_keys_python(codes, masks, group) == tuple(a.tolist() for a in numpy_keys)
+
+
+def test_symmetries_map_face_points():
+    box = Box.parse(CUBE)
+    cfg = Configuration.from_steiner(box, {0: "1/4", 2: "1/4", 1: "3/4", 3: "3/4", 4: "1/4", 8: "1/2", 9: "1/2"},
+                                     faces=[0, 4])
+    images = set()
+    for sym in box_symmetries(box):
+        image = sym.configuration(cfg)
+        assert image.code == sym.code(cfg.code) and image.point_faces == {sym.face_map[0], sym.face_map[4]}
+        assert {sym.node_map[i]: sym.point(p) for i, p in cfg.nodes().items()} == image.nodes()
+        images.add(image.code)
+    representative, _ = orbit_representatives([cfg.code], box_symmetries(box))
+    assert representative[0] in images

@@ -1,0 +1,61 @@
+"""``cospherical tessellate``: face points given on the command line."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from commands import cospherical
+
+from cospherical.cli import main
+
+
+def test_tessellate_with_faces_on_the_command_line():
+    by_flag = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--faces", "0", "4")
+    assert by_flag.returncode == 0, by_flag.stderr
+    data = json.loads(by_flag.stdout)
+    assert data["code"] == "888888888888+f04" and data["face_points"] == "explicit"
+    assert data["faces"] == [0, 4] and data["body_point"] is False and data["point_set_code"] == data["code"]
+    assert set(data["nodes"]) == {str(i) for i in range(20)} | {"20", "24"}
+    by_code = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888+f04")
+    assert by_code.stdout == by_flag.stdout
+    by_steiner = cospherical("tessellate", "--box", "1", "1", "1", "--steiner", *(f"{k}:1/2" for k in range(12)),
+                             "--faces", "0", "4")
+    assert json.loads(by_steiner.stdout)["elements"] == data["elements"]
+
+
+def test_no_faces_given_explicitly_is_policy_none():
+    explicit = json.loads(cospherical("tessellate", "--box", "1", "2", "4", "--code", "888888888888", "--faces").stdout)
+    none = json.loads(cospherical("tessellate", "--box", "1", "2", "4", "--code", "888888888888",
+                                  "--face-points", "none").stdout)
+    assert explicit["code"] == "888888888888+f" and none["code"] == "888888888888"
+    assert explicit["point_set_code"] == none["point_set_code"] == "888888888888+f"
+    assert explicit["elements"] == none["elements"] and explicit["nodes"] == none["nodes"]
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--code", "800000000000", "--faces", "0"], "face 0"),
+        (["--steiner", "0:1/4", "4:1/2", "8:1/2", "9:1/2", "--faces", "0"], "different parameters"),
+        (["--code", "888888888888", "--faces", "0", "0"], "twice"),
+        (["--code", "888888888888", "--faces", "6"], "face"),
+        (["--code", "888888888888", "--faces", "x"], "face"),
+        (["--code", "888888888888+f4x"], "suffix"),
+        (["--code", "888888888888+f44"], "twice"),
+        (["--code", "888888888888+f"], None),
+        (["--code", "888888888888+f0", "--faces", "4"], "suffix"),
+        (["--code", "888888888888", "--faces", "0", "--face-points", "none"], "not allowed"),
+        (["--code", "888888888888", "--body"], "body point"),
+    ],
+)
+def test_bad_face_points_on_the_command_line_exit_2_in_one_line(args, needle, capsys):
+    # in-process (test_cli runs the same error path as a subprocess): a dozen interpreter starts saved
+    status = main(["tessellate", "--box", "1", "1", "1", *args])
+    out, err = capsys.readouterr()
+    if needle is None:  # the empty suffix is a valid code
+        assert status == 0, err
+        return
+    assert status == 2 and out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0] and "Traceback" not in err, err
