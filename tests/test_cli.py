@@ -102,3 +102,23 @@ def test_each_study_family_has_its_own_help(capsys):
     assert "--face-points" not in texts["leaves"] and "--box" not in texts["intersection"]
     assert main(["study", "bisection", "--resume"]) == 2  # hidden, still refused by name
     assert "option of the intersection study only" in capsys.readouterr().err
+
+
+def test_the_scheduler_option_says_it_must_be_a_scheduler_you_run(capsys):
+    # Dask unpickles what the scheduler sends: connecting to one is trusting it with your account.
+    # The help of each --scheduler says so, and the Dask how-to says why, in one place.
+    import re
+    from pathlib import Path
+
+    from cospherical.cli import main
+
+    for argv in (["mesh", "--help"], ["study", "intersection", "--help"]):
+        with pytest.raises(SystemExit):
+            main(argv)
+        text = " ".join(capsys.readouterr().out.split())
+        start = text.rindex("--scheduler tcp://HOST:PORT")  # the option's entry, after the usage line
+        help_text = text[start:text.index("--scheduler-timeout", start)]
+        assert "must be a scheduler you run" in help_text and "unpickles" in help_text, help_text
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    warned = [p.name for p in docs.rglob("*.md") if re.search(r"only to a scheduler you run", p.read_text())]
+    assert warned == ["dask.md"]

@@ -78,7 +78,8 @@ def add_parser(commands) -> None:
                         "1 meshes the pieces one after another in this process")
     parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                         help="run the pieces on this Dask scheduler's workers (with --partitions; --out DIR must be "
-                        "a folder the workers share)")
+                        "a folder the workers share). It must be a scheduler you run: Dask unpickles what it "
+                        "sends, so it can run any code as you")
     parser.add_argument("--scheduler-timeout", type=float, default=30.0, metavar="SECONDS",
                         help="give up connecting to --scheduler after this long (default 30)")
     parser.add_argument("--dask-workers", type=int, metavar="N",

@@ -78,7 +78,8 @@ def _add_family(parser, family: str) -> None:
     option("--chunk-size", type=int, metavar="N", only=intersection,
            help="orbits per work unit and checkpoint (default 5000)")
     option("--scheduler", metavar="tcp://HOST:PORT", only=intersection,
-           help="run the work units on this Dask scheduler's workers")
+           help="run the work units on this Dask scheduler's workers. It must be a scheduler you run: Dask "
+           "unpickles what it sends, so it can run any code as you")
     option("--scheduler-timeout", type=float, metavar="SECONDS", only=intersection,
            help="give up connecting to --scheduler after this long (default 30)")
     option("--dask-workers", type=int, metavar="N", only=intersection,
