@@ -1,21 +1,28 @@
-"""The mesh VTU: read back by VTK (ParaView's reader) and meshio, cell for cell; exact data alongside; atomic."""
+"""Files of ``cospherical mesh``: the leaf list; pattern tables of orbit representatives looked up for every
+configuration of an orbit; the mesh VTU read back by VTK (ParaView's reader) and meshio, cell for cell, exact
+data alongside, written atomically."""
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from fractions import Fraction
 
 import numpy as np
+import pytest
 import vtk
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from vtk.util.numpy_support import vtk_to_numpy
 
+from cospherical.cli import main
 from cospherical.core.configuration import Box
-from cospherical.formats.mesh import write_vtu
+from cospherical.formats.mesh import read_leaves, table_lookup, write_vtu
+from cospherical.formats.patterns import load
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.octree import build_octree, parse_shape
+from tests.mesh.test_assembly import OCTANT
 
 CUBE = Box.parse(["1", "1", "1"])
 # 253 leaves, 449 elements of six types: two of them have no VTK cell (polyhedra)
@@ -223,3 +230,77 @@ def test_the_picture_cuts_what_vtk_cuts(tmp_path):
             assert tuple(pixels[int(centre[1]), int(centre[0])]) == TAB20[commonest.index(t) % 20]
             checked += 1
     assert checked > len(polygons) / 2
+
+
+def test_text_leaf_list(tmp_path):
+    path = tmp_path / "leaves.txt"
+    path.write_text("# octant\n" + "\n".join(" ".join(map(str, leaf)) for leaf in OCTANT) + "\n")
+    levels, positions = read_leaves(path)
+    assert len(levels) == 15 and positions.shape == (15, 3)
+
+
+@pytest.fixture(scope="module")
+def representatives_store(tmp_path_factory):
+    """The R = 2 intersection store: one configuration per orbit of the cube's 48 symmetries."""
+    from cospherical.catalogue import shipped_catalogue
+    from cospherical.formats.intersection_table import write_pattern_table
+    from cospherical.studies.intersection.table import TableRun
+    from cospherical.studies.intersection import run_intersection
+
+    path = tmp_path_factory.mktemp("store") / "intersection-r2.sqlite"
+    write_pattern_table(TableRun(run_intersection(2, jobs=1), jobs=1), shipped_catalogue()["version"], store=path)
+    return path
+
+
+def element_sets(mesh):
+    conn, sizes = mesh.connectivity()
+    ids, types = mesh.element_types()
+    return sorted((ids[types[e]], tuple(sorted(conn[e, :sizes[e]].tolist()))) for e in range(len(mesh)))
+
+
+def test_a_table_of_orbit_representatives_serves_every_configuration_of_an_orbit(representatives_store, tmp_path):
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    from cospherical.formats.mesh import write_vtu
+
+    table = load(representatives_store)
+    tree = build_octree(CUBE, 3, [parse_shape("plane:1,2,3,2")])  # standard cells and polyhedra
+    mesh = assemble(tree, table_lookup(table, "optimal", CUBE))
+    mapped = [p for p in mesh.patterns if p.mapped_from is not None]
+    assert mapped and not any(p.on_the_fly for p in mesh.patterns)
+    assert all(p.mapped_from.split("+")[0] in table.configurations for p in mapped)  # the bare code, its policy's
+    # element for element what tessellating each configuration gives, and a valid mesh
+    assert element_sets(mesh) == element_sets(assemble(tree))
+    # a reflection turns a VTK cell inside out unless its nodes are reordered: VTK's own validity test
+    write_vtu(mesh, tmp_path / "mesh.vtu")
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(tmp_path / "mesh.vtu"))
+    validator = vtk.vtkCellValidator()
+    validator.SetInputConnection(reader.GetOutputPort())
+    validator.Update()
+    assert (vtk_to_numpy(validator.GetOutput().GetCellData().GetArray("ValidityState")) == 0).all()
+    # the store's header names functions that exist
+    import importlib
+    import re
+
+    for name in re.findall(r"cospherical(?:\.\w+)+", table.header["symmetry"]):
+        module, _, attribute = name.rpartition(".")
+        assert hasattr(importlib.import_module(module), attribute), name
+
+
+@settings(max_examples=6, deadline=None)
+@given(st.tuples(*[st.integers(1, 15)] * 3), st.integers(2, 3))
+def test_mapped_configurations_equal_tessellated_ones(representatives_store, point, levels):
+    tree = build_octree(CUBE, levels, [parse_shape("point:" + ",".join(f"{x / 16}" for x in point))])
+    mesh = assemble(tree, table_lookup(load(representatives_store), "optimal", CUBE))
+    assert element_sets(mesh) == element_sets(assemble(tree))
+
+
+def test_the_report_says_where_each_configuration_came_from(representatives_store, capsys):
+    assert main(["mesh", "--domain", "1", "1", "1", "--levels", "3", "--refine", "sphere:0.5,0.5,0.5,0.3",
+                 "--patterns", str(representatives_store), "--format", "json", "--no-uniform", "--no-delaunay"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["configurations_mapped"] > 0 and report["tessellated_on_the_fly"] == 0
+    assert report["configurations_from_table"] + report["configurations_mapped"] + report["tessellated_on_the_fly"] \
+        == report["configurations"]
