@@ -1,9 +1,10 @@
-"""``cospherical tessellate``: face points given on the command line."""
+"""``cospherical tessellate``: face points given on the command line, and the VTU it writes."""
 
 from __future__ import annotations
 
 import json
 
+import meshio
 import pytest
 from commands import cospherical
 
@@ -59,3 +60,12 @@ def test_bad_face_points_on_the_command_line_exit_2_in_one_line(args, needle, ca
     assert status == 2 and out == ""
     lines = err.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0] and "Traceback" not in err, err
+
+
+@pytest.mark.oracle_meshio
+def test_tessellate_cli_writes_vtu(tmp_path):
+    path = tmp_path / "out.vtu"
+    result = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--vtu", str(path))
+    assert result.returncode == 0, result.stderr
+    mesh = meshio.read(path)
+    assert [block.type for block in mesh.cells] == ["hexahedron"] and len(mesh.cells[0].data) == 8

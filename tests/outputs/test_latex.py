@@ -1,28 +1,20 @@
-"""LaTeX tables compiled by a real pdflatex, pictures, and VTU export read back by meshio."""
+"""LaTeX tables compiled by a real pdflatex, byte-identical across runs, with escaped names and drawn pictures."""
 
 from __future__ import annotations
 
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
-import meshio
-import numpy as np
 import pytest
+from commands import cospherical
 from matplotlib.image import imread
 
-from cospherical import Configuration, tessellate
 from cospherical.catalogue import catalogue_path, load_catalogue
-from cospherical.formats.vtu import write_vtu
 from cospherical.outputs.latex import tikz_picture
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SUMMARIES = [ROOT / "results" / f"bisection-{box}.json" for box in ("1x1x1", "1x2x4", "1x1.4142x1.4142")]
-
-
-def cospherical(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "cospherical", *args], capture_output=True, text=True, cwd=cwd)
 
 
 @pytest.mark.oracle_pdflatex
@@ -62,43 +54,3 @@ def test_names_are_escaped_and_pictures_drawn():
     assert r"\draw[densely dashed, gray]" in picture or generic["vertices"] == 4
     elements = (ROOT / "results" / "latex" / "elements.tex").read_text()
     assert r"Generic \#" in elements and "Generic #" not in elements.replace(r"Generic \#", "")
-
-
-def test_render_refuses_bad_summaries(tmp_path):
-    bad = tmp_path / "bad.json"
-    bad.write_text('{"study": "bisection"}')
-    result = cospherical("render", "--summary", str(bad), "--out", str(tmp_path / "out"))
-    assert result.returncode == 2 and "not a study summary" in result.stderr
-    assert len(result.stderr.strip().splitlines()) == 1
-
-
-@pytest.mark.parametrize("option", [["--box", "1", "2", "4"], ["--element", "prism"], ["--face-points", "none"]])
-def test_render_refuses_a_study_option_beside_a_summary(tmp_path, capsys, option):
-    # it would do nothing: the summary says its own box, element and points
-    from cospherical.cli import main
-
-    assert main(["render", "--summary", str(SUMMARIES[0]), *option, "--out", str(tmp_path / "out")]) == 2
-    err = capsys.readouterr().err
-    assert f"{option[0]} goes with --study" in err and err.count("\n") == 1, err
-    assert not (tmp_path / "out").exists()
-@pytest.mark.oracle_meshio
-def test_vtu_reads_back(tmp_path):
-    for code, expect_polyhedra in (("888800000000", False), ("880000000000", True)):
-        tess = tessellate(Configuration.from_code(code, ("1", "2", "4") if not expect_polyhedra else ("1", "1", "1")))
-        path = tmp_path / f"{code}.vtu"
-        write_vtu(tess, path)
-        mesh = meshio.read(path)
-        assert len(mesh.points) == len(tess.nodes)
-        assert sum(len(block.data) for block in mesh.cells) == len(tess.elements)
-        assert any(block.type.startswith("polyhedron") for block in mesh.cells) == expect_polyhedra
-        hashes = sorted(int(x) for block in mesh.cell_data["type_hash"] for x in np.ravel(block))
-        assert hashes == sorted(int(e.type.id.rsplit("-", 1)[1], 16) for e in tess.elements)
-
-
-@pytest.mark.oracle_meshio
-def test_tessellate_cli_writes_vtu(tmp_path):
-    path = tmp_path / "out.vtu"
-    result = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--vtu", str(path))
-    assert result.returncode == 0, result.stderr
-    mesh = meshio.read(path)
-    assert [block.type for block in mesh.cells] == ["hexahedron"] and len(mesh.cells[0].data) == 8
