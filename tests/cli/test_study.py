@@ -1,4 +1,4 @@
-"""``cospherical study``: the JSON it prints and the files it writes."""
+"""``cospherical study``: each family's own help, the JSON it prints and the files it writes."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from commands import cospherical
 
 from cospherical.formats.patterns import load, pattern_name
@@ -50,3 +51,20 @@ def test_study_leaves_json_and_tables(tmp_path):
     assert json.loads((tmp_path / "leaves-1x2x4.json").read_text()) == data
     committed = ROOT / "patterns" / "leaves-1x2x4.yaml"
     assert (tmp_path / "leaves-1x2x4.yaml").read_bytes() == committed.read_bytes()
+
+
+def test_each_study_family_has_its_own_help(capsys):
+    from cospherical.cli import main
+
+    texts = {}
+    for family in ("bisection", "leaves", "intersection"):
+        with pytest.raises(SystemExit) as exit:
+            main(["study", family, "--help"])
+        assert exit.value.code == 0
+        texts[family] = capsys.readouterr().out
+    assert len(set(texts.values())) == 3
+    assert "--resume" in texts["intersection"] and "--resume" not in texts["bisection"]
+    assert "--element" in texts["bisection"] and "--element" not in texts["leaves"]
+    assert "--face-points" not in texts["leaves"] and "--box" not in texts["intersection"]
+    assert main(["study", "bisection", "--resume"]) == 2  # hidden, still refused by name
+    assert "option of the intersection study only" in capsys.readouterr().err

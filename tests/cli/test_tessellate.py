@@ -1,4 +1,5 @@
-"""``cospherical tessellate``: face points given on the command line, and the VTU it writes."""
+"""``cospherical tessellate``: its JSON and YAML, deterministic; face points given on the command line; the VTU
+it writes."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import json
 
 import meshio
 import pytest
+import yaml
 from commands import cospherical
 
 from cospherical.cli import main
@@ -51,7 +53,7 @@ def test_no_faces_given_explicitly_is_policy_none():
     ],
 )
 def test_bad_face_points_on_the_command_line_exit_2_in_one_line(args, needle, capsys):
-    # in-process (test_cli runs the same error path as a subprocess): a dozen interpreter starts saved
+    # in-process (cli/test_cli.py runs the same error path as a subprocess): a dozen interpreter starts saved
     status = main(["tessellate", "--box", "1", "1", "1", *args])
     out, err = capsys.readouterr()
     if needle is None:  # the empty suffix is a valid code
@@ -69,3 +71,31 @@ def test_tessellate_cli_writes_vtu(tmp_path):
     assert result.returncode == 0, result.stderr
     mesh = meshio.read(path)
     assert [block.type for block in mesh.cells] == ["hexahedron"] and len(mesh.cells[0].data) == 8
+
+
+def test_tessellate_json_contract():
+    result = cospherical("tessellate", "--box", "1", "1", "1", "--code", "800000000000")
+    assert result.returncode == 0, result.stderr
+    data = json.loads(result.stdout)
+    assert data["box"] == ["1", "1", "1"] and data["code"] == "800000000000"
+    assert data["nodes"]["8"] == [0.5, 0.0, 0.0]
+    assert set(data["nodes"]) == {str(i) for i in range(9)}
+    assert len(data["elements"]) == 4
+    for element in data["elements"]:
+        assert {"type", "name", "nodes", "vertices", "edges", "faces", "circumcenter"} <= set(element)
+        assert element["name"] == "Rectangular Pyramid" and len(element["nodes"]) == 5
+        assert (element["vertices"], element["edges"], element["faces"]) == (5, 8, 5)
+    assert data["fvm_adequate"] is True
+
+
+def test_tessellate_steiner_and_yaml_agree_with_code():
+    by_code = json.loads(cospherical("tessellate", "--box", "1", "sqrt(2)", "1.4142", "--code", "800080000008").stdout)
+    result = cospherical("tessellate", "--box", "1", "sqrt(2)", "1.4142", "--steiner", "0:1/2", "4:0.5", "11:8/16",
+                         "--format", "yaml")
+    assert result.returncode == 0, result.stderr
+    assert yaml.safe_load(result.stdout) == by_code
+
+
+def test_output_is_deterministic():
+    args = ("tessellate", "--box", "1", "2", "4", "--code", "88808a000c01", "--face-points", "none")
+    assert cospherical(*args).stdout == cospherical(*args).stdout
