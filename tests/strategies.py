@@ -1,7 +1,8 @@
-"""Hypothesis strategies for configurations."""
+"""Hypothesis strategies for configurations and refinement shapes."""
 
 from __future__ import annotations
 
+import math  # noqa: F401 (shapes() evaluates sqrt lengths with it)
 from fractions import Fraction
 
 from hypothesis import strategies as st
@@ -60,3 +61,20 @@ def random_configuration(rng) -> Configuration:
                 if k in steiner or rng.random() < 0.5:
                     steiner[k] = t
     return Configuration.from_steiner(box, steiner, rng.choice(["octree", "none"]))
+
+
+# Refinement shapes of the mesher (``--refine KIND:NUMBERS``) on boxes with rational and sqrt lengths
+NUMBERS = st.sampled_from(["0", "1", "1/3", "0.5", "-0.25", "2", "0.1234567891", "1e-10", "7/16", "sqrt(2)"])
+BOXES = st.sampled_from([("1", "1", "1"), ("1", "2", "4"), ("3/2", "1", "0.75"), ("sqrt(2)", "1", "1")])
+
+
+@st.composite
+def shapes(draw):
+    kind = draw(st.sampled_from(["point", "box", "plane", "sphere"]))
+    count = {"point": 3, "box": 6, "plane": 4, "sphere": 4}[kind]
+    values = [draw(NUMBERS) for _ in range(count)]
+    if kind == "box":
+        for a in range(3):
+            lo, hi = sorted(values[a::3][:2], key=lambda v: float(eval(v.replace("sqrt", "math.sqrt"))))
+            values[a], values[a + 3] = lo, hi
+    return f"{kind}:{','.join(values)}"

@@ -12,22 +12,20 @@ from __future__ import annotations
 import contextlib
 import io
 import json
-import math
 import os
 import resource
 import subprocess
 import sys
 import time
-from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from strategies import BOXES, shapes
 
 from cospherical.cli import main
-from cospherical.core.configuration import Box
 from cospherical.mesh import octree
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -166,71 +164,6 @@ def test_tree_size_is_estimated_and_refused_at_once():
                   "--max-leaves", "-5")[::2], "--max-leaves")
 
 
-NUMBERS = st.sampled_from(["0", "1", "1/3", "0.5", "-0.25", "2", "0.1234567891", "1e-10", "7/16", "sqrt(2)"])
-BOXES = st.sampled_from([("1", "1", "1"), ("1", "2", "4"), ("3/2", "1", "0.75"), ("sqrt(2)", "1", "1")])
-
-
-@st.composite
-def shapes(draw):
-    kind = draw(st.sampled_from(["point", "box", "plane", "sphere"]))
-    count = {"point": 3, "box": 6, "plane": 4, "sphere": 4}[kind]
-    values = [draw(NUMBERS) for _ in range(count)]
-    if kind == "box":
-        for a in range(3):
-            lo, hi = sorted(values[a::3][:2], key=lambda v: float(eval(v.replace("sqrt", "math.sqrt"))))
-            values[a], values[a + 3] = lo, hi
-    return f"{kind}:{','.join(values)}"
-
-
-def _brute_meets(shape: octree.Shape, box: Box, level: int, cell) -> bool:
-    """Does the closed cell meet the shape: Fractions, one cell at a time (rational lengths only)."""
-    n = 1 << level
-    lengths = [math.sqrt(float(s)) for s in box.squared]  # sqrt lengths only reach point and box
-    v = shape.values
-    if shape.kind in ("point", "box"):
-        lo, hi = (v[:3], v[:3]) if shape.kind == "point" else (v[:3], v[3:])
-        # i * len / n <= hi and (i + 1) * len / n >= lo, squared with signs
-        def le(i, q, b):  # i * sqrt(q) <= b, i >= 0
-            return b >= 0 and i * i * q <= b * b
-        return all(le(cell[a], box.squared[a], hi[a] * n) and not (lo[a] * n > 0 and (cell[a] + 1) ** 2 * box.squared[a]
-                   < (lo[a] * n) ** 2) for a in range(3))
-    del lengths
-    side = [Fraction(math.isqrt(q.numerator), math.isqrt(q.denominator)) for q in box.squared]
-    lo = [Fraction(cell[a], n) * side[a] for a in range(3)]
-    hi = [Fraction(cell[a] + 1, n) * side[a] for a in range(3)]
-    if shape.kind == "plane":
-        corners = [sum(v[a] * (hi[a] if bits >> a & 1 else lo[a]) for a in range(3)) for bits in range(8)]
-        return min(corners) <= v[3] <= max(corners)
-    near = sum(max(lo[a] - v[a], Fraction(0), v[a] - hi[a]) ** 2 for a in range(3))
-    far = sum(max(abs(lo[a] - v[a]), abs(hi[a] - v[a])) ** 2 for a in range(3))
-    return near <= v[3] ** 2 <= far
-
-
-@settings(max_examples=80, deadline=None, suppress_health_check=list(HealthCheck))
-@given(text=shapes(), texts=BOXES, level=st.integers(0, 3))
-def test_cell_tests_match_a_brute_force_and_the_size_bound_holds(text, texts, level):
-    box = Box.parse(texts)
-    try:
-        shape = octree.parse_shape(text)
-        n = 1 << level
-        cells = np.array([(i, j, k) for i in range(n) for j in range(n) for k in range(n)], dtype=np.int64)
-        hits = octree._meets(shape, box, level, cells)
-    except Exception as error:  # only the library's own refusal (a sphere over a sqrt length, a bad radius)
-        assert type(error).__name__ == "InputError", error
-        return
-    expected = [_brute_meets(shape, box, level, tuple(cell)) for cell in cells.tolist()]
-    assert hits.tolist() == expected
-    bound = octree._hits_bound(shape, box, level)
-    assert int(hits.sum()) <= bound
-    if shape.kind == "box":
-        assert int(hits.sum()) == bound
-    # the estimate bounds the unbalanced refinement's leaves
-    assert octree.estimate_leaves(box, level, [shape]) >= 1 + 7 * sum(
-        int(octree._meets(shape, box, m, np.array([(i, j, k) for i in range(1 << m) for j in range(1 << m)
-                                                   for k in range(1 << m)], dtype=np.int64)).sum())
-        for m in range(level))
-
-
 REFINE_TEXT = st.one_of(shapes(), st.text(alphabet="pointboxsphereplane:,.0123456789-e/+()sqrt ", max_size=30))
 
 
@@ -274,15 +207,6 @@ def test_a_table_of_another_element_is_refused_naming_both():
     line = one_line(*run("mesh", "--domain", 1, 1, 1, "--refine", "point:0.5,0.5,0.5", "--levels", 1,
                          "--patterns", PATTERNS / "bisection-prism-1x1x1.yaml", *QUICK)[::2], "prism", "cuboid")
     assert "1 x 1 x 1" in line
-
-
-def test_elements_of_a_code_not_held_is_a_key_error():
-    from cospherical.formats.patterns import load
-
-    table = load(PATTERNS / "bisection-1x1x1.yaml")
-    for code in (["x"], None, 7, "zzz"):
-        with pytest.raises(KeyError):
-            table.elements(code)
 
 
 # ---------------------------------------------------------------------------
@@ -455,7 +379,6 @@ def test_a_damaged_checkpoint_is_computed_again_never_counted(intersection_run, 
     assert len(notes) == 1 and path.name in notes[0] and "computed again" in notes[0], err
     assert json.loads(summary) == full
     assert path.read_bytes() == original  # rewritten whole, the same bytes
-
 
 
 def test_a_store_entry_with_a_bad_node_list_is_refused_like_a_yaml_one(tmp_path):

@@ -24,6 +24,7 @@ from cospherical.studies.leaves import leaf_codes
 
 CUBE = ("1", "1", "1")
 ROOT = Path(__file__).resolve().parents[2]
+PATTERNS = ROOT / "patterns"
 
 
 @pytest.fixture(scope="module")
@@ -175,3 +176,12 @@ def test_leaf_tables_pass_check_and_look_up_by_whole_point_set_code(tmp_path):
              **({"mirror": True} if e.mirrored else {})}
             for e in tess.elements
         ], code
+
+
+def test_elements_of_a_code_not_held_is_a_key_error():
+    from cospherical.formats.patterns import load
+
+    table = load(PATTERNS / "bisection-1x1x1.yaml")
+    for code in (["x"], None, 7, "zzz"):
+        with pytest.raises(KeyError):
+            table.elements(code)
