@@ -24,7 +24,7 @@ import time
 
 from cospherical import Box, Configuration, tessellate
 from cospherical.catalogue import known_name
-from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.engine import bisection_codes, run_study
 from record import recorded
 
 

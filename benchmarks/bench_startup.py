@@ -73,7 +73,7 @@ def wall(command, env=None) -> float:
 def qhull_all(every: int) -> float:
     """Seconds of ``qdelaunay`` over every ``every``-th bisection configuration, scaled to all."""
     from cospherical import Configuration
-    from cospherical.studies.bisection import bisection_codes
+    from cospherical.studies.engine import bisection_codes
 
     codes = bisection_codes()
     inputs = []

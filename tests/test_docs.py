@@ -155,7 +155,7 @@ def test_edge_table_is_the_code_s():
 
 def test_c_reader_of_the_store_gives_the_entries_python_gives(tmp_path):
     from cospherical.formats.patterns import load
-    from cospherical.formats.store import dictionary_of, pack, write_store
+    from cospherical.formats.sqlite_store import dictionary_of, pack, write_store
 
     cc = shutil.which("cc") or shutil.which("gcc")
     assert cc, "scripts/setup.sh installs gcc, libsqlite3-dev and zlib1g-dev"

@@ -280,7 +280,7 @@ def small_tables(tmp_path_factory):
     from cospherical.catalogue import shipped_catalogue
     from cospherical.core.configuration import Box
     from cospherical.formats.patterns import write_patterns
-    from cospherical.studies.bisection import run_study
+    from cospherical.studies.engine import run_study
 
     path = tmp_path_factory.mktemp("tables") / "small.yaml"
     study = run_study("bisection", Box.parse(("1", "2", "4")), list(SMALL_CODES))

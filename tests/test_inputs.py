@@ -215,7 +215,7 @@ def test_a_table_of_another_element_is_refused_naming_both():
 
 def _store(folder: Path) -> Path:
     from cospherical.formats.patterns import load
-    from cospherical.formats.store import dictionary_of, pack, write_store
+    from cospherical.formats.sqlite_store import dictionary_of, pack, write_store
 
     table = load(PATTERNS / "leaves-1x1x1.yaml")
     codes = sorted(table.configurations)[:20]
@@ -231,7 +231,7 @@ def test_a_store_entry_is_bounded_by_its_stored_size_and_its_header_by_its_keys(
 
     path = _store(tmp_path)
     assert run("check", path)[0] == 0
-    from cospherical.formats.store import MAX_ENTRY
+    from cospherical.formats.sqlite_store import MAX_ENTRY
 
     connection = sqlite3.connect(path)
     code = connection.execute("SELECT code FROM entries ORDER BY code LIMIT 1").fetchone()[0]
@@ -392,7 +392,7 @@ def test_a_damaged_checkpoint_is_computed_again_never_counted(intersection_run, 
 def test_a_store_entry_with_a_bad_node_list_is_refused_like_a_yaml_one(tmp_path):
     import sqlite3
 
-    from cospherical.formats.store import pack
+    from cospherical.formats.sqlite_store import pack
 
     path = _store(tmp_path)
     connection = sqlite3.connect(path)

@@ -37,11 +37,11 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     configuration.write_text(configuration.read_text() + "\nfrom .delaunay import delaunay_cells  # wrong on purpose\n")
     # A writer reaching into the studies: formats only reads and writes what is computed below it.
     diff = tmp_path / "cospherical" / "formats" / "diff.py"
-    diff.write_text(diff.read_text() + "\nfrom ..studies.bisection import run_study  # wrong on purpose\n")
+    diff.write_text(diff.read_text() + "\nfrom ..studies.engine import run_study  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
     assert "Contracts: 0 kept, 4 broken." in result.stdout
-    assert "cospherical.formats.diff -> cospherical.studies.bisection" in result.stdout
+    assert "cospherical.formats.diff -> cospherical.studies.engine" in result.stdout
     assert "cospherical.core.configuration -> cospherical.core.delaunay" in result.stdout
     assert "cospherical.core.geometry -> cospherical.catalogue" in result.stdout
     assert "cospherical.cli.check -> cospherical.cli.diff" in result.stdout

@@ -15,7 +15,7 @@ from cospherical import Box
 from cospherical.catalogue import catalogue_path, load_catalogue
 from cospherical.files.yamlio import dump_yaml, load_yaml
 from cospherical.formats.patterns import write_patterns
-from cospherical.studies.bisection import run_study
+from cospherical.studies.engine import run_study
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -12,7 +12,7 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 from cospherical import Box
 from cospherical.catalogue import element_options, minimal_kept_sets
 from cospherical.paper import paper_class
-from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.engine import bisection_codes, run_study
 
 BOXES = {"A": ("1", "1", "1"), "B": ("1", "2", "4"), "C": ("1", "1.4142", "1.4142")}
 

@@ -13,7 +13,7 @@ from strategies import random_configuration
 from cospherical import Box, Configuration, tessellate
 from cospherical.core.canonical import canonical_form
 from cospherical.core.symmetry import box_symmetries
-from cospherical.studies.bisection import run_study
+from cospherical.studies.engine import run_study
 
 CUBE = ("1", "1", "1")
 BOXES = {

@@ -44,7 +44,7 @@ def test_classification_on_id_ranks_is_the_classification_on_ids():
     # classify works on the ranks of the node ids and maps the answer back (a cache
     # shared by cells whose ids come in the same order): the same as on the ids.
     from cospherical.core.element_types import _classify_ranks, classify
-    from cospherical.studies.bisection import bisection_codes
+    from cospherical.studies.engine import bisection_codes
 
     seen = set()
     for box in (("1", "1", "1"), ("1", "2", "3")):

@@ -209,7 +209,7 @@ ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 
 @pytest.fixture(scope="module")
 def shape_studies():
-    from cospherical.studies.bisection import bisection_codes, run_study
+    from cospherical.studies.engine import bisection_codes, run_study
 
     return {name: run_study("bisection", standard_shape(name).box, bisection_codes(name), element=name)
             for name in SHAPES}

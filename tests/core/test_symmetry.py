@@ -6,7 +6,7 @@ import pytest
 
 from cospherical import Box, Configuration
 from cospherical.core.symmetry import box_symmetries, orbit_representatives
-from cospherical.studies.bisection import bisection_codes
+from cospherical.studies.engine import bisection_codes
 
 CUBE = ("1", "1", "1")
 

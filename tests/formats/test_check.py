@@ -9,7 +9,7 @@ from cospherical.catalogue import shipped_catalogue
 from cospherical.cli import main
 from cospherical.files.yamlio import dump_yaml, load_yaml
 from cospherical.formats.patterns import write_patterns
-from cospherical.studies.bisection import run_study
+from cospherical.studies.engine import run_study
 
 CUBE = ("1", "1", "1")
 

@@ -14,7 +14,7 @@ from cospherical import Box
 from cospherical.files.yamlio import dump_yaml, load_yaml
 from cospherical.formats.catalogue_file import build_catalogue, write_catalogue
 from cospherical.formats.patterns import write_patterns
-from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.engine import bisection_codes, run_study
 
 CODES = bisection_codes()[:96]
 

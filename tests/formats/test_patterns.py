@@ -19,7 +19,7 @@ from cospherical.errors import FormatError
 from cospherical.files.yamlio import dump_yaml, load_yaml
 from cospherical.formats.check import check_catalogue, check_patterns
 from cospherical.formats.patterns import load, pattern_name, write_patterns
-from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.engine import bisection_codes, run_study
 from cospherical.studies.leaves import leaf_codes
 
 CUBE = ("1", "1", "1")

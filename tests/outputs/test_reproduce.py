@@ -11,14 +11,14 @@ ROOT = Path(__file__).resolve().parents[2]
 def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypatch, capsys):
     # From nothing, in one run, whatever state the catalogue is in: here the catalogue the
     # package would read is corrupt, and the root holds stale, half-written and corrupt outputs.
-    import cospherical.catalogue.store as store
+    import cospherical.catalogue.names as names
     from cospherical.cli import main
 
     corrupt = tmp_path / "corrupt-catalogue.yaml"
     corrupt.write_text("types: [unclosed\n")
-    monkeypatch.setattr(store, "catalogue_path", lambda: corrupt)
-    store.shipped_catalogue.cache_clear()
-    store._shipped_names.cache_clear()
+    monkeypatch.setattr(names, "catalogue_path", lambda: corrupt)
+    names.shipped_catalogue.cache_clear()
+    names._shipped_names.cache_clear()
     root = tmp_path / "root"
     (root / "catalogue").mkdir(parents=True)
     (root / "catalogue" / "catalogue.yaml").write_text("types: [unclosed\n")
@@ -28,8 +28,8 @@ def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypat
     try:
         assert main(["reproduce", "--root", str(root)]) == 0, capsys.readouterr().err
     finally:
-        store.shipped_catalogue.cache_clear()
-        store._shipped_names.cache_clear()
+        names.shipped_catalogue.cache_clear()
+        names._shipped_names.cache_clear()
     tmp_path = root
     for folder in ("catalogue", "patterns", "results"):
         # results/sweep/, results/intersection/, results/mesh/ and results/benchmarks/ come from other

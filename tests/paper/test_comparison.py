@@ -6,7 +6,7 @@ import pytest
 
 from cospherical import Box
 from cospherical.paper import paper_comparison, paper_study_key
-from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.engine import bisection_codes, run_study
 from cospherical.studies.summary import study_summary
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from cospherical import Box
-from cospherical.studies.bisection import bisection_codes, run_study
+from cospherical.studies.engine import bisection_codes, run_study
 from cospherical.studies.intersection import INSERTION_ORDERS, intersection_codes, run_intersection, set_patterns
 from cospherical.studies.summary import study_summary
 

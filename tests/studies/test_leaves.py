@@ -7,7 +7,7 @@ from oracle import qhull_regions_by_orbit
 
 from cospherical import Box, Configuration
 from cospherical.core.symmetry import box_symmetries
-from cospherical.studies.bisection import bisection_codes
+from cospherical.studies.engine import bisection_codes
 from cospherical.studies.leaves import leaf_codes, run_leaves
 
 CUBE = ("1", "1", "1")

@@ -16,7 +16,7 @@ from .criteria import (
                        split_positions,
                        split_tessellation,
 )
-from .store import (SCHEMA_VERSION, catalogue_from_text, catalogue_names, catalogue_path, known_name, load_catalogue,
+from .names import (SCHEMA_VERSION, catalogue_from_text, catalogue_names, catalogue_path, known_name, load_catalogue,
                     shipped_catalogue, type_name, type_names)
 
 __all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "build_catalogue",

@@ -26,7 +26,7 @@ from ..files.flowyaml import decode_entry, split_section
 from ..files.yamlio import read_text
 from ..version import __version__
 from .criteria import option_types, split_options, split_positions
-from .store import SCHEMA_VERSION, type_names
+from .names import SCHEMA_VERSION, type_names
 
 __all__ = ["build_catalogue", "intersection_examples"]
 

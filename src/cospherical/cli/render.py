@@ -12,7 +12,7 @@ from ..core.shapes import ELEMENTS
 from ..errors import FormatError, InputError, UsageError
 from ..files.yamlio import load_yaml, validate
 from ..outputs.latex import render_tables
-from ..studies.bisection import bisection_codes, run_study
+from ..studies.engine import bisection_codes, run_study
 from ..studies.summary import study_summary
 from .output import FACE_POINTS_HELP
 from .progress import progress_bar

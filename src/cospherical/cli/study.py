@@ -15,7 +15,7 @@ from ..files.outputs import FolderLock
 from ..files.yamlio import atomic_write
 from ..outputs.report import text_report
 from ..paper import paper_comparison, paper_study_key
-from ..studies.bisection import bisection_codes, run_study
+from ..studies.engine import bisection_codes, run_study
 from ..studies.insertion import INSERTION_ORDERS
 from ..studies.leaves import leaf_codes, run_leaves
 from ..studies.summary import compared_with, study_summary

@@ -24,7 +24,7 @@ from ..files.flowyaml import split_section
 from ..files.yamlio import parse_yaml, read_text, validate
 from .diff import document_kind
 from .patterns import entry_elements, load, table_from_data, table_from_text
-from .store import is_store
+from .sqlite_store import is_store
 
 __all__ = ["check_catalogue", "check_patterns", "document_data", "read_document", "read_document_file",
            "validated"]

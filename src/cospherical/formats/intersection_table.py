@@ -15,7 +15,7 @@ from ..files.flowyaml import mapping_text
 from ..files.yamlio import atomic_open, yaml_text
 from ..version import __version__
 from .patterns import SCHEMA_VERSION
-from .store import dictionary_of, pack, write_store
+from .sqlite_store import dictionary_of, pack, write_store
 
 __all__ = ["SYMMETRY_CONVENTION", "YAML_UP_TO", "entry_chunk", "write_pattern_table"]
 
@@ -45,7 +45,7 @@ def write_pattern_table(run, catalogue_version: str, yaml_path=None, store=None)
     """Write the pattern table that ``run`` computes (a
     :class:`~cospherical.studies.intersection.table.TableRun`: the study's orbit representatives
     and kept sets) as YAML at ``yaml_path`` and/or as an indexed store
-    (:mod:`cospherical.formats.store`) at ``store``, from the same lines in one pass.
+    (:mod:`cospherical.formats.sqlite_store`) at ``store``, from the same lines in one pass.
     """
     header = {
         "schema_version": SCHEMA_VERSION, "generator": f"cospherical {__version__}",

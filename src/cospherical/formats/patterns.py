@@ -31,7 +31,7 @@ from ..files.data import data_path
 from ..files.flowyaml import decode_entry, mapping_line, split_section
 from ..files.yamlio import atomic_write, parse_yaml, read_text, validate, yaml_text
 from ..version import __version__
-from .store import is_store, open_store
+from .sqlite_store import is_store, open_store
 
 __all__ = ["Entries", "PatternTable", "SCHEMA_VERSION", "configuration_line", "element_entries", "element_entry",
            "entry_elements", "load", "pattern_name", "patterns_text", "table_from_data", "table_from_text",
@@ -68,7 +68,7 @@ def pattern_name(study: str, box_texts, face_points: str = "octree", element: st
 
 
 class StudyTable(Protocol):
-    """What a pattern table is written from: a study's result (:class:`cospherical.studies.bisection.Study`)."""
+    """What a pattern table is written from: a study's result (:class:`cospherical.studies.engine.Study`)."""
 
     name: str
     element: str
@@ -276,7 +276,7 @@ def load(path: str | Path) -> PatternTable:
     A table as this package writes it (one line per configuration) is indexed
     line by line and each entry decoded, as JSON, and validated when it is first
     used; any other YAML spelling of a table is read whole by the YAML parser.  An
-    indexed store (:mod:`cospherical.formats.store`, an SQLite file) is opened and
+    indexed store (:mod:`cospherical.formats.sqlite_store`, an SQLite file) is opened and
     queried one configuration at a time.
     The documentation's "Pattern tables for a mesher" has an example, run by the tests.
     """

@@ -14,7 +14,7 @@ from collections import Counter
 import numpy as np
 
 from ..core.configuration import Box, Configuration
-from ..studies.bisection import bisection_codes, run_study
+from ..studies.engine import bisection_codes, run_study
 from .assembly import PAPER_FINAL, Mesh, _type_info
 
 __all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "statistics", "uniform_study"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..catalogue import element_options, type_name
 from ..paper import comparison_notes, paper_class, paper_comparison, paper_notes, paper_studies, paper_study_key
-from ..studies.bisection import Study
+from ..studies.engine import Study
 
 __all__ = ["comparison_lines", "paper_set_gaps", "study_comparison_lines", "text_report"]
 

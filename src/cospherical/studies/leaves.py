@@ -9,7 +9,7 @@ consequence of the edges as the paper's octree policy has it.  The family is
 every edge mask with every admissible set of face points and no body point: 6210
 configurations, each named by its whole-point-set code (``+f`` suffix).
 
-The study is a bisection-style study (:func:`~cospherical.studies.bisection.run_study`:
+The study is a bisection-style study (:func:`~cospherical.studies.engine.run_study`:
 symmetry orbits over the whole point set, criteria, summaries, pattern tables);
 its reports set the octree-policy bisection study of the same box beside it
 (:func:`~cospherical.studies.summary.compared_with`).
@@ -23,7 +23,7 @@ from typing import Sequence
 from ..catalogue import CRITERIA
 from ..core.codes import point_suffix
 from ..core.configuration import FACE_EDGES, Box
-from .bisection import Progress, Study, bisection_codes, run_study
+from .engine import Progress, Study, bisection_codes, run_study
 
 __all__ = ["leaf_codes", "run_leaves"]
 

@@ -26,7 +26,7 @@ from ..core.geometry import Frame
 from ..core.symmetry import box_symmetries, orbit_representatives
 from ..core.tessellation import tessellate
 from ..errors import InputError
-from .bisection import bisection_codes
+from .engine import bisection_codes
 
 __all__ = ["Ray", "code_pieces", "ray_profile"]
 

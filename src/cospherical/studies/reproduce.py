@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from ..core.configuration import POINT_POLICIES, Box
-from .bisection import Study, bisection_codes, run_study
+from .engine import Study, bisection_codes, run_study
 from .leaves import leaf_codes, run_leaves
 
 __all__ = ["LEAF_BOXES", "PAPER_BOXES", "SHAPE_BOX", "SHAPE_ELEMENTS", "PaperStudies", "paper_studies_total",

@@ -17,7 +17,7 @@ from typing import Mapping
 from ..catalogue import type_name
 from ..core.element_types import ElementType
 from ..paper import paper_class
-from .bisection import Study
+from .engine import Study
 
 __all__ = ["TypeInfo", "compared_with", "frequency_table", "study_summary"]
 

@@ -8,7 +8,7 @@ from typing import Callable, Iterable
 from ..core.configuration import Box
 from ..core.exact import parse_rational, rational_text
 from ..errors import InputError
-from .bisection import bisection_codes, run_study
+from .engine import bisection_codes, run_study
 from .pool import process_pool
 
 __all__ = ["box_statistics", "grid_values", "sweep"]
