@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import hashlib
 from collections import Counter
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from ..caches import cached
 from .canonical import canonical_form
@@ -111,28 +111,24 @@ def _standard(faces, kinds) -> tuple[str | None, str | None]:
     return None, None
 
 
-_TYPES: dict[str, ElementType] = {}
-
-
 def element_type(code: str, faces, kinds) -> ElementType:
-    """The element type of a canonical code (faces and kinds of any member); one object per code."""
-    if code not in _TYPES:
-        _TYPES[code] = _new_type(code, faces, kinds)
-    return _TYPES[code]
+    """The element type of a canonical code (faces and kinds of any member).
 
-
-def systematic_name(vertices: int, face_summary: str) -> str:
-    return f"{vertices}-Vertex Polyhedron ({face_summary})"
-
-
-def _new_type(code: str, faces, kinds) -> ElementType:
+    No registry of types is kept (one would only grow in a long-running process): a type is a
+    frozen dataclass, compared and hashed by its fields, so two built from one code are equal
+    and interchangeable; the bounded classification caches below share the objects they keep.
+    """
     vertices = len({v for f in faces for v in f})
     edges = sum(len(f) for f in faces) // 2
     structural, vtk = _standard(faces, kinds)
     face_kinds = tuple(sorted(Counter(kinds).items()))
-    etype = ElementType(code, type_id(code, vertices, len(faces)), "", structural, vertices, edges, len(faces), face_kinds, vtk)
-    name = structural or systematic_name(vertices, etype.face_summary)
-    return replace(etype, name=name)
+    name = structural or systematic_name(vertices, face_summary(dict(face_kinds)))
+    return ElementType(code, type_id(code, vertices, len(faces)), name, structural, vertices, edges, len(faces),
+                       face_kinds, vtk)
+
+
+def systematic_name(vertices: int, face_summary: str) -> str:
+    return f"{vertices}-Vertex Polyhedron ({face_summary})"
 
 
 def _vtk_order(vtk: str, faces, kinds) -> tuple[int, ...]:
