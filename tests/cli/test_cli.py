@@ -1,7 +1,10 @@
 """The command line as a whole, run as a user runs it (a real subprocess): usage errors of every command,
-the collector frozen only as the process's command, the scheduler option's warning."""
+the collector frozen only as the process's command, the scheduler option's warning, a signal ending the run
+as signalled whatever a library makes of it."""
 
+import signal
 import sys
+import time
 
 import pytest
 from commands import cospherical
@@ -72,3 +75,56 @@ def test_the_scheduler_option_says_it_must_be_a_scheduler_you_run(capsys):
     docs = Path(__file__).resolve().parents[2] / "docs"
     warned = [p.name for p in docs.rglob("*.md") if re.search(r"only to a scheduler you run", p.read_text())]
     assert warned == ["dask.md"]
+
+
+@pytest.mark.parametrize("sig, status", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_that_a_library_turns_into_its_own_error_still_ends_the_run_as_signalled(
+        monkeypatch, capsys, sig, status):
+    # numba reports an exception raised by a signal handler during a compiled call as
+    # "SystemError: CPUDispatcher(...) returned a result with an exception set": the run
+    # must still end as the signal says, with one line and no traceback.
+    import cospherical.cli as cli
+    import cospherical.cli.tessellate as tessellate
+
+    def compiled_call(args):
+        try:
+            signal.raise_signal(sig)
+        except BaseException as error:
+            raise SystemError("CPUDispatcher(<function>) returned a result with an exception set") from error
+
+    monkeypatch.setattr(tessellate, "run", compiled_call)
+    handlers = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
+    try:
+        try:
+            code = cli.main(["tessellate", "--box", "1", "1", "1", "--code", "800000000000"])
+        except SystemExit as exit:
+            code = exit.code
+    finally:
+        signal.signal(signal.SIGTERM, handlers[0])
+        signal.signal(signal.SIGINT, handlers[1])
+    assert code == status
+    assert capsys.readouterr().err.strip() == ("cospherical: terminated" if sig == signal.SIGTERM
+                                               else "cospherical: interrupted")
+
+
+def test_a_signal_held_back_during_compilation_is_not_sent_again_after_the_run(monkeypatch, capsys):
+    # SIGTERM arriving inside numba's compiler is held back and re-sent shortly; when the
+    # run ends first (as terminated), the held-back signal must not arrive later.
+    import os
+
+    import cospherical.cli as cli
+    import cospherical.cli.tessellate as tessellate
+
+    compiler = {"__name__": "numba.core.compiler", "os": os, "signal": signal}
+    exec("def compile_(args):\n    os.kill(os.getpid(), signal.SIGTERM)\n    return 0\n", compiler)
+    monkeypatch.setattr(tessellate, "run", compiler["compile_"])
+    handlers = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
+    try:
+        with pytest.raises(SystemExit) as ended:
+            cli.main(["tessellate", "--box", "1", "1", "1", "--code", "800000000000"])
+        assert ended.value.code == 143
+        time.sleep(0.4)  # a re-sent SIGTERM would raise SystemExit here
+    finally:
+        signal.signal(signal.SIGTERM, handlers[0])
+        signal.signal(signal.SIGINT, handlers[1])
+    assert capsys.readouterr().err.strip() == "cospherical: terminated"
