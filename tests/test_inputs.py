@@ -242,7 +242,7 @@ def test_a_store_entry_is_bounded_by_its_stored_size_and_its_header_by_its_keys(
     one_line(result.returncode, result.stderr, f"stored in over {MAX_ENTRY} bytes")
     from cospherical.errors import FormatError
     from cospherical.formats.patterns import load
-    from cospherical.formats.store import open_store
+    from cospherical.formats.sqlite_store import open_store
 
     # refused when opened, before any lookup: a lookup by code reads every b-tree cell it compares
     # with whole (a 900 MB entry: 935 MB for 'mesh --patterns' to refuse it), whatever the query bounds
