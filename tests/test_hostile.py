@@ -636,23 +636,6 @@ def test_render_removes_its_own_old_outputs(tmp_path, capsys):
     capsys.readouterr()
 
 
-def test_every_option_has_help():
-    from cospherical.cli import build_parser
-
-    parser = build_parser()
-    subparsers = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
-    missing = [f"{name} {action.dest}" for name, sub in subparsers.choices.items() for action in sub._actions
-               if not action.help and action.dest != "help"]
-    assert missing == []
-
-
-def test_tessellate_help_shows_the_numbering(capsys):
-    with pytest.raises(SystemExit):
-        main(["tessellate", "--help"])
-    out = capsys.readouterr().out
-    assert "0 (0,0,0)" in out and "(0,1) (1,2)" in out and "20-25" in out
-
-
 def test_setup_installs_python3_venv():
     assert "python3-venv" in (ROOT / "scripts" / "setup.sh").read_text()
 

@@ -1,6 +1,6 @@
 """The command line as a whole, run as a user runs it (a real subprocess): usage errors of every command,
-the collector frozen only as the process's command, the scheduler option's warning, a signal ending the run
-as signalled whatever a library makes of it."""
+every option's help, the collector frozen only as the process's command, the scheduler option's warning, a
+signal ending the run as signalled whatever a library makes of it."""
 
 import signal
 import sys
@@ -128,3 +128,13 @@ def test_a_signal_held_back_during_compilation_is_not_sent_again_after_the_run(m
         signal.signal(signal.SIGTERM, handlers[0])
         signal.signal(signal.SIGINT, handlers[1])
     assert capsys.readouterr().err.strip() == "cospherical: terminated"
+
+
+def test_every_option_has_help():
+    from cospherical.cli import build_parser
+
+    parser = build_parser()
+    subparsers = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    missing = [f"{name} {action.dest}" for name, sub in subparsers.choices.items() for action in sub._actions
+               if not action.help and action.dest != "help"]
+    assert missing == []

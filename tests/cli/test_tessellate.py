@@ -1,5 +1,5 @@
-"""``cospherical tessellate``: its JSON and YAML, deterministic; face points given on the command line; the VTU
-it writes."""
+"""``cospherical tessellate``: its JSON and YAML, deterministic; its help's numbering; face points given on the
+command line; the VTU it writes."""
 
 from __future__ import annotations
 
@@ -99,3 +99,10 @@ def test_tessellate_steiner_and_yaml_agree_with_code():
 def test_output_is_deterministic():
     args = ("tessellate", "--box", "1", "2", "4", "--code", "88808a000c01", "--face-points", "none")
     assert cospherical(*args).stdout == cospherical(*args).stdout
+
+
+def test_tessellate_help_shows_the_numbering(capsys):
+    with pytest.raises(SystemExit):
+        main(["tessellate", "--help"])
+    out = capsys.readouterr().out
+    assert "0 (0,0,0)" in out and "(0,1) (1,2)" in out and "20-25" in out
