@@ -18,7 +18,7 @@ from fractions import Fraction
 from functools import cmp_to_key
 from itertools import combinations
 
-from .geometry import Frame, Sphere, cross, dot, sub
+from .geometry import Frame, Sphere, determinant, dot, plane_normal, sub
 
 __all__ = ["Cell", "delaunay_cells", "hull_faces"]
 
@@ -53,11 +53,10 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
     for i, j, k in combinations(members, 3):
         if (i, j, k) in done:
             continue
-        (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = coords[i], coords[j], coords[k]
-        ux, uy, uz, vx, vy, vz = x1 - x0, y1 - y0, z1 - z0, x2 - x0, y2 - y0, z2 - z0
-        nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+        nx, ny, nz = plane_normal(coords[i], coords[j], coords[k])
         if nx == ny == nz == 0:
             continue
+        x0, y0, z0 = coords[i]
         offset = nx * x0 + ny * y0 + nz * z0
         above = below = False
         on_plane = []
@@ -79,18 +78,15 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
         if len(on_plane) > 3:
             done.update(combinations(on_plane, 3))
         faces.append((_counter_clockwise(coords, on_plane, normal) if len(on_plane) > 3 else
-                      _triangle(on_plane, (ux, uy, uz), (vx, vy, vz), normal), normal))
+                      _triangle(on_plane, above), normal))
     return faces
 
 
-def _triangle(points: list[int], u, v, normal) -> tuple[int, ...]:
-    # points are i < j < k and u, v run from i to j and k: keep the order when
-    # u x v already points along the outward normal, else swap j and k.
+def _triangle(points: list[int], above: bool) -> tuple[int, ...]:
+    # points are i < j < k, and the plane normal (j - i) x (k - i) points along the outward
+    # normal exactly when the other points are below it: keep the order then, else swap j and k.
     i, j, k = points
-    same = (u[1] * v[2] - u[2] * v[1]) * normal[0] + (u[2] * v[0] - u[0] * v[2]) * normal[1] + (
-        u[0] * v[1] - u[1] * v[0]
-    ) * normal[2]
-    return (i, j, k) if same > 0 else (i, k, j)
+    return (i, k, j) if above else (i, j, k)
 
 
 def _counter_clockwise(coords, points: list[int], normal) -> tuple[int, ...]:
@@ -99,7 +95,7 @@ def _counter_clockwise(coords, points: list[int], normal) -> tuple[int, ...]:
 
     def turn(x: int, y: int) -> int:
         # x before y when y lies counter-clockwise of x, seen from the normal's tip.
-        return -dot(normal, cross(sub(coords[x], origin), sub(coords[y], origin)))
+        return -determinant(normal, sub(coords[x], origin), sub(coords[y], origin))
 
     rest = sorted((p for p in points if p != first), key=cmp_to_key(turn))
     return (first, *rest)

@@ -1,4 +1,4 @@
-"""Exact predicates on an integer frame.
+"""The exact geometry kernel: every predicate and construction of the project, on an integer frame.
 
 A point (s*a, t*b, u*c) of the box is stored as integers (S, T, U) = D*(s, t, u)
 with D the common denominator of all unit coordinates, and the squared box
@@ -11,6 +11,22 @@ through real points is a hyperplane through their lifted images, so
 co-sphericity and in-sphere tests are integer determinants.  Every decision in
 the project (coplanar, co-spherical, inside, right angle) is made here, with
 Python integers: no tolerance anywhere.
+
+Python integers (and ``Fraction``s where a caller has them) in the scalar
+functions and the :class:`Frame`: they never overflow.  The bulk functions on
+numpy arrays (:func:`six_volumes`, :func:`sphere_sides`, :func:`circumcentres`)
+choose their backend themselves, by a bound derived in their comments: numpy's
+int64 when every term provably stays below 2**62 or 2**63, else object arrays
+of Python integers; the same numbers either way (``python_integers=True`` takes
+Python integers regardless: tests compare the two).  The compiled walk
+(:mod:`cospherical.core.compiled`, numba, int64) is chosen only by its caller's
+explicit ``backend="compiled"`` and checks its own bound
+(:func:`cospherical.core.compiled.fits`).
+
+The module is in two parts, as a geometry kernel's traits are: predicates
+(signs: orientation, collinearity, side of a sphere) and constructions (exact
+numbers: vectors, normals, determinants, volumes, spheres, circumcentres).
+Code elsewhere asks these and computes no determinant of its own.
 """
 
 from __future__ import annotations
@@ -19,12 +35,70 @@ import math
 import operator
 from dataclasses import dataclass
 from fractions import Fraction
+from itertools import combinations
 from typing import Mapping, Sequence
 
-__all__ = ["Frame", "Sphere", "cross", "dot", "six_volume", "sphere_sides", "sub", "tetra_six_volume"]
+__all__ = ["Frame", "Sphere", "area_vector", "circumcentres", "collinear", "cross", "determinant", "dot",
+           "plane_normal", "six_volume", "six_volumes", "sphere_sides", "sub", "tetra_six_volume"]
 
 Vector = tuple[int, int, int]
 
+
+# ---------------------------------------------------------------------------------------------
+# Predicates: signs, decided exactly
+# ---------------------------------------------------------------------------------------------
+
+def tetra_six_volume(p: Sequence, q: Sequence, r: Sequence, s: Sequence):
+    """Six times the signed volume of the tetrahedron pqrs (zero: the four are coplanar), exact for
+    integers and Fractions alike: the orientation predicate (> 0 when right-handed)."""
+    return determinant(sub(q, p), sub(r, p), sub(s, p))
+
+
+def collinear(p: Sequence, q: Sequence, r: Sequence) -> bool:
+    """Whether the three points are on one line (or two of them coincide)."""
+    return not any(plane_normal(p, q, r))
+
+
+def sphere_sides(tets, points, weights: Sequence[int], python_integers: bool = False):
+    """Per row, where a point lies against a tetrahedron's circumsphere, in bulk: < 0 strictly inside, 0 on, > 0 outside.
+
+    ``tets``: integer array (n, 4, 3) of solid tetrahedra, either orientation;
+    ``points``: (n, 3); ``weights``: the frame's.  With d_k the edges from the first
+    vertex, e the point from it and L the lifted length (weights . x^2), the centre
+    c solves 2 W c . d_k = L(d_k), so W c = N / (2 det) by Cramer's rule
+    (N: the three determinants with one column replaced by L, :func:`_cramer`), and
+    e is inside exactly when L(e) < e . N / det.  numpy's int64 when the bound fits,
+    else (or with ``python_integers``) Python integers (object arrays): exact either way.
+
+    >>> import numpy as np
+    >>> cube = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 2]]] * 3)
+    >>> sphere_sides(cube, np.array([[1, 1, 1], [2, 2, 2], [3, 0, 0]]), (1, 1, 1)).tolist()
+    [-1, 0, 1]
+    """
+    import numpy as np
+
+    tets, points = np.asarray(tets, dtype=np.int64), np.asarray(points, dtype=np.int64)
+    d = tets[:, 1:] - tets[:, :1]
+    e = points - tets[:, 0]
+    extent = max(int(np.abs(d).max(initial=0)), int(np.abs(e).max(initial=0)), 1)
+    # |det| <= 6 E^3 and |lifted| <= 3 w E^2, so |det * L(e)| <= 18 w E^5 and |towards| <= 3 * 18 w E^5:
+    # every term and the side itself stay below 72 w E^5
+    if python_integers or 72 * max(weights) * extent ** 5 >= 2 ** 63:
+        d, e = d.astype(object), e.astype(object)
+        w = np.array([int(x) for x in weights], dtype=object)
+    else:
+        w = np.array(weights, dtype=np.int64)
+    det, numerators = _cramer(d, w)
+    towards = 0
+    for axis in range(3):
+        towards = towards + e[:, axis] * numerators[axis]
+    side = (det * (e * e * w).sum(axis=1) - towards) * np.where(det < 0, -1, 1)
+    return np.sign(side).astype(np.int8)
+
+
+# ---------------------------------------------------------------------------------------------
+# Constructions: exact numbers
+# ---------------------------------------------------------------------------------------------
 
 # map over operator functions, not generators: these run in the inner loops of the
 # Delaunay walk and the split search (about three times faster).
@@ -40,50 +114,36 @@ def cross(p: Sequence[int], q: Sequence[int]) -> Vector:
     return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
 
 
-def tetra_six_volume(p: Sequence, q: Sequence, r: Sequence, s: Sequence):
-    """Six times the signed volume of the tetrahedron pqrs (zero: the four are coplanar), exact for
-    integers and Fractions alike."""
-    return dot(sub(q, p), cross(sub(r, p), sub(s, p)))
+def determinant(u: Sequence, v: Sequence, w: Sequence):
+    """The determinant of the rows u, v, w (the triple product u . (v x w)), written out: it runs in
+    the inner loops of the dual's pieces and the hull's face order."""
+    return (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])
+            + u[2] * (v[0] * w[1] - v[1] * w[0]))
 
 
-def sphere_sides(tets, points, weights: Sequence[int]):
-    """Per row, where a point lies against a tetrahedron's circumsphere, in bulk: < 0 strictly inside, 0 on, > 0 outside.
+def plane_normal(p: Sequence, q: Sequence, r: Sequence) -> Vector:
+    """(q - p) x (r - p): normal to the plane of p, q, r, right-handed (zero when they are on a line),
+    written out: it runs once per point triple of every hull."""
+    (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = p, q, r
+    ux, uy, uz, vx, vy, vz = x1 - x0, y1 - y0, z1 - z0, x2 - x0, y2 - y0, z2 - z0
+    return (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
 
-    ``tets``: integer array (n, 4, 3) of solid tetrahedra, either orientation;
-    ``points``: (n, 3); ``weights``: the frame's.  With d_k the edges from the first
-    vertex, e the point from it and L the lifted length (weights . x^2), the centre
-    c solves 2 W c . d_k = L(d_k), so W c = N / (2 det) by Cramer's rule
-    (N: the three determinants with one column replaced by L), and e is inside
-    exactly when L(e) < e . N / det.  numpy's int64 when the bound fits, else Python
-    integers (object arrays): exact either way.
 
-    >>> import numpy as np
-    >>> cube = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 2]]] * 3)
-    >>> sphere_sides(cube, np.array([[1, 1, 1], [2, 2, 2], [3, 0, 0]]), (1, 1, 1)).tolist()
-    [-1, 0, 1]
+def area_vector(polygon: Sequence[Sequence]) -> Vector:
+    """Twice the vector area of a closed polygon (Newell's normal): for a planar polygon, normal to
+    its plane, right-handed around its order; never zero for a convex one, even with three
+    consecutive points on a line (a normal from three points would be).
+
+    >>> area_vector([(0, 0, 0), (1, 0, 0), (2, 0, 0), (2, 1, 0), (0, 1, 0)])
+    (0, 0, 4)
     """
-    import numpy as np
-
-    tets, points = np.asarray(tets, dtype=np.int64), np.asarray(points, dtype=np.int64)
-    d = tets[:, 1:] - tets[:, :1]
-    e = points - tets[:, 0]
-    extent = max(int(np.abs(d).max(initial=0)), int(np.abs(e).max(initial=0)), 1)
-    # |det| <= 6 E^3 and |lifted| <= 3 w E^2, so |det * L(e)| <= 18 w E^5 and |towards| <= 3 * 18 w E^5:
-    # every term and the side itself stay below 72 w E^5
-    if 72 * max(weights) * extent ** 5 >= 2 ** 63:
-        d, e = d.astype(object), e.astype(object)
-        w = np.array([int(x) for x in weights], dtype=object)
-    else:
-        w = np.array(weights, dtype=np.int64)
-    lifted = (d * d * w).sum(axis=2)
-    det = np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2]))
-    towards = 0
-    for axis in range(3):
-        m = d.copy()
-        m[:, :, axis] = lifted
-        towards = towards + e[:, axis] * np.einsum("ij,ij->i", m[:, 0], np.cross(m[:, 1], m[:, 2]))
-    side = (det * (e * e * w).sum(axis=1) - towards) * np.where(det < 0, -1, 1)
-    return np.sign(side).astype(np.int8)
+    m = len(polygon)
+    normal = (0, 0, 0)
+    for i in range(m):
+        p, q = polygon[i], polygon[(i + 1) % m]
+        normal = (normal[0] + (p[1] - q[1]) * (p[2] + q[2]), normal[1] + (p[2] - q[2]) * (p[0] + q[0]),
+                  normal[2] + (p[0] - q[0]) * (p[1] + q[1]))
+    return normal
 
 
 def six_volume(coords, cycles) -> int:
@@ -105,9 +165,86 @@ def six_volume(coords, cycles) -> int:
     return total
 
 
-def _det3(r0, r1, r2) -> int:
-    return dot(r0, cross(r1, r2))
+def six_volumes(tets, python_integers: bool = False):
+    """Per tetrahedron of an integer array (n, 4, 3), six times its signed volume, in bulk (0: flat).
 
+    int64 when |6 E^3| < 2**62 (E the largest edge component from the first vertex: each
+    triple-product term is at most 2 E^3), else (or with ``python_integers``) Python integers (an
+    object array).
+
+    >>> import numpy as np
+    >>> six_volumes(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], [[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 0, 1]]])).tolist()
+    [1, 0]
+    """
+    import numpy as np
+
+    tets = np.asarray(tets, dtype=np.int64)
+    d = tets[:, 1:] - tets[:, :1]
+    extent = int(np.abs(d).max()) if len(d) else 0
+    if python_integers or 6 * extent ** 3 >= 2**62:
+        d = d.astype(object)
+    return np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2]))
+
+
+def circumcentres(tets, weights: Sequence[int], python_integers: bool = False):
+    """Per tetrahedron of an integer array (n, 4, 3), its exact circumcentre in the same units, in bulk:
+    ``(numerators, denominators)``, each (n, 3), every coordinate a reduced fraction with a positive
+    denominator (the tetrahedra solid; ``weights``: the frame's, as in :func:`sphere_sides`).
+
+    The centre is p0 + N / (2 W det) per axis (:func:`_cramer`).  With E the largest edge
+    component from p0 and C the largest coordinate: |2 w det| <= 12 w E^3 and |N| <= 18 w E^4, so
+    the numerator p0 2 w det + N stays below 24 w E^3 (C + E + 1); int64 when that is below
+    2**62, else (or with ``python_integers``) Python integers (object arrays; the weights of extreme
+    boxes, 1e-12 x 1 x 3e9, have 43 digits and do not fit int64 at all).
+
+    >>> import numpy as np
+    >>> num, den = circumcentres(np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 4]]]), (1, 1, 1))
+    >>> num.tolist(), den.tolist()
+    ([[1, 1, 2]], [[1, 1, 1]])
+    """
+    import numpy as np
+
+    p = np.asarray(tets, dtype=np.int64)
+    d = p[:, 1:] - p[:, :1]
+    extent = int(np.abs(d).max(initial=0))
+    bound = 24 * max(weights) * extent ** 3 * (int(np.abs(p).max(initial=0)) + extent + 1)
+    if python_integers or bound >= 2**62:
+        d, w = d.astype(object), np.array(weights, dtype=object)
+    else:
+        w = np.array(weights, dtype=np.int64)
+    det, numerators = _cramer(d, w)
+    nums, dens = [], []
+    for axis in range(3):
+        den = 2 * w[axis] * det
+        num = p[:, 0, axis].astype(den.dtype) * den + numerators[axis]
+        sign = np.where(den < 0, -1, 1)
+        num, den = num * sign, den * sign
+        g = np.gcd(num, den) if den.dtype != object else np.frompyfunc(math.gcd, 2, 1)(num, den)
+        nums.append(num // g)
+        dens.append(den // g)
+    return np.stack(nums, axis=1), np.stack(dens, axis=1)
+
+
+def _cramer(d, w):
+    """The sphere through the origin and the rows d1, d2, d3 of ``d`` (n, 3, 3), in bulk: its centre c
+    solves 2 W c . d_k = L(d_k) (L the lifted length, ``w`` . d_k^2), so W c = N / (2 det) for M the
+    rows d_k, by Cramer's rule in integers.  Returns (det, [N_x, N_y, N_z]) in ``d``'s dtype; the
+    callers bound them (:func:`sphere_sides`, :func:`circumcentres`)."""
+    import numpy as np
+
+    lifted = (d * d * w).sum(axis=2)  # (n, 3): |d_k|^2 in the weighted metric
+    det = np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2]))
+    numerators = []
+    for axis in range(3):
+        m = d.copy()
+        m[:, :, axis] = lifted
+        numerators.append(np.einsum("ij,ij->i", m[:, 0], np.cross(m[:, 1], m[:, 2])))
+    return det, numerators
+
+
+# ---------------------------------------------------------------------------------------------
+# One point set: its integer frame, with the predicates and constructions above on its points
+# ---------------------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
 class Sphere:
@@ -124,6 +261,21 @@ class Sphere:
         a, b, c, d = self.normal
         x, y, z, w = lifted_point
         return a * x + b * y + c * z + d * w - self.offset
+
+    def side_at(self, point: Sequence[int], weights: Sequence[int], divisor: int = 1) -> int:
+        """The side of the point ``point / divisor`` (frame coordinates, ``weights`` the frame's), times
+        ``divisor**2``: the same sign as :meth:`side`, in integers, the point lifted here."""
+        a, b, c, d = self.normal
+        x, y, z = point
+        lifted = weights[0] * x * x + weights[1] * y * y + weights[2] * z * z
+        return (a * x + b * y + c * z) * divisor + d * lifted - self.offset * divisor * divisor
+
+    def scaled(self, g: int) -> "Sphere":
+        """The sphere :meth:`Frame.sphere` gives for the same four points with every coordinate times
+        ``g`` (about the origin): the coordinates scale by ``g`` and the lifted one by ``g**2``, so the
+        cofactors scale by ``g**4`` (x, y, z) and ``g**3`` (lifted), the offset by ``g**5``."""
+        n0, n1, n2, n3 = self.normal
+        return Sphere((g ** 4 * n0, g ** 4 * n1, g ** 4 * n2, g ** 3 * n3), g ** 5 * self.offset)
 
 
 @dataclass(frozen=True)
@@ -153,7 +305,7 @@ class Frame:
     def orient(self, i: int, j: int, k: int, m: int) -> int:
         """Sign-bearing 6x volume of (i, j, k, m), indices into ``coords``; > 0 when right-handed."""
         p = self.coords[i]
-        return _det3(sub(self.coords[j], p), sub(self.coords[k], p), sub(self.coords[m], p))
+        return determinant(sub(self.coords[j], p), sub(self.coords[k], p), sub(self.coords[m], p))
 
     def sphere(self, i: int, j: int, k: int, m: int) -> Sphere | None:
         """The sphere through four points, or ``None`` if they are coplanar."""
@@ -177,6 +329,19 @@ class Frame:
             normal = (-normal[0], -normal[1], -normal[2], -normal[3])
         return Sphere(normal, normal[0] * b0 + normal[1] * b1 + normal[2] * b2 + normal[3] * b3)
 
+    def spanning(self, members: Sequence[int]) -> tuple[int, int, int, int] | None:
+        """The first four of ``members`` (in the order of their combinations) not in one plane; ``None``
+        when every four are: the members are flat."""
+        return next((quad for quad in combinations(members, 4) if self.orient(*quad) != 0), None)
+
+    def circumsphere(self, members: Sequence[int]) -> Sphere | None:
+        """The sphere through all of ``members`` (indices into ``coords``): ``None`` when they are flat
+        or not co-spherical.  The sphere of the first four not in one plane (the first that has one)."""
+        sphere = next((s for s in (self.sphere(*quad) for quad in combinations(members, 4)) if s is not None), None)
+        if sphere is None or any(sphere.side(self.lifted[m]) != 0 for m in members):
+            return None
+        return sphere
+
     def center(self, sphere: Sphere) -> tuple[Fraction, Fraction, Fraction]:
         """Exact unit coordinates of a sphere's center."""
         n = sphere.normal
@@ -185,3 +350,8 @@ class Frame:
     def real_dot(self, u: Sequence[int], v: Sequence[int]) -> int:
         """A positive multiple of the real dot product of two frame vectors."""
         return sum(w * x * y for w, x, y in zip(self.weights, u, v))
+
+    def right_angle(self, i: int, j: int, k: int) -> bool:
+        """Whether the real angle at ``j`` between ``i`` and ``k`` (indices into ``coords``) is right."""
+        coords = self.coords
+        return self.real_dot(sub(coords[i], coords[j]), sub(coords[k], coords[j])) == 0

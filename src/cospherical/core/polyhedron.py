@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from .delaunay import Cell
-from .geometry import Frame, six_volume, sub
+from .geometry import Frame, six_volume
 
 __all__ = ["FACE_KINDS", "Polyhedron", "face_kind", "polyhedron"]
 
@@ -19,9 +19,7 @@ def face_kind(frame: Frame, cycle: tuple[int, ...]) -> str:
     """``triangle``, ``rectangle``, ``quadrilateral``, ``pentagon``, ... (frame indices)."""
     n = len(cycle)
     if n == 4:
-        pts = [frame.coords[i] for i in cycle]
-        edges = [sub(pts[(i + 1) % 4], pts[i]) for i in range(4)]
-        if all(frame.real_dot(edges[i], edges[(i + 1) % 4]) == 0 for i in range(4)):
+        if all(frame.right_angle(cycle[i - 1], cycle[i], cycle[(i + 1) % 4]) for i in range(4)):
             return "rectangle"
     return FACE_KINDS.get(n, f"{n}-gon")
 

@@ -42,7 +42,7 @@ from ..errors import InputError
 from .codes import EDGE_DIGITS, digit_parameters, mask_codes, parameter_digits
 from .configuration import CORNERS, EDGES, FACES, BaseConfiguration, Box, steiner_parameters
 from .exact import parse_rational
-from .geometry import cross, dot, six_volume, sub, tetra_six_volume
+from .geometry import area_vector, collinear, cross, dot, plane_normal, six_volume, sub, tetra_six_volume
 
 __all__ = ["ELEMENTS", "STANDARD_SHAPES", "Shape", "ShapeConfiguration", "mask_codes", "standard_shape"]
 
@@ -151,7 +151,7 @@ class Shape:
         # Coplanar in one pass, exactly: a corner off the line of corners 0 and 1 spans their
         # plane (none: all on one line); the corners are a solid iff one is off that plane.
         p, q = corners[0], corners[1]
-        r = next((c for c in corners[2:] if any(cross(sub(q, p), sub(c, p)))), None)
+        r = next((c for c in corners[2:] if not collinear(p, q, c)), None)
         if r is None or all(tetra_six_volume(p, q, r, c) == 0 for c in corners[2:]):
             raise InputError(f"{name}: the corners are coplanar: no solid")
         cycles = []
@@ -234,13 +234,9 @@ def _oriented_face(corners, cycle, f, name):
     """The cycle counter-clockwise seen from outside and the outward plane, after the checks."""
     pts = [corners[i] for i in cycle]
     m = len(cycle)
-    normal = (0, 0, 0)
-    for i in range(m):  # Newell's normal: exact, and nonzero for any convex polygon
-        p, q = pts[i], pts[(i + 1) % m]
-        normal = (normal[0] + (p[1] - q[1]) * (p[2] + q[2]), normal[1] + (p[2] - q[2]) * (p[0] + q[0]),
-                  normal[2] + (p[0] - q[0]) * (p[1] + q[1]))
+    normal = area_vector(pts)  # Newell's normal: exact, and nonzero for any convex polygon
     if normal == (0, 0, 0):  # a self-crossing order can cancel Newell's sum: any corner triple then
-        normal = next((n for a, b, c in combinations(pts, 3) if (n := cross(sub(b, a), sub(c, a))) != (0, 0, 0)),
+        normal = next((n for a, b, c in combinations(pts, 3) if (n := plane_normal(a, b, c)) != (0, 0, 0)),
                       normal)
     if normal == (0, 0, 0):
         raise InputError(f"{name}: face {f} {list(cycle)}: its corners are on one line")

@@ -25,7 +25,7 @@ from __future__ import annotations
 from itertools import combinations
 
 from .delaunay import hull_faces
-from .geometry import Frame, cross, dot, six_volume, sub
+from .geometry import Frame, dot, plane_normal, six_volume
 from .polyhedron import Polyhedron, face_kind
 
 __all__ = ["CRITERIA", "SPLIT_CRITERIA", "subdivisions"]
@@ -50,7 +50,7 @@ class _Element:
         coords = frame.coords
         self.planes = []
         for face in self.faces:
-            normal = cross(sub(coords[face[1]], coords[face[0]]), sub(coords[face[2]], coords[face[0]]))
+            normal = plane_normal(coords[face[0]], coords[face[1]], coords[face[2]])
             self.planes.append((normal, dot(normal, coords[face[0]])))
         # The boundary face of every three of its vertices: a hull face lies on a
         # boundary plane exactly when its first three points are on that face (three

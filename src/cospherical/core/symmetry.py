@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 from ..caches import cached
 from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, point_suffix
 from .configuration import BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis
-from .geometry import cross, dot, sub, tetra_six_volume
+from .geometry import cross, determinant, sub, tetra_six_volume
 from .polyhedron import Polyhedron
 from .shapes import Point, Shape
 
@@ -432,7 +432,7 @@ def _affine(sources: Sequence[Point], targets: Sequence[Point]):
     # Solve M (s_i - s_0) = (t_i - t_0) for i = 1..3 by Cramer's rule, row by row.
     u = [sub(s, sources[0]) for s in sources[1:]]
     v = [sub(t, targets[0]) for t in targets[1:]]
-    det = dot(u[0], cross(u[1], u[2]))
+    det = determinant(u[0], u[1], u[2])
     # With U the matrix of columns u[i], the rows of det * U^-1 are these cross products.
     inverse_t = [cross(u[1], u[2]), cross(u[2], u[0]), cross(u[0], u[1])]
     linear = tuple(tuple(sum(v[i][row] * inverse_t[i][col] for i in range(3)) / det for col in range(3))

@@ -141,7 +141,6 @@ def _check_recomputed(cfg, positions: dict, squared, entry: dict, criteria, wher
 def _recompute(points: tuple, squared) -> tuple | None:
     """(type id, mirrored, exact circumcenter in unit coordinates) of the element with these
     points, or ``None`` if they are not the vertices of a convex polyhedron on one sphere."""
-    from itertools import combinations
 
     unit = {i: tuple(Fraction(n, d) for n, d in point) for i, point in enumerate(points)}
     frame = Frame.build(unit, squared)
@@ -152,8 +151,8 @@ def _recompute(points: tuple, squared) -> tuple | None:
     if {i for cycle in cycles for i in cycle} != set(range(len(points))):
         return None
     etype, _, mirrored = classify_faces(tuple(cycles), tuple(face_kind(frame, cycle) for cycle in cycles))
-    sphere = next((s for s in (frame.sphere(*q) for q in combinations(range(len(points)), 4)) if s is not None), None)
-    if sphere is None or any(sphere.side(frame.lifted[i]) != 0 for i in range(len(points))):
+    sphere = frame.circumsphere(range(len(points)))
+    if sphere is None:
         return None
     return etype.id, mirrored, frame.center(sphere)
 

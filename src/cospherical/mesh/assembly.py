@@ -20,7 +20,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from fractions import Fraction
-from itertools import combinations
 from typing import Callable, Iterable
 
 import numpy as np
@@ -120,9 +119,7 @@ def local_pattern(configuration: Configuration, elements: Iterable[tuple[str, It
         except ValueError:  # flat: no hull, no volume; the volume check reports it
             cycles = []
         volume = Fraction(six_volume(frame.coords, cycles), 6 * frame.scale ** 3) if cycles else Fraction(0)
-        sphere = next((s for s in (frame.sphere(*q) for q in combinations(members, 4)) if s is not None), None)
-        if sphere is not None and any(sphere.side(frame.lifted[m]) != 0 for m in members):
-            sphere = None  # not co-spherical: not a Delaunay element
+        sphere = frame.circumsphere(members)  # None: not co-spherical, not a Delaunay element
         measured.append(LocalElement(
             type_id, element_nodes, tuple(tuple(frame.ids[i] for i in c) for c in cycles), volume, sphere,
             frame.center(sphere) if sphere is not None else None))

@@ -112,12 +112,11 @@ globally Delaunay, have no region: the mesh is returned as it is.
 
 from __future__ import annotations
 
-import math
 from fractions import Fraction
 
 import numpy as np
 
-from ..core.geometry import Frame, Sphere, sphere_sides
+from ..core.geometry import Frame, area_vector, circumcentres, six_volumes, sphere_sides
 from ..core.incremental_delaunay import delaunay_tetrahedra
 from ..core.tessellation import tessellation_elements
 from ..errors import InputError
@@ -361,10 +360,6 @@ class _Locator:
         return found
 
 
-def _object_if_large(array: np.ndarray, bound: int) -> np.ndarray:
-    return array.astype(object) if bound >= 2**62 else array
-
-
 def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull", proposal=None) -> np.ndarray:
     """The Delaunay tetrahedra of a region's vertices (global ids, in and out), without flat ones.
 
@@ -403,10 +398,7 @@ def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray
         return None
     simplices = triangulation.simplices.astype(np.int64)
     p = coords[simplices]  # (tets, 4, 3)
-    d = p[:, 1:] - p[:, :1]
-    extent = int(np.abs(d).max()) if len(d) else 0
-    d = _object_if_large(d, 6 * extent ** 3)
-    solid = np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2])) != 0
+    solid = six_volumes(p) != 0
     # each face between two solid tetrahedra, once (near < far): the far one's vertex across it
     near, face = np.nonzero(solid[:, None] & (triangulation.neighbors > np.arange(len(simplices))[:, None]))
     far = triangulation.neighbors[near, face]
@@ -462,8 +454,7 @@ def _planes(mesh: Mesh) -> list[list[list[tuple[np.ndarray, np.ndarray, int]]]]:
             faces = []
             for cycle in element.faces:
                 points = NODE_OFFSETS[list(cycle)]
-                # the polygon's area vector: never zero, though three consecutive nodes can be in line
-                normal = np.cross(points - points[0], np.roll(points, -1, axis=0) - points[0]).sum(axis=0)
+                normal = np.array(area_vector(points.tolist()), dtype=np.int64)
                 side = int(np.sign((centroid - len(element.nodes) * points[0]) @ normal))
                 faces.append((normal, points[0], side))
             # a flat element (no faces, reported by the volume check) holds nothing
@@ -473,33 +464,8 @@ def _planes(mesh: Mesh) -> list[list[list[tuple[np.ndarray, np.ndarray, int]]]]:
 
 def _same_sphere(mesh: Mesh, tets: np.ndarray, weights) -> np.ndarray:
     """Per tetrahedron (global vertex ids), the class of its exact circumcenter: one class, one cell."""
-    coords = mesh.vertices.astype(np.int64)
-    p = coords[tets]
-    d = p[:, 1:] - p[:, :1]
-    extent = int(np.abs(d).max())
-    bound = 24 * max(weights) * extent ** 3 * (int(coords.max()) + extent + 1)
-    d = _object_if_large(d, bound)
-    # weights of extreme boxes (1e-12 x 1 x 3e9: 43 digits) do not fit int64 at all
-    w = np.array(weights, dtype=object) if bound >= 2**62 else np.array(weights, dtype=np.int64)
-    lifted = (d * d * w).sum(axis=2)  # (tets, 3): |d|^2 in the weighted metric
-    # The sphere through the origin and d1, d2, d3: centre c with 2 W c . d_k = lifted_k,
-    # so (W c) = M^-1 lifted / 2 for M the rows d_k: Cramer's rule in integers.
-    det = np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2]))
-    numerators = []
-    for axis in range(3):
-        m = d.copy()
-        m[:, :, axis] = lifted
-        numerators.append(np.einsum("ij,ij->i", m[:, 0], np.cross(m[:, 1], m[:, 2])))
-    # centre (grid units) = p0 + num / (2 w det), per axis: an exact rational, as a reduced pair
-    key = []
-    for axis in range(3):
-        den = 2 * w[axis] * det
-        num = p[:, 0, axis].astype(den.dtype) * den + numerators[axis]
-        sign = np.where(den < 0, -1, 1)
-        num, den = num * sign, den * sign
-        g = np.gcd(num, den) if den.dtype != object else np.frompyfunc(math.gcd, 2, 1)(num, den)
-        key += [num // g, den // g]
-    key = np.stack(key, axis=1)
+    num, den = circumcentres(mesh.vertices.astype(np.int64)[tets], weights)
+    key = np.stack((num, den), axis=2).reshape(len(tets), 6)  # per axis its numerator and denominator
     if key.dtype == object:
         index: dict = {}
         return np.array([index.setdefault(tuple(row), len(index)) for row in key.tolist()], dtype=np.int64)
@@ -596,8 +562,7 @@ def _shape(offsets: list[tuple[int, int, int]], squared, types: dict, catalogue:
     order = list(element.nodes)
     at = {n: i for i, n in enumerate(order)}
     frame = Frame.build({i: points[n] for i, n in enumerate(order)}, squared)
-    sphere = next(s for s in (frame.sphere(0, j, k, m) for j in range(1, len(order)) for k in range(j + 1, len(order))
-                              for m in range(k + 1, len(order))) if s is not None)
+    sphere = frame.circumsphere(range(len(order)))
     centre = frame.center(sphere)
     return CellShape(element.type.id, tuple(offsets[n] for n in order),
                      tuple(tuple(at[n] for n in cycle) for cycle in element.polyhedron.faces),
@@ -607,18 +572,13 @@ def _shape(offsets: list[tuple[int, int, int]], squared, types: dict, catalogue:
 def _scaled(shape: CellShape, g: int) -> CellShape:
     """``shape`` scaled by the integer ``g`` about its anchor: what :func:`_shape` gives for the scaled offsets.
 
-    Lexicographic order, the type and its node order do not change; in
-    :meth:`~cospherical.core.geometry.Frame.sphere` the coordinates scale by ``g`` and the
-    lifted one by ``g**2``, so the cofactors of the same four nodes scale by ``g**4``
-    (x, y, z) and ``g**3`` (lifted), the offset by ``g**5``.
+    Lexicographic order, the type and its node order do not change, nor the four
+    nodes of its sphere (:meth:`~cospherical.core.geometry.Sphere.scaled`).
     """
     if g == 1:
         return shape
-    n0, n1, n2, n3 = shape.sphere.normal
     return CellShape(shape.type_id, tuple(tuple(g * x for x in o) for o in shape.offsets), shape.faces,
-                     shape.grid_volume * g ** 3, Sphere((g ** 4 * n0, g ** 4 * n1, g ** 4 * n2, g ** 3 * n3),
-                                                        g ** 5 * shape.sphere.offset),
-                     tuple(g * c for c in shape.center))
+                     shape.grid_volume * g ** 3, shape.sphere.scaled(g), tuple(g * c for c in shape.center))
 
 
 MODES = ("global", "leaf")

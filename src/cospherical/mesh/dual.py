@@ -55,7 +55,7 @@ import numpy as np
 
 from ..core.configuration import Box
 from ..core.delaunay import hull_faces
-from ..core.geometry import Frame, cross, dot, sub
+from ..core.geometry import Frame, determinant, dot, plane_normal, six_volumes, sub
 from ..errors import InputError
 from .octree import distinct
 
@@ -113,7 +113,7 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
     boundary: dict[tuple[int, Fraction], dict[int, Fraction]] = {}
     for cycle in faces:
         p0, p1, p2 = (ip[n] for n in cycle[:3])
-        normal = cross(sub(p1, p0), sub(p2, p0))  # no three points of a circle are collinear
+        normal = plane_normal(p0, p1, p2)  # no three points of a circle are collinear
         s = sum(normal[k] * normal[k] * (big // weight[k]) for k in range(3))
         dn = dot(sub(ic, p0), normal)
         face_center = tuple(ic[k] * s - dn * normal[k] * (big // weight[k]) for k in range(3))  # times D * S
@@ -130,7 +130,7 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
             xu, xv = ip[u], ip[v]
             mid = tuple((xu[k] + xv[k]) // 2 * s for k in range(3))
             along = sub(xu, xv)
-            piece = dot(along, cross(sub(face_center, mid), sub(cs, mid)))  # times D^3 S^2
+            piece = determinant(along, sub(face_center, mid), sub(cs, mid))  # times D^3 S^2
             length2 = sum(weight[k] * along[k] * along[k] for k in range(3))  # times lam D^2
             key = (u, v) if u < v else (v, u)
             edges[key] = edges.get(key, Fraction(0)) + Fraction(piece * lam, 2 * scale * s * s * length2)
@@ -139,7 +139,7 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
             if shares is not None:
                 # triangles (x_u, m, f) and (m, x_v, f): equal areas, half a base each (times D^2 S^2)
                 xs = tuple(x * s for x in xu)
-                area = outward * cross(sub(mid, xs), sub(face_center, xs))[k]
+                area = outward * plane_normal(xs, mid, face_center)[k]
                 face_area[u] = face_area.get(u, 0) + area
                 face_area[v] = face_area.get(v, 0) + area
         for node, total in face_volume.items():
@@ -524,8 +524,10 @@ def _element_groups(mesh, squared, conn: np.ndarray, element_sizes: np.ndarray):
             frame = Frame.build(points, squared)
             members = list(range(len(key)))
             faces = [cycle for cycle, _ in hull_faces(frame, members)]
-            sphere = frame.sphere(*_spanning(frame, members))
-            if sphere is None or any(sphere.side(frame.lifted[m]) != 0 for m in members):
+            if frame.spanning(members) is None:
+                raise InputError("a flat element: it has no dual")
+            sphere = frame.circumsphere(members)
+            if sphere is None:
                 raise InputError(f"element {e} is not co-spherical: it has no dual")
             center = frame.center(sphere)
             entry = by_shape[key] = (_Shape([element_pieces(points, faces, center, squared)]), [], [], center)
@@ -535,16 +537,6 @@ def _element_groups(mesh, squared, conn: np.ndarray, element_sizes: np.ndarray):
     groups = [(shape, np.array(ids, dtype=np.int64), np.arange(len(ids)), np.array(scales, dtype=np.int64))
               for shape, ids, scales, _ in by_shape.values()]
     return groups, centers
-
-
-def _spanning(frame: Frame, members: list[int]) -> tuple[int, int, int, int]:
-    """Four members not in one plane (an element has them: it has volume)."""
-    from itertools import combinations
-
-    for quad in combinations(members, 4):
-        if frame.orient(*quad) != 0:
-            return quad
-    raise InputError("a flat element: it has no dual")
 
 
 TETRAHEDRAL_LIMIT = 1_000_000  # vertices: above it the tetrahedral comparison is skipped (minutes and gigabytes)
@@ -579,8 +571,7 @@ def delaunay_tetrahedra(grid_vertices: np.ndarray) -> tuple[np.ndarray, str, int
     from scipy.spatial import Delaunay
 
     tets = Delaunay(points.astype(np.float64)).simplices.astype(np.int64)
-    a, b, c, d = (points[tets[:, k]] for k in range(4))
-    keep = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) != 0
+    keep = six_volumes(points[tets]) != 0
     return tets[keep], "qhull", int((~keep).sum())
 
 

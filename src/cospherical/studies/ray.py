@@ -17,12 +17,11 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 from fractions import Fraction
-from itertools import combinations
 
 from ..caches import cached
 from ..core.configuration import Box, Configuration
 from ..core.exact import Length
-from ..core.geometry import Frame
+from ..core.geometry import Frame, sub
 from ..core.symmetry import box_symmetries, orbit_representatives
 from ..core.tessellation import tessellate
 from ..errors import InputError
@@ -77,7 +76,7 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
     forms: list[tuple[int, int]] = []
     for element in tess.elements:
         members = [index[n] for n in element.polyhedron.nodes]
-        quad = next(q for q in combinations(members, 4) if f0.orient(*q) != 0)
+        quad = f0.spanning(members)
         s0, s1 = f0.sphere(*quad), f1.sphere(*quad)
         for x in range(len(f0.ids)):
             a, b = s0.side(f0.lifted[x]), s1.side(f1.lifted[x])
@@ -95,12 +94,10 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
         # right angles of four-sided faces
         for face in element.polyhedron.faces:
             if len(face) == 4:
-                pts = [f0.coords[index[n]] for n in face]
+                pts = [f0.coords[index[n]] for n in face]  # f1's too: the frames differ in their weights alone
                 for i in range(4):
-                    e = [q - p for p, q in zip(pts[i], pts[(i + 1) % 4])]
-                    e2 = [q - p for p, q in zip(pts[(i + 1) % 4], pts[(i + 2) % 4])]
-                    forms.append((sum(w * x * y for w, x, y in zip(ray.w0, e, e2)),
-                                  sum(w * x * y for w, x, y in zip(ray.w1, e, e2))))
+                    e, e2 = sub(pts[(i + 1) % 4], pts[i]), sub(pts[(i + 2) % 4], pts[(i + 1) % 4])
+                    forms.append((f0.real_dot(e, e2), f1.real_dot(e, e2)))
     for a, b in forms:
         if b and Fraction(-a, b) == u:
             raise Critical
