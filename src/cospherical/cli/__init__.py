@@ -1,4 +1,9 @@
-"""The ``cospherical`` command: a thin layer, one module per subcommand."""
+"""The ``cospherical`` command: a thin layer, one module per subcommand.
+
+A subcommand's module says what it is (``HELP``, one line; ``DESCRIPTION``), which options it
+takes (``add_arguments(parser)``) and what it does (``run(args)``, the exit status); the
+parser is put together here.
+"""
 
 from __future__ import annotations
 
@@ -30,7 +35,7 @@ class _Parser(argparse.ArgumentParser):
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The whole command's parser; ``only``: with that one subcommand alone.
 
-    A subcommand module imports what its ``run`` needs; importing all seven to
+    A subcommand module imports what its ``run`` needs; importing all eight to
     parse one command line would load everything (numpy, jinja2, ...) for a
     command that takes milliseconds.
     """
@@ -41,7 +46,10 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"cospherical {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for name in SUBCOMMANDS if only is None else (only,):
-        importlib.import_module(f"{__name__}.{name}").add_parser(commands)
+        command = importlib.import_module(f"{__name__}.{name}")
+        subparser = commands.add_parser(name, help=command.HELP, description=command.DESCRIPTION)
+        command.add_arguments(subparser)
+        subparser.set_defaults(run=command.run)
     return parser
 
 

@@ -8,23 +8,21 @@ from ..catalogue import catalogue_path, load_catalogue
 from ..formats.check import check_catalogue, check_patterns, read_document_file
 
 
-def add_parser(commands) -> None:
-    parser = commands.add_parser(
-        "check",
-        help="validate catalogue and pattern-table files",
-        description="Validate catalogues (schema, unique ids, consistent faces, known split types) and pattern "
-        "tables (schema, known types, node counts, and that every configuration's elements tile the box), and "
-        "dual.npz files of `cospherical mesh --dual` (members, checksums, control volumes summing to the domain, boundary areas to its surface, "
-        "and every coefficient, control volume and boundary area computed again from the file's elements and compared exactly). "
-        "Exit status 0 when every file is valid, 2 at the first problem.",
-    )
+HELP = "validate catalogue and pattern-table files"
+DESCRIPTION = ("Validate catalogues (schema, unique ids, consistent faces, known split types) and pattern "
+               "tables (schema, known types, node counts, and that every configuration's elements tile the box), and "
+               "dual.npz files of `cospherical mesh --dual` (members, checksums, control volumes summing to the domain, boundary areas to its surface, "
+               "and every coefficient, control volume and boundary area computed again from the file's elements and compared exactly). "
+               "Exit status 0 when every file is valid, 2 at the first problem.")
+
+
+def add_arguments(parser) -> None:
     parser.add_argument("files", nargs="+", type=Path, metavar="FILE",
                         help="catalogues and pattern tables, checked in order (about 10-20 s per 4096-configuration "
                         "pattern table: every configuration is recomputed)")
     parser.add_argument("--catalogue", type=Path, metavar="FILE",
                         help="catalogue that pattern tables refer to (default: the shipped one)")
     parser.add_argument("--no-tiling", action="store_true", help="skip the geometric tiling check (faster)")
-    parser.set_defaults(run=run)
 
 
 def run(args) -> int:

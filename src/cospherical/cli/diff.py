@@ -15,19 +15,17 @@ from ..formats.diff import diff_documents, has_changes, text_report
 from .output import dump
 
 
-def add_parser(commands) -> None:
-    parser = commands.add_parser(
-        "diff",
-        help="compare two catalogue or pattern-table versions",
-        description="Compare two catalogues (types matched by canonical code) or two pattern tables "
-        "(configurations whose elements changed, per criterion). Exit status: 0 no difference, "
-        "1 differences, 2 trouble.",
-    )
+HELP = "compare two catalogue or pattern-table versions"
+DESCRIPTION = ("Compare two catalogues (types matched by canonical code) or two pattern tables "
+               "(configurations whose elements changed, per criterion). Exit status: 0 no difference, "
+               "1 differences, 2 trouble.")
+
+
+def add_arguments(parser) -> None:
     parser.add_argument("files", nargs="+", metavar="FILE", help="OLD NEW, or with --rev just the file")
     parser.add_argument("--rev", metavar="REV", help="read OLD from git at this revision (e.g. HEAD~3)")
     parser.add_argument("--format", choices=("text", "json", "yaml"), default="text",
                         help="text (default): a readable report; json or yaml: the same report as data")
-    parser.set_defaults(run=run)
 
 
 def _from_git(rev: str, path: Path):

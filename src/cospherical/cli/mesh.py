@@ -22,17 +22,16 @@ from ..mesh.report import mesh_report
 from .progress import stage_bars
 
 
-def add_parser(commands) -> None:
-    parser = commands.add_parser(
-        "mesh",
-        help="mesh a 1-irregular octree from a pattern table and check the mesh exactly",
-        description="Mesh a 1-irregular octree: each leaf's true configuration, its elements from the pattern table "
-                    "(or tessellated), global vertices; where leaf elements are not globally Delaunay, the exact "
-                    "Delaunay subdivision of their leaves' vertices (--delaunay global, the default); exact checks "
-                    "(volume, conformity, circumcenters, global Delaunay), the frequencies of types and "
-                    "configurations in the mesh and, with --dual, the finite-volume dual (control volumes and "
-                    "coefficients).",
-    )
+HELP = "mesh a 1-irregular octree from a pattern table and check the mesh exactly"
+DESCRIPTION = ("Mesh a 1-irregular octree: each leaf's true configuration, its elements from the pattern table "
+               "(or tessellated), global vertices; where leaf elements are not globally Delaunay, the exact "
+               "Delaunay subdivision of their leaves' vertices (--delaunay global, the default); exact checks "
+               "(volume, conformity, circumcenters, global Delaunay), the frequencies of types and "
+               "configurations in the mesh and, with --dual, the finite-volume dual (control volumes and "
+               "coefficients).")
+
+
+def add_arguments(parser) -> None:
     parser.add_argument("--domain", nargs=3, metavar=("A", "B", "C"), required=True,
                         help="the root cell's lengths, exact: 1, 1.4142, 3/2, sqrt(2)")
     tree = parser.add_mutually_exclusive_group(required=True)
@@ -87,7 +86,6 @@ def add_parser(commands) -> None:
     parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check of the result")
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
-    parser.set_defaults(run=run)
 
 
 def _max_leaves(text: str | None) -> int | None:

@@ -1,12 +1,14 @@
-"""Writing command results: JSON or YAML, to stdout."""
+"""Writing command results: JSON or YAML to stdout; files into an ``--out`` folder held for the run."""
 
 from __future__ import annotations
 
+import functools
 import sys
 
 from ..files.jsontext import dump, to_json
+from ..files.outputs import FolderLock
 
-__all__ = ["FACE_POINTS_HELP", "FORMATS", "dump", "emit", "to_json"]
+__all__ = ["FACE_POINTS_HELP", "FORMATS", "dump", "emit", "holding_out", "to_json"]
 
 FORMATS = ("json", "yaml")
 FACE_POINTS_HELP = "octree (default): add face and body points of refined neighbours; none: corners and edge points only"
@@ -14,3 +16,17 @@ FACE_POINTS_HELP = "octree (default): add face and body points of refined neighb
 
 def emit(data, fmt: str) -> None:
     sys.stdout.write(dump(data, fmt))
+
+
+def holding_out(run):
+    """``run(args)`` with ``args.out``, when given, held by a :class:`FolderLock` for the whole run: one
+    run at a time fills a folder (a study's checkpoints, a sweep's figures)."""
+
+    @functools.wraps(run)
+    def held(args) -> int:
+        if args.out is None:
+            return run(args)
+        with FolderLock(args.out):
+            return run(args)
+
+    return held

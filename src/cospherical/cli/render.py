@@ -20,13 +20,12 @@ from .progress import progress_bar
 SUMMARY_KEYS = ("study", "box", "face_points", "configurations", "fvm_adequate", "fvm_adequate_open", "criteria")
 
 
-def add_parser(commands) -> None:
-    parser = commands.add_parser(
-        "render",
-        help="write LaTeX tables (and a PDF) of a study",
-        description="Render the element, frequency, FVM and paper-comparison tables of a study as LaTeX "
-        "(jinja2 templates), with a standalone document.tex that includes them all.",
-    )
+HELP = "write LaTeX tables (and a PDF) of a study"
+DESCRIPTION = ("Render the element, frequency, FVM and paper-comparison tables of a study as LaTeX "
+               "(jinja2 templates), with a standalone document.tex that includes them all.")
+
+
+def add_arguments(parser) -> None:
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--study", choices=["bisection"], help="run this study first")
     source.add_argument("--summary", nargs="+", type=Path, metavar="FILE",
@@ -42,7 +41,6 @@ def add_parser(commands) -> None:
                         "wrote there and this one does not is removed, nothing else)")
     parser.add_argument("--pdf", action="store_true",
                         help="compile document.tex with pdflatex (in a private folder) into DIR/document.pdf")
-    parser.set_defaults(run=run)
 
 
 def _load_summary(path: Path) -> dict:

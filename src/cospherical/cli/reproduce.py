@@ -9,18 +9,16 @@ from ..studies.reproduce import paper_studies_total
 from .progress import progress_bar
 
 
-def add_parser(commands) -> None:
-    parser = commands.add_parser(
-        "reproduce",
-        help="run the paper's bisection studies and regenerate catalogue/, patterns/ and results/",
-        description="Run the bisection studies of the paper's boxes A (1,1,1), B (1,2,4), C (1,1.4142,1.4142) "
-        "and of exact C (1,sqrt 2,sqrt 2), under both point policies, and the octree-leaf studies of A and B; "
-        "write the element catalogue, the pattern tables (octree policy and leaves) and a results summary with "
-        "the paper side by side.",
-    )
+HELP = "run the paper's bisection studies and regenerate catalogue/, patterns/ and results/"
+DESCRIPTION = ("Run the bisection studies of the paper's boxes A (1,1,1), B (1,2,4), C (1,1.4142,1.4142) "
+               "and of exact C (1,sqrt 2,sqrt 2), under both point policies, and the octree-leaf studies of A and B; "
+               "write the element catalogue, the pattern tables (octree policy and leaves) and a results summary with "
+               "the paper side by side.")
+
+
+def add_arguments(parser) -> None:
     parser.add_argument("--root", type=Path, default=Path("."), metavar="DIR",
                         help="where catalogue/, patterns/ and results/ go (default: the current folder)")
-    parser.set_defaults(run=run)
 
 
 def run(args) -> int:

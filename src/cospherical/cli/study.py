@@ -11,7 +11,6 @@ from ..catalogue import shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..errors import UsageError
-from ..files.outputs import FolderLock
 from ..files.yamlio import atomic_write
 from ..outputs.report import text_report
 from ..paper import paper_comparison, paper_study_key
@@ -19,7 +18,7 @@ from ..studies.engine import bisection_codes, run_study
 from ..studies.insertion import INSERTION_ORDERS
 from ..studies.leaves import leaf_codes, run_leaves
 from ..studies.summary import compared_with, study_summary
-from .output import FACE_POINTS_HELP, dump, emit
+from .output import FACE_POINTS_HELP, dump, emit, holding_out
 from .progress import progress_bar, stage_bars
 
 
@@ -40,14 +39,13 @@ FAMILIES = {
 }
 
 
-def add_parser(commands) -> None:
-    parser = commands.add_parser(
-        "study",
-        help="run a study over every configuration of a family",
-        description="Tessellate every configuration of a family (one per symmetry orbit) and report "
-        "the frequency of every element type. Each family has its own options: "
-        "cospherical study FAMILY --help.",
-    )
+HELP = "run a study over every configuration of a family"
+DESCRIPTION = ("Tessellate every configuration of a family (one per symmetry orbit) and report "
+               "the frequency of every element type. Each family has its own options: "
+               "cospherical study FAMILY --help.")
+
+
+def add_arguments(parser) -> None:
     families = parser.add_subparsers(dest="family", required=True, metavar="{bisection,leaves,intersection}",
                                      help="the family of configurations to study",
                                      parser_class=type(parser))
@@ -103,7 +101,6 @@ def _add_family(parser, family: str) -> None:
            help="text (default): the frequency table; json: the summary as data")
     option("--compare-paper", action="store_true", only=("bisection", "intersection"),
            help="print the paper's figures beside ours, each difference marked and explained")
-    parser.set_defaults(run=run)
 
 
 # Options of the intersection study only: given to the bisection study they are refused, not ignored.
@@ -113,14 +110,8 @@ INTERSECTION_DEFAULTS = {"resolution": 16, "order": "edge", "jobs": os.cpu_count
                          "scheduler_timeout": 30.0}
 
 
+@holding_out
 def run(args) -> int:
-    if args.out is None:
-        return _run(args)
-    with FolderLock(args.out):  # one run at a time fills a folder
-        return _run(args)
-
-
-def _run(args) -> int:
     if args.element != "cuboid" and args.family != "bisection":
         raise UsageError(f"cospherical study: error: --element {args.element}: the {args.family} study is of cuboids; "
                          "other base elements have the bisection study")

@@ -7,23 +7,21 @@ from pathlib import Path
 
 from ..core.exact import parse_rational
 from ..errors import InputError
-from ..files.outputs import FolderLock
 from ..files.yamlio import atomic_write
 from ..outputs.figures import heatmap_png, heatmap_tex, steps_png, steps_tex
 from ..outputs.latex import environment
 from ..studies.ray import Ray, profile_summary, ray_profile
 from ..studies.sweep import grid_values, sweep
-from .output import dump, emit
+from .output import dump, emit, holding_out
 from .progress import progress_bar
 
 
-def add_parser(commands) -> None:
-    parser = commands.add_parser(
-        "sweep",
-        help="bisection studies over aspect ratios: a grid of boxes, or exact thresholds along a ray",
-        description="Run the bisection study for every box (1, b, c) of a grid (b <= c), or find exactly, "
-        "along a ray of boxes such as (1, r, r), every r where the FVM-adequate count or the element set changes.",
-    )
+HELP = "bisection studies over aspect ratios: a grid of boxes, or exact thresholds along a ray"
+DESCRIPTION = ("Run the bisection study for every box (1, b, c) of a grid (b <= c), or find exactly, "
+               "along a ray of boxes such as (1, r, r), every r where the FVM-adequate count or the element set changes.")
+
+
+def add_arguments(parser) -> None:
     mode = parser.add_mutually_exclusive_group(required=True)
     mode.add_argument("--ratios", nargs=2, metavar=("B_MIN:B_MAX:STEPS", "C_MIN:C_MAX:STEPS"),
                       help="grid of b and c values, each MIN:MAX:STEPS (exact numbers)")
@@ -33,17 +31,10 @@ def add_parser(commands) -> None:
     parser.add_argument("--out", type=Path, metavar="DIR", help="also write JSON, PNG and pgfplots figures into DIR")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="text (default): a table; json: the counts as data")
-    parser.set_defaults(run=run)
 
 
+@holding_out
 def run(args) -> int:
-    if args.out is None:
-        return _run(args)
-    with FolderLock(args.out):  # one run at a time fills a folder
-        return _run(args)
-
-
-def _run(args) -> int:
     if args.ray:
         return _ray(args)
     b_values = grid_values(args.ratios[0], "b range")

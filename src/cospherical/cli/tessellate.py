@@ -35,14 +35,13 @@ node numbering (box A x B x C):
 """
 
 
-def add_parser(commands) -> None:
-    parser = commands.add_parser(
-        "tessellate",
-        help="tessellate one 1-irregular cuboid, prism, pyramid or tetrahedron",
-        description="Tessellate one 1-irregular element: Delaunay cells = largest co-spherical elements.",
-        epilog=NUMBERING,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "tessellate one 1-irregular cuboid, prism, pyramid or tetrahedron"
+DESCRIPTION = "Tessellate one 1-irregular element: Delaunay cells = largest co-spherical elements."
+
+
+def add_arguments(parser) -> None:
+    parser.epilog = NUMBERING  # laid out by hand: printed as written
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter
     element = parser.add_mutually_exclusive_group()
     element.add_argument("--element", choices=ELEMENTS, default="cuboid",
                          help="the base element in the box (default cuboid): prism (half the box), pyramid (on the "
@@ -70,7 +69,6 @@ def add_parser(commands) -> None:
                         "internal_edges_and_faces: split the types the catalogue does not keep for that criterion")
     parser.add_argument("--format", choices=FORMATS, default="json", help="json (default) or yaml, on stdout")
     parser.add_argument("--vtu", type=Path, metavar="FILE", help="also write the tessellation as a VTU mesh (ParaView)")
-    parser.set_defaults(run=run)
 
 
 def _shape_file(path: Path, box) -> Shape:

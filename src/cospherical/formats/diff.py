@@ -139,10 +139,9 @@ def text_report(report: dict, old_name: str, new_name: str) -> str:
     for key, change in report.get("header", {}).items():
         lines.append(f"header {key}: {change['old']!r} -> {change['new']!r}")
     if report["kind"] == "catalogue":
-        for entry in report.get("added", []):
-            lines.append(f"+ type {entry['id']} {entry['name']} (V/E/F {'/'.join(map(str, entry['vef']))})")
-        for entry in report.get("removed", []):
-            lines.append(f"- type {entry['id']} {entry['name']} (V/E/F {'/'.join(map(str, entry['vef']))})")
+        for sign, key in (("+", "added"), ("-", "removed")):
+            for entry in report.get(key, []):
+                lines.append(f"{sign} type {entry['id']} {entry['name']} (V/E/F {'/'.join(map(str, entry['vef']))})")
         for entry in report.get("renamed", []):
             lines.append(f"~ renamed {entry['id']}: {entry['old']!r} -> {entry['new']!r}")
         for entry in report.get("changed", []):
