@@ -114,6 +114,7 @@ def test_render_refuses_non_numbers_where_numbers_belong(tmp_path, capsys, edit,
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
 
 
+@pytest.mark.oracle_pdflatex
 def test_render_escapes_every_string_from_input(tmp_path):
     data = summary()
     for t in data["criteria"]["optimal"]["types"].values():

@@ -107,6 +107,7 @@ def test_a_full_disk_names_the_users_file_not_the_staging_one(tmp_path, limit):
 
 # --- render: pdflatex in a private folder, the user's files kept ----------------------------------------------
 
+@pytest.mark.oracle_pdflatex
 def test_render_pdf_never_writes_through_links_and_keeps_the_users_files(tmp_path, capsys):
     target = victim(tmp_path)
     out = tmp_path / "out"

@@ -66,6 +66,7 @@ def test_bad_input_is_refused_with_one_line(tmp_path, capsys, argv, needle):
     assert needle in err and err.count("\n") == 1, err
 
 
+@pytest.mark.oracle_vtk
 @pytest.mark.parametrize("pieces", [None, "2"])
 def test_leaf_cell_data_numbers_the_leaves_as_the_leaves_file_lists_them(tmp_path, pieces):
     """With --leaves, each cell's ``leaf`` is a line of the file, and the cell lies inside that line's leaf."""

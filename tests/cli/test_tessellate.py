@@ -88,6 +88,7 @@ def test_tessellate_json_contract():
     assert data["fvm_adequate"] is True
 
 
+@pytest.mark.oracle_pyyaml
 def test_tessellate_steiner_and_yaml_agree_with_code():
     by_code = json.loads(cospherical("tessellate", "--box", "1", "sqrt(2)", "1.4142", "--code", "800080000008").stdout)
     result = cospherical("tessellate", "--box", "1", "sqrt(2)", "1.4142", "--steiner", "0:1/2", "4:0.5", "11:8/16",

@@ -48,6 +48,7 @@ def cells_by_definition(points, weights) -> set[frozenset[int]]:
 WEIGHTS = st.sampled_from([(1, 1, 1), (1, 4, 16), (1, 2, 2), (9, 1, 4), (2, 3, 5)])  # (1, 2, 2): a sqrt(2) box
 
 
+@pytest.mark.oracle_qhull
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(st.tuples(*[st.integers(0, 3)] * 3), min_size=5, max_size=13, unique=True), WEIGHTS)
 def test_cells_are_the_delaunay_cells_by_definition(points, weights):
@@ -74,6 +75,7 @@ def test_bad_input():
         delaunay_tetrahedra(cube[:3], (1, 1, 1))
 
 
+@pytest.mark.oracle_qhull
 @pytest.mark.parametrize("domain, levels, shape", [
     (["1", "2", "4"], 3, "sphere:0.5,1,2,0.6"),
     (["1", "1", "4"], 3, "point:0.2,0.7,3.1"),

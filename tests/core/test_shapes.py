@@ -24,6 +24,7 @@ SHAPES = sorted(set(STANDARD_SHAPES) - {"cuboid"})  # the shapes besides the cub
 BOXES = {"cube": ("1", "1", "1"), "aspect4": ("1", "2", "4"), "sqrt2-exact": ("1", "sqrt(2)", "sqrt(2)")}
 
 
+@pytest.mark.oracle_networkx
 @pytest.mark.oracle_qhull
 @pytest.mark.parametrize("name", SHAPES)
 def test_every_bisection_configuration_matches_qhull(name):

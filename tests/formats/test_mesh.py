@@ -49,6 +49,7 @@ def field_text(grid, name) -> str:
     return bytes(vtk_to_numpy(grid.GetFieldData().GetArray(name))).decode()
 
 
+@pytest.mark.oracle_vtk
 def test_vtk_reads_the_same_cells_node_orders_and_data(tmp_path):
     mesh = mixed_mesh()
     fvm = np.arange(len(mesh)) % 3 == 0  # any per-element data comes back with its element
@@ -96,6 +97,7 @@ def test_vtk_reads_the_same_cells_node_orders_and_data(tmp_path):
     assert (points == exact / intervals).all()  # dyadic: the floats are exact too
 
 
+@pytest.mark.oracle_vtk
 def test_vtk_finds_every_cell_valid_and_the_volumes_exact(tmp_path):
     """VTK's own validity test (orientation, convexity, faces) and its cell volumes against the exact ones."""
     mesh = mixed_mesh()
@@ -117,6 +119,7 @@ def test_vtk_finds_every_cell_valid_and_the_volumes_exact(tmp_path):
     assert abs(volume.sum() - 1) < 1e-12
 
 
+@pytest.mark.oracle_meshio
 def test_meshio_reads_it(tmp_path):
     """meshio reads a grid of standard cells (its VTU reader refuses polyhedra mixed with other cells)."""
     import meshio
@@ -141,6 +144,7 @@ def test_meshio_reads_it(tmp_path):
     assert (back.point_data["grid_coordinates"] == mesh.vertices).all()
 
 
+@pytest.mark.oracle_vtk
 @settings(max_examples=8, deadline=None)
 @given(st.tuples(*[st.integers(1, 15)] * 3), st.integers(1, 3))
 def test_the_same_mesh_gives_the_same_bytes_and_vtk_the_whole_volume(tmp_path_factory, point, levels):
@@ -180,6 +184,7 @@ def test_a_full_disk_leaves_the_old_file(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["mesh.vtu"]
 
 
+@pytest.mark.oracle_vtk
 def test_the_picture_cuts_what_vtk_cuts(tmp_path):
     """The picture's sections are VTK's cut of the same grid by the same plane (vtkCutter), element for element."""
     from cospherical.outputs.mesh_picture import cut_polygons
@@ -258,6 +263,7 @@ def element_sets(mesh):
     return sorted((ids[types[e]], tuple(sorted(conn[e, :sizes[e]].tolist()))) for e in range(len(mesh)))
 
 
+@pytest.mark.oracle_vtk
 def test_a_table_of_orbit_representatives_serves_every_configuration_of_an_orbit(representatives_store, tmp_path):
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy

@@ -51,6 +51,7 @@ CASES = [
 ]
 
 
+@pytest.mark.oracle_qhull
 @pytest.mark.parametrize("domain, levels, shapes, balance", CASES)
 def test_global_mode_equals_qhull_merged_exactly(domain, levels, shapes, balance):
     box = Box.parse(domain)
@@ -73,6 +74,7 @@ def _box(values):
     return Box.parse([str(Fraction(p, q)) for p, q in values])
 
 
+@pytest.mark.oracle_qhull
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(st.tuples(st.integers(1, 7), st.integers(1, 5)), min_size=3, max_size=3),
        st.integers(2, 3), st.tuples(*[st.fractions(0, 1, max_denominator=16)] * 3),
@@ -86,6 +88,7 @@ def test_random_trees_on_random_rational_boxes(lengths, levels, where, balance):
     assert whole(mesh) == WHOLE
 
 
+@pytest.mark.oracle_vtk
 def test_cli_reports_both_modes(capsys, tmp_path):
     argv = ["mesh", "--domain", "1", "2", "4", "--levels", "3", "--refine", "point:0.1,0.1,0.1", "--format", "json",
             "--no-uniform", "--dual"]
@@ -220,6 +223,7 @@ def test_extreme_boxes_mesh_exactly(domain, shape, monkeypatch, capsys, tmp_path
     assert {k: report[k] for k in WHOLE} == WHOLE and report["elements"] > report["leaves"]
 
 
+@pytest.mark.oracle_qhull
 @settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(st.tuples(st.integers(1, 9), st.integers(1, 9)), min_size=3, max_size=3), st.booleans(),
        st.tuples(*[st.fractions(0, 1, max_denominator=8)] * 3))
@@ -300,6 +304,7 @@ def _overlapping(qhull):
     return np.ones(len(simplices), dtype=bool), np.c_[simplices[pair, 0], far, simplices[pair, 1:3]]
 
 
+@pytest.mark.oracle_qhull
 @pytest.mark.parametrize("change", [_missing, _overlapping])
 def test_a_wrong_proposal_the_local_check_passes_is_redone_exactly(change, monkeypatch):
     leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))
@@ -310,6 +315,7 @@ def test_a_wrong_proposal_the_local_check_passes_is_redone_exactly(change, monke
     assert whole(mesh) == WHOLE
 
 
+@pytest.mark.oracle_qhull
 def test_a_table_element_that_is_not_cospherical_is_replaced_by_delaunay_cells():
     # A pattern table may hold an element that is no Delaunay element at all (here a whole
     # leaf with its edge and face points as one element): it has no sphere to test, so it
@@ -336,6 +342,7 @@ def test_a_table_element_that_is_not_cospherical_is_replaced_by_delaunay_cells()
     assert mesh_cells(result) == oracle_cells(result)
 
 
+@pytest.mark.oracle_qhull
 def test_only_a_wrong_proposals_own_failure_sends_every_region_to_the_exact_engine(monkeypatch):
     # Tetrahedra of one centre that are not one cell (NotOneCell) are a proposal's fault: every region is
     # redone exactly.  Any other error on the way is a bug and must surface, not be taken for that one.

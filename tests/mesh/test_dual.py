@@ -241,6 +241,8 @@ OCTREES = {
 }
 
 
+@pytest.mark.oracle_voro
+@pytest.mark.oracle_discretize
 @pytest.mark.parametrize("name", sorted(OCTREES))
 def test_control_volumes_and_face_areas_are_voro_plus_plus_cells(name):
     """On cube octrees the dual is the Voronoi diagram clipped to the domain: voro++ agrees to 1e-12."""
@@ -263,6 +265,7 @@ def dual_run(tmp_path_factory):
     return out
 
 
+@pytest.mark.oracle_meshio
 def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
     import json
 
@@ -329,6 +332,8 @@ def test_a_full_disk_under_tetgens_scratch_file_names_that_file(monkeypatch):
     assert raised.value.filename.endswith("points.node") and raised.value.errno == errno.EFBIG
 
 
+@pytest.mark.oracle_tetgen
+@pytest.mark.oracle_discretize
 @pytest.mark.parametrize("name", ["sphere", "discretize points"])
 def test_tetgen_tetrahedra_of_the_same_vertices_give_the_same_dual_exactly(name):
     """An independent tetrahedral Delaunay mesh (TetGen) of the vertices has the same dual, exactly.

@@ -85,6 +85,7 @@ def brick():
     return mesh, single_cells(mesh)
 
 
+@pytest.mark.oracle_vtk
 @pytest.mark.parametrize("argv, pieces", [(SPHERE, 2), (SPHERE, 4), (BRICK, 2), (BRICK, 4)])
 def test_the_pieces_are_the_mesh_of_one_process(argv, pieces, tmp_path, capsys):
     mesh = single_mesh(argv)
@@ -124,6 +125,7 @@ def test_same_input_same_bytes(tmp_path, capsys):
     assert all((tmp_path / "a" / n).read_bytes() == (tmp_path / "b" / n).read_bytes() for n in names)
 
 
+@pytest.mark.oracle_vtk
 def test_on_a_local_dask_cluster(brick, tmp_path, capsys):
     import socket
     import warnings
