@@ -3,7 +3,8 @@ from pathlib import Path
 
 import pytest
 
-# The shared test helpers (oracle.py, strategies.py) live beside the tests.
+# The shared test helpers (oracle.py, strategies.py, commands.py, examples.py) live here, above the
+# test folders (tests/<package>/, one per package of src/cospherical): imported as top-level modules.
 sys.path.insert(0, str(Path(__file__).parent))
 
 
