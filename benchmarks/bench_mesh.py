@@ -15,7 +15,7 @@ check (the regions re-tessellated), and the same checks and statistics on it.
 Leaf mode = assembly + checks + statistics; global mode = the same assembly +
 the leaf mesh's Delaunay check + re-tessellation + checks + statistics of the
 result; their ratio is printed (target: at most 3).  Peak memory is the process's
-maximum resident set size.  Targets (issue 14): assembly >= 100,000 leaves/s,
+maximum resident set size.  Targets: assembly >= 100,000 leaves/s,
 volume + conformity + circumcenters < 2 min, Delaunay < 5 min, peak < 4 GB.
 Writes results/benchmarks/bench_mesh.json (benchmarks/record.py).
 """

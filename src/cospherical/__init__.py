@@ -1,9 +1,24 @@
 """cospherical: Delaunay tessellations of 1-irregular cuboids with co-spherical elements.
 
-The public API, re-exported here from the layers that define it (read top to
-bottom: ``core`` -> ``paper`` -> ``catalogue`` -> ``studies`` -> ``formats`` ->
-``outputs`` -> ``cli``; each imports only from those before it).  The names load
-on first use, so ``import cospherical`` stays cheap for the command line.
+The public API, re-exported here from the modules that define it.  The names load on
+first use, so ``import cospherical`` stays cheap for the command line.
+
+- Configurations and tessellations: ``Box``, ``Configuration``, ``Length`` (an exact
+  length), ``tessellate``, ``Tessellation``, ``Element``, ``ElementType``; the other base
+  elements: ``Shape``, ``ShapeConfiguration``, ``standard_shape``, ``tessellate_shape``.
+- The element catalogue: ``shipped_catalogue``, ``load_catalogue``, ``type_name``.
+- Pattern tables: ``load_patterns``, ``PatternTable``.
+- Errors: ``CosphericalError`` and its kinds ``InputError``, ``FormatError``, ``UsageError``;
+  and ``__version__``.
+
+The mesher's entry points are in its package, :mod:`cospherical.mesh` (``octree.build_octree``,
+``octree.leaves_octree``, ``assembly.assemble``, ``report.mesh_report``), its files in
+:mod:`cospherical.formats.mesh`; the command line is ``cospherical.cli.main``.  Each module's
+``__all__`` says what it makes public; a name with a leading underscore is internal.
+
+The layers, top to bottom, each importing only from those below it: ``cli``, ``outputs``,
+``formats``, ``mesh``, ``studies``, ``catalogue``, ``paper``, ``core`` and ``files``, then
+``errors``, ``version`` and ``caches`` (pyproject.toml's import-linter contracts).
 
 Examples
 --------

@@ -1,4 +1,8 @@
+"""``python -m cospherical``: the command line (:func:`cospherical.cli.main`)."""
+
 import sys
+
+__all__: list[str] = []  # a script: nothing to import from it
 
 try:
     from .cli import main

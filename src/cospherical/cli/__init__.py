@@ -19,11 +19,11 @@ import threading
 from ..errors import CosphericalError, UsageError
 from ..version import __version__
 
-__all__ = ["main"]
+__all__ = ["build_parser", "main"]
 
 # One module per subcommand, imported inside main() so that an interrupt while
 # the heavy libraries load is handled like any other.
-SUBCOMMANDS = ("tessellate", "study", "reproduce", "render", "diff", "check", "sweep", "mesh")
+_SUBCOMMANDS = ("tessellate", "study", "reproduce", "render", "diff", "check", "sweep", "mesh")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -45,7 +45,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"cospherical {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for name in SUBCOMMANDS if only is None else (only,):
+    for name in _SUBCOMMANDS if only is None else (only,):
         command = importlib.import_module(f"{__name__}.{name}")
         subparser = commands.add_parser(name, help=command.HELP, description=command.DESCRIPTION)
         command.add_arguments(subparser)
@@ -127,7 +127,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         words = sys.argv[1:] if argv is None else argv
         command = next((word for word in words if not word.startswith("-")), None)
-        args = build_parser(command if command in SUBCOMMANDS else None).parse_args(argv)
+        args = build_parser(command if command in _SUBCOMMANDS else None).parse_args(argv)
         status = args.run(args)
         sys.stdout.flush()  # a full disk or /dev/full shows here, as one line, not at exit
         if _terminated.is_set():

@@ -8,6 +8,8 @@ from ..catalogue import catalogue_path, load_catalogue
 from ..formats.check import check_catalogue, check_patterns, read_document_file
 
 
+__all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
+
 HELP = "validate catalogue and pattern-table files"
 DESCRIPTION = ("Validate catalogues (schema, unique ids, consistent faces, known split types) and pattern "
                "tables (schema, known types, node counts, and that every configuration's elements tile the box), and "

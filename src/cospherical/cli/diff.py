@@ -15,6 +15,8 @@ from ..formats.diff import diff_documents, has_changes, text_report
 from .output import dump
 
 
+__all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
+
 HELP = "compare two catalogue or pattern-table versions"
 DESCRIPTION = ("Compare two catalogues (types matched by canonical code) or two pattern tables "
                "(configurations whose elements changed, per criterion). Exit status: 0 no difference, "

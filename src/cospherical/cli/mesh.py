@@ -22,6 +22,8 @@ from ..mesh.report import mesh_report
 from .progress import stage_bars
 
 
+__all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
+
 HELP = "mesh a 1-irregular octree from a pattern table and check the mesh exactly"
 DESCRIPTION = ("Mesh a 1-irregular octree: each leaf's true configuration, its elements from the pattern table "
                "(or tessellated), global vertices; where leaf elements are not globally Delaunay, the exact "
@@ -116,7 +118,7 @@ def _levels(text: str | None) -> int:
     return int(value)
 
 
-SUMMARY_KEYS = ("delaunay_mode", "leaves", "vertices", "elements", "types", "volume_ok", "nonconforming_faces",
+_SUMMARY_KEYS = ("delaunay_mode", "leaves", "vertices", "elements", "types", "volume_ok", "nonconforming_faces",
                 "circumcenters_outside_leaf", "leaves_not_fvm_adequate", "boundary_circumcenters_outside",
                 "delaunay_violations", "regions_retessellated", "cells_spanning_leaves",
                 "configurations", "configurations_from_table", "configurations_mapped", "tessellated_on_the_fly",
@@ -150,7 +152,7 @@ def _text(value) -> str:
     return f"{value:,}" if isinstance(value, int) else str(value)
 
 
-OUTPUTS = ("mesh.vtu", "report.json", "mesh.png")
+_OUTPUTS = ("mesh.vtu", "report.json", "mesh.png")
 
 
 def run(args) -> int:
@@ -158,14 +160,14 @@ def run(args) -> int:
     if args.out is None:
         return _run(args, None)
     if pieces is not None:
-        names = ("mesh.pvtu", "report.json", *(piece_name(k) for k in range(pieces)))
+        names = ("mesh.pvtu", "report.json", *(_piece_name(k) for k in range(pieces)))
     else:
-        names = OUTPUTS + (("dual.npz",) if args.dual else ())
+        names = _OUTPUTS + (("dual.npz",) if args.dual else ())
     with OutputFolder(args.out, "mesh", names) as out:  # locked from the start; every file or none
         return _run(args, out)
 
 
-def piece_name(k: int) -> str:
+def _piece_name(k: int) -> str:
     return f"mesh-{k}.vtu"
 
 
@@ -298,7 +300,7 @@ def _print(args, report: dict) -> None:
     if args.format == "json":
         sys.stdout.write(report_json(report))
     else:
-        sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in SUMMARY_KEYS))
+        sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in _SUMMARY_KEYS))
 
 
 def _write_listed_piece(listed: np.ndarray, mesh, path, leaves: np.ndarray) -> None:
@@ -319,7 +321,7 @@ def _in_pieces(args, tree, described: dict, table: tuple | None, mode: str, out:
     write = write_piece if listed is None else partial(_write_listed_piece, listed)
 
     pieces = int(args.partitions)
-    paths = [str(out.path(piece_name(k))) for k in range(pieces)] if out is not None else None
+    paths = [str(out.path(_piece_name(k))) for k in range(pieces)] if out is not None else None
     report = mesh_in_pieces(tree, pieces, (table_lookup, table) if table is not None else None, args.criterion,
                             mode, described, args.patterns.name if args.patterns else None,
                             uniform=not args.no_uniform, delaunay=not args.no_delaunay,

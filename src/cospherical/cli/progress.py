@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 from contextlib import contextmanager
 
+__all__ = ["progress_bar", "stage_bars"]
+
 
 def _quiet(*args) -> None:
     pass

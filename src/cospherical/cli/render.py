@@ -17,7 +17,9 @@ from ..studies.summary import study_summary
 from .output import FACE_POINTS_HELP
 from .progress import progress_bar
 
-SUMMARY_KEYS = ("study", "box", "face_points", "configurations", "fvm_adequate", "fvm_adequate_open", "criteria")
+__all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
+
+_SUMMARY_KEYS = ("study", "box", "face_points", "configurations", "fvm_adequate", "fvm_adequate_open", "criteria")
 
 
 HELP = "write LaTeX tables (and a PDF) of a study"
@@ -46,8 +48,8 @@ def add_arguments(parser) -> None:
 def _load_summary(path: Path) -> dict:
     """A summary file, validated: every name in it is one of the known ones, every count a number."""
     data = load_yaml(path)  # JSON is YAML
-    if isinstance(data, dict) and any(key not in data for key in SUMMARY_KEYS):
-        missing = [k for k in SUMMARY_KEYS if k not in data]
+    if isinstance(data, dict) and any(key not in data for key in _SUMMARY_KEYS):
+        missing = [k for k in _SUMMARY_KEYS if k not in data]
         raise FormatError(f"{path}: not a study summary (missing {', '.join(missing)})")
     validate(data, "summary", path)
     _refuse_non_finite(data, path)

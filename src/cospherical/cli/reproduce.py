@@ -9,6 +9,8 @@ from ..studies.reproduce import paper_studies_total
 from .progress import progress_bar
 
 
+__all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
+
 HELP = "run the paper's bisection studies and regenerate catalogue/, patterns/ and results/"
 DESCRIPTION = ("Run the bisection studies of the paper's boxes A (1,1,1), B (1,2,4), C (1,1.4142,1.4142) "
                "and of exact C (1,sqrt 2,sqrt 2), under both point policies, and the octree-leaf studies of A and B; "

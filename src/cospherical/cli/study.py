@@ -21,8 +21,10 @@ from ..studies.summary import compared_with, study_summary
 from .output import FACE_POINTS_HELP, dump, emit, holding_out
 from .progress import progress_bar, stage_bars
 
+__all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
 
-FAMILIES = {
+
+_FAMILIES = {
     "bisection": ("a midpoint or nothing on each of the 12 edges: the paper's section 4",
                   "Tessellate all 4096 bisection configurations of a box (a midpoint or nothing on each of the 12 "
                   "edges; 512, 256 or 64 for a prism, pyramid or tetrahedron), one per symmetry orbit, and report "
@@ -49,7 +51,7 @@ def add_arguments(parser) -> None:
     families = parser.add_subparsers(dest="family", required=True, metavar="{bisection,leaves,intersection}",
                                      help="the family of configurations to study",
                                      parser_class=type(parser))
-    for family, (summary, description) in FAMILIES.items():
+    for family, (summary, description) in _FAMILIES.items():
         _add_family(families.add_parser(family, help=summary, description=description), family)
 
 
@@ -104,9 +106,9 @@ def _add_family(parser, family: str) -> None:
 
 
 # Options of the intersection study only: given to the bisection study they are refused, not ignored.
-INTERSECTION_ONLY = ("resolution", "order", "jobs", "chunk_size", "scheduler", "scheduler_timeout", "dask_workers",
+_INTERSECTION_ONLY = ("resolution", "order", "jobs", "chunk_size", "scheduler", "scheduler_timeout", "dask_workers",
                      "no_orbits", "resume", "patterns", "patterns_format")
-INTERSECTION_DEFAULTS = {"resolution": 16, "order": "edge", "jobs": os.cpu_count() or 1, "chunk_size": 5000,
+_INTERSECTION_DEFAULTS = {"resolution": 16, "order": "edge", "jobs": os.cpu_count() or 1, "chunk_size": 5000,
                          "scheduler_timeout": 30.0}
 
 
@@ -116,11 +118,11 @@ def run(args) -> int:
         raise UsageError(f"cospherical study: error: --element {args.element}: the {args.family} study is of cuboids; "
                          "other base elements have the bisection study")
     if args.family == "intersection":
-        for name, value in INTERSECTION_DEFAULTS.items():
+        for name, value in _INTERSECTION_DEFAULTS.items():
             if getattr(args, name) is None:
                 setattr(args, name, value)
         return _intersection(args)
-    given = [name for name in INTERSECTION_ONLY if getattr(args, name) not in (None, False)]  # bisection, leaves
+    given = [name for name in _INTERSECTION_ONLY if getattr(args, name) not in (None, False)]  # bisection, leaves
     if given:
         option = "--" + given[0].replace("_", "-")
         raise UsageError(f"cospherical study: error: {option} is an option of the intersection study only")

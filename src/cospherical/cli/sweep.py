@@ -16,6 +16,8 @@ from .output import dump, emit, holding_out
 from .progress import progress_bar
 
 
+__all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
+
 HELP = "bisection studies over aspect ratios: a grid of boxes, or exact thresholds along a ray"
 DESCRIPTION = ("Run the bisection study for every box (1, b, c) of a grid (b <= c), or find exactly, "
                "along a ray of boxes such as (1, r, r), every r where the FVM-adequate count or the element set changes.")

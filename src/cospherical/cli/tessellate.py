@@ -14,6 +14,8 @@ from ..files.yamlio import load_yaml
 from ..formats.tessellation import tessellation_data
 from .output import FACE_POINTS_HELP, FORMATS, emit
 
+__all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
+
 
 def _steiner(text: str) -> tuple[str, str]:
     edge, sep, t = text.partition(":")
@@ -22,7 +24,7 @@ def _steiner(text: str) -> tuple[str, str]:
     return edge, t
 
 
-NUMBERING = """\
+_NUMBERING = """\
 node numbering (box A x B x C):
   corners 0-7 (VTK hexahedron order): 0 (0,0,0), 1 (A,0,0), 2 (A,B,0), 3 (0,B,0),
                                       4 (0,0,C), 5 (A,0,C), 6 (A,B,C), 7 (0,B,C)
@@ -40,7 +42,7 @@ DESCRIPTION = "Tessellate one 1-irregular element: Delaunay cells = largest co-s
 
 
 def add_arguments(parser) -> None:
-    parser.epilog = NUMBERING  # laid out by hand: printed as written
+    parser.epilog = _NUMBERING  # laid out by hand: printed as written
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     element = parser.add_mutually_exclusive_group()
     element.add_argument("--element", choices=ELEMENTS, default="cuboid",

@@ -6,3 +6,5 @@ formats that read and write its results: ``octree`` builds or reads the tree,
 property exactly, ``dual`` gives its finite-volume dual (control volumes, coupling
 coefficients, the box method's matrix), ``statistics`` and ``report`` summarise the mesh.
 """
+
+__all__: list[str] = []  # nothing re-exported: the public names are each module's __all__
