@@ -39,7 +39,8 @@ from __future__ import annotations
 
 from typing import Sequence
 
-from .geometry import Frame, cross, sub
+from .geometry import Frame, collinear
+from .morton import morton_codes
 
 __all__ = ["delaunay_tetrahedra"]
 
@@ -77,16 +78,8 @@ def delaunay_tetrahedra(coords: Sequence[Sequence[int]], weights: Sequence[int])
 
 
 def _morton_order(coords) -> list[int]:
-    bits = max(max(p) for p in coords).bit_length()
-
-    def key(i: int) -> int:
-        x, y, z = coords[i]
-        code = 0
-        for b in range(bits - 1, -1, -1):
-            code = (code << 3) | ((x >> b & 1) << 2) | ((y >> b & 1) << 1) | (z >> b & 1)
-        return code
-
-    return sorted(range(len(coords)), key=lambda i: (key(i), coords[i]))
+    codes = morton_codes(coords).tolist()
+    return sorted(range(len(coords)), key=lambda i: (codes[i], coords[i]))
 
 
 class _Triangulation:
@@ -128,7 +121,7 @@ class _Triangulation:
                 if not ok:
                     raise ValueError(f"points {a} and {i} coincide")
             elif len(chosen) == 2:
-                ok = any(cross(sub(frame.coords[chosen[1]], frame.coords[a]), sub(frame.coords[i], frame.coords[a])))
+                ok = not collinear(frame.coords[a], frame.coords[chosen[1]], frame.coords[i])
             else:
                 ok = self.orient(*chosen, i) != 0
             if ok:

@@ -21,6 +21,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..core.morton import morton_codes
 from ..errors import InputError
 from .assembly import Mesh
 from .octree import distinct
@@ -373,22 +374,19 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         own[celly] = (cells.nodes[rows_leaf[pair_row[celly]]] == pair_vertex[celly, None]).any(axis=1)
     pair_row, pair_vertex = pair_row[~own], pair_vertex[~own]
     sides = np.zeros(len(pair_row), dtype=np.int8)
-    w0, w1, w2 = _weights(mesh)
+    weights = _weights(mesh)
     for i, (row, vertex) in enumerate(zip(pair_row.tolist(), pair_vertex.tolist())):
         if rows_pattern[row] < 0:
             shape = cells.shapes[rows_local[row]]
             x = [int(v) - int(o) for v, o in zip(mesh.vertices[vertex], cells.anchor[rows_leaf[row]])]
-            side = shape.sphere.side((*x, w0 * x[0] ** 2 + w1 * x[1] ** 2 + w2 * x[2] ** 2))
+            side = shape.sphere.side_at(x, weights)
         else:
             pattern = mesh.patterns[rows_pattern[row]]
             element = pattern.elements[rows_local[row]]
             leaf = rows_leaf[row]
             m = int(size[leaf])
             x = [pattern.scale * (int(v) - int(o)) for v, o in zip(mesh.vertices[vertex], origin[leaf])]
-            n0, n1, n2, n3 = element.sphere.normal
-            p0, p1, p2 = pattern.weights
-            side = (n0 * x[0] + n1 * x[1] + n2 * x[2]) * m + n3 * (p0 * x[0] ** 2 + p1 * x[1] ** 2 + p2 * x[2] ** 2) \
-                - element.sphere.offset * m * m
+            side = element.sphere.side_at(x, pattern.weights, m)
         sides[i] = (side > 0) - (side < 0)
     inside = sides < 0
     bad_rows = distinct(pair_row[inside])
@@ -411,13 +409,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
 def _morton_order(points: np.ndarray, low: np.ndarray, high: np.ndarray, bits: int = 10) -> np.ndarray:
     """The order of ``points`` along the Z-order curve of a ``2**bits`` grid on the box ``low``..``high``."""
     cell = np.clip((points - low) * ((1 << bits) / np.maximum(high - low, 1e-300)), 0, (1 << bits) - 1)
-    cell = cell.astype(np.int64)
-    # each coordinate's bits spread three apart by a table, the three interleaved
-    spread = np.zeros(1 << bits, dtype=np.int64)
-    for bit in range(bits):
-        spread |= ((np.arange(1 << bits) >> bit) & 1) << (3 * bit)
-    code = (spread[cell[:, 0]] << 2) | (spread[cell[:, 1]] << 1) | spread[cell[:, 2]]
-    return np.argsort(code, kind="stable")
+    return np.argsort(morton_codes(cell.astype(np.int64)), kind="stable")
 
 
 def _weights(mesh: Mesh) -> tuple[int, int, int]:

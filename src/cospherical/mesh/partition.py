@@ -45,6 +45,7 @@ import numpy as np
 
 from ..catalogue import shipped_catalogue
 from ..core.configuration import Box
+from ..core.morton import morton_codes
 from ..errors import InputError
 from ..studies.intersection.backends import completed
 from .assembly import Cells, assemble, vertex_keys
@@ -73,11 +74,7 @@ def morton_pieces(tree: Octree, pieces: int) -> list[np.ndarray]:
         raise InputError(f"--partitions {pieces}: from 1 to the tree's {len(tree):,} leaves")
     depth = tree.depth
     corner = tree.positions.astype(np.int64) << (depth - tree.levels.astype(np.int64))[:, None]
-    code = np.zeros(len(tree), dtype=np.int64)
-    for bit in range(depth):  # interleave the bits: x, y, z from the most significant down
-        for axis in range(3):
-            code |= ((corner[:, axis] >> bit) & 1) << (3 * bit + 2 - axis)
-    order = np.argsort(code, kind="stable")
+    order = np.argsort(morton_codes(corner), kind="stable")
     bounds = [len(tree) * k // pieces for k in range(pieces + 1)]
     return [np.sort(order[bounds[k]:bounds[k + 1]]) for k in range(pieces)]
 
