@@ -18,6 +18,7 @@ from pathlib import Path
 import jinja2
 
 from ..core.element_types import face_summary
+from ..core.geometry import cross, plane_normal
 from ..errors import InputError
 from ..files.data import data_path
 from ..files.outputs import OutputFolder, atomic_open
@@ -64,15 +65,11 @@ def _normalise(v):
     return tuple(x / n for x in v)
 
 
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
 def _projection(entry: dict, size: float):
     """Screen coordinates of the example's vertices and each edge's visibility."""
     d = _normalise(_TOWARD_VIEWER)
-    right = _normalise(_cross((0, 0, 1), d))
-    up = _cross(d, right)
+    right = _normalise(cross((0, 0, 1), d))
+    up = cross(d, right)
     points = entry["example"]["coordinates"]
     screen = [(sum(a * b for a, b in zip(p, right)), sum(a * b for a, b in zip(p, up))) for p in points]
     xs, ys = [s[0] for s in screen], [s[1] for s in screen]
@@ -83,7 +80,7 @@ def _projection(entry: dict, size: float):
     for face in entry["reference_faces"]:
         nodes = face["nodes"]
         p0, p1, p2 = (points[i] for i in nodes[:3])
-        normal = _cross([b - a for a, b in zip(p0, p1)], [b - a for a, b in zip(p0, p2)])
+        normal = plane_normal(p0, p1, p2)
         front = sum(a * b for a, b in zip(normal, d)) > 0
         for i, v in enumerate(nodes):
             edge = tuple(sorted((v, nodes[(i + 1) % len(nodes)])))
