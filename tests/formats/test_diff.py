@@ -5,10 +5,10 @@ from __future__ import annotations
 import copy
 import json
 import subprocess
-import sys
 
 import pytest
 import yaml
+from commands import cospherical
 
 from cospherical import Box
 from cospherical.files.yamlio import dump_yaml, load_yaml
@@ -17,10 +17,6 @@ from cospherical.formats.patterns import write_patterns
 from cospherical.studies.engine import bisection_codes, run_study
 
 CODES = bisection_codes()[:96]
-
-
-def cospherical(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "cospherical", *args], capture_output=True, text=True, cwd=cwd)
 
 
 @pytest.fixture(scope="module")
