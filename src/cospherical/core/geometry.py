@@ -39,7 +39,7 @@ from itertools import combinations
 from typing import Mapping, Sequence
 
 __all__ = ["Frame", "Sphere", "area_vector", "circumcentres", "collinear", "cross", "determinant", "dot",
-           "plane_normal", "six_volume", "six_volumes", "sphere_sides", "sub", "tetra_six_volume"]
+           "in_closed_box", "plane_normal", "six_volume", "six_volumes", "sphere_sides", "sub", "tetra_six_volume"]
 
 Vector = tuple[int, int, int]
 
@@ -94,6 +94,19 @@ def sphere_sides(tets, points, weights: Sequence[int], python_integers: bool = F
         towards = towards + e[:, axis] * numerators[axis]
     side = (det * (e * e * w).sum(axis=1) - towards) * np.where(det < 0, -1, 1)
     return np.sign(side).astype(np.int8)
+
+
+def in_closed_box(numerators, denominators, low, high):
+    """Per row of rational points ``numerators / denominators`` (n, 3), in bulk, whether it lies in the
+    closed box ``low``..``high`` (broadcast per row or per axis; denominators positive): each numerator
+    against the bounds times its denominator, in the arrays' own integers (the caller's bound makes
+    int64 exact, else it passes Python integers).
+
+    >>> import numpy as np
+    >>> in_closed_box(np.array([[1, 2, 3], [1, 2, 7]]), np.array([[2], [2]]), 0, 3).tolist()
+    [True, False]
+    """
+    return ((numerators >= low * denominators) & (numerators <= high * denominators)).all(axis=1)
 
 
 # ---------------------------------------------------------------------------------------------

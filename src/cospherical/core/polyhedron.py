@@ -5,10 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from .delaunay import Cell
-from .geometry import Frame, six_volume
+from .delaunay import Cell, hull_faces
+from .geometry import Frame, Sphere, six_volume
 
-__all__ = ["FACE_KINDS", "Polyhedron", "face_kind", "polyhedron"]
+__all__ = ["FACE_KINDS", "Measured", "Polyhedron", "face_kind", "measure", "polyhedron"]
 
 # Face labels of the canonical code; a four-gon is a rectangle only with four
 # exact right angles, otherwise a quadrilateral.
@@ -54,6 +54,36 @@ class Polyhedron:
         if closed:
             return all(0 <= x <= 1 for x in self.center)
         return all(0 < x < 1 for x in self.center)
+
+
+@dataclass(frozen=True)
+class Measured:
+    """An element measured exactly from its node list (see :func:`measure`).
+
+    ``cycles``: its hull's faces as cycles of frame indices, counter-clockwise seen
+    from outside (none: the nodes are flat); ``unit_volume``: its volume over the
+    box's (0 when flat); ``sphere``: its circumsphere in the frame, ``None`` when the
+    nodes are flat or not all on one sphere; ``center``: the sphere's centre in unit
+    coordinates, ``None`` with it.
+    """
+
+    cycles: tuple[tuple[int, ...], ...]
+    unit_volume: Fraction
+    sphere: Sphere | None
+    center: tuple[Fraction, Fraction, Fraction] | None
+
+
+def measure(frame: Frame, members) -> Measured:
+    """Measure the element whose vertices are ``members`` (indices into the frame), exactly: the one
+    place a mesh, a pattern check and the dual get an element's faces, volume and sphere from."""
+    members = list(members)
+    try:
+        cycles = tuple(cycle for cycle, _ in hull_faces(frame, members))
+    except ValueError:  # flat: no hull, no volume
+        cycles = ()
+    volume = Fraction(six_volume(frame.coords, cycles), 6 * frame.scale ** 3) if cycles else Fraction(0)
+    sphere = frame.circumsphere(members)
+    return Measured(cycles, volume, sphere, frame.center(sphere) if sphere is not None else None)
 
 
 def polyhedron(frame: Frame, cell: Cell) -> Polyhedron:

@@ -15,10 +15,9 @@ from fractions import Fraction
 from ..catalogue import catalogue_from_text
 from ..core.base_element import base_element
 from ..core.configuration import Box
-from ..core.delaunay import hull_faces
 from ..core.element_types import classify_faces
 from ..core.geometry import Frame, six_volume
-from ..core.polyhedron import face_kind
+from ..core.polyhedron import face_kind, measure
 from ..errors import FormatError, InputError
 from ..files.flowyaml import split_section
 from ..files.yamlio import parse_yaml, read_text, validate
@@ -144,17 +143,14 @@ def _recompute(points: tuple, squared) -> tuple | None:
 
     unit = {i: tuple(Fraction(n, d) for n, d in point) for i, point in enumerate(points)}
     frame = Frame.build(unit, squared)
-    try:
-        cycles = sorted(cycle for cycle, _ in hull_faces(frame, list(range(len(points)))))
-    except ValueError:
-        return None
+    element = measure(frame, range(len(points)))
+    cycles = sorted(element.cycles)
     if {i for cycle in cycles for i in cycle} != set(range(len(points))):
         return None
     etype, _, mirrored = classify_faces(tuple(cycles), tuple(face_kind(frame, cycle) for cycle in cycles))
-    sphere = frame.circumsphere(range(len(points)))
-    if sphere is None:
+    if element.sphere is None:
         return None
-    return etype.id, mirrored, frame.center(sphere)
+    return etype.id, mirrored, element.center
 
 
 def _element_geometry(element: dict, points: tuple, squared, types, shape=None) -> tuple | None:

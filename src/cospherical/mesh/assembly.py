@@ -27,9 +27,9 @@ import numpy as np
 from ..catalogue import apply_catalogue_criterion, shipped_catalogue
 from ..core.codes import mask_code, point_suffix
 from ..core.configuration import CORNERS, EDGES, FACES, Box, Configuration
-from ..core.delaunay import hull_faces
 from ..core.element_types import ElementType
-from ..core.geometry import Frame, Sphere, six_volume
+from ..core.polyhedron import measure
+from ..core.geometry import Frame, Sphere, in_closed_box
 from ..core.tessellation import tessellate
 from ..errors import InputError
 from ..paper import paper_class
@@ -113,16 +113,12 @@ def local_pattern(configuration: Configuration, elements: Iterable[tuple[str, It
         if missing:
             raise InputError(f"pattern table: configuration {configuration.code}: an element ({type_id}) uses "
                              f"node {missing[0]}, which the leaf does not have")
-        members = [index[n] for n in element_nodes]
-        try:
-            cycles = [cycle for cycle, _ in hull_faces(frame, members)]
-        except ValueError:  # flat: no hull, no volume; the volume check reports it
-            cycles = []
-        volume = Fraction(six_volume(frame.coords, cycles), 6 * frame.scale ** 3) if cycles else Fraction(0)
-        sphere = frame.circumsphere(members)  # None: not co-spherical, not a Delaunay element
+        # a flat element has no faces and no volume (the volume check reports it); one not co-spherical
+        # has no sphere (it is not a Delaunay element)
+        element = measure(frame, [index[n] for n in element_nodes])
         measured.append(LocalElement(
-            type_id, element_nodes, tuple(tuple(frame.ids[i] for i in c) for c in cycles), volume, sphere,
-            frame.center(sphere) if sphere is not None else None))
+            type_id, element_nodes, tuple(tuple(frame.ids[i] for i in c) for c in element.cycles),
+            element.unit_volume, element.sphere, element.center))
     return LocalPattern(configuration.point_set_code or "", configuration, tuple(measured), frame.scale,
                         frame.weights, on_the_fly, mapped_from)
 
@@ -333,9 +329,7 @@ class Mesh:
         num, den = self.cell_centers()
         size = self.leaf_size()[self.cells.leaf].astype(num.dtype)
         low = self.tree.positions[self.cells.leaf].astype(num.dtype) * size[:, None]
-        scaled = den[:, None]
-        inside = (num >= low * scaled) & (num <= (low + size[:, None]) * scaled)
-        return inside.all(axis=1).astype(bool)
+        return in_closed_box(num, den[:, None], low, low + size[:, None]).astype(bool)
 
 def _type_info(type_id: str, etype: ElementType | None, catalogue: dict) -> dict:
     """Name, paper class, VTK cell and size of a type: from the catalogue, else from the type itself."""

@@ -21,6 +21,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..core.geometry import in_closed_box
 from ..core.morton import morton_codes
 from ..errors import InputError
 from .assembly import Mesh
@@ -244,10 +245,10 @@ def _outside_domain(mesh: Mesh) -> int:
             kind = np.int64 if grid * (max(q) + max(map(abs, p))) < 2**62 else object
             p, q = np.array(p, dtype=kind), np.array(q, dtype=kind)
             at = low.astype(kind) * q[None] + p[None] * size[leaves, None].astype(kind)
-            outside += int(((at < 0) | (at > q[None] * grid)).any(axis=1).sum())
+            outside += int((~in_closed_box(at, q[None], 0, grid)).sum())
     if mesh.cells is not None:
         num, den = mesh.cell_centers()
-        outside += int(((num < 0) | (num > den[:, None] * grid)).any(axis=1).sum())
+        outside += int((~in_closed_box(num, den[:, None], 0, grid)).sum())
     return outside
 
 

@@ -54,8 +54,8 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..core.configuration import Box
-from ..core.delaunay import hull_faces
 from ..core.geometry import Frame, determinant, dot, plane_normal, six_volumes, sub
+from ..core.polyhedron import measure
 from ..errors import InputError
 from .octree import distinct
 
@@ -522,15 +522,14 @@ def _element_groups(mesh, squared, conn: np.ndarray, element_sizes: np.ndarray):
         if entry is None:
             points = {n: tuple(Fraction(int(x)) for x in p) for n, p in enumerate(key)}
             frame = Frame.build(points, squared)
-            members = list(range(len(key)))
-            faces = [cycle for cycle, _ in hull_faces(frame, members)]
-            if frame.spanning(members) is None:
-                raise InputError("a flat element: it has no dual")
-            sphere = frame.circumsphere(members)
-            if sphere is None:
+            element = measure(frame, range(len(key)))
+            if not element.cycles:
+                raise InputError(f"element {e} is flat: it has no dual")
+            if element.sphere is None:
                 raise InputError(f"element {e} is not co-spherical: it has no dual")
-            center = frame.center(sphere)
-            entry = by_shape[key] = (_Shape([element_pieces(points, faces, center, squared)]), [], [], center)
+            center = element.center
+            entry = by_shape[key] = (_Shape([element_pieces(points, element.cycles, center, squared)]), [], [],
+                                     center)
         entry[1].append(ids)
         entry[2].append(scale)
         centers[e] = (low + np.array([float(x) for x in entry[3]]) * scale) * (lengths / mesh.grid)
