@@ -16,7 +16,7 @@ from ..errors import FormatError
 from .data import data_path
 from .outputs import atomic_open, atomic_path, atomic_write
 
-__all__ = ["FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
+__all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
 
 _Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 
@@ -58,8 +58,8 @@ MAX_INPUT_BYTES = 512 * 2**20
 # stays below ~1.5 GB.  The files we write (one JSON line per entry) are split before it and
 # have no such bound.
 MAX_YAML_PARSE = 16 * 2**20
-MAX_DEPTH = 64
-MAX_INDENT = 256
+_MAX_DEPTH = 64
+_MAX_INDENT = 256
 
 
 def machine_memory() -> int:
@@ -133,8 +133,8 @@ def check_nesting(text: str, name: str) -> None:
         flow = int(np.cumsum(steps).max()) if len(steps) else 0
     # Block collections: indentation and leading "- " / "? " indicators.
     block = max((len(m) for m in re.findall(r"^[ ?\-]+", text, re.M)), default=0)
-    if flow > MAX_DEPTH or block > MAX_INDENT:
-        raise FormatError(f"{name}: nested too deeply (more than {MAX_DEPTH} levels)")
+    if flow > _MAX_DEPTH or block > _MAX_INDENT:
+        raise FormatError(f"{name}: nested too deeply (more than {_MAX_DEPTH} levels)")
 
 
 def _refuse_aliases(data, name: str) -> None:

@@ -32,7 +32,7 @@ __all__ = ["check_catalogue", "check_patterns", "document_data", "read_document"
 def check_catalogue(data: dict, name: str) -> None:
     """Ids, codes and names unique; faces consistent with V/E/F; splits name known types."""
     ids = Counter(t["id"] for t in data["types"])
-    check_unique(data, name)
+    _check_unique(data, name)
     for i, t in enumerate(data["types"]):
         where = f"{name}: types/{i} ({t['id']})"
         faces = [f["nodes"] for f in t["reference_faces"]]
@@ -52,7 +52,7 @@ def check_catalogue(data: dict, name: str) -> None:
             raise FormatError(f"{name}: criteria/{criterion}/kept: unknown type {unknown[0]!r}")
 
 
-def check_unique(data: dict, name: str) -> None:
+def _check_unique(data: dict, name: str) -> None:
     """Every type once: the same id, canonical code or name twice makes a catalogue ambiguous."""
     for field in ("id", "code", "name"):
         repeated = [k for k, n in Counter(t[field] for t in data["types"]).items() if n > 1]
@@ -218,7 +218,7 @@ def read_document(text: str, name: str):
     section = split_section(text, "types")
     if section is not None and isinstance(section[1], list):
         catalogue = catalogue_from_text(text, name)
-        check_unique(catalogue, name)
+        _check_unique(catalogue, name)
         return "catalogue", catalogue
     kind, data = validated(parse_yaml(text, name), name)
     return kind, (data if kind == "catalogue" else table_from_data(data, name))
@@ -244,5 +244,5 @@ def validated(data, name: str) -> tuple[str, dict]:
     kind = document_kind(data, name)
     validate(data, kind, name)
     if kind == "catalogue":
-        check_unique(data, name)
+        _check_unique(data, name)
     return kind, data

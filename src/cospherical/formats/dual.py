@@ -81,9 +81,9 @@ from ..mesh.dual import Dual
 __all__ = ["DUAL_FORMAT_VERSION", "read_dual", "verify_dual", "write_dual"]
 
 DUAL_FORMAT_VERSION = 3
-MAX_DUAL_FILE = 16 * 1024**3
+_MAX_DUAL_FILE = 16 * 1024**3
 # member -> (dtype kind, columns or None, which count: n vertices, m edges, e elements)
-MEMBERS = {
+_MEMBERS = {
     "grid_vertices": ("i", 3, "n"), "vertices": ("f", 3, "n"), "edges": ("i", 2, "m"), "length": ("f", None, "m"),
     "area": ("f", None, "m"), "coefficient": ("f", None, "m"), "coefficient_exact": ("iU", None, "m"),
     "control_volume": ("f", None, "n"), "volume_exact": ("iU", None, "n"), "boundary": ("b", None, "n"),
@@ -92,7 +92,7 @@ MEMBERS = {
 }
 # the most vertices an element may list: a leaf's 26 points, or a cell of the global mode (co-spherical
 # grid points); bounds the exact hull computed per distinct element shape when the dual is verified
-MAX_ELEMENT_NODES = 64
+_MAX_ELEMENT_NODES = 64
 _STAMP = (1980, 1, 1, 0, 0, 0)
 _MAX_DIGITS = 200
 # the manifest's exact numbers as written: plain integers and fractions of bounded length, so that a
@@ -101,7 +101,7 @@ _INTEGER = re.compile(r"-?[0-9]{1,%d}" % _MAX_DIGITS)
 _MAX_TEXT_DIGITS = 1000  # the manifest's exact numbers, written as text
 _POSITIVE = re.compile(r"[1-9][0-9]{0,%d}" % (_MAX_TEXT_DIGITS - 1))
 _POSITIVE_FRACTION = re.compile(r"[1-9][0-9]{0,%d}(/[1-9][0-9]{0,%d})?" % (_MAX_TEXT_DIGITS - 1, _MAX_TEXT_DIGITS - 1))
-MAX_GRID = 1 << 40
+_MAX_GRID = 1 << 40
 
 
 def _npy(array: np.ndarray) -> bytes:
@@ -118,7 +118,7 @@ def _exact(array: np.ndarray) -> np.ndarray:
 
 def write_dual(dual: Dual, path: str | Path) -> None:
     """Write ``dual`` as ``dual.npz`` (see the module), atomically and deterministically."""
-    arrays = {name: getattr(dual, name) for name in MEMBERS}
+    arrays = {name: getattr(dual, name) for name in _MEMBERS}
     arrays["coefficient_exact"] = _exact(arrays["coefficient_exact"])
     arrays["volume_exact"] = _exact(arrays["volume_exact"])
     arrays["boundary_area_exact"] = _exact(arrays["boundary_area_exact"])
@@ -149,8 +149,8 @@ def _regular(path: Path) -> None:
         raise FormatError(f"{path}: cannot read: {error.strerror or error}") from None
     if not stat.S_ISREG(info.st_mode):
         raise FormatError(f"{path}: cannot read: not a regular file")
-    if info.st_size > MAX_DUAL_FILE:
-        raise FormatError(f"{path}: cannot read: too large ({info.st_size} bytes; at most {MAX_DUAL_FILE})")
+    if info.st_size > _MAX_DUAL_FILE:
+        raise FormatError(f"{path}: cannot read: too large ({info.st_size} bytes; at most {_MAX_DUAL_FILE})")
 
 
 def _member(archive: zipfile.ZipFile, name: str, path: Path, limit: int) -> tuple[bytes, np.ndarray]:
@@ -175,7 +175,7 @@ def _check_headers(archive: zipfile.ZipFile, path: Path) -> None:
     says is damaged.
     """
     headers = {}
-    for name in MEMBERS:
+    for name in _MEMBERS:
         info = archive.getinfo(f"{name}.npy")
         with archive.open(info) as stream:
             try:
@@ -193,14 +193,14 @@ def _check_headers(archive: zipfile.ZipFile, path: Path) -> None:
         headers[name] = dtype, shape
     counts = {"n": headers["grid_vertices"][1][:1], "m": headers["edges"][1][:1],
               "e": headers["element_circumcenter"][1][:1]}
-    for name, (kinds, columns, count) in MEMBERS.items():
+    for name, (kinds, columns, count) in _MEMBERS.items():
         dtype, shape = headers[name]
-        if columns == "w":  # any width from 4 to MAX_ELEMENT_NODES
-            columns = shape[1] if len(shape) == 2 and 4 <= shape[1] <= MAX_ELEMENT_NODES else "4..64"
+        if columns == "w":  # any width from 4 to _MAX_ELEMENT_NODES
+            columns = shape[1] if len(shape) == 2 and 4 <= shape[1] <= _MAX_ELEMENT_NODES else "4..64"
         expected = counts[count] + (() if columns is None else (columns,))
         if dtype.kind not in kinds or shape != expected:
             raise FormatError(f"{path}: member {name}: {dtype} {shape}, expected {'/'.join(kinds)} {expected}")
-    needed = 2 * sum(archive.getinfo(f"{name}.npy").file_size for name in MEMBERS)  # the data and its array
+    needed = 2 * sum(archive.getinfo(f"{name}.npy").file_size for name in _MEMBERS)  # the data and its array
     if needed > machine_memory() // 2:
         raise FormatError(f"{path}: cannot read: its members need {needed:,} bytes, more than half this "
                           f"machine's memory ({machine_memory() // 2:,})")
@@ -214,7 +214,7 @@ def read_dual(path: str | Path) -> Dual:
     try:
         with zipfile.ZipFile(path) as archive:
             names = sorted(archive.namelist())
-            expected = sorted(f"{name}.npy" for name in ("manifest", *MEMBERS))
+            expected = sorted(f"{name}.npy" for name in ("manifest", *_MEMBERS))
             if names != expected:
                 extra = sorted(set(names) ^ set(expected))
                 raise FormatError(f"{path}: not a cospherical dual: member {extra[0] if extra else '?'} "
@@ -224,7 +224,7 @@ def read_dual(path: str | Path) -> Dual:
             manifest = _manifest(raw, path)
             _check_headers(archive, path)
             arrays = {}
-            for name in MEMBERS:
+            for name in _MEMBERS:
                 blob, arrays[name] = _member(archive, name, path, limit)
                 if hashlib.sha256(blob).hexdigest() != manifest["sha256"].get(name):
                     raise FormatError(f"{path}: member {name}: checksum mismatch (the file was changed or damaged)")
@@ -278,8 +278,8 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
                          ("volume_factor_squared", _POSITIVE_FRACTION), ("boundary_area_denominator", _POSITIVE)):
         if not pattern.fullmatch(manifest[key]):
             raise FormatError(f"{path}: manifest: {key} is not a positive integer or fraction of at most 1000 digits")
-    if not 0 < manifest["grid"] <= MAX_GRID:
-        raise FormatError(f"{path}: manifest: grid {manifest['grid']} is not in 1..{MAX_GRID}")
+    if not 0 < manifest["grid"] <= _MAX_GRID:
+        raise FormatError(f"{path}: manifest: grid {manifest['grid']} is not in 1..{_MAX_GRID}")
     try:
         box = Box.parse(manifest["domain"])
         grid = int(manifest["grid"])

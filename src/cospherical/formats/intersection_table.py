@@ -31,7 +31,7 @@ SYMMETRY_CONVENTION = (
 # The largest resolution whose table is also written as YAML by default: at R = 4 the
 # YAML is 71 MB; at R = 8 1.9 GB, beyond the 512 MB the YAML reader accepts.
 YAML_UP_TO = 4
-SAMPLES = 16  # about 40 kB of entries at R = 8: the dictionary is their last 32 kB
+_SAMPLES = 16  # about 40 kB of entries at R = 8: the dictionary is their last 32 kB
 
 
 def entry_chunk(entries: list[tuple[str, str]], yaml: bool, dictionary: bytes | None) -> tuple[str, list[tuple[str, bytes]]]:
@@ -56,7 +56,7 @@ def write_pattern_table(run, catalogue_version: str, yaml_path=None, store=None)
     }
     run.cells()
     # the store's compression dictionary: entries spread over the whole table
-    dictionary = dictionary_of(run.sample_entries(SAMPLES)) if store else None
+    dictionary = dictionary_of(run.sample_entries(_SAMPLES)) if store else None
 
     def rows_in_order(handle):
         for text, packed in run.chunks(entry_chunk, bool(yaml_path), dictionary):

@@ -32,11 +32,11 @@ from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
 
-__all__ = ["REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "vtu_arrays",
+__all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "vtu_arrays",
            "write_piece", "write_pvtu", "write_report", "write_vtu"]
 
 REPORT_SCHEMA_VERSION = 1
-MAX_LEAF_FILE = 2 * 1024**3
+_MAX_LEAF_FILE = 2 * 1024**3
 # A level is at most MAX_LEVEL and a position below 2**MAX_LEVEL: a longer number is out of
 # range whatever its value, and int() of thousands of digits is slow and then refused.
 MAX_LEAF_DIGITS = 12
@@ -65,7 +65,7 @@ def read_leaves(path: str | Path, max_leaves: int | None = None) -> tuple[np.nda
     path = Path(path)
     bound = leaf_bound() if max_leaves is None else max_leaves
     # a leaf takes at least 8 bytes ("0 0 0 0\\n"); a line of a hand-written list rarely more than 64
-    most = min(MAX_LEAF_FILE, 64 * bound + 4096)
+    most = min(_MAX_LEAF_FILE, 64 * bound + 4096)
     try:
         size = os.stat(path).st_size
     except OSError:

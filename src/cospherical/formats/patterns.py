@@ -38,7 +38,7 @@ __all__ = ["Entries", "PatternTable", "SCHEMA_VERSION", "configuration_line", "e
            "write_patterns"]
 
 SCHEMA_VERSION = 1
-SCHEMES = {
+_SCHEMES = {
     "bisection": "midpoints: every Steiner point at t = 1/2",
     "leaves": "octree leaves: midpoints at t = 1/2, the centre of every face whose neighbour is refined "
     "(any set of faces with four split edges), never a body point; keys are whole-point-set codes",
@@ -57,7 +57,7 @@ def pattern_name(study: str, box_texts, face_points: str = "octree", element: st
     >>> pattern_name("bisection", ["1/3", "sqrt(2/3)", "2*sqrt(2)"], "none")
     'bisection-1_3xsqrt2_3xsqrt8-none'
     """
-    if study not in SCHEMES and study != "intersection" or face_points not in (*POINT_POLICIES, "explicit") \
+    if study not in _SCHEMES and study != "intersection" or face_points not in (*POINT_POLICIES, "explicit") \
             or element not in ELEMENTS:
         raise InputError(f"study {study!r} of a {element!r} with face points {face_points!r}: not a known study")
     texts = Box.parse(box_texts).texts
@@ -67,7 +67,7 @@ def pattern_name(study: str, box_texts, face_points: str = "octree", element: st
         "" if face_points in ("octree", "explicit") else f"-{face_points}")
 
 
-class StudyTable(Protocol):
+class _StudyTable(Protocol):
     """What a pattern table is written from: a study's result (:class:`cospherical.studies.engine.Study`)."""
 
     name: str
@@ -81,7 +81,7 @@ class StudyTable(Protocol):
         criterion, and the map from those onto the configuration (see :func:`configuration_line`)."""
 
 
-def patterns_text(study: StudyTable, catalogue_version: str) -> str:
+def patterns_text(study: _StudyTable, catalogue_version: str) -> str:
     """The pattern table of a study as YAML text (deterministic)."""
     header = {
         "schema_version": SCHEMA_VERSION,
@@ -91,7 +91,7 @@ def patterns_text(study: StudyTable, catalogue_version: str) -> str:
         **({"element": study.element} if study.element != "cuboid" else {}),
         "box": list(study.box.texts),
         "face_points": study.face_points,
-        "scheme": SCHEMES.get(study.name, study.name),
+        "scheme": _SCHEMES.get(study.name, study.name),
         "criteria": list(study.criteria),
     }
     lines = [yaml_text(header), "configurations:\n"]
@@ -128,7 +128,7 @@ def element_entries(tess) -> list[dict]:
     return [element_entry(element, scale) for element in tess.elements]
 
 
-def write_patterns(study: StudyTable, path: str | Path, catalogue_version: str) -> None:
+def write_patterns(study: _StudyTable, path: str | Path, catalogue_version: str) -> None:
     atomic_write(path, patterns_text(study, catalogue_version))
 
 

@@ -33,23 +33,23 @@ from ..files.yamlio import atomic_path, parse_json
 __all__ = ["MAGIC", "StoreEntries", "dictionary_of", "is_store", "open_store", "pack", "write_store"]
 
 MAGIC = b"SQLite format 3\x00"
-LAYOUT = 1  # the store's own layout version, in its meta table
+_LAYOUT = 1  # the store's own layout version, in its meta table
 # Measured on R = 8 entries (2.7 kB each) with a dictionary of entries spread over the
 # table: level 1 gives 400 bytes, 6 gives 230 (at 1.3 times level 1's time), 9 gives 215 (at 2.6).
 LEVEL = 6
-DICTIONARY_SIZE = 32768  # zlib's window: a longer dictionary is not used
+_DICTIONARY_SIZE = 32768  # zlib's window: a longer dictionary is not used
 # The store's tables, exactly as written and as the reader requires them: a file with
 # views (a recursive one never ends), triggers or other tables is not a store.
-TABLES = {
+_TABLES = {
     "meta": "CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL)",
     "entries": "CREATE TABLE entries (code TEXT PRIMARY KEY, entry BLOB NOT NULL) WITHOUT ROWID",
     "dictionary": "CREATE TABLE dictionary (data BLOB NOT NULL)",
 }
-SCHEMA = {*(("table", name, sql) for name, sql in TABLES.items()), ("index", "sqlite_autoindex_meta_1", None)}
+_SCHEMA = {*(("table", name, sql) for name, sql in _TABLES.items()), ("index", "sqlite_autoindex_meta_1", None)}
 # Bounds on what a store's reader takes: far above anything written (an entry is a few kB;
 # the header a few hundred bytes), far below what would exhaust memory.
 MAX_ENTRY = 1 << 20
-MAX_HEADER = 1 << 16
+_MAX_HEADER = 1 << 16
 # An entry as stored is never longer than its text (a few hundred bytes packed).  A scan reads
 # a blob's length from its record header, never the blob; but a lookup by code seeks through
 # the entries' b-tree, and SQLite reads every cell it compares the code with whole, overflow
@@ -74,7 +74,7 @@ def is_store(path: str | Path) -> bool:
 
 def dictionary_of(samples: list[str]) -> bytes:
     """The preset dictionary made of sample entry texts from all over a table."""
-    return "".join(samples).encode("utf-8")[-DICTIONARY_SIZE:]
+    return "".join(samples).encode("utf-8")[-_DICTIONARY_SIZE:]
 
 
 def pack(text: str, dictionary: bytes) -> bytes:
@@ -92,10 +92,10 @@ def write_store(path: str | Path, header: dict, dictionary: bytes, rows) -> None
         try:
             connection.execute("PRAGMA journal_mode = OFF")
             connection.execute("PRAGMA synchronous = OFF")
-            for sql in TABLES.values():
+            for sql in _TABLES.values():
                 connection.execute(sql)
             connection.executemany("INSERT INTO meta VALUES (?, ?)",
-                                   [("layout", str(LAYOUT)), ("header", json.dumps(header, sort_keys=True))])
+                                   [("layout", str(_LAYOUT)), ("header", json.dumps(header, sort_keys=True))])
             connection.execute("INSERT INTO dictionary VALUES (?)", (dictionary,))
             count = 0
             batch = []
@@ -135,24 +135,24 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
         raise FormatError(f"{path}: not a complete pattern-table store (truncated, in WAL mode, or not an SQLite database)")
     try:
         connection = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True, check_same_thread=False)
-        if set(connection.execute("SELECT type, name, sql FROM sqlite_master")) != SCHEMA:
+        if set(connection.execute("SELECT type, name, sql FROM sqlite_master")) != _SCHEMA:
             raise ValueError("its tables are not those of a store (meta, entries, dictionary as written)")
         # Only the rows we know, and only as long as we ever write them: a hostile
         # store's gigabyte of header or dictionary is never read.
         meta = dict(connection.execute("SELECT key, value FROM meta WHERE key IN ('layout', 'header', 'count') "
-                                       "AND length(value) <= ?", (MAX_HEADER,)))
-        if meta.get("layout") != str(LAYOUT):
-            raise FormatError(f"{path}: store layout {meta.get('layout')!r}, expected {LAYOUT}")
+                                       "AND length(value) <= ?", (_MAX_HEADER,)))
+        if meta.get("layout") != str(_LAYOUT):
+            raise FormatError(f"{path}: store layout {meta.get('layout')!r}, expected {_LAYOUT}")
         if "header" not in meta or "count" not in meta:
-            raise ValueError(f"no header and count of at most {MAX_HEADER} bytes")
+            raise ValueError(f"no header and count of at most {_MAX_HEADER} bytes")
         header = parse_json(meta["header"], f"{path}: header")
         count = int(meta["count"])
         rows = connection.execute("SELECT data FROM dictionary WHERE length(data) <= ? LIMIT 2",
-                                  (DICTIONARY_SIZE,)).fetchall()
+                                  (_DICTIONARY_SIZE,)).fetchall()
         if not isinstance(header, dict) or not 0 <= count <= 16 ** 12 or len(rows) != 1 \
                 or not isinstance(rows[0][0], bytes):
             raise ValueError(f"its header is not a mapping, its count is not that of a table, or it has not one "
-                             f"dictionary of at most {DICTIONARY_SIZE} bytes")
+                             f"dictionary of at most {_DICTIONARY_SIZE} bytes")
         (dictionary,) = rows[0]
         if connection.execute(_OVERSIZED).fetchone() is not None:
             raise FormatError(f"{path}: store damaged: an entry is stored in over {MAX_ENTRY} bytes")

@@ -18,7 +18,7 @@ TAB20 = ((31, 119, 180), (174, 199, 232), (255, 127, 14), (255, 187, 120), (44, 
          (227, 119, 194), (247, 182, 210), (127, 127, 127), (199, 199, 199), (188, 189, 34), (219, 219, 141),
          (23, 190, 207), (158, 218, 229))
 WHITE, BLACK, GREY = (255, 255, 255), (0, 0, 0), (204, 204, 204)
-OVER = 3  # over-sampling of the polygons: their outlines a third of a pixel wide, as thin as matplotlib's
+_OVER = 3  # over-sampling of the polygons: their outlines a third of a pixel wide, as thin as matplotlib's
 
 
 def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[str]]:
@@ -85,12 +85,12 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
     width, height, x0, y0, scale = frame(a, b)
     w, h = max(1, round(scale * a)), max(1, round(scale * b))  # a 1e-12 x 1 section is one pixel wide, not empty
     image = Image.new("RGB", (width, height), WHITE)
-    over = Image.new("RGB", (w * OVER, h * OVER), WHITE)
+    over = Image.new("RGB", (w * _OVER, h * _OVER), WHITE)
     pen = ImageDraw.Draw(over)
-    s = scale * OVER
+    s = scale * _OVER
     for polygon, t in zip(polygons, types):
         pen.polygon([(x * s, (b - y) * s) for x, y in polygon.tolist()], fill=colour[t], outline=BLACK)
-    image.paste(over.reduce(OVER), (x0, y0))
+    image.paste(over.reduce(_OVER), (x0, y0))
     draw = ImageDraw.Draw(image)
     draw.rectangle((x0 - 1, y0 - 1, x0 + w, y0 + h), outline=BLACK)
     ticks, label = ImageFont.load_default(18), ImageFont.load_default(18)

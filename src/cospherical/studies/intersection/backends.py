@@ -16,7 +16,7 @@ __all__ = ["check_backend", "completed"]
 MAX_WORKERS = 256
 # --scheduler-timeout at most (seconds): dask turns it into a timedelta, which inf or 1e308 is not
 # (inf was a KeyError traceback, 1e308 a run that never ended).
-MAX_TIMEOUT = 86400.0
+_MAX_TIMEOUT = 86400.0
 
 
 def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, timeout: float | None,
@@ -42,9 +42,9 @@ def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, ti
     if scheduler:
         if not re.fullmatch(r"(tcp|tls|ucx)://[A-Za-z0-9._\[\]:-]+", scheduler):
             raise UsageError(f"{prog}: error: --scheduler {scheduler!r}: give tcp://HOST:PORT")
-        if not (math.isfinite(timeout) and 0 < timeout <= MAX_TIMEOUT):
+        if not (math.isfinite(timeout) and 0 < timeout <= _MAX_TIMEOUT):
             raise UsageError(f"{prog}: error: --scheduler-timeout {timeout}: must be more than 0 seconds and at "
-                             f"most {MAX_TIMEOUT:,.0f}")
+                             f"most {_MAX_TIMEOUT:,.0f}")
         import dask
 
         dask.config.set({"distributed.comm.timeouts.connect": f"{timeout}s"})

@@ -45,8 +45,8 @@ __all__ = ["CHUNK", "ELEMENT_CHUNK", "ElementEntry", "cell_polyhedron", "element
 CHUNK = 5000
 ELEMENT_CHUNK = 500
 # Bumped when a checkpoint's content changes, so --resume never reads an older layout.
-CHECKPOINT_FORMAT = 3
-CELLS_PER_CONFIGURATION = 96  # the compiled walk's room per configuration, tetrahedra included
+_CHECKPOINT_FORMAT = 3
+_CELLS_PER_CONFIGURATION = 96  # the compiled walk's room per configuration, tetrahedra included
 
 
 @dataclass(frozen=True)
@@ -83,7 +83,7 @@ def tessellate_chunk(codes: np.ndarray, every_cell: bool = False) -> dict[str, n
     closed, open_ = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
     # A cell other than a tetrahedron has at least five of the at most 27 points, so 27 per
     # configuration is ample; with tetrahedra, 96 (27 measured at most at 1/16). Beyond, an error.
-    room = (CELLS_PER_CONFIGURATION if every_cell else 27) * n
+    room = (_CELLS_PER_CONFIGURATION if every_cell else 27) * n
     poly_mask, poly_code = np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64)
     written = compiled.cube_batch(codes, *_cube_tables(), tets, closed, open_, polys, poly_mask, poly_code, every_cell)
     if written < 0:
@@ -129,11 +129,11 @@ def _element_chunk_json(part) -> str:
 # A checkpoint is one line naming the SHA-256 of its content, then the content: a file
 # damaged in any byte fails the sum and is computed again, never counted.
 _CHECKSUM = re.compile(rb"cospherical checkpoint sha256 ([0-9a-f]{64})\n")
-ALL_NODES = (1 << 27) - 1
+_ALL_NODES = (1 << 27) - 1
 # Bytes of a checkpoint per unit, far above what is written (stage 1: 18 bytes per configuration
 # and 16 per cell; stage 2: about 1 kB per element), so that a damaged file is never read whole.
-CELL_BYTES = 18 + 16 * CELLS_PER_CONFIGURATION
-ELEMENT_BYTES = 64 * 1024
+_CELL_BYTES = 18 + 16 * _CELLS_PER_CONFIGURATION
+_ELEMENT_BYTES = 64 * 1024
 
 
 def _checkpoint_bytes(payload: bytes) -> bytes:
@@ -163,7 +163,7 @@ def _read_cells(path: Path, count: int) -> dict[str, np.ndarray]:
     value in its range); ValueError says why it cannot be used."""
     import zipfile
 
-    payload = _checked_payload(path, 4096 + CELL_BYTES * count)
+    payload = _checked_payload(path, 4096 + _CELL_BYTES * count)
     try:
         with zipfile.ZipFile(io.BytesIO(payload)) as archive:
             # stored, never deflated: what an array claims is what the file holds
@@ -190,8 +190,8 @@ def _read_cells(path: Path, count: int) -> dict[str, np.ndarray]:
         raise ValueError("arrays of the wrong types")
     tets, polys, mask, code = part["tets"], part["polys"], part["poly_mask"], part["poly_code"]
     if tets.min(initial=0) < 0 or polys.min(initial=0) < 0 \
-            or (tets + polys).max(initial=0) > CELLS_PER_CONFIGURATION or len(mask) != len(code) \
-            or len(mask) != int(polys.sum()) or mask.min(initial=1) < 1 or mask.max(initial=0) > ALL_NODES \
+            or (tets + polys).max(initial=0) > _CELLS_PER_CONFIGURATION or len(mask) != len(code) \
+            or len(mask) != int(polys.sum()) or mask.min(initial=1) < 1 or mask.max(initial=0) > _ALL_NODES \
             or code.min(initial=0) < 0 or code.max(initial=0) >= 16**12:
         raise ValueError("counts or cells out of range")
     return part
@@ -199,7 +199,7 @@ def _read_cells(path: Path, count: int) -> dict[str, np.ndarray]:
 
 def _read_elements(path: Path, count: int):
     """A stage-2 checkpoint of ``count`` elements, checked: ``(entries, types)``; ValueError says why not."""
-    text = _checked_payload(path, 4096 + ELEMENT_BYTES * count).decode("utf-8")
+    text = _checked_payload(path, 4096 + _ELEMENT_BYTES * count).decode("utf-8")
     data = parse_json(text, path.name)
     try:
         entries, types = data
@@ -286,7 +286,7 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     else:
         reps, sizes, configurations = orbits(resolution, order)
     folder = Path(checkpoints) if checkpoints else None
-    tag = f"v{CHECKPOINT_FORMAT}-r{resolution}-{order}-c{chunk}{'-brute' if brute_force else ''}"
+    tag = f"v{_CHECKPOINT_FORMAT}-r{resolution}-{order}-c{chunk}{'-brute' if brute_force else ''}"
     if folder:
         folder.mkdir(parents=True, exist_ok=True)
     backend = dict(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)

@@ -42,7 +42,7 @@ from .run import cell_polyhedron, tessellate_chunk
 __all__ = ["CHUNK", "CellText", "TableRun", "cell_texts", "distinct_cells", "representative_cells", "table_entries"]
 
 CHUNK = 20_000
-CELL_CHUNK = 2_000
+_CELL_CHUNK = 2_000
 
 
 def representative_cells(codes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -124,7 +124,7 @@ def table_entries(codes, cells: Mapping[tuple[int, int], CellText], criteria: li
     return entries
 
 
-def finished_chunk(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str], finish: Callable, *args):
+def _finished_chunk(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str], finish: Callable, *args):
     """Pass 3 on a chunk (in a worker): its entries as (code, entry JSON), handed to ``finish(entries, *args)``."""
     return finish(table_entries(codes, cells, criteria), *args)
 
@@ -164,7 +164,7 @@ class TableRun:
         _, first = np.unique(rows[:, :2], axis=0, return_index=True)
         distinct = [tuple(row) for row in rows[first].tolist()]
         del found, rows
-        tasks = {s: (distinct[s:s + CELL_CHUNK], self.kept) for s in range(0, len(distinct), CELL_CHUNK)}
+        tasks = {s: (distinct[s:s + _CELL_CHUNK], self.kept) for s in range(0, len(distinct), _CELL_CHUNK)}
         for start, part in completed(cell_texts, tasks, **backend):
             self._texts.update(((mask, masked), text) for (mask, masked, _), text in zip(tasks[start][0], part))
             self._report("elements", len(part))
@@ -182,7 +182,7 @@ class TableRun:
         tasks = {s: (reps[s:s + chunk], {pair: self._texts[pair] for pair in held.pop(s)}, self.criteria, finish, *args)
                  for s in range(0, len(reps), chunk)}
         waiting, next_start = {}, 0
-        for start, part in completed(finished_chunk, tasks, **self._backend):
+        for start, part in completed(_finished_chunk, tasks, **self._backend):
             waiting[start] = part
             while next_start in waiting:
                 yield waiting.pop(next_start)
