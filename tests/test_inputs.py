@@ -382,6 +382,10 @@ DAMAGE = {
     "a type not among its chunk's": ("elements", lambda p: _with_checksum(_elements_with(
         p, lambda e, t: [[{**e[0], "type": "v9f9-000000"}, *e[1:]], t]))),
     "fewer entries than elements": ("elements", lambda p: _with_checksum(_elements_with(p, lambda e, t: [e[:-1], t]))),
+    # each value in range, the sum renewed: only stage 2, which finds the names are not cells of their
+    # configurations, can tell (it was a ValueError traceback; a mask that is a cell elsewhere counted wrongly)
+    "one mask everywhere, sum renewed": ("cells", lambda p: _with_checksum(_cells_with(
+        p, poly_mask=lambda a: np.full_like(a, a[0])))),
 }
 
 

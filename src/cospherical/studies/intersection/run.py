@@ -92,23 +92,55 @@ def tessellate_chunk(codes: np.ndarray, every_cell: bool = False) -> dict[str, n
             "poly_mask": poly_mask[:written], "poly_code": poly_code[:written]}
 
 
-def cell_polyhedron(node_mask: int, code: int):
+class NotACell(ValueError):
+    """Stage 1 named a cell, (node mask, configuration code), whose points are not one co-spherical
+    cell of that configuration.  The tessellation names only cells: such a name comes from a
+    stage-1 checkpoint changed with its checksum renewed, whose values are each in range."""
+
+    def __init__(self, node_mask: int, code: int):
+        super().__init__(node_mask, code)  # the arguments again: a worker's error is pickled
+        self.node_mask, self.code = node_mask, code
+
+    def __str__(self) -> str:
+        return f"node mask {self.node_mask:#x} of configuration {key_code(self.code)} is not one cell"
+
+
+def cell_polyhedron(node_mask: int, code: int, of_configuration: bool = True):
     """A cell named as stage 1 names it, (node mask, a configuration code holding it), as
-    ``(points, polyhedron)``: its (node, unit coordinates) pairs and its exact polyhedron."""
+    ``(points, polyhedron)``: its (node, unit coordinates) pairs and its exact polyhedron.
+
+    A name whose points are not one co-spherical cell, or (``of_configuration``) not a
+    Delaunay cell of that configuration, raises :class:`NotACell`.  Only the tetrahedron's
+    representative (:func:`_tetrahedron`: four corners of the cube) is not the latter."""
     nodes = Configuration.from_code(key_code(code)).nodes()
+    if node_mask & ~sum(1 << n for n in nodes):  # a node the configuration does not have
+        raise NotACell(node_mask, code)
     points = tuple((n, nodes[n]) for n in sorted(nodes) if node_mask >> n & 1)
     frame = Frame.build(dict(points), (1, 1, 1))
-    (cell,) = delaunay_cells(frame, "compiled")  # co-spherical points: one cell; the study's bulk walk
-    return points, polyhedron(frame, cell)
+    try:
+        cells = delaunay_cells(frame, "compiled")  # co-spherical points: one cell; the study's bulk walk
+    except ValueError:  # delaunay_cells' refusal of points that do not span 3D
+        raise NotACell(node_mask, code) from None
+    if len(cells) != 1:
+        raise NotACell(node_mask, code)
+    # and a cell of the configuration: its sphere holds no other node of it, inside or on it (unit cube)
+    centre = cells[0].center
+    radius = sum((a - c) ** 2 for a, c in zip(points[0][1], centre))
+    if of_configuration and any(sum((a - c) ** 2 for a, c in zip(point, centre)) <= radius
+                                for n, point in nodes.items() if not node_mask >> n & 1):
+        raise NotACell(node_mask, code)
+    return points, polyhedron(frame, cells[0])
 
 
-def element_entries(elements: list[tuple[int, int]]) -> tuple[list[ElementEntry], dict[str, TypeInfo]]:
+def element_entries(elements: list[tuple[int, int]],
+                    of_configuration: bool = True) -> tuple[list[ElementEntry], dict[str, TypeInfo]]:
     """Stage 2: per (node mask, code of a configuration holding it), the element's
-    :class:`ElementEntry`; and every type met (pieces included), described."""
+    :class:`ElementEntry`; and every type met (pieces included), described
+    (``of_configuration``: as for :func:`cell_polyhedron`)."""
     squared = (1, 1, 1)
     entries, types = [], {}
     for node_mask, code in elements:
-        points, poly = cell_polyhedron(node_mask, code)
+        points, poly = cell_polyhedron(node_mask, code, of_configuration)
         etype = classify(poly)[0]
         types.setdefault(etype.id, TypeInfo.of(etype))
         options = {}
@@ -236,7 +268,7 @@ def _npz_bytes(arrays: dict) -> bytes:
 def _tetrahedron():
     """The entry of the tetrahedron (every 4-point cell has this one type; no split)."""
     corners = (0, 1, 3, 4)  # of the cube with no Steiner point (code 0)
-    return element_entries([(sum(1 << n for n in corners), 0)])
+    return element_entries([(sum(1 << n for n in corners), 0)], of_configuration=False)
 
 
 def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, checkpoints=None,
@@ -295,50 +327,48 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     # Stage 1: cells.
     starts = range(0, len(reps), chunk)
     stage1: dict[int, dict] = {}
+    resumed: set[int] = set()  # the stage-1 chunks read from checkpoints: what stage 2 may find not cells
     damaged: list[str] = []
     for i, start in enumerate(starts):
         part = _resumed(_read_cells, folder / f"{tag}-cells-{i:05d}.npz", len(reps[start:start + chunk]),
                         damaged) if folder else None
         if part is not None:
             stage1[i] = part
+            resumed.add(i)
             report("cells", int(sizes[start:start + chunk].sum()))
     _notice(notice, damaged)
-    todo = {i: (reps[start:start + chunk],) for i, start in enumerate(starts) if i not in stage1}
-    for i, part in completed(tessellate_chunk, todo, **backend):
-        stage1[i] = part
-        if folder:
-            atomic_write(folder / f"{tag}-cells-{i:05d}.npz", _checkpoint_bytes(_npz_bytes(part)))
-        report("cells", int(sizes[i * chunk:(i + 1) * chunk].sum()))
-    cells = {name: np.concatenate([stage1[i][name] for i in range(len(starts))]) if starts else np.zeros(0, np.int64)
-             for name in ("tets", "closed", "open", "polys", "poly_mask", "poly_code")}
 
-    # Stage 2: every distinct non-tetrahedral element, once.
-    pairs = np.stack([cells["poly_mask"], cells["poly_code"]], axis=1)
-    distinct, first, element_of = np.unique(pairs, axis=0, return_index=True, return_inverse=True)
-    element_of = element_of.reshape(-1)
-    owner = np.repeat(reps, cells["polys"])[first]  # a configuration holding each element
-    work = [(int(mask), int(code)) for (mask, _), code in zip(distinct.tolist(), owner.tolist())]
-    element_starts = range(0, len(work), ELEMENT_CHUNK)
-    stage2: dict[int, tuple] = {}
-    damaged = []
-    for i, start in enumerate(element_starts):
-        part = _resumed(_read_elements, folder / f"{tag}-elements-{i:05d}.json",
-                        len(work[start:start + ELEMENT_CHUNK]), damaged) if folder else None
-        if part is not None:
-            stage2[i] = part
-            report("elements", len(part[0]))
-    _notice(notice, damaged)
-    todo = {i: (work[start:start + ELEMENT_CHUNK],) for i, start in enumerate(element_starts) if i not in stage2}
-    for i, part in completed(element_entries, todo, **backend):
-        stage2[i] = part
-        if folder:
-            atomic_write(folder / f"{tag}-elements-{i:05d}.json",
-                         _checkpoint_bytes(_element_chunk_json(part).encode("utf-8")))
-        report("elements", len(part[0]))
-    entries, types = _tetrahedron()
-    for i in range(len(element_starts)):
-        entries.extend(stage2[i][0])
-        types.update(stage2[i][1])
+    def tessellate_missing():
+        todo = {i: (reps[start:start + chunk],) for i, start in enumerate(starts) if i not in stage1}
+        for i, part in completed(tessellate_chunk, todo, **backend):
+            stage1[i] = part
+            if folder:
+                atomic_write(folder / f"{tag}-cells-{i:05d}.npz", _checkpoint_bytes(_npz_bytes(part)))
+            report("cells", int(sizes[i * chunk:(i + 1) * chunk].sum()))
+
+    tessellate_missing()
+    while True:
+        cells = {name: np.concatenate([stage1[i][name] for i in range(len(starts))]) if starts
+                 else np.zeros(0, np.int64) for name in ("tets", "closed", "open", "polys", "poly_mask", "poly_code")}
+        # Stage 2: every distinct non-tetrahedral element, once.
+        pairs = np.stack([cells["poly_mask"], cells["poly_code"]], axis=1)
+        distinct, first, element_of = np.unique(pairs, axis=0, return_index=True, return_inverse=True)
+        element_of = element_of.reshape(-1)
+        holder = np.repeat(np.arange(len(reps)), cells["polys"])[first]  # a configuration holding each element
+        work = [(int(mask), int(code)) for (mask, _), code in zip(distinct.tolist(), np.asarray(reps)[holder].tolist())]
+        try:
+            entries, types = _element_stage(work, folder, tag, backend, report, notice)
+            break
+        except NotACell as error:
+            # a stage-1 checkpoint named it (the tessellation names only cells): that chunk is damaged
+            position = {element: k for k, element in enumerate(work)}.get((error.node_mask, error.code))
+            i = None if position is None else int(holder[position]) // chunk
+            if i not in resumed:
+                raise
+            _notice(notice, [f"{tag}-cells-{i:05d}.npz ({error})"])
+            del stage1[i]
+            resumed.discard(i)
+            tessellate_missing()
     if examples is not None:
         tetrahedron = (sum(1 << n for n in (0, 1, 3, 4)), 0)  # as _tetrahedron() makes it
         for (mask, code), entry in zip([tetrahedron, *work], entries):
@@ -352,6 +382,44 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
         "configurations": configurations, "orbits": len(reps),
         **statistics(sizes, cells, element_of + 1, entries, types),
     }
+
+
+def _element_stage(work: list[tuple[int, int]], folder: Path | None, tag: str, backend: dict, report,
+                   notice) -> tuple[list, dict]:
+    """Stage 2 of :func:`run_intersection`: the entries of ``work`` (after the tetrahedron's) and the types.
+
+    Its checkpoints are named by a digest of ``work``: they are the entries of these elements
+    only, never reused for another stage 1 (one whose damaged checkpoint was computed again).
+    """
+    digest = hashlib.sha256(json.dumps(work).encode()).hexdigest()[:16]
+    element_starts = range(0, len(work), ELEMENT_CHUNK)
+    stage2: dict[int, tuple] = {}
+    damaged: list[str] = []
+    for i, start in enumerate(element_starts):
+        part = _resumed(_read_elements, folder / f"{tag}-w{digest}-elements-{i:05d}.json",
+                        len(work[start:start + ELEMENT_CHUNK]), damaged) if folder else None
+        if part is not None:
+            stage2[i] = part
+            report("elements", len(part[0]))
+    _notice(notice, damaged)
+    todo = {i: (work[start:start + ELEMENT_CHUNK],) for i, start in enumerate(element_starts) if i not in stage2}
+    written: list[Path] = []
+    try:
+        for i, part in completed(element_entries, todo, **backend):
+            stage2[i] = part
+            if folder:
+                written.append(folder / f"{tag}-w{digest}-elements-{i:05d}.json")
+                atomic_write(written[-1], _checkpoint_bytes(_element_chunk_json(part).encode("utf-8")))
+            report("elements", len(part[0]))
+    except NotACell:  # this work is abandoned: its checkpoints would only ever be stale
+        for path in written:
+            path.unlink(missing_ok=True)
+        raise
+    entries, types = _tetrahedron()
+    for i in range(len(element_starts)):
+        entries.extend(stage2[i][0])
+        types.update(stage2[i][1])
+    return entries, types
 
 
 def _notice(notice, damaged: list[str]) -> None:
@@ -369,7 +437,7 @@ def example_elements(examples: dict) -> dict[str, tuple[str, tuple[int, ...]]]:
     found = {}
     for type_id, example in examples.items():
         mask, code = example[:2]
-        points, poly = cell_polyhedron(mask, code)
+        points, poly = cell_polyhedron(mask, code, of_configuration=False)  # the tetrahedron's example too
         if len(example) == 2:
             found[type_id] = (key_code(code), tuple(n for n, _ in points))
             continue
