@@ -1,5 +1,5 @@
 """``cospherical tessellate``: its JSON and YAML, deterministic; its help's numbering; face points given on the
-command line; the VTU it writes."""
+command line; other elements and shape files; the VTU it writes."""
 
 from __future__ import annotations
 
@@ -107,3 +107,20 @@ def test_tessellate_help_shows_the_numbering(capsys):
         main(["tessellate", "--help"])
     out = capsys.readouterr().out
     assert "0 (0,0,0)" in out and "(0,1) (1,2)" in out and "20-25" in out
+
+
+def test_cli_element_and_shape_file(tmp_path):
+    import json
+
+    result = cospherical("tessellate", "--element", "pyramid", "--box", "1", "1", "1", "--code", "88880000")
+    data = json.loads(result.stdout)
+    assert data["element"] == "pyramid" and data["faces"] == [0] and "13" in data["nodes"]
+    assert [e["name"] for e in data["elements"]] == ["Rectangular Pyramid"] * 4
+    bad = tmp_path / "bowtie.yaml"
+    bad.write_text("corners: [[0,0,0],[1,0,0],[1,1,0],[0,1,0],['1/2','1/2',1]]\n"
+                   "edges: [[0,1],[1,2],[2,3],[3,0],[0,4],[1,4],[2,4],[3,4]]\n"
+                   "faces: [[0,1,3,2],[0,1,4],[1,2,4],[2,3,4],[3,0,4]]\n")
+    for args in (["--shape", str(bad)], ["--element", "prism", "--code", "88888888"],
+                 ["--element", "tetrahedron", "--steiner", "6:1/2"], ["--element", "prism", "--faces", "0"]):
+        result = cospherical("tessellate", "--box", "1", "1", "1", *args)
+        assert result.returncode == 2 and result.stdout == "" and len(result.stderr.strip().splitlines()) == 1, args

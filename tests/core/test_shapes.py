@@ -3,8 +3,6 @@ checked against Qhull's merged regions and by invariants on random Steiner posit
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from collections import Counter, defaultdict
 from fractions import Fraction
 
@@ -166,27 +164,6 @@ def test_bad_vertices_are_refused(vertices, edges, faces, message):
         Shape.from_vertices(vertices, edges, faces)
 
 
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "cospherical", *args], capture_output=True, text=True)
-
-
-def test_cli_element_and_shape_file(tmp_path):
-    import json
-
-    result = _cli("tessellate", "--element", "pyramid", "--box", "1", "1", "1", "--code", "88880000")
-    data = json.loads(result.stdout)
-    assert data["element"] == "pyramid" and data["faces"] == [0] and "13" in data["nodes"]
-    assert [e["name"] for e in data["elements"]] == ["Rectangular Pyramid"] * 4
-    bad = tmp_path / "bowtie.yaml"
-    bad.write_text("corners: [[0,0,0],[1,0,0],[1,1,0],[0,1,0],['1/2','1/2',1]]\n"
-                   "edges: [[0,1],[1,2],[2,3],[3,0],[0,4],[1,4],[2,4],[3,4]]\n"
-                   "faces: [[0,1,3,2],[0,1,4],[1,2,4],[2,3,4],[3,0,4]]\n")
-    for args in (["--shape", str(bad)], ["--element", "prism", "--code", "88888888"],
-                 ["--element", "tetrahedron", "--steiner", "6:1/2"], ["--element", "prism", "--faces", "0"]):
-        result = _cli("tessellate", "--box", "1", "1", "1", *args)
-        assert result.returncode == 2 and result.stdout == "" and len(result.stderr.strip().splitlines()) == 1, args
-
-
 @pytest.mark.oracle_qhull
 def test_general_quadrilateral_face_point():
     # A trapezoid face: the face point is where the two cut lines cross, not the corners' mean.
@@ -200,101 +177,3 @@ def test_general_quadrilateral_face_point():
     tess = tessellate_shape(cfg)
     assert sum(e.polyhedron.unit_volume for e in tess.elements) == shape.unit_volume
     assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes())
-
-
-# ---------------------------------------------------------------------------
-# The bisection studies of the three shapes
-
-ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture(scope="module")
-def shape_studies():
-    from cospherical.studies.engine import bisection_codes, run_study
-
-    return {name: run_study("bisection", standard_shape(name).box, bisection_codes(name), element=name)
-            for name in SHAPES}
-
-
-@pytest.mark.parametrize("name", SHAPES)
-def test_study_counts_equal_direct_counts(shape_studies, name):
-    """Orbit statistics (one tessellation per orbit, weighted by orbit sizes) equal tessellating
-    every configuration, and every member's mapped tessellation is its direct one."""
-    study = shape_studies[name]
-    shape = standard_shape(name)
-    counts, fvm, fvm_open = Counter(), 0, 0
-    for code in study.codes:
-        cfg = ShapeConfiguration.from_code(shape, code)
-        tess = tessellate_shape(cfg)
-        counts.update(e.type.id for e in tess.elements)
-        fvm += tess.fvm_adequate
-        fvm_open += tess.fvm_adequate_open
-        # The FVM verdicts against float circumcenters and a tolerance (the unit box: no scaling).
-        margin = min(_float_margin(shape, [cfg.real_nodes()[v] for v in e.nodes]) for e in tess.elements)
-        assert (tess.fvm_adequate, tess.fvm_adequate_open) == (margin > -1e-9, margin > 1e-9), code
-        mapped = study.tessellation(code)
-        assert [(e.type.id, e.nodes, e.mirrored) for e in mapped.elements] == \
-            [(e.type.id, e.nodes, e.mirrored) for e in tess.elements], code
-    assert {t.type.id: t.count for t in study.type_counts()} == dict(counts)
-    assert (study.fvm_adequate, study.fvm_adequate_open) == (fvm, fvm_open)
-    assert study.configurations == 1 << len(shape.edges)
-
-
-def _float_margin(shape, points) -> float:
-    """The least distance of the points' circumcenter inside the shape's face planes (negative: outside)."""
-    import numpy as np
-
-    p = np.array(points)
-    center = np.linalg.lstsq(2 * (p[1:] - p[0]), (p[1:] ** 2).sum(1) - (p[0] ** 2).sum(), rcond=None)[0]
-    margins = []
-    for normal, offset in shape.planes:
-        n = np.array([float(x) for x in normal])
-        margins.append((float(offset) - n @ center) / np.linalg.norm(n))
-    return min(margins)
-
-
-@pytest.mark.parametrize("name", SHAPES)
-def test_committed_shape_tables_pass_check(name):
-    from cospherical import load_catalogue
-    from cospherical.catalogue import catalogue_path
-    from cospherical.formats.check import check_patterns
-    from cospherical.formats.patterns import load
-
-    table = load(ROOT / "patterns" / f"bisection-{name}-1x1x1.yaml")
-    shape = standard_shape(name)
-    assert table.header["element"] == name and len(table.configurations) == 1 << len(shape.edges)
-    check_patterns(table, load_catalogue(catalogue_path()), name)  # known types, node counts, tiling
-    for code in list(table.configurations)[::5]:
-        tess = tessellate_shape(ShapeConfiguration.from_code(shape, code))
-        assert table.elements(code) == [
-            {"type": e.type.id, "nodes": list(e.nodes), "circumcenter": list(tess.circumcenter(e)),
-             **({"mirror": True} if e.mirrored else {})} for e in tess.elements]
-        assert table.configurations[code]["fvm_adequate"] == tess.fvm_adequate
-
-
-def test_study_cli_element(tmp_path):
-    import json
-
-    result = _cli("study", "bisection", "--element", "tetrahedron", "--format", "json", "--out", str(tmp_path))
-    data = json.loads(result.stdout)
-    assert data["element"] == "tetrahedron" and data["configurations"] == 64
-    optimal = data["criteria"]["optimal"]
-    assert optimal["total"] == sum(t["count"] for t in optimal["types"].values())
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["bisection-tetrahedron-1x1x1.json",
-                                                          "bisection-tetrahedron-1x1x1.yaml"]
-    assert _cli("check", str(tmp_path / "bisection-tetrahedron-1x1x1.yaml")).returncode == 0
-    result = _cli("study", "leaves", "--element", "prism")
-    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
-
-
-@pytest.mark.oracle_pdflatex
-def test_committed_shape_latex_compiles(tmp_path):
-    import shutil
-
-    for path in (ROOT / "results" / "latex-shapes").iterdir():
-        shutil.copy(path, tmp_path)
-    result = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "document.tex"], cwd=tmp_path,
-                            capture_output=True, text=True)
-    assert result.returncode == 0, result.stdout[-2000:]
-    text = subprocess.run(["pdftotext", str(tmp_path / "document.pdf"), "-"], capture_output=True, text=True).stdout
-    assert all(f"1 x 1 x 1 ({name})" in text for name in SHAPES)

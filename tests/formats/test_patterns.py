@@ -13,7 +13,7 @@ import pytest
 import yaml
 from commands import cospherical
 
-from cospherical import Box, Configuration, tessellate
+from cospherical import Box, Configuration, ShapeConfiguration, standard_shape, tessellate, tessellate_shape
 from cospherical.catalogue import catalogue_path, load_catalogue, shipped_catalogue
 from cospherical.errors import FormatError
 from cospherical.files.yamlio import dump_yaml, load_yaml
@@ -21,6 +21,7 @@ from cospherical.formats.check import check_catalogue, check_patterns
 from cospherical.formats.patterns import load, pattern_name, write_patterns
 from cospherical.studies.engine import bisection_codes, run_study
 from cospherical.studies.leaves import leaf_codes
+from tests.core.test_shapes import SHAPES
 
 CUBE = ("1", "1", "1")
 ROOT = Path(__file__).resolve().parents[2]
@@ -185,3 +186,22 @@ def test_elements_of_a_code_not_held_is_a_key_error():
     for code in (["x"], None, 7, "zzz"):
         with pytest.raises(KeyError):
             table.elements(code)
+
+
+@pytest.mark.parametrize("name", SHAPES)
+def test_committed_shape_tables_pass_check(name):
+    from cospherical import load_catalogue
+    from cospherical.catalogue import catalogue_path
+    from cospherical.formats.check import check_patterns
+    from cospherical.formats.patterns import load
+
+    table = load(ROOT / "patterns" / f"bisection-{name}-1x1x1.yaml")
+    shape = standard_shape(name)
+    assert table.header["element"] == name and len(table.configurations) == 1 << len(shape.edges)
+    check_patterns(table, load_catalogue(catalogue_path()), name)  # known types, node counts, tiling
+    for code in list(table.configurations)[::5]:
+        tess = tessellate_shape(ShapeConfiguration.from_code(shape, code))
+        assert table.elements(code) == [
+            {"type": e.type.id, "nodes": list(e.nodes), "circumcenter": list(tess.circumcenter(e)),
+             **({"mirror": True} if e.mirrored else {})} for e in tess.elements]
+        assert table.configurations[code]["fvm_adequate"] == tess.fvm_adequate

@@ -12,6 +12,7 @@ from matplotlib.image import imread
 
 from cospherical.catalogue import catalogue_path, load_catalogue
 from cospherical.outputs.latex import tikz_picture
+from tests.core.test_shapes import SHAPES
 
 ROOT = Path(__file__).resolve().parents[2]
 SUMMARIES = [ROOT / "results" / f"bisection-{box}.json" for box in ("1x1x1", "1x2x4", "1x1.4142x1.4142")]
@@ -54,3 +55,16 @@ def test_names_are_escaped_and_pictures_drawn():
     assert r"\draw[densely dashed, gray]" in picture or generic["vertices"] == 4
     elements = (ROOT / "results" / "latex" / "elements.tex").read_text()
     assert r"Generic \#" in elements and "Generic #" not in elements.replace(r"Generic \#", "")
+
+
+@pytest.mark.oracle_pdflatex
+def test_committed_shape_latex_compiles(tmp_path):
+    import shutil
+
+    for path in (ROOT / "results" / "latex-shapes").iterdir():
+        shutil.copy(path, tmp_path)
+    result = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "document.tex"], cwd=tmp_path,
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout[-2000:]
+    text = subprocess.run(["pdftotext", str(tmp_path / "document.pdf"), "-"], capture_output=True, text=True).stdout
+    assert all(f"1 x 1 x 1 ({name})" in text for name in SHAPES)
