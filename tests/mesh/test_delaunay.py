@@ -133,35 +133,6 @@ def test_python_integers_give_the_same_cells(monkeypatch):
     assert mesh_cells(global_delaunay(leaf)) == fast
 
 
-def test_the_kernels_bulk_backends_agree():
-    # int64 (under each function's bound) and Python integers: the same numbers, on random tetrahedra
-    # whose coordinates reach the bound's scale, flat ones and a shared sphere among them
-    from cospherical.core import geometry
-
-    rng = np.random.default_rng(5)
-    tets = rng.integers(0, 1 << 12, size=(300, 4, 3))
-    tets[:20, 3] = tets[:20, 0] + tets[:20, 1] - tets[:20, 2]  # flat: a parallelogram
-    cube = np.array([[0, 0, 0], [8, 0, 0], [0, 8, 0], [0, 0, 8], [8, 8, 8]])
-    tets[20:40] = cube[[0, 1, 2, 3]] + rng.integers(0, 1 << 10, size=(20, 1, 3))
-    points = rng.integers(0, 1 << 12, size=(300, 3))
-    points[20:40] = tets[20:40, 0] + 8  # on the cube's sphere
-    weights = (1, 2, 3)
-    six = geometry.six_volumes(tets)
-    assert six.dtype == np.int64 and (six[:20] == 0).all() and (six[20:] != 0).all()
-    assert six.tolist() == geometry.six_volumes(tets, python_integers=True).tolist()
-    solid = tets[20:]
-    sides = geometry.sphere_sides(solid, points[20:], weights)
-    assert sides.tolist() == geometry.sphere_sides(solid, points[20:], weights, python_integers=True).tolist()
-    assert (sides[:20] == 0).all() and {-1, 1} <= set(sides[20:].tolist())
-    fast, exact = geometry.circumcentres(solid, weights), geometry.circumcentres(solid, weights, python_integers=True)
-    assert fast[0].dtype == np.int64 and exact[0].dtype == object
-    assert [a.tolist() for a in fast] == [a.tolist() for a in exact]
-    # each centre is equidistant (weighted) from its four vertices
-    for tet, num, den in zip(solid[:5].tolist(), *(a[:5].tolist() for a in exact)):
-        centre = [Fraction(n, d) for n, d in zip(num, den)]
-        assert len({sum(w * (x - c) ** 2 for w, x, c in zip(weights, p, centre)) for p in tet}) == 1
-
-
 def test_the_final_check_skips_only_what_the_leaf_check_proved():
     # kept leaf elements and proven cells are not tested again: they must be leaf elements that passed,
     # and testing every cell again must find nothing the shorter check missed

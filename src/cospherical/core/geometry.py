@@ -364,7 +364,8 @@ class Frame:
         """A positive multiple of the real dot product of two frame vectors."""
         return sum(w * x * y for w, x, y in zip(self.weights, u, v))
 
-    def right_angle(self, i: int, j: int, k: int) -> bool:
-        """Whether the real angle at ``j`` between ``i`` and ``k`` (indices into ``coords``) is right."""
-        coords = self.coords
-        return self.real_dot(sub(coords[i], coords[j]), sub(coords[k], coords[j])) == 0
+    def right_angled(self, cycle: Sequence[int]) -> bool:
+        """Whether every real angle of the polygon ``cycle`` (indices into ``coords``) is right."""
+        points = [self.coords[i] for i in cycle]
+        edges = [sub(q, p) for p, q in zip(points, points[1:] + points[:1])]
+        return all(self.real_dot(e, f) == 0 for e, f in zip(edges, edges[1:] + edges[:1]))

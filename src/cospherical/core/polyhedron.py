@@ -19,7 +19,7 @@ def face_kind(frame: Frame, cycle: tuple[int, ...]) -> str:
     """``triangle``, ``rectangle``, ``quadrilateral``, ``pentagon``, ... (frame indices)."""
     n = len(cycle)
     if n == 4:
-        if all(frame.right_angle(cycle[i - 1], cycle[i], cycle[(i + 1) % 4]) for i in range(4)):
+        if frame.right_angled(cycle):
             return "rectangle"
     return FACE_KINDS.get(n, f"{n}-gon")
 
