@@ -1,0 +1,253 @@
+"""``dual.npz``, the dual ``cospherical mesh --dual`` writes: deterministic, read back alike by meshio; truncated,
+tampered, re-signed with hostile numbers or inflating files refused in one line."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+
+@pytest.fixture(scope="module")
+def dual_run(tmp_path_factory):
+    from cospherical.cli import main
+
+    out = tmp_path_factory.mktemp("dual")
+    argv = ["mesh", "--domain", "1", "2", "4", "--refine", "point:1/5,3/10,2/5", "--levels", "3", "--dual",
+            "--no-uniform", "--format", "json", "--delaunay", "leaf"]
+    assert main([*argv, "--out", str(out / "a")]) == 0
+    assert main([*argv, "--out", str(out / "b")]) == 0
+    return out
+
+
+@pytest.mark.oracle_meshio
+def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
+    import json
+
+    import meshio
+
+    from cospherical.formats.dual import read_dual
+
+    a, b = dual_run / "a", dual_run / "b"
+    assert (a / "dual.npz").read_bytes() == (b / "dual.npz").read_bytes()
+    report = json.loads((a / "report.json").read_text())
+    dual = read_dual(a / "dual.npz")
+    assert dual.volume_sum() == 1 and len(dual.edges) == report["dual"]["edges"]
+    # a 1 x 2 x 4 leaf mesh is not Delaunay: the report says so, the file keeps every edge
+    assert report["negative_coefficients"] == dual.negative_coefficients()
+    assert report["negative_coefficients"]["interior"] > 0
+    assert report["dual"]["mixed"]["nonzeros"] == dual.laplacian().nnz
+    vtu = meshio.read(a / "mesh.vtu")
+    assert np.array_equal(vtu.point_data["control_volume"], dual.control_volume)
+    assert np.array_equal(vtu.point_data["boundary_area"], dual.boundary_area)
+    assert dual.boundary_area_sums() == (2, 2, 2)  # read back: the exact areas and their factors
+    ok = np.concatenate(vtu.cell_data["delaunay_ok"])
+    assert (ok == 0).sum() == report["delaunay_violations"] > 0
+    assert np.concatenate(vtu.cell_data["circumcenter"]).shape == (report["elements"], 3)
+
+
+def test_a_truncated_or_tampered_dual_npz_is_refused_with_one_line(dual_run, tmp_path, capsys):
+    import zipfile
+
+    from cospherical.cli import main
+
+    good = (dual_run / "a" / "dual.npz").read_bytes()
+    assert main(["check", str(dual_run / "a" / "dual.npz")]) == 0
+    (tmp_path / "truncated.npz").write_bytes(good[: len(good) // 2])
+    # a member rewritten with a valid zip CRC: only the manifest's checksum can tell
+    with zipfile.ZipFile(dual_run / "a" / "dual.npz") as source, \
+            zipfile.ZipFile(tmp_path / "tampered.npz", "w") as target:
+        for info in source.infolist():
+            data = source.read(info)
+            if info.filename == "coefficient.npy":
+                data = data[:-8] + np.float64(1e9).tobytes()
+            target.writestr(info, data)
+    flipped = bytearray(good)
+    flipped[len(good) // 3] ^= 0xFF
+    (tmp_path / "flipped.npz").write_bytes(bytes(flipped))
+    (tmp_path / "empty.npz").write_bytes(b"")
+    capsys.readouterr()
+    for name in ("truncated", "tampered", "flipped", "empty"):
+        assert main(["check", str(tmp_path / f"{name}.npz")]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{name}.npz" in err and "Traceback" not in err
+
+
+def _resigned(good: Path, target: Path, manifest_edit=None, members: dict | None = None) -> None:
+    """A dual.npz whose manifest or members were rewritten and whose checksums were renewed to match:
+    only the reader's own bounds can refuse it."""
+    import hashlib
+    import io
+    import json
+    import zipfile
+
+    with zipfile.ZipFile(good) as source:
+        blobs = {info.filename[:-4]: source.read(info) for info in source.infolist()}
+    manifest = json.loads(np.lib.format.read_array(io.BytesIO(blobs.pop("manifest"))).tobytes().decode())
+    for name, array in (members or {}).items():
+        buffer = io.BytesIO()
+        np.lib.format.write_array(buffer, array, allow_pickle=False)
+        blobs[name] = buffer.getvalue()
+    manifest["sha256"] = {name: hashlib.sha256(blob).hexdigest() for name, blob in blobs.items()}
+    if manifest_edit:
+        manifest = manifest_edit(manifest) or manifest
+    buffer = io.BytesIO()
+    text = manifest if isinstance(manifest, str) else json.dumps(manifest)  # an edit may give the text itself
+    np.lib.format.write_array(buffer, np.frombuffer(text.encode(), dtype=np.uint8))
+    with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("manifest.npy", buffer.getvalue())
+        for name, blob in blobs.items():
+            archive.writestr(f"{name}.npy", blob)
+
+
+@pytest.mark.parametrize("case", ["factor 1e999999999", "factor 1e400", "grid 10**400", "integers --5",
+                                  "integers of 5000 digits", "boundary factors not the domain's",
+                                  "manifest nested 100,000 deep", "manifest with a repeated key",
+                                  "a grid vertex outside the grid"])
+def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, tmp_path, capsys, case):
+    from cospherical.cli import main
+
+    good = dual_run / "a" / "dual.npz"
+    edits = {"factor 1e999999999": lambda m: m.update(volume_factor_squared="1e999999999"),
+             "factor 1e400": lambda m: m.update(volume_factor_squared="1" + "0" * 400),
+             "grid 10**400": lambda m: m.update(grid=10**400),
+             "boundary factors not the domain's": lambda m: m.update(boundary_factors_squared=["1e400", "1", "1"]),
+             # the manifest read by the readers' one JSON parser (json.loads recursed: a RecursionError
+             # traceback), which also refuses a repeated key instead of keeping the last
+             "manifest nested 100,000 deep": lambda m: "[" * 100_000 + "]" * 100_000,
+             "manifest with a repeated key": lambda m: json.dumps(m)[:-1] + ', "version": 1}'}
+    members = None
+    if case.startswith("integers"):
+        from cospherical.formats.dual import read_dual
+
+        count = len(read_dual(good).volume_exact)
+        members = {"volume_exact": np.array(["--5" if "--5" in case else "9" * 5000] * count)}
+    if case == "a grid vertex outside the grid":  # re-signed: the checks' sums never read the vertices
+        from cospherical.formats.dual import read_dual
+
+        vertices = read_dual(good).grid_vertices.copy()
+        vertices[0] = [-1, 10**15, 0]
+        members = {"grid_vertices": vertices}
+    _resigned(good, tmp_path / "hostile.npz", edits.get(case), members)
+    capsys.readouterr()
+    start = time.monotonic()
+    assert main(["check", str(tmp_path / "hostile.npz")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert time.monotonic() - start < 30  # 10**999999999 would take far longer
+    assert case != "manifest with a repeated key" or "repeated key 'version'" in err, err
+
+
+def _edited(good: Path, target: Path, edit) -> None:
+    """A re-signed copy of ``good`` whose members ``edit(arrays)`` changed in place (numpy arrays by name)."""
+    import io
+    import zipfile
+
+    with zipfile.ZipFile(good) as source:
+        arrays = {info.filename[:-4]: np.lib.format.read_array(io.BytesIO(source.read(info)))
+                  for info in source.infolist() if info.filename != "manifest.npy"}
+    changed = set(edit(arrays))
+    _resigned(good, target, members={name: arrays[name] for name in changed})
+
+
+def test_a_resigned_edit_that_keeps_every_sum_is_refused_naming_the_edge(dual_run, tmp_path, capsys):
+    # +k on one coefficient and -k on another (floats made to agree): every identity check makes is a sum,
+    # so only computing the dual again from the file's elements can tell
+    from cospherical.cli import main
+    from cospherical.formats.dual import read_dual
+
+    good = dual_run / "a" / "dual.npz"
+    dual = read_dual(good)
+    interior = np.flatnonzero(~dual.boundary[dual.edges].all(axis=1))
+    a, b = int(interior[3]), int(interior[-5])
+    factor = dual.volume_factor / dual.coefficient_denominator
+
+    def balanced_coefficients(arrays):
+        arrays["coefficient_exact"][[a, b]] += [7, -7]
+        arrays["coefficient"][[a, b]] = arrays["coefficient_exact"][[a, b]] * factor
+        arrays["area"][[a, b]] = arrays["coefficient"][[a, b]] * arrays["length"][[a, b]]
+        return ["coefficient_exact", "coefficient", "area"]
+
+    def balanced_volumes(arrays):
+        arrays["volume_exact"][[0, 5]] += [3, -3]
+        return ["volume_exact"]
+
+    def a_float_alone(arrays):
+        arrays["coefficient"][b] *= 1.5
+        return ["coefficient"]
+
+    def a_vertex_twice(arrays):
+        arrays["element_nodes"][2, 1] = arrays["element_nodes"][2, 0]
+        return ["element_nodes"]
+
+    i, j = dual.edges[min(a, b)]
+    for edit, needle in ((balanced_coefficients, f"member coefficient_exact: edge {i}-{j} "),
+                         (balanced_volumes, "member volume_exact: vertex 0 "),
+                         (a_float_alone, f"member coefficient: edge {dual.edges[b, 0]}-{dual.edges[b, 1]} "),
+                         (a_vertex_twice, "member element_nodes: element 2 names a vertex twice")):
+        target = tmp_path / f"{edit.__name__}.npz"
+        _edited(good, target, edit)
+        if edit is not a_vertex_twice:  # the reader refuses that one itself
+            again = read_dual(target)
+            assert again.volume_sum() == 1 and again.boundary_area_sums() == (2, 2, 2)
+        capsys.readouterr()
+        assert main(["check", str(target)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and needle in err and "Traceback" not in err, (needle, err)
+
+
+def test_a_dual_npz_that_inflates_is_refused_from_its_headers(dual_run, tmp_path, capsys, monkeypatch):
+    """A member whose header claims 100 MB of zeros (deflated to 100 KB, re-signed) is refused
+    from the headers, before its data is read: the shapes disagree. Consistent claims beyond
+    half the machine's memory are refused likewise (here the machine is made small)."""
+    import hashlib
+    import io
+    import tracemalloc
+    import zipfile
+
+    from cospherical.cli import main
+    from cospherical.formats import dual as dual_format
+
+    good = dual_run / "a" / "dual.npz"
+    bomb = tmp_path / "bomb.npz"
+    count = 25 << 22  # 105 MB
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "|b1", "fortran_order": False, "shape": (count,)})
+    digest = hashlib.sha256(header.getvalue())
+    zeros = bytes(1 << 22)
+    for _ in range(count // len(zeros)):
+        digest.update(zeros)
+    with zipfile.ZipFile(good) as source, zipfile.ZipFile(bomb, "w", zipfile.ZIP_DEFLATED, compresslevel=1) as out:
+        for info in source.infolist():
+            if info.filename == "boundary.npy":
+                with out.open("boundary.npy", "w", force_zip64=True) as member:
+                    member.write(header.getvalue())
+                    for _ in range(count // len(zeros)):
+                        member.write(zeros)
+            elif info.filename == "manifest.npy":
+                manifest = json.loads(np.lib.format.read_array(io.BytesIO(source.read(info))).tobytes())
+                manifest["sha256"]["boundary"] = digest.hexdigest()  # re-signed: only the reader's bounds refuse it
+                text = np.frombuffer(json.dumps(manifest).encode(), dtype=np.uint8)
+                buffer = io.BytesIO()
+                np.lib.format.write_array(buffer, text)
+                out.writestr("manifest.npy", buffer.getvalue())
+            else:
+                out.writestr(info.filename, source.read(info))
+    assert bomb.stat().st_size < 1 << 20
+    capsys.readouterr()
+    tracemalloc.start()
+    try:
+        assert main(["check", str(bomb)]) == 2
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"member boundary: bool ({count},), expected b (" in err, err
+    assert peak < 20 * 2**20, peak  # it read the 100 MB (twice: the data and its array) before
+
+    monkeypatch.setattr(dual_format, "machine_memory", lambda: 2 * good.stat().st_size)
+    assert main(["check", str(good)]) == 2
+    assert "more than half this machine's memory" in capsys.readouterr().err
