@@ -43,7 +43,6 @@ _API = {
     "ElementType": "cospherical.core.element_types",
     "Element": "cospherical.core.tessellation",
     "Shape": "cospherical.core.shapes",
-    "ShapeConfiguration": "cospherical.core.shapes",
     "standard_shape": "cospherical.core.shapes",
     "tessellate_shape": "cospherical.core.tessellation",
     "Tessellation": "cospherical.core.tessellation",

@@ -13,10 +13,10 @@ from oracle import qhull_regions
 from strategies import LENGTHS, PARAMETERS
 from tests.core.test_delaunay import check_canonical_codes
 
-from cospherical import InputError, Shape, ShapeConfiguration, standard_shape, tessellate_shape
+from cospherical import Configuration, InputError, Shape, standard_shape, tessellate_shape
 from cospherical.core.geometry import Frame
 from cospherical.core.shapes import STANDARD_SHAPES, mask_codes
-from cospherical.core.symmetry import shape_orbit_representatives, shape_symmetries
+from cospherical.core.symmetry import orbit_representatives, shape_symmetries
 
 SHAPES = sorted(set(STANDARD_SHAPES) - {"cuboid"})  # the shapes besides the cuboid, whose tests are their own
 BOXES = {"cube": ("1", "1", "1"), "aspect4": ("1", "2", "4"), "sqrt2-exact": ("1", "sqrt(2)", "sqrt(2)")}
@@ -31,7 +31,7 @@ def test_every_bisection_configuration_matches_qhull(name):
     shape = standard_shape(name)
     samples: dict[str, list] = defaultdict(list)
     for code in mask_codes(len(shape.edges)):
-        cfg = ShapeConfiguration.from_code(shape, code)
+        cfg = Configuration.from_code(code, shape=shape)
         tess = tessellate_shape(cfg)
         assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes()), code
         for e in tess.elements:
@@ -46,7 +46,7 @@ def test_other_boxes_match_qhull(box):
     for name in SHAPES:
         shape = standard_shape(name, BOXES[box])
         for code in mask_codes(len(shape.edges))[::7]:
-            cfg = ShapeConfiguration.from_code(shape, code)
+            cfg = Configuration.from_code(code, shape=shape)
             assert {frozenset(e.nodes) for e in tessellate_shape(cfg).elements} == qhull_regions(cfg.real_nodes())
 
 
@@ -57,7 +57,7 @@ def shape_configurations(draw):
     if draw(st.booleans()):  # equal parameters where faces can carry points
         t = draw(PARAMETERS)
         steiner = {k: t for k in range(len(shape.edges)) if draw(st.booleans()) or k in steiner}
-    return ShapeConfiguration.from_steiner(shape, steiner, draw(st.sampled_from(["octree", "none"])))
+    return Configuration.from_steiner(None, steiner, draw(st.sampled_from(["octree", "none"])), shape=shape)
 
 
 @settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -94,7 +94,7 @@ def _quadruples(members):
 def test_fvm_is_the_base_element():
     # The tetrahedron with every midpoint: the middle octahedron's center (1/4, 1/4, 1/4)... lies
     # inside; a long thin box moves circumcenters out of the element but not out of the box.
-    tess = tessellate_shape(ShapeConfiguration.from_code(standard_shape("tetrahedron", ("1", "1", "8")), "888888"))
+    tess = tessellate_shape(Configuration.from_code("888888", shape=standard_shape("tetrahedron", ("1", "1", "8"))))
     centers = [e.polyhedron.center for e in tess.elements]
     assert all(all(0 <= x <= 1 for x in c) for c in centers)
     assert not tess.fvm_adequate
@@ -125,14 +125,14 @@ def test_symmetry_groups_and_orbits():
     for name in SHAPES:
         shape = standard_shape(name)
         codes = mask_codes(len(shape.edges))
-        reps, index = shape_orbit_representatives(codes, shape_symmetries(shape))
+        reps, index = orbit_representatives(codes, shape_symmetries(shape))
         for code, rep, i in zip(codes, reps, index):
             sym = shape_symmetries(shape)[i]
             assert sym.code(code) == rep
             assert sym.inverse().code(rep) == code
             # the image tessellation is the tessellation of the image
-            ours = tessellate_shape(ShapeConfiguration.from_code(shape, code))
-            theirs = tessellate_shape(ShapeConfiguration.from_code(shape, rep))
+            ours = tessellate_shape(Configuration.from_code(code, shape=shape))
+            theirs = tessellate_shape(Configuration.from_code(rep, shape=shape))
             assert sorted(sym.polyhedron(e.polyhedron).faces for e in ours.elements) == \
                 sorted(e.polyhedron.faces for e in theirs.elements)
 
@@ -171,7 +171,7 @@ def test_general_quadrilateral_face_point():
     edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
     faces = [(0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
     shape = Shape.from_vertices([[Fraction(x, 4) for x in p] for p in corners], edges, faces)
-    cfg = ShapeConfiguration.from_steiner(shape, {0: "1/2", 1: "1/2", 2: "1/2", 3: "1/2"})
+    cfg = Configuration.from_steiner(steiner={0: "1/2", 1: "1/2", 2: "1/2", 3: "1/2"}, shape=shape)
     assert cfg.point_faces == {0}
     assert cfg.nodes()[20 + 0] == (Fraction(1, 2), Fraction(1, 4), 0)
     tess = tessellate_shape(cfg)

@@ -9,7 +9,7 @@ from collections import Counter
 
 import pytest
 
-from cospherical import ShapeConfiguration, standard_shape, tessellate_shape
+from cospherical import Configuration, standard_shape, tessellate_shape
 from tests.core.test_shapes import SHAPES
 
 
@@ -37,7 +37,7 @@ def test_study_counts_equal_direct_counts(shape_studies, name):
     shape = standard_shape(name)
     counts, fvm, fvm_open = Counter(), 0, 0
     for code in study.codes:
-        cfg = ShapeConfiguration.from_code(shape, code)
+        cfg = Configuration.from_code(code, shape=shape)
         tess = tessellate_shape(cfg)
         counts.update(e.type.id for e in tess.elements)
         fvm += tess.fvm_adequate

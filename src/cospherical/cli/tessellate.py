@@ -7,9 +7,9 @@ from pathlib import Path
 
 from ..catalogue import CRITERIA, apply_catalogue_criterion
 from ..core.configuration import POINT_POLICIES, Configuration
-from ..core.shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape
+from ..core.shapes import ELEMENTS, Shape, standard_shape
 from ..core.tessellation import tessellate
-from ..errors import FormatError, InputError, UsageError
+from ..errors import FormatError, InputError
 from ..files.yamlio import load_yaml
 from ..formats.tessellation import tessellation_data
 from .output import FACE_POINTS_HELP, FORMATS, emit
@@ -63,9 +63,9 @@ def add_arguments(parser) -> None:
     face_points.add_argument("--face-points", choices=POINT_POLICIES,
                              help=FACE_POINTS_HELP)
     face_points.add_argument("--faces", nargs="*", metavar="F",
-                             help="the faces (0..5) carrying a centre point, given explicitly (no F: none), as at "
+                             help="the faces (0..5 of a cuboid; quadrilaterals of another element) carrying a centre point, given explicitly (no F: none), as at "
                              "an octree leaf whose face neighbours across F are refined")
-    parser.add_argument("--body", action="store_true", help="with --faces 0 1 2 3 4 5: the body point (node 26) too")
+    parser.add_argument("--body", action="store_true", help="with --faces 0 1 2 3 4 5: the body point (node 26 of a cuboid) too")
     parser.add_argument("--criterion", choices=CRITERIA, default="optimal",
                         help="optimal (default): largest co-spherical elements; internal_faces / "
                         "internal_edges_and_faces: split the types the catalogue does not keep for that criterion")
@@ -86,17 +86,10 @@ def _shape_file(path: Path, box) -> Shape:
 def _configuration(args):
     """The configuration the arguments name: a cuboid's or another shape's."""
     policy = args.face_points or "octree"  # no default in the parser: --faces excludes it
-    if args.element != "cuboid" or args.shape:
-        if args.faces is not None or args.body:
-            raise UsageError("cospherical tessellate: error: --faces and --body are for cuboids; another element "
-                             "puts a point on every quadrilateral face whose edges allow one (--face-points)")
-        shape = _shape_file(args.shape, args.box) if args.shape else standard_shape(args.element, args.box)
-        if args.code is not None:
-            return ShapeConfiguration.from_code(shape, args.code, policy)
-        return ShapeConfiguration.from_steiner(shape, args.steiner, policy)
+    shape = _shape_file(args.shape, args.box) if args.shape else standard_shape(args.element, args.box)
     if args.code is not None:
-        return Configuration.from_code(args.code, args.box, policy, args.faces, args.body)
-    return Configuration.from_steiner(args.box, args.steiner, policy, args.faces, args.body)
+        return Configuration.from_code(args.code, None, policy, args.faces, args.body, shape=shape)
+    return Configuration.from_steiner(None, args.steiner, policy, args.faces, args.body, shape=shape)
 
 
 def run(args) -> int:

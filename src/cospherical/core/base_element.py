@@ -4,8 +4,7 @@ What a study, a table check or a mesher needs of its base element, in one typed
 object: configurations from codes, the symmetry group, the orbit
 representatives of codes under it (the cube's fast paths stay behind
 :func:`~cospherical.core.symmetry.orbit_representatives`), and the
-tessellation.  The cuboid is one of the standard shapes here; its
-configurations alone carry explicit face and body points (a point suffix).
+tessellation.  The cuboid is one of the standard shapes here.
 
 Examples
 --------
@@ -23,14 +22,9 @@ from functools import cached_property
 from typing import Sequence
 
 from ..caches import cached
-from .configuration import EDGES, BaseConfiguration, Box, Configuration
-from .shapes import ELEMENTS, Shape, ShapeConfiguration, standard_shape
-from .symmetry import (
-    BaseSymmetry,
-    box_symmetries,
-    orbit_representatives,
-    shape_symmetries,
-)
+from .configuration import Box, Configuration
+from .shapes import ELEMENTS, Shape, standard_shape
+from .symmetry import Symmetry, orbit_representatives, shape_symmetries
 from .tessellation import Tessellation, tessellate
 
 __all__ = ["ELEMENTS", "BaseElement", "base_element"]
@@ -39,9 +33,8 @@ __all__ = ["ELEMENTS", "BaseElement", "base_element"]
 class BaseElement:
     """A base element (``cuboid``, ``prism``, ``pyramid``, ``tetrahedron``) in a box, under a face-point policy.
 
-    ``shape`` is the :class:`~cospherical.core.shapes.Shape` of the non-cuboid
-    elements; the cuboid's numbering is the VTK hexahedron's of
-    :mod:`cospherical.core.configuration`.
+    ``shape`` is its :class:`~cospherical.core.shapes.Shape` (the cuboid's numbering is the
+    VTK hexahedron's).
     """
 
     name: str
@@ -49,24 +42,22 @@ class BaseElement:
     face_points: str = "octree"
 
     @cached_property
-    def shape(self) -> Shape | None:
-        return None if self.name == "cuboid" else standard_shape(self.name, self.box)
+    def shape(self) -> Shape:
+        return standard_shape(self.name, self.box)
 
     @property
     def edges(self) -> int:
         """The number of edges, hence of digits in a configuration code."""
-        return len(EDGES) if self.shape is None else len(self.shape.edges)
+        return len(self.shape.edges)
 
-    def configuration(self, code: str) -> BaseConfiguration:
-        """The configuration of a code (for the cuboid, optionally with a point suffix ``+f...``)."""
-        if self.shape is None:
-            return Configuration.from_code(code, self.box, self.face_points)
-        return ShapeConfiguration.from_code(self.shape, code, self.face_points)
+    def configuration(self, code: str) -> Configuration:
+        """The configuration of a code, optionally with a point suffix ``+f...``."""
+        return Configuration.from_code(code, face_points=self.face_points, shape=self.shape)
 
     @cached_property
-    def symmetries(self) -> tuple[BaseSymmetry, ...]:
+    def symmetries(self) -> tuple[Symmetry, ...]:
         """The isometries of the element in its box, identity first."""
-        return box_symmetries(self.box) if self.shape is None else shape_symmetries(self.shape)
+        return shape_symmetries(self.shape)
 
     def orbit_representatives(self, codes: Sequence[str], backend: str = "python") -> tuple[list[str], list[int]]:
         """For each code, its orbit's representative (the smallest image) and the index in
@@ -74,7 +65,7 @@ class BaseElement:
         path, as in :func:`~cospherical.core.symmetry.orbit_representatives`)."""
         return orbit_representatives(codes, self.symmetries, backend)
 
-    def tessellate(self, configuration: BaseConfiguration, backend: str = "python") -> Tessellation:
+    def tessellate(self, configuration: Configuration, backend: str = "python") -> Tessellation:
         """The Delaunay tessellation of one of this element's configurations (``backend``: the
         Delaunay walk's, as in :func:`~cospherical.core.tessellation.tessellate`)."""
         return tessellate(configuration, backend)

@@ -2,9 +2,9 @@
 
 A code has one hexadecimal digit per edge of the base element: digit k is
 ``0`` where edge k carries no Steiner point and ``n`` where it carries one at
-t = n/16 from the edge's lower end.  A cuboid's point set may name its face
-and body points in a suffix: ``+f``, the faces carrying a point in increasing
-order, then ``b`` for the body point (``888888888888+f04``); one point set,
+t = n/16 from the edge's lower end.  A point set may name its face and body
+points in a suffix: ``+f``, the faces carrying a point in increasing order,
+then ``b`` for the body point (``888888888888+f04``); one point set,
 one code, since pattern tables are looked up by the code's text.  A symmetry
 that reverses an edge sends digit n to 16 - n.  The intersection study keys
 the 12 digits of a cuboid code as one base-16 number.
@@ -25,20 +25,28 @@ import re
 from fractions import Fraction
 from typing import TYPE_CHECKING, Iterable, Sequence
 
+from ..caches import cached
 from ..errors import InputError
 
 if TYPE_CHECKING:
     import numpy as np
 
-__all__ = ["CUBOID_CODE", "EDGE_DIGITS", "REVERSED_DIGIT", "code_digits", "digit_parameters", "key_code", "mask_code",
+__all__ = ["REVERSED_DIGIT", "code_digits", "digit_parameters", "edge_code_pattern", "key_code", "mask_code",
            "mask_codes", "parameter_digits", "parse_point_suffix", "point_suffix"]
 
-# Any number of edge digits (another shape's code), and a cuboid's: 12 digits and an optional point suffix.
-EDGE_DIGITS = re.compile(r"^[0-9a-fA-F]+$")
-CUBOID_CODE = re.compile(r"^(?P<edges>[0-9a-fA-F]{12})(?:\+(?P<suffix>.*))?$", re.DOTALL)
-_SUFFIX = re.compile(r"^f(?P<faces>[0-5]*)(?P<body>b?)$")
+_SUFFIX = re.compile(r"^f(?P<faces>[0-9]*)(?P<body>b?)$")
 # The digit of the same point seen from the edge's other end.
 REVERSED_DIGIT = {"%x" % n: "%x" % ((16 - n) % 16) for n in range(16)}
+
+
+@cached(maxsize=16)
+def edge_code_pattern(edges: int) -> re.Pattern:
+    """The codes of an element with ``edges`` edges: that many digits and an optional point suffix.
+
+    >>> edge_code_pattern(6).match("800000+f")["suffix"]
+    'f'
+    """
+    return re.compile(rf"^(?P<edges>[0-9a-fA-F]{{{edges}}})(?:\+(?P<suffix>.*))?$", re.DOTALL)
 
 
 def digit_parameters(digits: str) -> tuple[Fraction | None, ...]:
@@ -74,7 +82,8 @@ def parse_point_suffix(code: str, suffix: str) -> tuple[frozenset[int], bool]:
     match = _SUFFIX.match(suffix)
     if not match:
         raise InputError(f"configuration code {code!r}: malformed point suffix {'+' + suffix!r}: write +f, then "
-                         "the faces carrying a point (0..5, increasing), then b for the body point, e.g. +f04")
+                         "the faces carrying a point (0..5 on a cuboid, increasing), then b for the body point, "
+                         "e.g. +f04")
     digits = match["faces"]
     if len(set(digits)) != len(digits):
         raise InputError(f"configuration code {code!r}: a face is given twice in the suffix")

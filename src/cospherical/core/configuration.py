@@ -1,107 +1,43 @@
-"""1-irregular cuboid configurations: box, Steiner points, node numbering.
+"""1-irregular configurations of a base element: its shape, Steiner points, face and body points.
 
-Node numbering (shared by every part and file format, see design.md): corners
-0-7 in VTK hexahedron order, the Steiner point on edge k is node 8+k, face
-points are nodes 20-25 and the body point is node 26, in VTK triquadratic
-hexahedron order.  Positions are kept in *unit* coordinates (s, t, u) in
-[0, 1]^3, exact rationals; the real point is (s*a, t*b, u*c).
+One class for every base element, the cuboid one standard shape among prism,
+pyramid and tetrahedron (:mod:`cospherical.core.shapes`, which also holds the
+node numbering: for the cuboid, corners 0-7 in VTK hexahedron order, the
+Steiner point on edge k is node 8+k, face points are nodes 20-25 and the body
+point is node 26, in VTK triquadratic hexahedron order).  Positions are kept in
+*unit* coordinates (s, t, u), exact rationals; the real point is (s*a, t*b, u*c).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import cached_property
 from typing import Iterable, Mapping
 
 from ..errors import InputError
-from .codes import CUBOID_CODE, digit_parameters, parameter_digits, parse_point_suffix, point_suffix
-from .exact import Length, parse_rational
+from .codes import digit_parameters, edge_code_pattern, parameter_digits, parse_point_suffix, point_suffix
+from .exact import parse_rational
+from .shapes import BODY_NODE, CORNERS, EDGES, FACE_EDGES, FACES, Box, Point, Shape, edge_axis, standard_shape
 
 __all__ = [
     "BODY_NODE",
-    "BaseConfiguration",
     "Box",
     "CORNERS",
     "Configuration",
     "EDGES",
     "FACES",
+    "FACE_EDGES",
     "FACE_POINT_SOURCES",
     "POINT_POLICIES",
     "edge_axis",
     "parse_point_suffix",
     "point_suffix",
+    "steiner_parameters",
 ]
 
-CORNERS: tuple[tuple[int, int, int], ...] = (
-    (0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0),
-    (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1),
-)
-EDGES: tuple[tuple[int, int], ...] = (
-    (0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6),
-    (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7),
-)
-# Face k carries node 20+k (VTK triquadratic hexahedron order).
-FACES: tuple[tuple[int, int, int, int], ...] = (
-    (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7), (0, 1, 2, 3), (4, 5, 6, 7),
-)
-BODY_NODE = 26
 POINT_POLICIES = ("octree", "none")
-AXIS_NAMES = "xyz"
-
-
-def edge_axis(edge: int) -> int:
-    """The coordinate axis (0, 1, 2) along which edge ``edge`` runs."""
-    p, q = (CORNERS[i] for i in EDGES[edge])
-    return next(axis for axis in range(3) if p[axis] != q[axis])
-
-
-def _face_edges(face: int) -> tuple[int, ...]:
-    corners = set(FACES[face])
-    return tuple(k for k, (p, q) in enumerate(EDGES) if p in corners and q in corners)
-
-
-FACE_EDGES = tuple(_face_edges(f) for f in range(6))
-EDGE_AXES = tuple(edge_axis(k) for k in range(12))
-# Unit coordinates of the corners, and of each edge's lower-coordinate end.
-_CORNER_POINTS = tuple(tuple(Fraction(x) for x in corner) for corner in CORNERS)
-_EDGE_STARTS = tuple(min((_CORNER_POINTS[i] for i in EDGES[k])) for k in range(12))
-
-
-@dataclass(frozen=True)
-class Box:
-    """Edge lengths a, b, c of the cuboid, exact.
-
-    Examples
-    --------
-    >>> Box.parse(["1", "sqrt(2)", "1.4142"]).texts
-    ('1', 'sqrt(2)', '1.4142')
-    """
-
-    a: Length
-    b: Length
-    c: Length
-
-    @classmethod
-    def parse(cls, lengths: Iterable) -> "Box":
-        values = list(lengths)
-        if len(values) != 3:
-            raise InputError(f"box {values!r}: needs exactly three lengths A B C")
-        return cls(*(Length.parse(v) for v in values))
-
-    @property
-    def lengths(self) -> tuple[Length, Length, Length]:
-        return (self.a, self.b, self.c)
-
-    @property
-    def squared(self) -> tuple[Fraction, Fraction, Fraction]:
-        return (self.a.squared, self.b.squared, self.c.squared)
-
-    @property
-    def texts(self) -> tuple[str, str, str]:
-        return tuple(length.text for length in self.lengths)
-
-    def to_float(self) -> tuple[float, float, float]:
-        return tuple(float(length) for length in self.lengths)
+FACE_POINT_SOURCES = (*POINT_POLICIES, "explicit")
 
 
 def steiner_parameters(steiner: Mapping | Iterable | None, edges: int = 12,
@@ -135,52 +71,46 @@ def steiner_parameters(steiner: Mapping | Iterable | None, edges: int = 12,
     return tuple(params)
 
 
-FACE_POINT_SOURCES = (*POINT_POLICIES, "explicit")
-
-
-def _face_numbers(faces: Iterable, where: str) -> frozenset[int]:
+def _face_numbers(faces: Iterable, shape: Shape, where: str) -> frozenset[int]:
     numbers = []
+    last = len(shape.faces) - 1
     for face in faces:
         text = str(face).strip()
         # isascii: str.isdigit() also accepts digits such as '²' that int() refuses
         if isinstance(face, bool) or not isinstance(face, (int, str)) or not (text.isascii() and text.isdigit()) \
-                or int(text) > 5:
-            raise InputError(f"{where}: face {face!r}: not a face number 0..5")
+                or int(text) > last:
+            raise InputError(f"{where}: face {face!r}: not a face number 0..{last}"
+                             + ("" if shape.name == "cuboid" else f" of the {shape.name}"))
         if int(text) in numbers:
             raise InputError(f"{where}: face {int(text)} given twice")
         numbers.append(int(text))
     return frozenset(numbers)
 
 
-class BaseConfiguration:
-    """What every configuration of a base element is, a cuboid's or another shape's.
-
-    It has ``box``, ``steiner`` (a parameter or ``None`` per edge), ``face_points``
-    (the policy), ``code`` and ``point_set_code``, ``point_faces`` and
-    ``has_body_point``, ``shape`` (``None`` for the cuboid), ``nodes()`` (node id
-    -> exact unit coordinates) and ``contains(point)`` (the FVM test); the
-    tessellation, the studies and the writers use nothing else.
-    """
-
-    def real_nodes(self) -> dict[int, tuple[float, float, float]]:
-        """Node id -> float coordinates in the real box (for output and plotting)."""
-        scale = self.box.to_float()
-        return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}
+def _shape(shape: Shape | None, box) -> Shape:
+    """The base element of a constructor: ``shape``, or the cuboid in ``box`` (default the cube)."""
+    if shape is None:
+        return standard_shape("cuboid", ("1", "1", "1") if box is None else box)
+    if box is not None:
+        raise InputError("configuration: give the box or the shape (which has its box), not both")
+    return shape
 
 
 @dataclass(frozen=True)
-class Configuration(BaseConfiguration):
-    """A 1-irregular cuboid: a box, at most one Steiner point per edge, and its face and body points.
+class Configuration:
+    """A 1-irregular base element: its shape, at most one Steiner point per edge, and its face and body points.
 
-    ``steiner[k]`` is the parameter t in (0, 1) of the point on edge k (measured
-    from the edge's lower-coordinate end), or ``None``.  ``face_points`` says how
-    the face points (nodes 20-25) and the body point (node 26) are given: by a
-    policy, ``octree`` (the paper's: every admissible face, the body point when
-    all six) or ``none``, or ``explicit``: then ``faces`` is the set of faces
-    carrying a point and ``body`` whether the body point is there.  A face may
-    carry a point only where its four edges are split with opposite edges at the
-    same parameter (its point lies where the two cut lines cross); the body
-    point needs all six face points (a cuboid refined into eight).
+    ``shape`` is the base element in its box (:func:`~cospherical.core.shapes.standard_shape`:
+    the cuboid, a prism, a pyramid, a tetrahedron; or any convex
+    :class:`~cospherical.core.shapes.Shape`).  ``steiner[k]`` is the parameter t in (0, 1)
+    of the point on edge k (measured from the edge's lower end), or ``None``.
+    ``face_points`` says how the face points and the body point are given: by a policy,
+    ``octree`` (the paper's: every admissible face, and the body point of a parallelepiped
+    when all six) or ``none``, or ``explicit``: then ``faces`` is the set of faces carrying a
+    point and ``body`` whether the body point is there.  A face may carry a point only where
+    it is a quadrilateral whose four edges are split with opposite edges at the same
+    parameter (its point lies where the two cut lines cross); the body point needs a point on
+    every face of a parallelepiped (a cuboid refined into eight).
 
     Examples
     --------
@@ -194,17 +124,21 @@ class Configuration(BaseConfiguration):
     ('888888888888+f04', [20, 24])
     >>> Configuration.from_code("888888888888").point_set_code
     '888888888888+f012345b'
+    >>> pyramid = Configuration.from_code("88880000", shape=standard_shape("pyramid"))
+    >>> sorted(pyramid.nodes())[-1], pyramid.point_faces
+    (13, frozenset({0}))
     """
 
-    box: Box
+    shape: Shape
     steiner: tuple[Fraction | None, ...]
     face_points: str = "octree"
     faces: frozenset[int] | None = None
     body: bool = False
 
     def __post_init__(self) -> None:
-        if len(self.steiner) != 12:
-            raise InputError(f"steiner: needs 12 entries, got {len(self.steiner)}")
+        shape = self.shape
+        if len(self.steiner) != len(shape.edges):
+            raise InputError(f"steiner: needs {len(shape.edges)} entries, got {len(self.steiner)}")
         if self.face_points not in FACE_POINT_SOURCES:
             raise InputError(f"face-point policy {self.face_points!r}: choose one of {', '.join(POINT_POLICIES)}")
         if (self.faces is not None) != (self.face_points == "explicit"):
@@ -213,54 +147,66 @@ class Configuration(BaseConfiguration):
             raise InputError(f"body point: the {self.face_points} policy decides it; give the faces explicitly")
         if self.faces is None:
             return
-        object.__setattr__(self, "faces", _face_numbers(self.faces, "face points"))
+        object.__setattr__(self, "faces", _face_numbers(self.faces, shape, "face points"))
         for face in sorted(self.faces):
             reason = self._inadmissible(face)
             if reason:
-                corners = " ".join(map(str, FACES[face]))
+                corners = " ".join(map(str, shape.faces[face]))
                 raise InputError(f"face {face} (corners {corners}) cannot carry a point: {reason}")
-        if self.body and len(self.faces) != 6:
-            raise InputError("body point: needs all six face points (a cuboid refined into eight), "
-                             f"got faces {', '.join(map(str, sorted(self.faces))) or 'none'}")
+        if self.body:
+            if shape.body_node is None:
+                raise InputError(f"body point: the {shape.name} has none (only a parallelepiped, refined into "
+                                 "eight, has one)")
+            if len(self.faces) != len(shape.faces):
+                raise InputError("body point: needs all six face points (a cuboid refined into eight), "
+                                 f"got faces {', '.join(map(str, sorted(self.faces))) or 'none'}")
 
     @classmethod
     def from_steiner(
         cls,
-        box: Box | Iterable = ("1", "1", "1"),
+        box: Box | Iterable | None = None,
         steiner: Mapping | Iterable | None = None,
         face_points: str = "octree",
         faces: Iterable | None = None,
         body: bool = False,
+        shape: Shape | None = None,
     ) -> "Configuration":
         """Build from ``{edge: t}`` or ``[(edge, t), ...]``; t may be a string, int or Fraction.
 
-        ``faces`` (face numbers 0..5) and ``body`` give the face and body points
-        explicitly; then ``face_points`` is ignored.
+        The element is ``shape``, or the cuboid in ``box`` (default the cube).  ``faces``
+        (face numbers) and ``body`` give the face and body points explicitly; then
+        ``face_points`` is ignored.
         """
-        box = box if isinstance(box, Box) else Box.parse(box)
-        return cls._build(box, steiner_parameters(steiner), face_points, faces, body)
+        shape = _shape(shape, box)
+        return cls._build(shape, steiner_parameters(steiner, len(shape.edges), shape.name), face_points, faces, body)
 
     @classmethod
     def from_code(
         cls,
         code: str,
-        box: Box | Iterable = ("1", "1", "1"),
+        box: Box | Iterable | None = None,
         face_points: str = "octree",
         faces: Iterable | None = None,
         body: bool = False,
+        shape: Shape | None = None,
     ) -> "Configuration":
-        """Build from a configuration code: 12 hex digits (digit k: t = n/16 on edge k, 0 = none),
-        optionally followed by the point suffix ``+f<faces>[b]``.
+        """Build from a configuration code: one hexadecimal digit per edge (digit n: t = n/16 on
+        that edge, 0 = none; 12 for the cuboid), optionally followed by the point suffix
+        ``+f<faces>[b]``.
 
-        A suffix names every face and body point, whatever ``face_points`` says; a
-        bare code takes them from the policy (``octree`` or ``none``), or from
-        ``faces`` and ``body``.  ``face_points="explicit"`` asks for a suffix.
+        The element is ``shape``, or the cuboid in ``box`` (default the cube).  A suffix
+        names every face and body point, whatever ``face_points`` says; a bare code takes
+        them from the policy (``octree`` or ``none``), or from ``faces`` and ``body``.
+        ``face_points="explicit"`` asks for a suffix.
         """
-        match = CUBOID_CODE.match(code) if isinstance(code, str) else None
+        shape = _shape(shape, box)
+        count = len(shape.edges)
+        match = edge_code_pattern(count).match(code) if isinstance(code, str) else None
         if not match:
-            raise InputError(f"configuration code {code!r}: needs exactly 12 hexadecimal digits, "
-                             "optionally followed by a point suffix such as +f04")
-        box = box if isinstance(box, Box) else Box.parse(box)
+            raise InputError(f"configuration code {code!r}: "
+                             + ("needs exactly 12 hexadecimal digits" if shape.name == "cuboid" else
+                                f"the {shape.name} needs exactly {count} hexadecimal digits, one per edge")
+                             + ", optionally followed by a point suffix such as +f04")
         params = digit_parameters(match["edges"])
         if match["suffix"] is not None:
             if faces is not None or body:
@@ -270,17 +216,21 @@ class Configuration(BaseConfiguration):
         elif face_points == "explicit" and faces is None:
             raise InputError(f"configuration code {code!r}: needs a point suffix (+f<faces>[b]) "
                              "where the face points are explicit")
-        return cls._build(box, params, face_points, faces, body)
+        return cls._build(shape, params, face_points, faces, body)
 
     @classmethod
-    def _build(cls, box, params, face_points, faces, body) -> "Configuration":
+    def _build(cls, shape, params, face_points, faces, body) -> "Configuration":
         if faces is not None or body:  # __post_init__ checks and normalises the faces
-            return cls(box, params, "explicit", tuple(faces or ()), body)
-        return cls(box, params, face_points)
+            return cls(shape, params, "explicit", tuple(faces or ()), body)
+        return cls(shape, params, face_points)
+
+    @property
+    def box(self) -> Box:
+        return self.shape.box
 
     @property
     def code(self) -> str | None:
-        """The configuration code as its own policy reads it: 12 hex digits under ``octree``
+        """The configuration code as its own policy reads it: the edge digits under ``octree``
         or ``none``, with the point suffix when the points are explicit; ``None`` when some
         t is not a multiple of 1/16."""
         if self.face_points == "explicit":
@@ -289,16 +239,17 @@ class Configuration(BaseConfiguration):
 
     @property
     def point_set_code(self) -> str | None:
-        """The code of the whole point set, the same under every policy (always suffixed)."""
+        """The code of the whole point set, the same under every policy (always suffixed;
+        ``None`` as :attr:`code`, or where a face number has more than one digit)."""
         digits = parameter_digits(self.steiner)
-        if digits is None:
+        if digits is None or any(f > 9 for f in self.point_faces):
             return None
         return f"{digits}+{point_suffix(self.point_faces, self.has_body_point)}"
 
-    @property
+    @cached_property
     def admissible_faces(self) -> frozenset[int]:
-        """The faces that may carry a point: four split edges, opposite ones at the same t."""
-        return frozenset(f for f in range(6) if not self._inadmissible(f))
+        """The faces that may carry a point: quadrilaterals with four split edges, opposite ones at the same t."""
+        return frozenset(f for f in self.shape.quad_faces if self._face_parameters(f) is not None)
 
     @property
     def point_faces(self) -> frozenset[int]:
@@ -309,60 +260,67 @@ class Configuration(BaseConfiguration):
 
     @property
     def has_body_point(self) -> bool:
-        """Whether node 26 is there: explicit, or under ``octree`` when all six faces carry a point."""
+        """Whether the body point is there: explicit, or under ``octree`` when every face of a
+        parallelepiped carries a point."""
         if self.face_points == "explicit":
             return self.body
-        return self.face_points == "octree" and len(self.point_faces) == 6
+        return (self.face_points == "octree" and self.shape.body_node is not None
+                and len(self.point_faces) == len(self.shape.faces))
 
     def explicit(self) -> "Configuration":
         """The same point set with its face and body points given explicitly."""
-        return Configuration(self.box, self.steiner, "explicit", self.point_faces, self.has_body_point)
+        return Configuration(self.shape, self.steiner, "explicit", self.point_faces, self.has_body_point)
 
-    def nodes(self) -> dict[int, tuple[Fraction, Fraction, Fraction]]:
+    def nodes(self) -> dict[int, Point]:
         """Node id -> exact unit coordinates (s, t, u), ids in increasing order."""
-        nodes = dict(enumerate(_CORNER_POINTS))
+        shape = self.shape
+        nodes = dict(enumerate(shape.corners))
+        first = len(shape.corners)
         for k, t in enumerate(self.steiner):
             if t is not None:
-                start = list(_EDGE_STARTS[k])
-                start[EDGE_AXES[k]] = t
-                nodes[8 + k] = tuple(start)
+                nodes[first + k] = shape.edge_point(k, t)
         for f in sorted(self.point_faces):
-            nodes[20 + f] = self._face_point(f)
+            nodes[shape.face_nodes[f]] = shape.face_point(f, *self._face_parameters(f))
         if self.has_body_point:
-            nodes[BODY_NODE] = tuple(self._parallel_parameter(axis) for axis in range(3))
+            # every face carries a point, so all the edges of a parallel class are split at one t
+            origin, classes = shape.parallelepiped
+            point = shape.corners[origin]
+            for d, edges in classes:
+                t = self.steiner[edges[0]]
+                point = tuple(x + t * y if y else x for x, y in zip(point, d))
+            nodes[shape.body_node] = point
         return nodes
 
-    def _parallel_parameter(self, axis: int) -> Fraction:
-        return next(t for k, t in enumerate(self.steiner) if EDGE_AXES[k] == axis)
+    def real_nodes(self) -> dict[int, tuple[float, float, float]]:
+        """Node id -> float coordinates in the real box (for output and plotting)."""
+        scale = self.box.to_float()
+        return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}
+
+    def _face_parameters(self, f: int) -> tuple[Fraction, Fraction] | None:
+        """The parameters (t along c0->c1, s along c0->c3) of face f's cut lines, or ``None``
+        when it cannot carry a point."""
+        return None if self._inadmissible(f) else self._cut_parameters(f)[::2]
+
+    def _cut_parameters(self, f: int) -> list[Fraction]:
+        # the parameters on the sides of Shape.cut_sides, each measured the way its side runs
+        return [self.steiner[k] if forward else 1 - self.steiner[k] for k, forward in self.shape.cut_sides[f]]
 
     def _inadmissible(self, face: int) -> str | None:
         """Why face ``face`` cannot carry a point, or ``None`` when it can."""
-        edges = FACE_EDGES[face]
-        unsplit = [k for k in edges if self.steiner[k] is None]
+        sides = self.shape.cut_sides.get(face)
+        if sides is None:
+            return f"it has {len(self.shape.faces[face])} corners: only a quadrilateral face carries a point"
+        unsplit = sorted(k for k, _ in sides if self.steiner[k] is None)
         if unsplit:
             return f"edge {unsplit[0]} carries no Steiner point"
-        for axis in sorted({EDGE_AXES[k] for k in edges}):
-            p, q = (k for k in edges if EDGE_AXES[k] == axis)
-            if self.steiner[p] != self.steiner[q]:
+        params = self._cut_parameters(face)
+        for i in sorted((0, 2), key=lambda i: min(sides[i][0], sides[i + 1][0])):  # the pair of the lowest edge first
+            if params[i] != params[i + 1]:
+                p, q = sorted((sides[i][0], sides[i + 1][0]))
                 return (f"opposite edges {p} and {q} are split at different parameters, "
                         f"{self.steiner[p]} and {self.steiner[q]}")
         return None
 
-    def _face_point(self, face: int) -> tuple[Fraction, Fraction, Fraction]:
-        # The face of a refined neighbour, where the two cut lines cross.
-        point = list(_CORNER_POINTS[FACES[face][0]])
-        for k in FACE_EDGES[face]:
-            point[EDGE_AXES[k]] = self.steiner[k]
-        return tuple(point)
-
-    @property
-    def shape(self) -> None:
-        """``None``: the cuboid's numbering is this module's, not a
-        :class:`~cospherical.core.shapes.Shape` (whose configurations have one)."""
-        return None
-
     def contains(self, point, closed: bool = True) -> bool:
-        """Whether a point (unit coordinates) lies in the closed (or open) box, exactly: the FVM test."""
-        if closed:
-            return all(0 <= x <= 1 for x in point)
-        return all(0 < x < 1 for x in point)
+        """Whether a point (unit coordinates) lies in the closed (or open) base element, exactly: the FVM test."""
+        return self.shape.contains(point, closed)

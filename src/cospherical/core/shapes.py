@@ -1,33 +1,41 @@
-"""1-irregular convex base elements other than the cuboid: prisms, pyramids, tetrahedra, any convex polyhedron.
+"""Base elements: the cuboid, prisms, pyramids, tetrahedra, any convex polyhedron, in a box.
 
 The paper's conclusion says its algorithm tessellates "any 1-irregular convex
-configuration" unchanged; this module is that generalisation.  A :class:`Shape`
-is a convex polyhedron given by exact corners in *unit* coordinates (s, t, u),
-scaled by a box A x B x C (the real point is (s*A, t*B, u*C)), its edges and its
-faces.  Because the map from unit to real coordinates is a positive diagonal
-scaling, convexity, planarity and orientation are decided on the unit
-coordinates, and everything metric goes through the box's squared lengths, as
-for cuboids (:mod:`cospherical.core.geometry`): the whole pipeline stays exact
-for ``sqrt(2)`` boxes too.
+configuration" unchanged; this module is that generalisation, with the cuboid
+one standard shape among the others.  A :class:`Shape` is a convex polyhedron
+given by exact corners in *unit* coordinates (s, t, u), scaled by a box
+A x B x C (the real point is (s*A, t*B, u*C)), its edges and its faces.
+Because the map from unit to real coordinates is a positive diagonal scaling,
+convexity, planarity and orientation are decided on the unit coordinates, and
+everything metric goes through the box's squared lengths
+(:mod:`cospherical.core.geometry`): the whole pipeline stays exact for
+``sqrt(2)`` boxes too.
 
 Node numbering: the corners in the order given (VTK order for the standard
 shapes), then one node per edge (edge k carries node ``len(corners) + k``), then
-one node per quadrilateral face, in face order.  A Steiner point on edge k sits
-at parameter t in (0, 1) from the edge's *lower end* (its lexicographically
+one node per quadrilateral face, in face order, then, for a parallelepiped, the
+body point.  For the cuboid this is VTK's triquadratic hexahedron: corners 0-7,
+edge points 8-19, face points 20-25, body point 26.  A Steiner point on edge k
+sits at parameter t in (0, 1) from the edge's *lower end* (its lexicographically
 smallest corner in unit coordinates; for the axis-parallel edges of a cuboid
-this is the lower-coordinate end).  A quadrilateral face carries a point when
+this is the lower-coordinate end).  A quadrilateral face may carry a point when
 its four edges are split with opposite edges at the same parameter (measured in
-the same direction); the point is where the two cut lines cross.  Triangles and
-the interior carry nothing: a refined neighbour puts nothing there.
+the same direction); the point is where the two cut lines cross.  Triangles
+carry nothing: a refined neighbour puts nothing there.  The body point of a
+parallelepiped needs a point on all six faces (the element refined into eight).
 
-Their tessellation is :func:`cospherical.core.tessellation.tessellate`, as a cuboid's;
-their isometries :func:`cospherical.core.symmetry.shape_symmetries`.
+Their configurations are :class:`cospherical.core.configuration.Configuration`,
+their tessellation :func:`cospherical.core.tessellation.tessellate`, their
+isometries :func:`cospherical.core.symmetry.shape_symmetries`.
 
 Examples
 --------
 >>> prism = standard_shape("prism")
 >>> len(prism.corners), len(prism.edges), prism.quad_faces
 (6, 9, (2, 3, 4))
+>>> cuboid = standard_shape("cuboid")
+>>> cuboid.quad_faces, cuboid.body_node
+((0, 1, 2, 3, 4, 5), 26)
 """
 
 from __future__ import annotations
@@ -36,17 +44,80 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
 from itertools import combinations
-from typing import Iterable, Mapping, Sequence
+from typing import Iterable, Sequence
 
+from ..caches import cached
 from ..errors import InputError
-from .codes import EDGE_DIGITS, digit_parameters, mask_codes, parameter_digits
-from .configuration import CORNERS, EDGES, FACES, BaseConfiguration, Box, steiner_parameters
-from .exact import parse_rational
+from .codes import mask_codes
+from .exact import Length, parse_rational
 from .geometry import area_vector, collinear, cross, dot, plane_normal, six_volume, sub, tetra_six_volume
 
-__all__ = ["ELEMENTS", "STANDARD_SHAPES", "Shape", "ShapeConfiguration", "mask_codes", "standard_shape"]
+__all__ = ["BODY_NODE", "Box", "CORNERS", "EDGES", "ELEMENTS", "FACES", "FACE_EDGES", "STANDARD_SHAPES", "Shape",
+           "edge_axis", "mask_codes", "standard_shape"]
 
 Point = tuple[Fraction, Fraction, Fraction]
+
+
+@dataclass(frozen=True)
+class Box:
+    """Edge lengths a, b, c of the box that scales a base element, exact.
+
+    Examples
+    --------
+    >>> Box.parse(["1", "sqrt(2)", "1.4142"]).texts
+    ('1', 'sqrt(2)', '1.4142')
+    """
+
+    a: Length
+    b: Length
+    c: Length
+
+    @classmethod
+    def parse(cls, lengths: Iterable) -> "Box":
+        values = list(lengths)
+        if len(values) != 3:
+            raise InputError(f"box {values!r}: needs exactly three lengths A B C")
+        return cls(*(Length.parse(v) for v in values))
+
+    @property
+    def lengths(self) -> tuple[Length, Length, Length]:
+        return (self.a, self.b, self.c)
+
+    @property
+    def squared(self) -> tuple[Fraction, Fraction, Fraction]:
+        return (self.a.squared, self.b.squared, self.c.squared)
+
+    @property
+    def texts(self) -> tuple[str, str, str]:
+        return tuple(length.text for length in self.lengths)
+
+    def to_float(self) -> tuple[float, float, float]:
+        return tuple(float(length) for length in self.lengths)
+
+
+# The cuboid's numbering (VTK hexahedron), shared by every part and file format.
+CORNERS: tuple[tuple[int, int, int], ...] = (
+    (0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0),
+    (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1),
+)
+EDGES: tuple[tuple[int, int], ...] = (
+    (0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6),
+    (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7),
+)
+# Face k carries node 20+k (VTK triquadratic hexahedron order).
+FACES: tuple[tuple[int, int, int, int], ...] = (
+    (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7), (0, 1, 2, 3), (4, 5, 6, 7),
+)
+BODY_NODE = 26
+
+
+def edge_axis(edge: int) -> int:
+    """The coordinate axis (0, 1, 2) along which the cuboid's edge ``edge`` runs."""
+    p, q = (CORNERS[i] for i in EDGES[edge])
+    return next(axis for axis in range(3) if p[axis] != q[axis])
+
+
+FACE_EDGES = tuple(tuple(k for k, (p, q) in enumerate(EDGES) if {p, q} <= set(face)) for face in FACES)
 
 _H = Fraction(1, 2)
 # The standard shapes, corners in VTK order (hexahedron, wedge, pyramid, tetra), edges in the
@@ -196,10 +267,48 @@ class Shape:
                              "not one closed convex surface")
         return cls(name, box, corners, tuple(pairs), tuple(oriented), tuple(planes))
 
+    def __hash__(self) -> int:
+        # Hashed once: a shape keys the caches of its symmetries and of its configurations' maps.
+        return self._hash
+
+    @cached_property
+    def _hash(self) -> int:
+        return hash((self.name, self.box, self.corners, self.edges, self.faces))
+
     @cached_property
     def quad_faces(self) -> tuple[int, ...]:
         """The faces with four corners: face ``quad_faces[q]`` carries node ``len(corners) + len(edges) + q``."""
         return tuple(f for f, face in enumerate(self.faces) if len(face) == 4)
+
+    @cached_property
+    def face_nodes(self) -> dict[int, int]:
+        """Quadrilateral face -> the node of its point."""
+        first = len(self.corners) + len(self.edges)
+        return {f: first + q for q, f in enumerate(self.quad_faces)}
+
+    @cached_property
+    def parallelepiped(self) -> tuple[int, tuple[tuple[Point, tuple[int, ...]], ...]] | None:
+        """``(corner, ((d0, edges0), (d1, edges1), (d2, edges2)))`` when the shape is a
+        parallelepiped: every point is ``corner + x d0 + y d1 + z d2`` for x, y, z in [0, 1],
+        each d running along the edges of its class from their lower ends; ``None`` for any
+        other shape."""
+        if len(self.corners) != 8 or len(self.quad_faces) != 6:
+            return None
+        classes: dict[Point, list[int]] = {}
+        for k in range(len(self.edges)):
+            d = sub(self.corners[self._edge_end[k]], self.corners[self.edge_start(k)])
+            classes.setdefault(d, []).append(k)
+        if len(classes) != 3:
+            return None
+        origin = min(range(8), key=lambda i: self.corners[i])
+        return origin, tuple((d, tuple(edges)) for d, edges in classes.items())
+
+    @property
+    def body_node(self) -> int | None:
+        """The node of the body point (a parallelepiped's; ``None``: the shape has none)."""
+        if self.parallelepiped is None:
+            return None
+        return len(self.corners) + len(self.edges) + len(self.quad_faces)
 
     @cached_property
     def unit_volume(self) -> Fraction:
@@ -208,13 +317,54 @@ class Shape:
 
     def edge_start(self, k: int) -> int:
         """The corner from which edge k's parameter is measured: its lexicographically smallest."""
-        return min(self.edges[k], key=lambda i: self.corners[i])
+        return self._edge_starts[k]
+
+    @cached_property
+    def _edge_starts(self) -> tuple[int, ...]:
+        return tuple(min(edge, key=lambda i: self.corners[i]) for edge in self.edges)
+
+    @cached_property
+    def _edge_end(self) -> tuple[int, ...]:
+        return tuple(j if i == start else i for (i, j), start in zip(self.edges, self._edge_starts))
+
+    @cached_property
+    def _edge_lines(self) -> tuple:
+        # Per edge: its start point and the axes along which it runs, with the extent on each.
+        lines = []
+        for k in range(len(self.edges)):
+            p, q = self.corners[self.edge_start(k)], self.corners[self._edge_end[k]]
+            lines.append((p, tuple((a, q[a] - p[a]) for a in range(3) if q[a] != p[a])))
+        return tuple(lines)
 
     def edge_point(self, k: int, t: Fraction) -> Point:
-        start = self.edge_start(k)
-        end = self.edges[k][0] if self.edges[k][1] == start else self.edges[k][1]
-        p, q = self.corners[start], self.corners[end]
-        return tuple(a + t * (b - a) for a, b in zip(p, q))
+        """The point at parameter t of edge k, exactly."""
+        start, runs = self._edge_lines[k]
+        point = list(start)
+        for axis, extent in runs:  # the coordinates along which the edge does not run stay
+            point[axis] = t if extent == 1 and start[axis] == 0 else start[axis] + t * extent
+        return tuple(point)
+
+    def face_point(self, f: int, t: Fraction, s: Fraction) -> Point:
+        """The point of quadrilateral face f (cycle c0 c1 c2 c3) where its two cut lines cross: the
+        line through the points at t on sides c0->c1 and c3->c2, and the one through the points
+        at s on sides c0->c3 and c1->c2."""
+        c = [self.corners[i] for i in self.faces[f]]
+        if all(a + b == d + e for a, b, d, e in zip(c[0], c[2], c[1], c[3])):
+            # a parallelogram: the cut lines run along its sides
+            return tuple(a + t * (b - a) + s * (d - a) for a, b, d in zip(c[0], c[1], c[3]))
+        p = [a + t * (b - a) for a, b in zip(c[0], c[1])]
+        q = [a + t * (b - a) for a, b in zip(c[3], c[2])]
+        r = [a + s * (b - a) for a, b in zip(c[0], c[3])]
+        u = [a + s * (b - a) for a, b in zip(c[1], c[2])]
+        # p + x (q - p) = r + y (u - r): two of the three coordinate equations have
+        # a nonzero determinant, because the cut lines of a convex face cross.
+        d1, d2, e = sub(q, p), sub(u, r), sub(r, p)
+        for i, j in combinations(range(3), 2):
+            det = d1[i] * -d2[j] + d2[i] * d1[j]
+            if det:
+                x = (e[i] * -d2[j] + d2[i] * e[j]) / det
+                return tuple(a + x * b for a, b in zip(p, d1))
+        raise AssertionError("the cut lines of a convex face cross")  # pragma: no cover
 
     def edge_index(self, i: int, j: int) -> int:
         return self._edge_index[frozenset((i, j))]
@@ -223,11 +373,44 @@ class Shape:
     def _edge_index(self) -> dict[frozenset[int], int]:
         return {frozenset(e): k for k, e in enumerate(self.edges)}
 
+    @cached_property
+    def _bounds(self) -> tuple:
+        # A face plane normal to an axis bounds that coordinate alone: (axis, lower, upper) per
+        # axis bounded on both sides this way (the box's three), and the other planes as they are.
+        lower, upper, axis_planes, others = {}, {}, {}, []
+        for normal, offset in self.planes:
+            axes = [a for a in range(3) if normal[a] != 0]
+            if len(axes) == 1:
+                bound = offset / normal[axes[0]]
+                bound = int(bound) if bound.denominator == 1 else bound  # ints compare faster
+                (upper if normal[axes[0]] > 0 else lower)[axes[0]] = bound
+                axis_planes.setdefault(axes[0], []).append((normal, offset))
+            else:
+                others.append((normal, offset))
+        both = tuple((a, lower[a], upper[a]) for a in range(3) if a in lower and a in upper)
+        others += [plane for a, planes in axis_planes.items() if not (a in lower and a in upper) for plane in planes]
+        return both, tuple(others)
+
     def contains(self, point: Sequence[Fraction], closed: bool = True) -> bool:
         """Whether a point (unit coordinates) lies in the closed (or open) element, exactly."""
+        axis_bounds, others = self._bounds
         if closed:
-            return all(dot(normal, point) <= offset for normal, offset in self.planes)
-        return all(dot(normal, point) < offset for normal, offset in self.planes)
+            return all(low <= point[a] <= high for a, low, high in axis_bounds) and \
+                all(dot(normal, point) <= offset for normal, offset in others)
+        return all(low < point[a] < high for a, low, high in axis_bounds) and \
+            all(dot(normal, point) < offset for normal, offset in others)
+
+    @cached_property
+    def cut_sides(self) -> dict[int, tuple[tuple[int, bool], ...]]:
+        """Quadrilateral face (cycle c0 c1 c2 c3) -> its sides c0->c1, c3->c2, c0->c3, c1->c2 (two
+        pairs of opposite sides, each pair run the same way): (edge, whether the edge's parameter
+        runs that way)."""
+        sides = {}
+        for f in self.quad_faces:
+            c = self.faces[f]
+            sides[f] = tuple((self.edge_index(a, b), self.edge_start(self.edge_index(a, b)) == a)
+                             for a, b in ((c[0], c[1]), (c[3], c[2]), (c[0], c[3]), (c[1], c[2])))
+        return sides
 
 
 def _oriented_face(corners, cycle, f, name):
@@ -270,7 +453,7 @@ def _oriented_face(corners, cycle, f, name):
 def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
     """One of the standard shapes (VTK hexahedron, wedge, pyramid, tetra) in a box A x B x C.
 
-    ``cuboid``: the whole box, numbered as :mod:`cospherical.core.configuration` numbers it;
+    ``cuboid``: the whole box, numbered as VTK's hexahedron (:data:`CORNERS`, :data:`EDGES`, :data:`FACES`);
     ``prism``: the right triangular prism (0,0,0) (A,0,0) (0,B,0) (0,0,C) (A,0,C) (0,B,C),
     half a box; ``pyramid``: the square pyramid on the box's bottom face with its
     apex at the box centre, a sixth of a box; ``tetrahedron``: the corner
@@ -285,122 +468,13 @@ def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
     ...
     cospherical.errors.InputError: element 'cube': choose one of cuboid, prism, pyramid, tetrahedron
     """
+    box = box if isinstance(box, Box) else Box.parse(box)
+    return _standard_shape(name, box)
+
+
+@cached(maxsize=64)  # one object per shape and box: its symmetries and maps are cached on it
+def _standard_shape(name: str, box: Box) -> Shape:
     if name not in STANDARD_SHAPES:
         raise InputError(f"element {name!r}: choose one of {', '.join(ELEMENTS)}")
     corners, edges, faces = STANDARD_SHAPES[name]
     return Shape.from_vertices(corners, edges, faces, box, name)
-
-
-@dataclass(frozen=True)
-class ShapeConfiguration(BaseConfiguration):
-    """A 1-irregular element of a :class:`Shape`: at most one Steiner point per edge.
-
-    ``steiner[k]`` is the parameter of the point on edge k from its lower end,
-    or ``None``.  Face points follow the ``octree`` policy (the paper's: every
-    quadrilateral face whose four edges are split, opposite ones at the same
-    parameter) or ``none``.
-
-    Examples
-    --------
-    >>> cfg = ShapeConfiguration.from_code(standard_shape("pyramid"), "88880000")
-    >>> sorted(cfg.nodes())[-1], cfg.point_faces
-    (13, frozenset({0}))
-    """
-
-    shape: Shape
-    steiner: tuple[Fraction | None, ...]
-    face_points: str = "octree"
-
-    def __post_init__(self) -> None:
-        if len(self.steiner) != len(self.shape.edges):
-            raise InputError(f"steiner: needs {len(self.shape.edges)} entries, got {len(self.steiner)}")
-        if self.face_points not in ("octree", "none"):
-            raise InputError(f"face-point policy {self.face_points!r}: choose one of octree, none")
-
-    @classmethod
-    def from_code(cls, shape: Shape, code: str, face_points: str = "octree") -> "ShapeConfiguration":
-        """From one hexadecimal digit per edge (digit n: a point at t = n/16; ``0``: none)."""
-        count = len(shape.edges)
-        if not isinstance(code, str) or len(code) != count or not EDGE_DIGITS.match(code):
-            raise InputError(f"configuration code {code!r}: the {shape.name} needs exactly {count} hexadecimal "
-                             "digits, one per edge")
-        return cls(shape, digit_parameters(code), face_points)
-
-    @classmethod
-    def from_steiner(cls, shape: Shape, steiner: Mapping | Iterable | None = None,
-                     face_points: str = "octree") -> "ShapeConfiguration":
-        """From ``{edge: t}`` or ``[(edge, t), ...]``, t a string, int or Fraction strictly between 0 and 1."""
-        return cls(shape, steiner_parameters(steiner, len(shape.edges), shape.name), face_points)
-
-    @property
-    def box(self) -> Box:
-        return self.shape.box
-
-    @property
-    def code(self) -> str | None:
-        """One hexadecimal digit per edge; ``None`` when some t is not a multiple of 1/16."""
-        return parameter_digits(self.steiner)
-
-    @property
-    def point_set_code(self) -> str | None:
-        return self.code
-
-    @property
-    def has_body_point(self) -> bool:
-        return False
-
-    @cached_property
-    def point_faces(self) -> frozenset[int]:
-        """The quadrilateral faces carrying a point (face numbers of the shape)."""
-        if self.face_points == "none":
-            return frozenset()
-        return frozenset(f for f in self.shape.quad_faces if self._face_parameters(f) is not None)
-
-    def _face_parameters(self, f: int):
-        # Along the face cycle (c0, c1, c2, c3): sides c0->c1 and c3->c2 are
-        # opposite, as are c0->c3 and c1->c2; each needs the same parameter.
-        c = self.shape.faces[f]
-        params = []
-        for a, b in ((c[0], c[1]), (c[3], c[2]), (c[0], c[3]), (c[1], c[2])):
-            k = self.shape.edge_index(a, b)
-            t = self.steiner[k]
-            if t is None:
-                return None
-            params.append(t if self.shape.edge_start(k) == a else 1 - t)
-        if params[0] != params[1] or params[2] != params[3]:
-            return None
-        return params[0], params[2]
-
-    def _face_point(self, f: int) -> Point:
-        c = [self.shape.corners[i] for i in self.shape.faces[f]]
-        t, s = self._face_parameters(f)
-        p = [a + t * (b - a) for a, b in zip(c[0], c[1])]
-        q = [a + t * (b - a) for a, b in zip(c[3], c[2])]
-        r = [a + s * (b - a) for a, b in zip(c[0], c[3])]
-        u = [a + s * (b - a) for a, b in zip(c[1], c[2])]
-        # p + x (q - p) = r + y (u - r): two of the three coordinate equations have
-        # a nonzero determinant, because the cut lines of a convex face cross.
-        d1, d2, e = sub(q, p), sub(u, r), sub(r, p)
-        for i, j in combinations(range(3), 2):
-            det = d1[i] * -d2[j] + d2[i] * d1[j]
-            if det:
-                x = (e[i] * -d2[j] + d2[i] * e[j]) / det
-                return tuple(a + x * b for a, b in zip(p, d1))
-        raise AssertionError("the cut lines of a convex face cross")  # pragma: no cover
-
-    def nodes(self) -> dict[int, Point]:
-        """Node id -> exact unit coordinates: corners, edge points, face points."""
-        shape = self.shape
-        nodes = dict(enumerate(shape.corners))
-        for k, t in enumerate(self.steiner):
-            if t is not None:
-                nodes[len(shape.corners) + k] = shape.edge_point(k, t)
-        first = len(shape.corners) + len(shape.edges)
-        for q, f in enumerate(shape.quad_faces):
-            if f in self.point_faces:
-                nodes[first + q] = self._face_point(f)
-        return nodes
-
-    def contains(self, point, closed: bool = True) -> bool:
-        """Whether a point (unit coordinates) lies in the closed (or open) base element, exactly: the FVM test."""
-        return self.shape.contains(point, closed)

@@ -1,7 +1,9 @@
-"""The symmetry group of a box (or of another base element) acting on node ids, configurations and tessellations.
+"""The symmetry group of a base element acting on node ids, configurations and tessellations.
 
-A symmetry permutes the axes (only axes of equal length may be swapped) and
-reflects any of them: 48 elements for a cube, 16 when exactly two lengths
+A symmetry is an isometry of the element in its box: a permutation of its
+corners, with the affine map of unit coordinates that makes it.  For the cuboid
+these are the box's: axes permuted (only axes of equal length may be swapped)
+and any of them reflected, 48 elements for a cube, 16 when exactly two lengths
 agree, 8 otherwise.  A study tessellates one representative per orbit and maps
 the result to every other member.
 """
@@ -23,92 +25,128 @@ if TYPE_CHECKING:
 
 from ..caches import cached
 from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, point_suffix
-from .configuration import BODY_NODE, CORNERS, EDGES, FACES, Box, Configuration, edge_axis
+from .configuration import CORNERS, EDGES, FACES, Box, Configuration
 from .geometry import cross, determinant, sub, tetra_six_volume
 from .polyhedron import Polyhedron
-from .shapes import Point, Shape
+from .shapes import Point, Shape, standard_shape
 
-__all__ = ["BaseSymmetry", "ShapeSymmetry", "Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
-           "orbit_point_keys", "orbit_representatives", "shape_orbit_representatives", "shape_symmetries"]
-
-
-class BaseSymmetry:
-    """What every isometry of a base element is, a box's (:class:`Symmetry`) or another shape's
-    (:class:`ShapeSymmetry`).
-
-    It has ``proper`` (keeps orientation), ``point(p)`` (its action on unit
-    coordinates), ``node_map`` (node id -> image), ``edge_map`` (per edge: the
-    image edge and whether t becomes 1 - t), ``code(code)`` (the image of a
-    configuration code) and ``inverse()``; studies and tables use nothing else.
-    """
-
-    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
-        """The image of a polyhedron, faces normalised as the Delaunay stage writes them."""
-        return map_polyhedron(poly, self.node_map, self.proper, self.point)
+__all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
+           "orbit_point_keys", "orbit_representatives", "shape_symmetries"]
 
 
 @dataclass(frozen=True)
-class Symmetry(BaseSymmetry):
-    """A symmetry of a box: ``point -> q`` with ``q[i] = p[perm[i]]``, reflected (``1 - x``) where ``flips[i]``."""
+class Symmetry:
+    """An isometry of a base element: a permutation of its corners, acting on nodes, codes and points.
 
-    perm: tuple[int, int, int]
-    flips: tuple[bool, bool, bool]
+    ``corner_map[i]`` is the image of corner i; ``linear`` and ``shift`` the affine map of
+    unit coordinates (rational: it maps rational corners to rational corners).  It has
+    ``proper`` (keeps orientation), ``point(p)``, ``node_map`` (node id -> image),
+    ``edge_map`` (per edge: the image edge and whether t becomes 1 - t), ``face_map``,
+    ``code(code)``, ``configuration(cfg)``, ``polyhedron(poly)`` and ``inverse()``.
 
-    @property
+    Examples
+    --------
+    >>> swap = shape_symmetries(standard_shape("prism"))[1]  # x <-> y: corners 1 and 2, 4 and 5
+    >>> swap.corner_map, swap.proper, swap.code("800000000")
+    ((0, 2, 1, 3, 5, 4), False, '008000000')
+    >>> flip = box_symmetries(Box.parse(["1", "1", "1"]))[1]  # z -> 1 - z
+    >>> flip.code("800000000000+f4"), flip.node_map[26]
+    ('000080000000+f5', 26)
+    """
+
+    shape: Shape = field(repr=False, compare=False)
+    corner_map: tuple[int, ...]
+    linear: tuple[tuple[Fraction, ...], ...] = field(repr=False)
+    shift: tuple[Fraction, ...] = field(repr=False)
+
+    @cached_property
     def proper(self) -> bool:
         """Whether it keeps orientation (a rotation rather than a reflection)."""
-        inversions = sum(1 for i in range(3) for j in range(i + 1, 3) if self.perm[i] > self.perm[j])
-        return (inversions + sum(self.flips)) % 2 == 0
+        m = self.linear
+        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) > 0
+
+    @cached_property
+    def _axes(self) -> tuple[tuple[int, bool], ...] | None:
+        # The box's symmetries take each coordinate to one coordinate, or to 1 minus it: the
+        # cheap form of point() that a study's mapping of every member runs on.
+        axes = []
+        for row, b in zip(self.linear, self.shift):
+            nonzero = [(a, x) for a, x in enumerate(row) if x != 0]
+            if len(nonzero) != 1 or (nonzero[0][1], b) not in ((1, 0), (-1, 1)):
+                return None
+            axes.append((nonzero[0][0], nonzero[0][1] < 0))
+        return tuple(axes)
 
     def point(self, p):
-        return tuple(1 - p[a] if f else p[a] for a, f in zip(self.perm, self.flips))
+        """The image of a point (unit coordinates)."""
+        if self._axes is not None:
+            return tuple(1 - p[a] if flip else p[a] for a, flip in self._axes)
+        return tuple(sum(a * x for a, x in zip(row, p)) + b for row, b in zip(self.linear, self.shift))
 
-    @property
-    def node_map(self) -> tuple[int, ...]:
-        """Image of every node id 0..26."""
-        return _node_map(self)
-
-    @property
+    @cached_property
     def edge_map(self) -> tuple[tuple[int, bool], ...]:
         """For edge k: (image edge, whether t becomes 1 - t)."""
-        return _edge_map(self)
+        shape, image = self.shape, self.corner_map
+        result = []
+        for k, (i, j) in enumerate(shape.edges):
+            target = shape.edge_index(image[i], image[j])
+            result.append((target, image[shape.edge_start(k)] != shape.edge_start(target)))
+        return tuple(result)
+
+    @cached_property
+    def face_map(self) -> tuple[int, ...]:
+        """The image of every face."""
+        index = {frozenset(face): f for f, face in enumerate(self.shape.faces)}
+        return tuple(index[frozenset(self.corner_map[i] for i in face)] for face in self.shape.faces)
+
+    @cached_property
+    def node_map(self) -> tuple[int, ...]:
+        """The image of every node id: corners, edge points, face points, the body point."""
+        shape = self.shape
+        nodes = list(self.corner_map)
+        nodes += [len(shape.corners) + target for target, _ in self.edge_map]
+        nodes += [shape.face_nodes[self.face_map[f]] for f in shape.quad_faces]
+        if shape.body_node is not None:
+            nodes.append(shape.body_node)
+        return tuple(nodes)
 
     def configuration(self, cfg: Configuration) -> Configuration:
         """The image of a configuration; explicit face and body points go with it."""
-        params: list[Fraction | None] = [None] * 12
+        params: list[Fraction | None] = [None] * len(cfg.steiner)
         for k, t in enumerate(cfg.steiner):
             if t is not None:
                 image, reverse = self.edge_map[k]
                 params[image] = 1 - t if reverse else t
         if cfg.face_points != "explicit":
-            return Configuration(cfg.box, tuple(params), cfg.face_points)
+            return Configuration(cfg.shape, tuple(params), cfg.face_points)
         faces = frozenset(self.face_map[f] for f in cfg.faces)
-        return Configuration(cfg.box, tuple(params), "explicit", faces, cfg.body)
-
-    @property
-    def face_map(self) -> tuple[int, ...]:
-        """Image of every face 0..5 (face f carries node 20+f)."""
-        return tuple(self.node_map[20 + f] - 20 for f in range(6))
+        return Configuration(cfg.shape, tuple(params), "explicit", faces, cfg.body)
 
     def code(self, code: str) -> str:
         """The image of a configuration code (digit n becomes 16 - n on a reversed edge; the
         faces of a point suffix map with their nodes)."""
         edges, plus, suffix = code.partition("+")
-        digits = ["0"] * 12
+        digits = ["0"] * len(edges)
         for (image, reverse), digit in zip(self.edge_map, edges):
-            digits[image] = REVERSED_DIGIT[digit] if reverse else digit
+            digits[image] = REVERSED_DIGIT[digit.lower()] if reverse else digit
         if not plus:
             return "".join(digits)
         faces, body = parse_point_suffix(code, suffix)
         return "".join(digits) + "+" + point_suffix({self.face_map[f] for f in faces}, body)
 
+    def polyhedron(self, poly: Polyhedron) -> Polyhedron:
+        """The image of a polyhedron, faces normalised as the Delaunay stage writes them."""
+        return map_polyhedron(poly, self.node_map, self.proper, self.point)
+
     def inverse(self) -> "Symmetry":
-        perm = [0, 0, 0]
-        flips = [False] * 3
-        for i, a in enumerate(self.perm):
-            perm[a] = i
-            flips[a] = self.flips[i]
-        return Symmetry(tuple(perm), tuple(flips))
+        return self._inverse
+
+    @cached_property
+    def _inverse(self) -> "Symmetry":
+        n = len(self.corner_map)
+        return next(s for s in shape_symmetries(self.shape)
+                    if all(s.corner_map[self.corner_map[i]] == i for i in range(n)))
 
 
 def map_polyhedron(poly: Polyhedron, nodes, proper: bool, point) -> Polyhedron:
@@ -130,57 +168,6 @@ def map_polyhedron(poly: Polyhedron, nodes, proper: bool, point) -> Polyhedron:
         unit_volume=poly.unit_volume,
         center=point(poly.center),
     )
-
-
-# The orbit kernel takes a configuration's face and body points as a mask: bit f for
-# face f, this bit for the body point (no symmetry moves it).
-_BODY_BIT = 1 << 6
-
-
-def _point_mask(code: str) -> int:
-    faces, body = parse_point_suffix(code, code[13:])
-    return sum(1 << f for f in faces) | (_BODY_BIT if body else 0)
-
-
-def _mask_suffix(mask: int) -> str:
-    return point_suffix((f for f in range(6) if mask >> f & 1), bool(mask & _BODY_BIT))
-
-
-@cached(maxsize=1)  # shared by the node maps of all symmetries
-def _positions() -> dict[tuple[Fraction, ...], int]:
-    half = Fraction(1, 2)
-    positions = {tuple(map(Fraction, c)): i for i, c in enumerate(CORNERS)}
-    for k, (p, q) in enumerate(EDGES):
-        positions[tuple((Fraction(x) + y) / 2 for x, y in zip(CORNERS[p], CORNERS[q]))] = 8 + k
-    for f, corners in enumerate(FACES):
-        positions[tuple(sum(Fraction(CORNERS[c][a]) for c in corners) / 4 for a in range(3))] = 20 + f
-    positions[(half, half, half)] = BODY_NODE
-    return positions
-
-
-@cached(maxsize=64)
-def _node_map(sym: Symmetry) -> tuple[int, ...]:
-    positions = _positions()
-    image = {node: positions[sym.point(p)] for p, node in positions.items()}
-    return tuple(image[i] for i in range(27))
-
-
-@cached(maxsize=64)
-def _edge_map(sym: Symmetry) -> tuple[tuple[int, bool], ...]:
-    result = []
-    for k in range(12):
-        image = _node_map(sym)[8 + k] - 8
-        axis = edge_axis(k)
-        new_axis = sym.perm.index(axis)
-        result.append((image, sym.flips[new_axis]))
-    return tuple(result)
-
-
-def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
-    """All symmetries of the box, identity first."""
-    squared = box.squared
-    perms = [p for p in permutations(range(3)) if all(squared[i] == squared[p[i]] for i in range(3))]
-    return tuple(Symmetry(p, f) for p in perms for f in product((False, True), repeat=3))
 
 
 KEY_BACKENDS = ("numpy", "compiled")
@@ -247,25 +234,23 @@ def _orbit_keys_numpy(digits, targets, reverse, masks, faces):
     return best, best_mask, best_sym
 
 
-def orbit_representatives(codes: Sequence[str], symmetries: Sequence[BaseSymmetry],
+def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry],
                           backend: str = "python") -> tuple[list[str], list[int]]:
-    """For each code, its orbit's representative (the smallest image code, as a base-16 number)
-    and the index of a symmetry taking the code to it.
+    """For each code, its orbit's representative (the smallest image: edge digits as a base-16
+    number, then the face and body points) and the index of the first symmetry taking the code to it.
 
-    The one orbit function of every base element.  Under a box's symmetries (a
-    cuboid) a code with a point suffix (``+f...``) has a representative with
-    one, and the work goes through the cube's fast paths, chosen by ``backend``:
-    ``"python"`` (the default: once per orbit, about 50 us a code in the worst
-    case, no numpy, whose import costs a tenth of a second: a bisection study's
-    4096 codes take 15 ms), ``"numpy"`` (about 6 us a code after its import) or
-    ``"compiled"`` (:func:`orbit_point_keys`, for hundreds of thousands of
-    codes).  ``"python"`` needs the symmetries to form a group, as a box's
-    always do; on any other set it computes with numpy.  Under another shape's
-    isometries every image of each code is compared, whatever the backend.
+    The one orbit function of every base element; a code with a point suffix
+    (``+f...``) has a representative with one.  ``backend``: ``"python"`` (the
+    default: once per orbit, about 50 us a code in the worst case, no numpy, whose
+    import costs a tenth of a second: a bisection study's 4096 codes take 15 ms),
+    or, for the cuboid, the cube's fast paths ``"numpy"`` (about 6 us a code after
+    its import) and ``"compiled"`` (:func:`orbit_point_keys`, for hundreds of
+    thousands of codes); other elements' codes take the Python path whatever the
+    backend.  ``"python"`` needs the symmetries to form a group, as an element's
+    isometries always do; on any other set of the cuboid's it computes with numpy.
 
     Examples
     --------
-    >>> from cospherical.core.shapes import standard_shape
     >>> shape = standard_shape("tetrahedron")
     >>> orbit_representatives(["800000", "008000", "080000"], shape_symmetries(shape))[0]
     ['000800', '000800', '000008']
@@ -274,59 +259,85 @@ def orbit_representatives(codes: Sequence[str], symmetries: Sequence[BaseSymmetr
     """
     if backend not in ("python", *KEY_BACKENDS):
         raise ValueError(f"backend {backend!r}: one of python, {', '.join(KEY_BACKENDS)}")
-    if symmetries and isinstance(symmetries[0], ShapeSymmetry):
-        return _every_image_representatives(codes, symmetries)
+    if not symmetries:
+        raise ValueError("orbit representatives: no symmetries (the identity at least)")
+    shape = symmetries[0].shape
+    cube_path = len(shape.edges) == 12 and len(shape.faces) == 6
+    body_bit = 1 << len(shape.faces)
     suffixed = ["+" in code for code in codes]
-    masks = [_point_mask(code) if s else 0 for code, s in zip(codes, suffixed)]
-    group = _group(tuple(symmetries)) if backend == "python" else None
+    masks = [_point_mask(code, body_bit) if s else 0 for code, s in zip(codes, suffixed)]
+    group = _group(tuple(symmetries)) if backend == "python" or not cube_path else None
     if group is not None:
         keys, image_masks, sym_index = _orbit_keys_python(codes, masks, group)
+    elif not cube_path:
+        raise ValueError("orbit representatives: these symmetries are no group of the element")
     else:
         import numpy as np
 
         keys, image_masks, sym_index = (a.tolist() for a in orbit_point_keys(
             code_digits(codes), np.array(masks, dtype=np.int64), symmetries,
             "numpy" if backend == "python" else backend))
-    reps = [key_code(k) + ("+" + _mask_suffix(m) if s else "") for k, m, s in zip(keys, image_masks, suffixed)]
+    width = len(shape.edges)
+    reps = ["%0*x" % (width, k) + ("+" + _mask_suffix(m, body_bit) if s else "")
+            for k, m, s in zip(keys, image_masks, suffixed)]
     return reps, sym_index
+
+
+def _point_mask(code: str, body_bit: int = 1 << 6) -> int:
+    # The face and body points of a code as a mask: bit f for face f, body_bit (1 << the number
+    # of faces, the cuboid's by default) for the body point, which no symmetry moves
+    faces, body = parse_point_suffix(code, code.partition("+")[2])
+    return sum(1 << f for f in faces) | (body_bit if body else 0)
+
+
+def _mask_suffix(mask: int, body_bit: int) -> str:
+    return point_suffix((f for f in range(body_bit.bit_length() - 1) if mask >> f & 1), bool(mask & body_bit))
 
 
 @dataclass(frozen=True)
 class _Group:
-    """What :func:`_orbit_keys_python` needs of a group of box symmetries."""
+    """What :func:`_orbit_keys_python` needs of a group of symmetries."""
 
-    images: tuple  # per symmetry: picks the image's 12 hex digits from a code's digits and their reversals
+    images: tuple  # per symmetry: picks the image's hex digits from a code's digits and their reversals
     faces: tuple[tuple[int, ...], ...]  # per symmetry: the image of every face
     compose: tuple[tuple[int, ...], ...]  # compose[u][v]: the index of u after v
     inverse: tuple[int, ...]
+    edges: int  # the number of edges, hence of digits in a code
+    body_bit: int  # the body point's bit in a mask: 1 << the number of faces
 
 
 @cached(maxsize=16)
 def _group(symmetries: tuple[Symmetry, ...]) -> _Group | None:
     """The tables of :class:`_Group`; ``None`` unless the symmetries form a group
-    (those of a box always do)."""
-    index = {sym: i for i, sym in enumerate(symmetries)}
+    (an element's isometries always do)."""
+    index = {sym.corner_map: i for i, sym in enumerate(symmetries)}
     compose = []
     for u in symmetries:
         row = []
         for v in symmetries:
-            # (u after v)(p)[i] = v(p)[u.perm[i]], reflected by u.flips[i]
-            image = index.get(Symmetry(tuple(v.perm[a] for a in u.perm),
-                                       tuple(v.flips[a] != f for a, f in zip(u.perm, u.flips))))
+            image = index.get(tuple(u.corner_map[c] for c in v.corner_map))
             if image is None:
                 return None
             row.append(image)
         compose.append(tuple(row))
-    inverse = tuple(index.get(sym.inverse()) for sym in symmetries)
+    inverse = []
+    for sym in symmetries:
+        back = [0] * len(sym.corner_map)
+        for i, c in enumerate(sym.corner_map):
+            back[c] = i
+        inverse.append(index.get(tuple(back)))
     if None in inverse:
         return None
     images = []
     for sym in symmetries:
-        source = [0] * 12  # digit j of the image: digit k of the code, or its reversal (at 12 + k)
+        n = len(sym.edge_map)
+        source = [0] * n  # digit j of the image: digit k of the code, or its reversal (at n + k)
         for k, (target, reverse) in enumerate(sym.edge_map):
-            source[target] = 12 * reverse + k
-        images.append(itemgetter(*source))
-    return _Group(tuple(images), tuple(sym.face_map for sym in symmetries), tuple(compose), inverse)
+            source[target] = n * reverse + k
+        images.append(itemgetter(*source) if n > 1 else (lambda digits, k=source[0]: (digits[k],)))
+    shape = symmetries[0].shape
+    return _Group(tuple(images), tuple(sym.face_map for sym in symmetries), tuple(compose), tuple(inverse),
+                  len(shape.edges), 1 << len(shape.faces))
 
 
 _REVERSAL = str.maketrans(REVERSED_DIGIT)
@@ -337,17 +348,18 @@ def _orbit_keys_python(codes, masks, group: _Group):
     # mask) and first symmetry reaching it, found once per orbit.  The images of an
     # orbit's first code r under every symmetry are its members; a member m = s(r)
     # is taken to the smallest image exactly by the t = u after s^-1 with u(r) smallest.
+    edges, body_bit = group.edges, group.body_bit
     answers: dict[tuple[int, int], tuple[int, int, int]] = {}
     keys, image_masks, sym_index = [], [], []
     for code, mask in zip(codes, masks):
-        row = (int(code[:12], 16), mask)
+        row = (int(code[:edges], 16), mask)
         if row not in answers:
-            digits = code[:12].lower()
+            digits = code[:edges].lower()
             digits += digits.translate(_REVERSAL)
             images = []
             for pick, faces in zip(group.images, group.faces):
-                image_mask = mask & _BODY_BIT
-                for f in range(6):
+                image_mask = mask & body_bit
+                for f in range(len(faces)):
                     if mask >> f & 1:
                         image_mask |= 1 << faces[f]
                 images.append((int("".join(pick(digits)), 16), image_mask))
@@ -364,69 +376,6 @@ def _orbit_keys_python(codes, masks, group: _Group):
     return keys, image_masks, sym_index
 
 
-@dataclass(frozen=True)
-class ShapeSymmetry(BaseSymmetry):
-    """An isometry of a shape: a permutation of its corners, acting on nodes, codes and points.
-
-    ``corner_map[i]`` is the image of corner i; ``linear`` and ``shift`` the
-    affine map of unit coordinates (rational: it maps rational corners to
-    rational corners); ``proper`` whether it keeps orientation.
-
-    Examples
-    --------
-    >>> from cospherical.core.shapes import standard_shape
-    >>> swap = shape_symmetries(standard_shape("prism"))[1]  # x <-> y: corners 1 and 2, 4 and 5
-    >>> swap.corner_map, swap.proper, swap.code("800000000")
-    ((0, 2, 1, 3, 5, 4), False, '008000000')
-    """
-
-    shape: Shape = field(repr=False, compare=False)
-    corner_map: tuple[int, ...]
-    linear: tuple[tuple[Fraction, ...], ...] = field(repr=False)
-    shift: tuple[Fraction, ...] = field(repr=False)
-
-    @property
-    def proper(self) -> bool:
-        m = self.linear
-        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) > 0
-
-    def point(self, p):
-        return tuple(sum(a * x for a, x in zip(row, p)) + b for row, b in zip(self.linear, self.shift))
-
-    @cached_property
-    def edge_map(self) -> tuple[tuple[int, bool], ...]:
-        """For edge k: (image edge, whether t becomes 1 - t)."""
-        shape, image = self.shape, self.corner_map
-        result = []
-        for k, (i, j) in enumerate(shape.edges):
-            target = shape.edge_index(image[i], image[j])
-            result.append((target, image[shape.edge_start(k)] != shape.edge_start(target)))
-        return tuple(result)
-
-    @cached_property
-    def node_map(self) -> dict[int, int]:
-        shape = self.shape
-        nc, ne = len(shape.corners), len(shape.edges)
-        nodes = dict(enumerate(self.corner_map))
-        nodes.update({nc + k: nc + target for k, (target, _) in enumerate(self.edge_map)})
-        face_of = {frozenset(shape.faces[f]): q for q, f in enumerate(shape.quad_faces)}
-        for q, f in enumerate(shape.quad_faces):
-            nodes[nc + ne + q] = nc + ne + face_of[frozenset(self.corner_map[i] for i in shape.faces[f])]
-        return nodes
-
-    def code(self, code: str) -> str:
-        """The image of a configuration code (digit n becomes 16 - n on a reversed edge)."""
-        digits = ["0"] * len(code)
-        for (target, reverse), digit in zip(self.edge_map, code):
-            digits[target] = REVERSED_DIGIT[digit.lower()] if reverse else digit
-        return "".join(digits)
-
-    def inverse(self) -> "ShapeSymmetry":
-        return next(s for s in shape_symmetries(self.shape)
-                    if all(s.corner_map[self.corner_map[i]] == i for i in range(len(self.corner_map))))
-
-
 def _affine(sources: Sequence[Point], targets: Sequence[Point]):
     """The affine map of unit coordinates taking four affinely independent points to four others."""
     # Solve M (s_i - s_0) = (t_i - t_0) for i = 1..3 by Cramer's rule, row by row.
@@ -441,14 +390,19 @@ def _affine(sources: Sequence[Point], targets: Sequence[Point]):
     return linear, shift
 
 
-@cached(maxsize=64)  # a study maps every member through its shape's symmetries
-def shape_symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
-    """The isometries of the scaled shape, identity first (see :class:`ShapeSymmetry`).
+_CUBOID_CORNERS = tuple(tuple(Fraction(x) for x in c) for c in CORNERS)
 
-    >>> from cospherical.core.shapes import standard_shape
-    >>> [len(shape_symmetries(standard_shape(name))) for name in ("prism", "pyramid", "tetrahedron")]
-    [4, 8, 6]
+
+@cached(maxsize=64)  # a study maps every member through its shape's symmetries
+def shape_symmetries(shape: Shape) -> tuple[Symmetry, ...]:
+    """The isometries of the scaled shape, identity first (see :class:`Symmetry`).
+
+    >>> [len(shape_symmetries(standard_shape(name))) for name in ("cuboid", "prism", "pyramid", "tetrahedron")]
+    [48, 4, 8, 6]
     """
+    if shape.corners == _CUBOID_CORNERS and shape.edges == EDGES \
+            and [set(face) for face in shape.faces] == [set(face) for face in FACES]:
+        return _box_isometries(shape)  # the same group, in the box's order (see _box_isometries)
     corners, weights = shape.corners, shape.box.squared
 
     def distance(i, j):
@@ -473,21 +427,31 @@ def shape_symmetries(shape: Shape) -> tuple[ShapeSymmetry, ...]:
     result = []
     for images in sorted(found, key=lambda p: p != tuple(range(n))):
         linear, shift = _affine([corners[i] for i in basis], [corners[images[i]] for i in basis])
-        result.append(ShapeSymmetry(shape, images, linear, shift))
+        result.append(Symmetry(shape, images, linear, shift))
     return tuple(result)
 
 
-def _every_image_representatives(codes: Sequence[str],
-                                symmetries: Sequence[ShapeSymmetry]) -> tuple[list[str], list[int]]:
-    # orbit_representatives under a shape's isometries (a few, on codes of at most 512): every image
-    reps, index = [], []
-    for code in codes:
-        images = [sym.code(code) for sym in symmetries]
-        best = min(range(len(images)), key=lambda i: (int(images[i], 16), i))
-        reps.append(images[best])
-        index.append(best)
-    return reps, index
+def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
+    """All symmetries of the box: the isometries of the cuboid in it, identity first."""
+    return shape_symmetries(standard_shape("cuboid", box))
 
 
-# The name under which the orbits of other shapes were first public: the same function.
-shape_orbit_representatives = orbit_representatives
+def _box_isometries(shape: Shape) -> tuple[Symmetry, ...]:
+    # The cuboid's isometries built directly as the box's: q[i] = p[perm[i]], reflected
+    # (1 - x) where flips[i], permutations (of axes of equal length) first, then the
+    # reflections; the order that the study tables' symmetry indices refer to.
+    squared = shape.box.squared
+    corner_index = {corner: i for i, corner in enumerate(CORNERS)}
+    result = []
+    for perm in permutations(range(3)):
+        if any(squared[i] != squared[perm[i]] for i in range(3)):
+            continue
+        for flips in product((False, True), repeat=3):
+            def point(p):
+                return tuple(1 - p[a] if f else p[a] for a, f in zip(perm, flips))
+            corner_map = tuple(corner_index[point(c)] for c in CORNERS)
+            linear = tuple(tuple(Fraction(-1 if f else 1) if col == a else Fraction(0) for col in range(3))
+                           for a, f in zip(perm, flips))
+            shift = tuple(Fraction(int(f)) for f in flips)
+            result.append(Symmetry(shape, corner_map, linear, shift))
+    return tuple(result)

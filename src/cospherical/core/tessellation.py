@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from .configuration import BaseConfiguration
+from .configuration import Configuration
 from .delaunay import delaunay_cells
 from .element_types import ElementType, classify
 from .geometry import Frame
@@ -48,7 +48,7 @@ def element_entry(element: Element, scale) -> dict:
 class Tessellation:
     """The Delaunay tessellation of one configuration (of a cuboid or another shape), elements sorted by node ids."""
 
-    configuration: BaseConfiguration
+    configuration: Configuration
     nodes: dict[int, tuple[Fraction, Fraction, Fraction]]
     elements: tuple[Element, ...]
 
@@ -69,7 +69,7 @@ class Tessellation:
         return tuple(float(x) * s for x, s in zip(element.polyhedron.center, scale))
 
 
-def tessellate(configuration: BaseConfiguration, backend: str = "python") -> Tessellation:
+def tessellate(configuration: Configuration, backend: str = "python") -> Tessellation:
     """The Delaunay tessellation of a configuration, its elements the largest co-spherical sets.
 
     Every cell is the convex hull of all points on one empty sphere, decided in
@@ -78,9 +78,9 @@ def tessellate(configuration: BaseConfiguration, backend: str = "python") -> Tes
 
     Parameters
     ----------
-    configuration : Configuration or ShapeConfiguration
-        The box, its Steiner points, and its face and body points; or another
-        shape's configuration.
+    configuration : Configuration
+        The base element in its box (the cuboid or another shape), its Steiner
+        points, and its face and body points.
     backend : str
         The Delaunay walk (:func:`cospherical.core.delaunay.delaunay_cells`):
         ``"python"`` (the default, for small work) or ``"compiled"`` (bulk work
@@ -105,11 +105,11 @@ def tessellate(configuration: BaseConfiguration, backend: str = "python") -> Tes
     Another base element (:mod:`cospherical.core.shapes`) goes through the same
     pipeline; its FVM test asks for circumcenters in that element:
 
-    >>> from cospherical.core.shapes import ShapeConfiguration, standard_shape
-    >>> tess = tessellate(ShapeConfiguration.from_code(standard_shape("prism"), "888888888"))
+    >>> from cospherical.core.shapes import standard_shape
+    >>> tess = tessellate(Configuration.from_code("888888888", shape=standard_shape("prism")))
     >>> sorted(e.type.name for e in tess.elements), tess.fvm_adequate
     (['Cuboid', 'Cuboid', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism', 'Triangular Prism'], True)
-    >>> tess = tessellate(ShapeConfiguration.from_code(standard_shape("tetrahedron"), "800000"))
+    >>> tess = tessellate(Configuration.from_code("800000", shape=standard_shape("tetrahedron")))
     >>> [e.type.name for e in tess.elements], sum(e.polyhedron.unit_volume for e in tess.elements)
     (['Tetrahedron', 'Tetrahedron'], Fraction(1, 6))
     """

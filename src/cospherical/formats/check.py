@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections import Counter
 from fractions import Fraction
+from math import lcm
 
 from ..catalogue import catalogue_from_text
 from ..core.base_element import base_element
@@ -18,6 +19,7 @@ from ..core.configuration import Box
 from ..core.element_types import classify_faces
 from ..core.geometry import Frame, six_volume
 from ..core.polyhedron import face_kind, measure
+from ..core.shapes import Shape
 from ..errors import FormatError, InputError
 from ..files.flowyaml import split_section
 from ..files.yamlio import parse_yaml, read_text, validate
@@ -82,7 +84,6 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
         # Positions as integer pairs: they key the geometry cache, and hashing
         # Fractions would be most of the check's time.
         positions = {n: tuple((x.numerator, x.denominator) for x in point) for n, point in nodes.items()}
-        shape = cfg.shape
         checked = []
         for criterion in header["criteria"]:
             where = f"{name}: configurations/{code}/{criterion}"
@@ -99,7 +100,7 @@ def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True
                     if t is None:
                         raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
             if tiling and types:
-                _check_tiling(nodes, positions, box.squared, elements, types, geometry, where, shape)
+                _check_tiling(nodes, positions, box.squared, elements, types, geometry, where, cfg.shape)
         if tiling and types:
             _check_recomputed(cfg, positions, box.squared, entry, header["criteria"], f"{name}: configurations/{code}",
                               recomputed)
@@ -153,8 +154,8 @@ def _recompute(points: tuple, squared) -> tuple | None:
     return etype.id, mirrored, element.center
 
 
-def _element_geometry(element: dict, points: tuple, squared, types, shape=None) -> tuple | None:
-    """(unit volume, faces as (node set, on the boundary of the box or ``shape``)) of an element,
+def _element_geometry(element: dict, points: tuple, squared, types, shape: Shape) -> tuple | None:
+    """(unit volume, faces as (node set, on the boundary of the base element ``shape``)) of an element,
     or ``None`` if its nodes do not make a proper element of its type."""
     frame = Frame.build(dict(enumerate(points)), squared)  # frame index = position in the element's node list
     cycles = [face["nodes"] for face in types[element["type"]]["reference_faces"]]
@@ -164,23 +165,23 @@ def _element_geometry(element: dict, points: tuple, squared, types, shape=None) 
     if six <= 0:
         return None
     nodes, coords, scale = element["nodes"], frame.coords, frame.scale
-    # The box's or the shape's face planes, in the frame's integer coordinates (x = coords / scale).
-    planes = [] if shape is None else [(normal, offset * scale) for normal, offset in shape.planes]
+    # The shape's face planes, in the frame's integer coordinates (x = coords / scale), with
+    # integer normals: the test runs on integers, as the box's did.
+    planes = []
+    for normal, offset in shape.planes:
+        common = lcm(*(x.denominator for x in normal))
+        planes.append((tuple(int(x * common) for x in normal), offset * scale * common))
     faces = []
     for cycle in cycles:
-        if shape is None:
-            on_boundary = any(all(coords[p][axis] == coords[cycle[0]][axis] for p in cycle)
-                              and coords[cycle[0]][axis] in (0, scale) for axis in range(3))
-        else:
-            on_boundary = any(all(sum(a * x for a, x in zip(normal, coords[p])) == offset for p in cycle)
-                              for normal, offset in planes)
+        on_boundary = any(all(sum(a * x for a, x in zip(normal, coords[p])) == offset for p in cycle)
+                          for normal, offset in planes)
         faces.append((frozenset(nodes[p] for p in cycle), on_boundary))
     return Fraction(six, 6 * scale**3), tuple(faces)
 
 
 def _check_tiling(nodes: dict, positions: dict, squared, elements, types, geometry: dict, where: str,
-                  shape=None) -> None:
-    """The elements fill the box (or the ``shape``) exactly and meet face to face."""
+                  shape: Shape) -> None:
+    """The elements fill the base element ``shape`` exactly and meet face to face."""
     total = Fraction(0)
     faces: Counter = Counter()
     for k, element in enumerate(elements):
@@ -195,9 +196,9 @@ def _check_tiling(nodes: dict, positions: dict, squared, elements, types, geomet
         volume, element_faces = found
         total += volume
         faces.update(element_faces)
-    if total != (1 if shape is None else shape.unit_volume):
-        raise FormatError(f"{where}: the elements do not fill the {'box' if shape is None else shape.name} "
-                          f"(volume {total} of {1 if shape is None else shape.unit_volume})")
+    if total != shape.unit_volume:
+        raise FormatError(f"{where}: the elements do not fill the {'box' if shape.name == 'cuboid' else shape.name} "
+                          f"(volume {total} of {shape.unit_volume})")
     for (face, on_boundary), count in faces.items():
         if count != (1 if on_boundary else 2):
             raise FormatError(f"{where}: face {sorted(face)} belongs to {count} elements: they do not meet face to face")

@@ -22,7 +22,7 @@ def tessellation_data(tess: Tessellation) -> dict:
     cfg = tess.configuration
     real = cfg.real_nodes()
     return {
-        **({"element": cfg.shape.name} if cfg.shape is not None else {}),
+        **({"element": cfg.shape.name} if cfg.shape.name != "cuboid" else {}),  # the cuboid is the default
         "box": list(cfg.box.texts),
         "code": cfg.code,
         "point_set_code": cfg.point_set_code,  # the key of this point set in any pattern table

@@ -18,10 +18,10 @@ from typing import Callable, Iterator, Sequence
 
 from ..catalogue import CRITERIA, Choice, choose
 from ..core.base_element import base_element
-from ..core.configuration import EDGES, BaseConfiguration, Box
+from ..core.configuration import Box, Configuration
 from ..core.element_types import ElementType
 from ..core.shapes import mask_codes, standard_shape
-from ..core.symmetry import BaseSymmetry
+from ..core.symmetry import Symmetry
 from ..core.tessellation import Element, Tessellation
 
 __all__ = ["Study", "TypeCount", "bisection_codes", "map_tessellation", "run_study"]
@@ -36,10 +36,10 @@ def bisection_codes(element: str = "cuboid") -> list[str]:
     >>> len(bisection_codes()), bisection_codes("tetrahedron")[:3]
     (4096, ['000000', '800000', '080000'])
     """
-    return mask_codes(len(EDGES) if element == "cuboid" else len(standard_shape(element).edges))
+    return mask_codes(len(standard_shape(element).edges))
 
 
-def map_tessellation(tess: Tessellation, sym: BaseSymmetry, target: BaseConfiguration) -> Tessellation:
+def map_tessellation(tess: Tessellation, sym: Symmetry, target: Configuration) -> Tessellation:
     """The image of ``tess`` under ``sym``; ``target`` is the image configuration."""
     elements = []
     for element in tess.elements:
@@ -63,7 +63,7 @@ class Study:
     box: Box
     face_points: str
     codes: tuple[str, ...]
-    representative: dict[str, tuple[str, BaseSymmetry]]  # code -> (orbit representative, symmetry to it)
+    representative: dict[str, tuple[str, Symmetry]]  # code -> (orbit representative, symmetry to it)
     choices: dict[str, Choice]  # criterion -> kept types and the representatives' tessellations
     element: str = "cuboid"  # the base element: cuboid, prism, pyramid or tetrahedron
 
