@@ -108,6 +108,17 @@ def test_heavy_examples_say_their_time_and_size():
     assert [(page, line) for page, text in PAGES.items() for line in heavy_lines_without_figures(text)] == []
 
 
+def test_every_benchmark_example_runs_at_a_small_size():
+    # a benchmark's default size is the figure it records (minutes of CPU, GBs): its example line must
+    # have a SMALLER rule, or the test below runs it at that size
+    from examples import SMALLER
+
+    lines = {line for text in [*PAGES.values(), (ROOT / "README.md").read_text()] for line in shell_examples(text)}
+    benchmarks = [line for line in lines if line.startswith("python benchmarks/")]
+    assert benchmarks, "the pages show the benchmarks"
+    assert [line for line in benchmarks if not any(pattern.search(line) for pattern, _ in SMALLER)] == []
+
+
 def _docs_lines() -> list[str]:
     lines = dict.fromkeys(line for text in PAGES.values() for line in shell_examples(text))
     return [line for line in lines if line not in README_LINES and not any(skip in line for skip in NOT_RUN)]
