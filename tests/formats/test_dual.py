@@ -251,3 +251,37 @@ def test_a_dual_npz_that_inflates_is_refused_from_its_headers(dual_run, tmp_path
     monkeypatch.setattr(dual_format, "machine_memory", lambda: 2 * good.stat().st_size)
     assert main(["check", str(good)]) == 2
     assert "more than half this machine's memory" in capsys.readouterr().err
+
+
+def test_elements_whose_exact_hulls_are_too_much_work_are_refused_before_any_geometry(dual_run, tmp_path, capsys,
+                                                                                         monkeypatch):
+    """Re-signed elements of 64 co-spherical vertices, each a different shape: every distinct shape costs
+    an exact hull (about 0.1 CPU-s at 64 vertices), so a small file of many of them would keep check busy
+    for hours; the work is bounded from the elements alone, before any hull is computed."""
+    from cospherical.cli import main
+    from cospherical.formats.dual import read_dual
+    from cospherical.mesh import dual as mesh_dual_module
+
+    good = dual_run / "a" / "dual.npz"
+    dual = read_dual(good)
+    # grid points on one sphere of the 1 x 2 x 4 domain's metric: x^2 + 4 y^2 + 16 z^2 = 324
+    sphere = [(x, y, z) for x in range(-18, 19) for y in range(-9, 10) for z in range(-4, 5)
+              if x * x + 4 * y * y + 16 * z * z == 324]
+    sphere = sphere[:len(dual.grid_vertices)]
+    assert len(sphere) == 65
+    vertices = dual.grid_vertices.copy()
+    vertices[:len(sphere)] = np.array(sphere) + [18, 9, 5]
+    count = 30
+    nodes = np.array([[v for v in range(65) if v != e] for e in range(count)])
+    assert len({tuple(row) for row in nodes}) == count  # 30 distinct shapes of 64 co-spherical vertices
+    _resigned(good, tmp_path / "hulls.npz", lambda m: m.update(grid=64),
+              {"grid_vertices": vertices, "element_nodes": nodes, "element_sizes": np.full(count, 64),
+               "element_circumcenter": np.zeros((count, 3))})
+    measured = []
+    real_measure = mesh_dual_module.measure
+    monkeypatch.setattr(mesh_dual_module, "measure", lambda *args: measured.append(args) or real_measure(*args))
+    capsys.readouterr()
+    assert main(["check", str(tmp_path / "hulls.npz")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "member element_nodes: " in err and "Traceback" not in err, err
+    assert measured == []

@@ -52,7 +52,10 @@ volume and boundary area with the file's, exactly, and every float with the one 
 exact value gives.  A change that keeps the sums (one coefficient ``+k``, another
 ``-k``) is refused with the first edge it changed.  The cost is that of computing
 the dual from its elements: 0.9 CPU-s for the 50,912 elements of the 21,512-leaf
-example of the results page, linear in the elements.  The circumcentres
+example of the results page, linear in the elements.  Elements whose distinct shapes
+would need more exact hull work than their number justifies (a small file of many
+different 64-vertex shapes would take hours) are refused before any hull is computed.
+The circumcentres
 (``element_circumcenter``, floats for display) are not compared.
 """
 
@@ -93,6 +96,13 @@ _MEMBERS = {
 # the most vertices an element may list: a leaf's 26 points, or a cell of the global mode (co-spherical
 # grid points); bounds the exact hull computed per distinct element shape when the dual is verified
 _MAX_ELEMENT_NODES = 64
+# The exact work of verifying: a hull per distinct element shape, which tries every triple of its
+# vertices (about 2 microseconds a triple; 0.1 CPU-s at 64 vertices). A file of many distinct large
+# shapes would take hours, so their triples are bounded before any hull: a fixed allowance (about 2
+# CPU-s) and so many per element (our meshes need a few: the results page's 50,912 elements are 363
+# shapes of at most 8 vertices, 3,660 triples), which keeps the hulls within a few times the rest.
+_TRIPLES_ALLOWED = 1_000_000
+_TRIPLES_PER_ELEMENT = 100
 _STAMP = (1980, 1, 1, 0, 0, 0)
 _MAX_DIGITS = 200
 # the manifest's exact numbers as written: plain integers and fractions of bounded length, so that a
@@ -335,6 +345,36 @@ class _Vertices:
     vertices: np.ndarray
 
 
+def _bound_hull_work(dual: Dual, path: str | Path) -> None:
+    """Refuse elements whose distinct shapes need more exact hull work than :data:`_TRIPLES_ALLOWED`
+    and :data:`_TRIPLES_PER_ELEMENT` allow (see there), from the vertex ids alone.
+
+    Shapes are told apart up to translation, finer than the dual's grouping (which also divides out
+    a power of two), so the work counted is never less than the work done.
+    """
+    nodes, vertices = dual.element_nodes, dual.grid_vertices
+    allowed = _TRIPLES_ALLOWED + _TRIPLES_PER_ELEMENT * len(nodes)
+    seen: set[bytes] = set()
+    triples = 0
+    step = max(1, (1 << 20) // max(1, nodes.shape[1]))  # elements per block: a few MB of coordinates
+    for start in range(0, len(nodes), step):
+        block = nodes[start:start + step].astype(np.int64)
+        used = block >= 0
+        coords = vertices[np.where(used, block, 0)]
+        low = np.where(used[..., None], coords, np.iinfo(np.int64).max).min(axis=1)
+        relative = np.where(used[..., None], coords - low[:, None, :], -1).reshape(len(block), -1)
+        rows = np.ascontiguousarray(relative).view(np.dtype((np.void, relative.shape[1] * 8))).ravel()
+        for row in np.unique(rows):  # as raw bytes: ten times faster than np.unique(axis=0)
+            key = row.tobytes()
+            if key not in seen:
+                seen.add(key)
+                triples += math.comb(int((np.frombuffer(key, dtype=np.int64)[::3] >= 0).sum()), 3)
+                if triples > allowed:
+                    raise FormatError(f"{path}: member element_nodes: {len(seen):,} distinct element shapes whose "
+                                      f"exact hulls are more work than {len(nodes):,} elements may need "
+                                      f"({triples:,} vertex triples, at most {allowed:,})")
+
+
 def verify_dual(dual: Dual, path: str | Path) -> None:
     """Compute ``dual`` again from its vertices and elements and compare, exactly (see the module).
 
@@ -343,6 +383,7 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
     """
     from ..mesh.dual import _scaled, boundary_areas, mesh_dual
 
+    _bound_hull_work(dual, path)
     try:
         again = mesh_dual(_Vertices(dual.box, dual.grid, dual.grid_vertices), (dual.element_nodes, dual.element_sizes))
     except InputError as error:  # an element that is flat or not co-spherical has no dual
