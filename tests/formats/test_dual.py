@@ -106,7 +106,7 @@ def _resigned(good: Path, target: Path, manifest_edit=None, members: dict | None
 @pytest.mark.parametrize("case", ["factor 1e999999999", "factor 1e400", "grid 10**400", "integers --5",
                                   "integers of 5000 digits", "boundary factors not the domain's",
                                   "manifest nested 100,000 deep", "manifest with a repeated key",
-                                  "a grid vertex outside the grid"])
+                                  "a grid vertex outside the grid", "version 2 (no elements)"])
 def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, tmp_path, capsys, case):
     from cospherical.cli import main
 
@@ -118,7 +118,8 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
              # the manifest read by the readers' one JSON parser (json.loads recursed: a RecursionError
              # traceback), which also refuses a repeated key instead of keeping the last
              "manifest nested 100,000 deep": lambda m: "[" * 100_000 + "]" * 100_000,
-             "manifest with a repeated key": lambda m: json.dumps(m)[:-1] + ', "version": 1}'}
+             "manifest with a repeated key": lambda m: json.dumps(m)[:-1] + ', "version": 1}',
+             "version 2 (no elements)": lambda m: m.update(version=2)}
     members = None
     if case.startswith("integers"):
         from cospherical.formats.dual import read_dual
@@ -139,6 +140,8 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
     assert err.count("\n") == 1 and "Traceback" not in err, err
     assert time.monotonic() - start < 30  # 10**999999999 would take far longer
     assert case != "manifest with a repeated key" or "repeated key 'version'" in err, err
+    assert not case.startswith("version") or "dual format version 2; this reads 3 (write it again with " \
+        "cospherical mesh --dual)" in err, err
 
 
 def _edited(good: Path, target: Path, edit) -> None:

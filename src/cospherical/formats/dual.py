@@ -6,7 +6,7 @@ same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` element
 
 ===========================  ==========  ==================================================
 ``manifest``                 uint8       JSON text: ``format`` (``cospherical-dual``),
-                                         ``version`` (2), ``domain`` (the box, exact
+                                         ``version`` (3), ``domain`` (the box, exact
                                          texts), ``grid``, the exact denominators and
                                          factors (decimal texts), ``sha256`` of every
                                          other member
@@ -258,7 +258,8 @@ def _manifest(raw: np.ndarray, path: Path) -> dict:
     if not isinstance(manifest, dict) or manifest.get("format") != "cospherical-dual":
         raise FormatError(f"{path}: not a cospherical dual (its manifest names no format cospherical-dual)")
     if manifest.get("version") != DUAL_FORMAT_VERSION:
-        raise FormatError(f"{path}: dual format version {manifest.get('version')!r}; this reads {DUAL_FORMAT_VERSION}")
+        raise FormatError(f"{path}: dual format version {manifest.get('version')!r}; this reads {DUAL_FORMAT_VERSION} "
+                          "(write it again with cospherical mesh --dual)")
     for key, kind in (("domain", list), ("grid", int), ("coefficient_denominator", str), ("volume_denominator", str),
                       ("volume_factor_squared", str), ("boundary_area_denominator", str),
                       ("boundary_factors_squared", list), ("sha256", dict)):
