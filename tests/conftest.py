@@ -1,4 +1,5 @@
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 import pytest
@@ -8,12 +9,42 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 
 
+def pytest_addoption(parser):
+    parser.addoption("--full", action="store_true",
+                     help="heavy oracles check every case, not the seeded sample the default run checks")
+
+
+@pytest.fixture(scope="session")
+def full(request) -> bool:
+    """Whether ``--full`` was given: a test that checks a seeded sample of a large set checks all of it."""
+    return request.config.getoption("--full")
+
+
+class _Studies(Mapping):
+    """The bisection study of each box, with every criterion, made when first read: a worker that
+    runs only the tests of one box makes only its study."""
+
+    def __init__(self, boxes: dict):
+        self._boxes, self._made = boxes, {}
+
+    def __getitem__(self, key):
+        if key not in self._made:
+            from cospherical import Box
+            from cospherical.studies.engine import bisection_codes, run_study
+
+            self._made[key] = run_study("bisection", Box.parse(self._boxes[key]), bisection_codes())
+        return self._made[key]
+
+    def __iter__(self):
+        return iter(self._boxes)
+
+    def __len__(self):
+        return len(self._boxes)
+
+
 @pytest.fixture(scope="session")
 def paper_studies():
-    """The paper's three bisection studies (boxes A, B, C; every criterion), made once per test
-    process: the paper's tables and the split checks of several modules read them, none changes them."""
-    from cospherical import Box
-    from cospherical.studies.engine import bisection_codes, run_study
-
-    boxes = {"A": ("1", "1", "1"), "B": ("1", "2", "4"), "C": ("1", "1.4142", "1.4142")}
-    return {key: run_study("bisection", Box.parse(box), bisection_codes()) for key, box in boxes.items()}
+    """The paper's three bisection studies (boxes A, B, C; every criterion), each made once per test
+    process: the paper's tables, the split checks of several modules and the intersection study at
+    resolution 2 read them, none changes them."""
+    return _Studies({"A": ("1", "1", "1"), "B": ("1", "2", "4"), "C": ("1", "1.4142", "1.4142")})
