@@ -249,7 +249,21 @@ class Configuration:
     @cached_property
     def admissible_faces(self) -> frozenset[int]:
         """The faces that may carry a point: quadrilaterals with four split edges, opposite ones at the same t."""
-        return frozenset(f for f in self.shape.quad_faces if self._face_parameters(f) is not None)
+        return frozenset(self._face_cuts)
+
+    @cached_property
+    def _face_cuts(self) -> dict[int, tuple[Fraction, Fraction]]:
+        # Admissible face -> the parameters (t along c0->c1, s along c0->c3) of its cut lines.
+        cuts = {}
+        steiner = self.steiner
+        for f, ((a, fa), (b, fb), (c, fc), (d, fd)) in self.shape.cut_sides.items():
+            ta, tb, tc, td = steiner[a], steiner[b], steiner[c], steiner[d]
+            if ta is None or tb is None or tc is None or td is None:
+                continue
+            # opposite sides at one parameter, measured the same way (one of them reversed: 1 - t)
+            if (ta == tb if fa == fb else ta == 1 - tb) and (tc == td if fc == fd else tc == 1 - td):
+                cuts[f] = (ta if fa else 1 - ta, tc if fc else 1 - tc)
+        return cuts
 
     @property
     def point_faces(self) -> frozenset[int]:
@@ -279,8 +293,8 @@ class Configuration:
         for k, t in enumerate(self.steiner):
             if t is not None:
                 nodes[first + k] = shape.edge_point(k, t)
-        for f in sorted(self.point_faces):
-            nodes[shape.face_nodes[f]] = shape.face_point(f, *self._face_parameters(f))
+        for f in sorted(self.point_faces):  # each admissible: explicit faces are checked on construction
+            nodes[shape.face_nodes[f]] = shape.face_point(f, *self._face_cuts[f])
         if self.has_body_point:
             # every face carries a point, so all the edges of a parallel class are split at one t
             origin, classes = shape.parallelepiped
@@ -295,11 +309,6 @@ class Configuration:
         """Node id -> float coordinates in the real box (for output and plotting)."""
         scale = self.box.to_float()
         return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}
-
-    def _face_parameters(self, f: int) -> tuple[Fraction, Fraction] | None:
-        """The parameters (t along c0->c1, s along c0->c3) of face f's cut lines, or ``None``
-        when it cannot carry a point."""
-        return None if self._inadmissible(f) else self._cut_parameters(f)[::2]
 
     def _cut_parameters(self, f: int) -> list[Fraction]:
         # the parameters on the sides of Shape.cut_sides, each measured the way its side runs

@@ -348,10 +348,18 @@ class Shape:
         """The point of quadrilateral face f (cycle c0 c1 c2 c3) where its two cut lines cross: the
         line through the points at t on sides c0->c1 and c3->c2, and the one through the points
         at s on sides c0->c3 and c1->c2."""
+        parallelogram = self._parallelograms.get(f)
+        if parallelogram is not None:  # the cut lines run along its sides: c0 + t (c1 - c0) + s (c3 - c0)
+            point = list(parallelogram[0])
+            for axis, along_t, along_s in parallelogram[1]:
+                x = point[axis]
+                if along_t:
+                    x = t if along_t == 1 and x == 0 else x + t * along_t
+                if along_s:
+                    x = s if along_s == 1 and x == 0 else x + s * along_s
+                point[axis] = x
+            return tuple(point)
         c = [self.corners[i] for i in self.faces[f]]
-        if all(a + b == d + e for a, b, d, e in zip(c[0], c[2], c[1], c[3])):
-            # a parallelogram: the cut lines run along its sides
-            return tuple(a + t * (b - a) + s * (d - a) for a, b, d in zip(c[0], c[1], c[3]))
         p = [a + t * (b - a) for a, b in zip(c[0], c[1])]
         q = [a + t * (b - a) for a, b in zip(c[3], c[2])]
         r = [a + s * (b - a) for a, b in zip(c[0], c[3])]
@@ -365,6 +373,19 @@ class Shape:
                 x = (e[i] * -d2[j] + d2[i] * e[j]) / det
                 return tuple(a + x * b for a, b in zip(p, d1))
         raise AssertionError("the cut lines of a convex face cross")  # pragma: no cover
+
+    @cached_property
+    def _parallelograms(self) -> dict:
+        # Per quadrilateral face that is a parallelogram: c0 and, per coordinate that varies over
+        # the face, (axis, its change along c0->c1, along c0->c3); the face points of a
+        # configuration are computed from these (the cuboid's coordinates are then t or s alone).
+        found = {}
+        for f in self.quad_faces:
+            c = [self.corners[i] for i in self.faces[f]]
+            if all(a + b == d + e for a, b, d, e in zip(c[0], c[2], c[1], c[3])):
+                found[f] = (c[0], tuple((a, c[1][a] - c[0][a], c[3][a] - c[0][a]) for a in range(3)
+                                        if c[1][a] != c[0][a] or c[3][a] != c[0][a]))
+        return found
 
     def edge_index(self, i: int, j: int) -> int:
         return self._edge_index[frozenset((i, j))]
@@ -468,8 +489,16 @@ def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
     ...
     cospherical.errors.InputError: element 'cube': choose one of cuboid, prism, pyramid, tetrahedron
     """
-    box = box if isinstance(box, Box) else Box.parse(box)
+    if not isinstance(box, Box):
+        lengths = tuple(box)
+        # a box given as texts, as most callers give it, is parsed once
+        box = _parsed_box(lengths) if all(isinstance(x, str) for x in lengths) else Box.parse(lengths)
     return _standard_shape(name, box)
+
+
+@cached(maxsize=64)
+def _parsed_box(lengths: tuple[str, ...]) -> Box:
+    return Box.parse(lengths)
 
 
 @cached(maxsize=64)  # one object per shape and box: its symmetries and maps are cached on it
