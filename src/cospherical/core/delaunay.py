@@ -179,11 +179,7 @@ def delaunay_cells(frame: Frame, backend: str = "python") -> list[Cell]:
                 g = nx * x + ny * y_ + nz * z - offset
                 if -h * best_g > -best_h * g:
                     best_h, best_g = h, g
-            a, b, c, d = first.normal
-            best = Sphere(
-                (best_g * a - best_h * nx, best_g * b - best_h * ny, best_g * c - best_h * nz, best_g * d),
-                best_g * first.offset - best_h * offset,
-            )
+            best = first.pencil(normal, offset, best_h, best_g)
             a, b, c, d = best.normal  # best.side(point) == 0, inlined: the walk's innermost loop
             neighbour = [m for m, (x, y, z, w) in enumerate(lifted) if a * x + b * y + c * z + d * w == best.offset]
             if frozenset(neighbour) not in seen:

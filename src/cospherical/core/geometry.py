@@ -39,7 +39,7 @@ from itertools import combinations
 from typing import Mapping, Sequence
 
 __all__ = ["Frame", "Sphere", "area_vector", "circumcentres", "collinear", "cross", "determinant", "dot",
-           "in_closed_box", "plane_normal", "six_volume", "six_volumes", "sphere_sides", "sub", "tetra_six_volume"]
+           "in_closed_box", "plane_normal", "plane_projection", "six_volume", "six_volumes", "sphere_sides", "sub", "tetra_six_volume"]
 
 Vector = tuple[int, int, int]
 
@@ -157,6 +157,21 @@ def area_vector(polygon: Sequence[Sequence]) -> Vector:
         normal = (normal[0] + (p[1] - q[1]) * (p[2] + q[2]), normal[1] + (p[2] - q[2]) * (p[0] + q[0]),
                   normal[2] + (p[0] - q[0]) * (p[1] + q[1]))
     return normal
+
+
+def plane_projection(point: Sequence[int], origin: Sequence[int], normal: Sequence[int],
+                     inverse_weights: Sequence[int]) -> tuple[Vector, int]:
+    """The projection of ``point`` onto the plane through ``origin`` with ``normal`` (frame coordinates),
+    orthogonal in the real metric: ``inverse_weights`` proportional to the inverse weights (integers,
+    lcm(w) // w_k).  Returns ``(numerators, s)``, the projection being numerators / s with
+    s = sum N_k^2 / w_k (scaled as the inverse weights): along the real normal, W^-1 N.
+
+    >>> plane_projection((3, 4, 5), (0, 0, 1), (0, 0, 1), (1, 1, 1))
+    ((3, 4, 1), 1)
+    """
+    s = sum(n * n * v for n, v in zip(normal, inverse_weights))
+    along = dot(sub(point, origin), normal)
+    return tuple(x * s - along * n * v for x, n, v in zip(point, normal, inverse_weights)), s
 
 
 def six_volume(coords, cycles) -> int:
@@ -282,6 +297,13 @@ class Sphere:
         x, y, z = point
         lifted = weights[0] * x * x + weights[1] * y * y + weights[2] * z * z
         return (a * x + b * y + c * z) * divisor + d * lifted - self.offset * divisor * divisor
+
+    def pencil(self, normal: Sequence[int], offset: int, h: int, g: int) -> "Sphere":
+        """The sphere ``g * self - h * plane`` of the pencil through the circle where the plane
+        ``normal . x = offset`` meets this sphere (``g > 0`` keeps the lifted coefficient positive)."""
+        a, b, c, d = self.normal
+        return Sphere((g * a - h * normal[0], g * b - h * normal[1], g * c - h * normal[2], g * d),
+                      g * self.offset - h * offset)
 
     def scaled(self, g: int) -> "Sphere":
         """The sphere :meth:`Frame.sphere` gives for the same four points with every coordinate times

@@ -54,7 +54,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..core.configuration import Box
-from ..core.geometry import Frame, determinant, dot, plane_normal, six_volumes, sub
+from ..core.geometry import Frame, determinant, plane_normal, plane_projection, six_volumes, sub
 from ..core.polyhedron import measure
 from ..errors import InputError
 from .octree import distinct
@@ -104,7 +104,7 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
     w = tuple(Fraction(x) for x in squared)
     lam = math.lcm(*(x.denominator for x in w))
     weight = tuple(int(x * lam) for x in w)
-    big = math.lcm(*weight)
+    inverse = tuple(math.lcm(*weight) // x for x in weight)
     scale = 2 * math.lcm(*(Fraction(x).denominator for p in (*points.values(), center) for x in p))
     ip = {n: tuple(int(Fraction(x) * scale) for x in p) for n, p in points.items()}
     ic = tuple(int(Fraction(x) * scale) for x in center)
@@ -114,9 +114,7 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
     for cycle in faces:
         p0, p1, p2 = (ip[n] for n in cycle[:3])
         normal = plane_normal(p0, p1, p2)  # no three points of a circle are collinear
-        s = sum(normal[k] * normal[k] * (big // weight[k]) for k in range(3))
-        dn = dot(sub(ic, p0), normal)
-        face_center = tuple(ic[k] * s - dn * normal[k] * (big // weight[k]) for k in range(3))  # times D * S
+        face_center, s = plane_projection(ic, p0, normal, inverse)  # the face's circle centre, times D * S
         cs = tuple(x * s for x in ic)
         plane = [k for k in range(3) if normal[k] != 0]
         shares = None
