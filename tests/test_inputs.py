@@ -414,6 +414,27 @@ def test_a_damaged_checkpoint_is_computed_again_never_counted(intersection_run, 
     assert path.read_bytes() == original  # rewritten whole, the same bytes
 
 
+def test_a_store_with_a_long_code_is_refused_without_reading_it(tmp_path):
+    """length() of a text reads it whole: a 150 MB code took as much memory to refuse as it is long."""
+    import sqlite3
+
+    path = _store(tmp_path)
+    connection = sqlite3.connect(path)
+    connection.execute("INSERT INTO entries VALUES (?, zeroblob(10))", ("0" * 150_000_000,))
+    connection.commit()
+    connection.close()
+    program = ("import re, sys\n"
+               "from cospherical.errors import FormatError\n"
+               "from cospherical.formats.sqlite_store import open_store\n"
+               "try:\n    open_store(sys.argv[1])\nexcept FormatError as error:\n    print(error)\n"
+               # this process's peak (ru_maxrss would be the parent's, kept across exec)
+               "print(re.search(r'VmHWM:\\s*(\\d+)', open('/proc/self/status').read()).group(1))")
+    result = subprocess.run([sys.executable, "-c", program, str(path)], capture_output=True, text=True, timeout=120)
+    line, peak_kb = result.stdout.splitlines()
+    assert "store damaged: an entry is stored in over" in line, result
+    assert int(peak_kb) < 100_000, peak_kb  # 150 MB and more before
+
+
 def test_a_store_entry_with_a_bad_node_list_is_refused_like_a_yaml_one(tmp_path):
     import sqlite3
 

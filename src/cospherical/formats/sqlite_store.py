@@ -57,6 +57,11 @@ _MAX_HEADER = 1 << 16
 # the sizes are bounded by one scan when the store is opened (5 ms for 32,077 entries), and
 # again in each query, for a file changed after it was opened.
 _OVERSIZED = f"SELECT 1 FROM entries WHERE length(entry) > {MAX_ENTRY} OR length(code) > {MAX_ENTRY} LIMIT 1"
+# length() of a blob reads its size from the record header, but length() of a text (the code) reads
+# the text whole (a 200 MB code: 221 MB to refuse the store).  SQLite's dbstat table gives each
+# page's largest record payload from the cell headers, following overflow chains page by page in
+# the page cache: no record is ever held whole.  Two bounded columns and a header of a few bytes.
+_OVERSIZED_RECORD = f"SELECT 1 FROM dbstat WHERE name = 'entries' AND mx_payload > {2 * MAX_ENTRY + 64} LIMIT 1"
 _BOUNDED_ENTRY = f"CASE WHEN length(entry) <= {MAX_ENTRY} THEN entry END"
 
 
@@ -154,7 +159,11 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
             raise ValueError(f"its header is not a mapping, its count is not that of a table, or it has not one "
                              f"dictionary of at most {_DICTIONARY_SIZE} bytes")
         (dictionary,) = rows[0]
-        if connection.execute(_OVERSIZED).fetchone() is not None:
+        try:
+            oversized = connection.execute(_OVERSIZED_RECORD).fetchone() is not None
+        except sqlite3.OperationalError:  # an SQLite built without dbstat: the scan below reads a long code whole
+            oversized = False
+        if oversized or connection.execute(_OVERSIZED).fetchone() is not None:
             raise FormatError(f"{path}: store damaged: an entry is stored in over {MAX_ENTRY} bytes")
     except FormatError:
         raise  # names the store and the place already
