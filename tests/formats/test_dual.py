@@ -186,11 +186,18 @@ def test_a_resigned_edit_that_keeps_every_sum_is_refused_naming_the_edge(dual_ru
         arrays["element_nodes"][2, 1] = arrays["element_nodes"][2, 0]
         return ["element_nodes"]
 
+    def a_vertex_moved_onto_another(arrays):  # an element with an edge of length 0: a ZeroDivisionError before
+        arrays["grid_vertices"][dual.element_nodes[0, 1]] = arrays["grid_vertices"][dual.element_nodes[0, 0]]
+        return ["grid_vertices"]
+
     i, j = dual.edges[min(a, b)]
+    first, second = sorted(dual.element_nodes[0, :2].tolist())
     for edit, needle in ((balanced_coefficients, f"member coefficient_exact: edge {i}-{j} "),
                          (balanced_volumes, "member volume_exact: vertex 0 "),
                          (a_float_alone, f"member coefficient: edge {dual.edges[b, 0]}-{dual.edges[b, 1]} "),
-                         (a_vertex_twice, "member element_nodes: element 2 names a vertex twice")):
+                         (a_vertex_twice, "member element_nodes: element 2 names a vertex twice"),
+                         (a_vertex_moved_onto_another, f"member grid_vertices: vertices {first} and {second} are "
+                                                       "one grid point")):
         target = tmp_path / f"{edit.__name__}.npz"
         _edited(good, target, edit)
         if edit is not a_vertex_twice:  # the reader refuses that one itself

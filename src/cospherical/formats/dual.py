@@ -346,6 +346,17 @@ class _Vertices:
     vertices: np.ndarray
 
 
+def _distinct_vertices(vertices: np.ndarray, path: str | Path) -> None:
+    """Refuse two vertices at one grid point: an element holding both has an edge of length 0,
+    which no dual has (its coefficient would divide by it)."""
+    order = np.lexsort(vertices.T[::-1])
+    same = np.flatnonzero(np.all(vertices[order[1:]] == vertices[order[:-1]], axis=1))
+    if len(same):
+        i, j = sorted(int(v) for v in order[same[0]:same[0] + 2])
+        raise FormatError(f"{path}: member grid_vertices: vertices {i} and {j} are one grid point "
+                          f"{vertices[i].tolist()}")
+
+
 def _bound_hull_work(dual: Dual, path: str | Path) -> None:
     """Refuse elements whose distinct shapes need more exact hull work than :data:`_TRIPLES_ALLOWED`
     and :data:`_TRIPLES_PER_ELEMENT` allow (see there), from the vertex ids alone.
@@ -384,6 +395,7 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
     """
     from ..mesh.dual import _scaled, boundary_areas, mesh_dual
 
+    _distinct_vertices(dual.grid_vertices, path)
     _bound_hull_work(dual, path)
     try:
         again = mesh_dual(_Vertices(dual.box, dual.grid, dual.grid_vertices), (dual.element_nodes, dual.element_sizes))
