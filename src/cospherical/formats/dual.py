@@ -368,7 +368,7 @@ def _bound_hull_work(dual: Dual, path: str | Path) -> None:
     allowed = _TRIPLES_ALLOWED + _TRIPLES_PER_ELEMENT * len(nodes)
     seen: set[bytes] = set()
     triples = 0
-    step = max(1, (1 << 20) // max(1, nodes.shape[1]))  # elements per block: a few MB of coordinates
+    step = max(1, (1 << 17) // nodes.shape[1])  # elements per block: 3 MB of coordinates (24 bytes a vertex)
     for start in range(0, len(nodes), step):
         block = nodes[start:start + step].astype(np.int64)
         used = block >= 0
