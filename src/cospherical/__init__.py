@@ -4,8 +4,8 @@ The public API, re-exported here from the modules that define it.  The names loa
 first use, so ``import cospherical`` stays cheap for the command line.
 
 - Configurations and tessellations: ``Box``, ``Configuration``, ``Length`` (an exact
-  length), ``tessellate``, ``Tessellation``, ``Element``, ``ElementType``; the other base
-  elements: ``Shape``, ``ShapeConfiguration``, ``standard_shape``, ``tessellate_shape``.
+  length), ``tessellate``, ``Tessellation``, ``Element``, ``ElementType``; the base elements
+  (the cuboid, a prism, pyramid, tetrahedron or any convex shape): ``Shape``, ``standard_shape``.
 - The element catalogue: ``shipped_catalogue``, ``load_catalogue``, ``type_name``.
 - Pattern tables: ``load_patterns``, ``PatternTable``.
 - Errors: ``CosphericalError`` and its kinds ``InputError``, ``FormatError``, ``UsageError``;
@@ -44,7 +44,6 @@ _API = {
     "Element": "cospherical.core.tessellation",
     "Shape": "cospherical.core.shapes",
     "standard_shape": "cospherical.core.shapes",
-    "tessellate_shape": "cospherical.core.tessellation",
     "Tessellation": "cospherical.core.tessellation",
     "tessellate": "cospherical.core.tessellation",
     "load_catalogue": "cospherical.catalogue",

@@ -13,7 +13,7 @@ from oracle import qhull_regions
 from strategies import LENGTHS, PARAMETERS
 from tests.core.test_delaunay import check_canonical_codes
 
-from cospherical import Configuration, InputError, Shape, standard_shape, tessellate_shape
+from cospherical import Configuration, InputError, Shape, standard_shape, tessellate
 from cospherical.core.geometry import Frame
 from cospherical.core.shapes import STANDARD_SHAPES, mask_codes
 from cospherical.core.symmetry import orbit_representatives, shape_symmetries
@@ -32,7 +32,7 @@ def test_every_bisection_configuration_matches_qhull(name):
     samples: dict[str, list] = defaultdict(list)
     for code in mask_codes(len(shape.edges)):
         cfg = Configuration.from_code(code, shape=shape)
-        tess = tessellate_shape(cfg)
+        tess = tessellate(cfg)
         assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes()), code
         for e in tess.elements:
             if len(samples[e.type.code]) < 3:
@@ -47,7 +47,7 @@ def test_other_boxes_match_qhull(box):
         shape = standard_shape(name, BOXES[box])
         for code in mask_codes(len(shape.edges))[::7]:
             cfg = Configuration.from_code(code, shape=shape)
-            assert {frozenset(e.nodes) for e in tessellate_shape(cfg).elements} == qhull_regions(cfg.real_nodes())
+            assert {frozenset(e.nodes) for e in tessellate(cfg).elements} == qhull_regions(cfg.real_nodes())
 
 
 @st.composite
@@ -66,7 +66,7 @@ def test_invariants_on_random_steiner_positions(cfg):
     """Volumes add up to the element's exactly, elements meet face to face (an inner face in two
     elements, a boundary face in one, on the element's boundary), and every sphere is empty."""
     shape = cfg.shape
-    tess = tessellate_shape(cfg)
+    tess = tessellate(cfg)
     assert sum(e.polyhedron.unit_volume for e in tess.elements) == shape.unit_volume
     nodes = tess.nodes
     frame = Frame.build(nodes, cfg.box.squared)
@@ -94,7 +94,7 @@ def _quadruples(members):
 def test_fvm_is_the_base_element():
     # The tetrahedron with every midpoint: the middle octahedron's center (1/4, 1/4, 1/4)... lies
     # inside; a long thin box moves circumcenters out of the element but not out of the box.
-    tess = tessellate_shape(Configuration.from_code("888888", shape=standard_shape("tetrahedron", ("1", "1", "8"))))
+    tess = tessellate(Configuration.from_code("888888", shape=standard_shape("tetrahedron", ("1", "1", "8"))))
     centers = [e.polyhedron.center for e in tess.elements]
     assert all(all(0 <= x <= 1 for x in c) for c in centers)
     assert not tess.fvm_adequate
@@ -131,8 +131,8 @@ def test_symmetry_groups_and_orbits():
             assert sym.code(code) == rep
             assert sym.inverse().code(rep) == code
             # the image tessellation is the tessellation of the image
-            ours = tessellate_shape(Configuration.from_code(code, shape=shape))
-            theirs = tessellate_shape(Configuration.from_code(rep, shape=shape))
+            ours = tessellate(Configuration.from_code(code, shape=shape))
+            theirs = tessellate(Configuration.from_code(rep, shape=shape))
             assert sorted(sym.polyhedron(e.polyhedron).faces for e in ours.elements) == \
                 sorted(e.polyhedron.faces for e in theirs.elements)
 
@@ -174,6 +174,6 @@ def test_general_quadrilateral_face_point():
     cfg = Configuration.from_steiner(steiner={0: "1/2", 1: "1/2", 2: "1/2", 3: "1/2"}, shape=shape)
     assert cfg.point_faces == {0}
     assert cfg.nodes()[20 + 0] == (Fraction(1, 2), Fraction(1, 4), 0)
-    tess = tessellate_shape(cfg)
+    tess = tessellate(cfg)
     assert sum(e.polyhedron.unit_volume for e in tess.elements) == shape.unit_volume
     assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes())

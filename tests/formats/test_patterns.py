@@ -13,7 +13,7 @@ import pytest
 import yaml
 from commands import cospherical
 
-from cospherical import Box, Configuration, standard_shape, tessellate, tessellate_shape
+from cospherical import Box, Configuration, standard_shape, tessellate
 from cospherical.catalogue import catalogue_path, load_catalogue, shipped_catalogue
 from cospherical.errors import FormatError
 from cospherical.files.yamlio import dump_yaml, load_yaml
@@ -200,7 +200,7 @@ def test_committed_shape_tables_pass_check(name):
     assert table.header["element"] == name and len(table.configurations) == 1 << len(shape.edges)
     check_patterns(table, load_catalogue(catalogue_path()), name)  # known types, node counts, tiling
     for code in list(table.configurations)[::5]:
-        tess = tessellate_shape(Configuration.from_code(code, shape=shape))
+        tess = tessellate(Configuration.from_code(code, shape=shape))
         assert table.elements(code) == [
             {"type": e.type.id, "nodes": list(e.nodes), "circumcenter": list(tess.circumcenter(e)),
              **({"mirror": True} if e.mirrored else {})} for e in tess.elements]

@@ -9,7 +9,7 @@ from collections import Counter
 
 import pytest
 
-from cospherical import Configuration, standard_shape, tessellate_shape
+from cospherical import Configuration, standard_shape, tessellate
 from tests.core.test_shapes import SHAPES
 
 
@@ -38,7 +38,7 @@ def test_study_counts_equal_direct_counts(shape_studies, name):
     counts, fvm, fvm_open = Counter(), 0, 0
     for code in study.codes:
         cfg = Configuration.from_code(code, shape=shape)
-        tess = tessellate_shape(cfg)
+        tess = tessellate(cfg)
         counts.update(e.type.id for e in tess.elements)
         fvm += tess.fvm_adequate
         fvm_open += tess.fvm_adequate_open

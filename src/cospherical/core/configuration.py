@@ -18,10 +18,9 @@ from typing import Iterable, Mapping
 from ..errors import InputError
 from .codes import digit_parameters, edge_code_pattern, parameter_digits, parse_point_suffix, point_suffix
 from .exact import parse_rational
-from .shapes import BODY_NODE, CORNERS, EDGES, FACE_EDGES, FACES, Box, Point, Shape, edge_axis, standard_shape
+from .shapes import CORNERS, EDGES, FACE_EDGES, FACES, Box, Point, Shape, edge_axis, standard_shape
 
 __all__ = [
-    "BODY_NODE",
     "Box",
     "CORNERS",
     "Configuration",

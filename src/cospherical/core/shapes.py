@@ -52,7 +52,7 @@ from .codes import mask_codes
 from .exact import Length, parse_rational
 from .geometry import area_vector, collinear, cross, dot, plane_normal, six_volume, sub, tetra_six_volume
 
-__all__ = ["BODY_NODE", "Box", "CORNERS", "EDGES", "ELEMENTS", "FACES", "FACE_EDGES", "STANDARD_SHAPES", "Shape",
+__all__ = ["Box", "CORNERS", "EDGES", "ELEMENTS", "FACES", "FACE_EDGES", "STANDARD_SHAPES", "Shape",
            "edge_axis", "mask_codes", "standard_shape"]
 
 Point = tuple[Fraction, Fraction, Fraction]
@@ -108,7 +108,6 @@ EDGES: tuple[tuple[int, int], ...] = (
 FACES: tuple[tuple[int, int, int, int], ...] = (
     (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7), (0, 1, 2, 3), (4, 5, 6, 7),
 )
-BODY_NODE = 26
 
 
 def edge_axis(edge: int) -> int:

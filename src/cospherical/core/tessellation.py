@@ -11,7 +11,7 @@ from .element_types import ElementType, classify
 from .geometry import Frame
 from .polyhedron import Polyhedron, polyhedron
 
-__all__ = ["Element", "Tessellation", "element_entry", "tessellate", "tessellate_shape", "tessellation_elements"]
+__all__ = ["Element", "Tessellation", "element_entry", "tessellate", "tessellation_elements"]
 
 
 @dataclass(frozen=True)
@@ -126,7 +126,3 @@ def tessellation_elements(nodes, squared, backend: str = "python") -> tuple[Elem
     for cell in delaunay_cells(frame, backend):
         elements.append(Element.from_polyhedron(polyhedron(frame, cell)))
     return tuple(elements)
-
-
-# The name under which a shape's tessellation was first public: the same function.
-tessellate_shape = tessellate
