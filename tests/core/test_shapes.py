@@ -100,6 +100,39 @@ def test_fvm_is_the_base_element():
     assert not tess.fvm_adequate
 
 
+def test_every_element_takes_explicit_face_points_and_point_suffixes():
+    """One configuration class: a prism's quadrilateral face carries an explicit point, named by a
+    point suffix that round-trips and maps with the symmetries; a triangle or a body point is refused."""
+    prism = standard_shape("prism")
+    cfg = Configuration.from_code("888888888", faces=[2], shape=prism)
+    assert cfg.code == cfg.point_set_code == "888888888+f2" and cfg.point_faces == {2}
+    assert cfg.nodes()[6 + 9 + 0] == (Fraction(1, 2), 0, Fraction(1, 2))  # face 2 (y = 0) is quad face 0
+    again = Configuration.from_code(cfg.code, shape=prism)
+    assert again == cfg and again.nodes() == cfg.nodes()
+    assert Configuration.from_code("888888888", shape=prism).point_set_code == "888888888+f234"
+    swap = shape_symmetries(prism)[1]  # x <-> y takes face 2 (y = 0) to face 4 (x = 0)
+    assert swap.code(cfg.code) == "888888888+f4" == swap.configuration(cfg).code
+    for faces, body, message in (([0], False, "face 0 .* only a quadrilateral"), ([2, 3, 4], True, "body point")):
+        with pytest.raises(InputError, match=message):
+            Configuration.from_code("888888888", faces=faces, body=body, shape=prism)
+
+
+@pytest.mark.oracle_qhull
+def test_a_parallelepiped_has_a_body_point():
+    # A sheared box: every face carrying its point (octree policy), the body point where the three
+    # cut planes cross, node 26 as in the cuboid; the tessellation is Qhull's.
+    corners = [(0, 0, 0), (1, 0, 0), (2, 1, 0), (1, 1, 0), (0, 0, 1), (1, 0, 1), (2, 1, 1), (1, 1, 1)]
+    edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
+    faces = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7), (0, 1, 2, 3), (4, 5, 6, 7)]
+    shape = Shape.from_vertices([[Fraction(x, 2) for x in p] for p in corners], edges, faces)
+    cfg = Configuration.from_code("888888888888", shape=shape)
+    assert cfg.point_faces == set(range(6)) and cfg.has_body_point
+    assert cfg.nodes()[26] == (Fraction(1, 2), Fraction(1, 4), Fraction(1, 4))
+    tess = tessellate(cfg)
+    assert sum(e.polyhedron.unit_volume for e in tess.elements) == shape.unit_volume
+    assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes())
+
+
 @pytest.mark.parametrize("box", BOXES.values())
 def test_the_cuboid_is_a_standard_shape(box):
     """The standard cuboid is the box with the cuboid's numbering (VTK hexahedron: corners, edges,
