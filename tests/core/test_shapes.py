@@ -210,3 +210,18 @@ def test_general_quadrilateral_face_point():
     tess = tessellate(cfg)
     assert sum(e.polyhedron.unit_volume for e in tess.elements) == shape.unit_volume
     assert {frozenset(e.nodes) for e in tess.elements} == qhull_regions(cfg.real_nodes())
+
+
+def test_a_shape_pickled_by_another_process_hashes_as_here():
+    # A study's pool moves shapes between processes, whose string hashes differ: an unpickled
+    # shape must find its equal in a dict (the caches keyed by shapes) of this process.
+    import os
+    import pickle
+    import subprocess
+    import sys
+
+    made = subprocess.run([sys.executable, "-c", "import pickle, sys; from cospherical import standard_shape; "
+                           "s = standard_shape('prism'); hash(s); sys.stdout.buffer.write(pickle.dumps(s))"],
+                          capture_output=True, env={**os.environ, "PYTHONHASHSEED": "1"}, check=True)
+    there = pickle.loads(made.stdout)
+    assert there == standard_shape("prism") and {standard_shape("prism"): "here"}[there] == "here"

@@ -274,6 +274,13 @@ class Shape:
     def _hash(self) -> int:
         return hash((self.name, self.box, self.corners, self.edges, self.faces))
 
+    def __getstate__(self) -> dict:
+        # A string's hash differs from process to process: a pickled shape (a study's pool)
+        # computes its hash again where it is unpickled.
+        state = dict(self.__dict__)
+        state.pop("_hash", None)
+        return state
+
     @cached_property
     def quad_faces(self) -> tuple[int, ...]:
         """The faces with four corners: face ``quad_faces[q]`` carries node ``len(corners) + len(edges) + q``."""
