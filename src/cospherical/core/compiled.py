@@ -26,11 +26,11 @@ from numba import njit
 from ..caches import cached
 from .configuration import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
 
-__all__ = ["cube_batch", "fits", "orbit_keys", "walk"]
+__all__ = ["buffers", "cube_batch", "cube_tables", "fits", "orbit_keys", "walk"]
 
-MAX_POINTS = 62
-MAX_CELLS = 1024
-MAX_FACES = 8192
+_MAX_POINTS = 62
+_MAX_CELLS = 1024
+_MAX_FACES = 8192
 
 
 def fits(coords, weights, scale: int) -> bool:
@@ -45,7 +45,7 @@ def fits(coords, weights, scale: int) -> bool:
     stay below 36864 C^6 L = 110592 W C^8 < 2**17 W C^8.  The circumcenter test
     compares 5376 C^5 L with 2 W (2304 C^6) scale.
     """
-    if len(coords) > MAX_POINTS:
+    if len(coords) > _MAX_POINTS:
         return False
     c = max(1, max(abs(x) for point in coords for x in point))
     w = max(weights)
@@ -296,12 +296,12 @@ def walk(coords, lifted, weights, cell_mask, cell_sphere, face_cell, face_nodes,
 def buffers(points: int):
     """Output arrays for :func:`walk` on up to ``points`` points."""
     return (
-        np.empty(MAX_CELLS, dtype=np.int64),
-        np.empty((MAX_CELLS, 5), dtype=np.int64),
-        np.empty(MAX_FACES, dtype=np.int64),
-        np.empty((MAX_FACES, points), dtype=np.int64),
-        np.empty(MAX_FACES, dtype=np.int64),
-        np.empty((MAX_FACES, 3), dtype=np.int64),
+        np.empty(_MAX_CELLS, dtype=np.int64),
+        np.empty((_MAX_CELLS, 5), dtype=np.int64),
+        np.empty(_MAX_FACES, dtype=np.int64),
+        np.empty((_MAX_FACES, points), dtype=np.int64),
+        np.empty(_MAX_FACES, dtype=np.int64),
+        np.empty((_MAX_FACES, 3), dtype=np.int64),
     )
 
 
@@ -375,12 +375,12 @@ def cube_batch(codes, corners, starts, axes, face_edges, face_base, tets, closed
     coords = np.zeros((27, 3), dtype=np.int64)
     lifted = np.empty((27, 4), dtype=np.int64)
     weights = np.ones(3, dtype=np.int64)
-    cell_mask = np.empty(MAX_CELLS, dtype=np.int64)
-    cell_sphere = np.empty((MAX_CELLS, 5), dtype=np.int64)
-    face_cell = np.empty(MAX_FACES, dtype=np.int64)
-    face_nodes = np.empty((MAX_FACES, 27), dtype=np.int64)
-    face_len = np.empty(MAX_FACES, dtype=np.int64)
-    face_normal = np.empty((MAX_FACES, 3), dtype=np.int64)
+    cell_mask = np.empty(_MAX_CELLS, dtype=np.int64)
+    cell_sphere = np.empty((_MAX_CELLS, 5), dtype=np.int64)
+    face_cell = np.empty(_MAX_FACES, dtype=np.int64)
+    face_nodes = np.empty((_MAX_FACES, 27), dtype=np.int64)
+    face_len = np.empty(_MAX_FACES, dtype=np.int64)
+    face_normal = np.empty((_MAX_FACES, 3), dtype=np.int64)
     digits = np.empty(12, dtype=np.int64)
     face_digits = np.zeros(6, dtype=np.int64)
     for f in range(6):

@@ -120,7 +120,7 @@ def _first_cell(frame: Frame) -> tuple[list[int], Sphere]:
     raise ValueError("no empty sphere: the points do not span 3D")
 
 
-BACKENDS = ("python", "compiled")
+_BACKENDS = ("python", "compiled")
 
 
 def delaunay_cells(frame: Frame, backend: str = "python") -> list[Cell]:
@@ -135,8 +135,8 @@ def delaunay_cells(frame: Frame, backend: str = "python") -> list[Cell]:
     study: 144 orbits) keeps the default and bulk work (the intersection study)
     asks for ``"compiled"``.
     """
-    if backend not in BACKENDS:
-        raise ValueError(f"backend {backend!r}: one of {', '.join(BACKENDS)}")
+    if backend not in _BACKENDS:
+        raise ValueError(f"backend {backend!r}: one of {', '.join(_BACKENDS)}")
     if backend == "compiled":
         cells = _compiled_cells(frame)
         if cells is not None:

@@ -10,7 +10,7 @@ from ..caches import cached
 from .canonical import canonical_form
 from .polyhedron import Polyhedron
 
-__all__ = ["ElementType", "classify", "classify_faces", "element_type"]
+__all__ = ["ElementType", "classify", "classify_faces", "element_type", "face_summary", "systematic_name"]
 
 # Names are in Title Case, as the paper names its classes ("Quadrilateral Pyramid").
 _POLYGON_ADJECTIVE = {3: "Triangular", 4: "Quadrilateral", 5: "Pentagonal", 6: "Hexagonal", 7: "Heptagonal", 8: "Octagonal"}

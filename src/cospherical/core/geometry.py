@@ -41,7 +41,7 @@ from typing import Mapping, Sequence
 __all__ = ["Frame", "Sphere", "area_vector", "circumcentres", "collinear", "cross", "determinant", "dot",
            "in_closed_box", "plane_normal", "plane_projection", "six_volume", "six_volumes", "sphere_sides", "sub", "tetra_six_volume"]
 
-Vector = tuple[int, int, int]
+_Vector = tuple[int, int, int]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -123,7 +123,7 @@ def dot(p: Sequence[int], q: Sequence[int]) -> int:
     return sum(map(operator.mul, p, q))
 
 
-def cross(p: Sequence[int], q: Sequence[int]) -> Vector:
+def cross(p: Sequence[int], q: Sequence[int]) -> _Vector:
     return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
 
 
@@ -134,7 +134,7 @@ def determinant(u: Sequence, v: Sequence, w: Sequence):
             + u[2] * (v[0] * w[1] - v[1] * w[0]))
 
 
-def plane_normal(p: Sequence, q: Sequence, r: Sequence) -> Vector:
+def plane_normal(p: Sequence, q: Sequence, r: Sequence) -> _Vector:
     """(q - p) x (r - p): normal to the plane of p, q, r, right-handed (zero when they are on a line),
     written out: it runs once per point triple of every hull."""
     (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = p, q, r
@@ -142,7 +142,7 @@ def plane_normal(p: Sequence, q: Sequence, r: Sequence) -> Vector:
     return (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
 
 
-def area_vector(polygon: Sequence[Sequence]) -> Vector:
+def area_vector(polygon: Sequence[Sequence]) -> _Vector:
     """Twice the vector area of a closed polygon (Newell's normal): for a planar polygon, normal to
     its plane, right-handed around its order; never zero for a convex one, even with three
     consecutive points on a line (a normal from three points would be).
@@ -160,7 +160,7 @@ def area_vector(polygon: Sequence[Sequence]) -> Vector:
 
 
 def plane_projection(point: Sequence[int], origin: Sequence[int], normal: Sequence[int],
-                     inverse_weights: Sequence[int]) -> tuple[Vector, int]:
+                     inverse_weights: Sequence[int]) -> tuple[_Vector, int]:
     """The projection of ``point`` onto the plane through ``origin`` with ``normal`` (frame coordinates),
     orthogonal in the real metric: ``inverse_weights`` proportional to the inverse weights (integers,
     lcm(w) // w_k).  Returns ``(numerators, s)``, the projection being numerators / s with
@@ -318,10 +318,10 @@ class Frame:
     """Integer coordinates of a point set in a box, with exact predicates."""
 
     ids: tuple[int, ...]
-    coords: tuple[Vector, ...]
+    coords: tuple[_Vector, ...]
     lifted: tuple[tuple[int, int, int, int], ...]
     scale: int
-    weights: Vector
+    weights: _Vector
 
     @classmethod
     def build(cls, unit_points: Mapping[int, Sequence[Fraction]], squared_lengths: Sequence[Fraction]) -> "Frame":

@@ -52,7 +52,7 @@ from .codes import mask_codes
 from .exact import Length, parse_rational
 from .geometry import area_vector, collinear, cross, dot, plane_normal, six_volume, sub, tetra_six_volume
 
-__all__ = ["Box", "CORNERS", "EDGES", "ELEMENTS", "FACES", "FACE_EDGES", "STANDARD_SHAPES", "Shape",
+__all__ = ["Box", "CORNERS", "EDGES", "ELEMENTS", "FACES", "FACE_EDGES", "Point", "STANDARD_SHAPES", "Shape",
            "edge_axis", "mask_codes", "standard_shape"]
 
 Point = tuple[Fraction, Fraction, Fraction]
@@ -144,7 +144,7 @@ STANDARD_SHAPES: dict[str, tuple[tuple, tuple, tuple]] = {
 ELEMENTS = tuple(STANDARD_SHAPES)
 # A base element of a mesh has a handful of corners; its tessellation's exact tests grow
 # with their number, so a shape file of thousands is refused before any is read.
-MAX_CORNERS = 64
+_MAX_CORNERS = 64
 
 
 def _point(value, where: str) -> Point:
@@ -205,8 +205,8 @@ class Shape:
         box = box if isinstance(box, Box) else Box.parse(box)
         if not all(isinstance(x, Sequence) and not isinstance(x, str) for x in (vertices, edges, faces)):
             raise InputError(f"{name}: corners, edges and faces must be lists")
-        if not 4 <= len(vertices) <= MAX_CORNERS:
-            raise InputError(f"{name}: needs 4 to {MAX_CORNERS} corners, got {len(vertices)}")
+        if not 4 <= len(vertices) <= _MAX_CORNERS:
+            raise InputError(f"{name}: needs 4 to {_MAX_CORNERS} corners, got {len(vertices)}")
         # a convex polyhedron has at most 2n - 4 faces and 3n - 6 edges: longer lists are refused unread
         if len(faces) > 2 * len(vertices) or len(edges) > 3 * len(vertices):
             raise InputError(f"{name}: {len(faces)} faces and {len(edges)} edges: more than {len(vertices)} "

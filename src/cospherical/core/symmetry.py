@@ -170,7 +170,7 @@ def map_polyhedron(poly: Polyhedron, nodes, proper: bool, point) -> Polyhedron:
     )
 
 
-KEY_BACKENDS = ("numpy", "compiled")
+_KEY_BACKENDS = ("numpy", "compiled")
 
 
 def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry],
@@ -198,8 +198,8 @@ def orbit_point_keys(
     for the kernel."""
     import numpy as np
 
-    if backend not in KEY_BACKENDS:
-        raise ValueError(f"backend {backend!r}: one of {', '.join(KEY_BACKENDS)}")
+    if backend not in _KEY_BACKENDS:
+        raise ValueError(f"backend {backend!r}: one of {', '.join(_KEY_BACKENDS)}")
     digits = np.ascontiguousarray(digits).reshape(-1, 12)  # any integer type: millions of rows stay small
     masks = np.zeros(len(digits), dtype=np.int64) if masks is None else np.ascontiguousarray(masks, dtype=np.int64)
     targets = np.array([[target for target, _ in sym.edge_map] for sym in symmetries], dtype=np.int64).reshape(-1, 12)
@@ -257,8 +257,8 @@ def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry],
     >>> orbit_representatives(["800000000000", "000000000008"], box_symmetries(Box.parse(["1", "1", "1"])))[0]
     ['000000000008', '000000000008']
     """
-    if backend not in ("python", *KEY_BACKENDS):
-        raise ValueError(f"backend {backend!r}: one of python, {', '.join(KEY_BACKENDS)}")
+    if backend not in ("python", *_KEY_BACKENDS):
+        raise ValueError(f"backend {backend!r}: one of python, {', '.join(_KEY_BACKENDS)}")
     if not symmetries:
         raise ValueError("orbit representatives: no symmetries (the identity at least)")
     shape = symmetries[0].shape

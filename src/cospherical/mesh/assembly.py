@@ -344,10 +344,10 @@ def _type_info(type_id: str, etype: ElementType | None, catalogue: dict) -> dict
     return {"name": type_id, "paper_class": None, "vtk": None, "vertices": None, "faces": None}
 
 
-def leaf_code(edges: int, faces: int) -> str:
+def _leaf_code(edges: int, faces: int) -> str:
     """The whole-point-set code of a leaf from its edge and face bit masks.
 
-    >>> leaf_code(0b1, 0), leaf_code(0xfff, 0b010001)
+    >>> _leaf_code(0b1, 0), _leaf_code(0xfff, 0b010001)
     ('800000000000+f', '888888888888+f04')
     """
     return mask_code(edges, 12) + "+" + point_suffix((f for f in range(6) if faces >> f & 1), False)
@@ -431,7 +431,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     leaf_pattern = (np.cumsum(seen) - 1)[value]
     patterns, types = [], {}
     for value in distinct.tolist():
-        code = leaf_code(value & 0xFFF, value >> 12)
+        code = _leaf_code(value & 0xFFF, value >> 12)
         if (code, criterion) not in cache:
             cache[code, criterion] = _pattern(Configuration.from_code(code, tree.box), lookup, types, criterion,
                                               catalogue)

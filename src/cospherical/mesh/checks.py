@@ -31,8 +31,8 @@ from .octree import distinct
 # Python integers and its pair ~100 bytes. A 1.38 M-leaf sphere tree needs 2.5 M; a box of
 # lengths 1e-12 x 1 x 3e9 at level 5 needed 40.6 M (floats there cannot separate the vertices
 # near a sphere), and at level 6 it passed 19.5 GB before the kernel killed it.
-MAX_EXACT_TESTS = 1 << 24
-PAIR_CHUNK = 1 << 22
+_MAX_EXACT_TESTS = 1 << 24
+_PAIR_CHUNK = 1 << 22
 
 __all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "match_seams"]
 
@@ -342,14 +342,14 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     # the element's own nodes are on its sphere; anything more (or less) is looked at exactly
     suspect = np.flatnonzero(counts != n_nodes)
     tests = int(counts[suspect].sum())
-    if tests > MAX_EXACT_TESTS:
+    if tests > _MAX_EXACT_TESTS:
         raise InputError(f"the exact Delaunay check needs {tests:,} sphere tests, above the bound of "
-                         f"{MAX_EXACT_TESTS:,}: on a box this stretched, floats cannot tell which vertices "
+                         f"{_MAX_EXACT_TESTS:,}: on a box this stretched, floats cannot tell which vertices "
                          "are near each sphere (a coarser tree, or --delaunay leaf --no-delaunay)")
     pairs_row, pairs_vertex = [], []
-    # chunks of at most PAIR_CHUNK vertices found (a Python list of them is 36 bytes a vertex), and
+    # chunks of at most _PAIR_CHUNK vertices found (a Python list of them is 36 bytes a vertex), and
     # at least one sphere each
-    ends = np.searchsorted(np.cumsum(counts[suspect]), np.arange(1, tests // PAIR_CHUNK + 2) * PAIR_CHUNK, "right")
+    ends = np.searchsorted(np.cumsum(counts[suspect]), np.arange(1, tests // _PAIR_CHUNK + 2) * _PAIR_CHUNK, "right")
     for start, end in zip(np.r_[0, ends[:-1]], ends):
         rows = suspect[start:max(end, start + 1)]
         if not len(rows):

@@ -126,7 +126,7 @@ from .checks import _weights, check_delaunay
 __all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
 ENGINES = ("qhull", "exact")
-NO_REGION = -1  # the region of a leaf element that is kept, and of a vertex of no region
+_NO_REGION = -1  # the region of a leaf element that is kept, and of a vertex of no region
 
 
 class NotOneCell(Exception):
@@ -200,7 +200,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     """
     nodes = mesh.element_nodes(elements)
     part, regions = _regions(nodes, len(mesh.vertices))
-    region = np.full(len(mesh), NO_REGION, dtype=np.int64)
+    region = np.full(len(mesh), _NO_REGION, dtype=np.int64)
     region[elements] = part
     # each region's vertices: unique (region, vertex) pairs, in region order
     valid = nodes >= 0
@@ -209,7 +209,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     bounds = np.searchsorted(pairs // len(mesh.vertices), np.arange(regions + 1))
     vertices = pairs % len(mesh.vertices)
     # the regions' vertex sets are disjoint (a shared vertex would join them): a vertex names its region
-    vertex_region = np.full(len(mesh.vertices), NO_REGION, dtype=np.int64)
+    vertex_region = np.full(len(mesh.vertices), _NO_REGION, dtype=np.int64)
     vertex_region[vertices] = pairs // len(mesh.vertices)
     located = _Locator(mesh)
     # the other elements of the leaves that give up theirs: cells as they are, proven by the check
@@ -217,7 +217,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     counts = mesh.element_offsets[leaves + 1] - mesh.element_offsets[leaves]
     given_up = np.repeat(mesh.element_offsets[leaves] - np.r_[0, np.cumsum(counts)[:-1]], counts) \
         + np.arange(int(counts.sum()))
-    proven = mesh.element_nodes(given_up[region[given_up] == NO_REGION])
+    proven = mesh.element_nodes(given_up[region[given_up] == _NO_REGION])
     bad = _leaves_of(mesh, elements)
     wanted = _region_volumes(mesh, elements, part, regions)
     tets = [_region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine, proposal) for r in range(regions)]
@@ -280,13 +280,13 @@ def _failing_regions(mesh: Mesh, found: dict, vertex_region: np.ndarray, wanted:
     fresh = np.flatnonzero(~cells.proven)
     # A fresh cell's vertices are its tetrahedra's, all of one region (the regions' vertex sets are
     # disjoint): its first vertex names the region.  The proven cells belong to no region.
-    cell_region = np.full(len(cells), NO_REGION, dtype=np.int64)
+    cell_region = np.full(len(cells), _NO_REGION, dtype=np.int64)
     cell_region[fresh] = vertex_region[cells.nodes[fresh, 0]]
     # check_delaunay tests only the fresh cells (the kept leaf elements and the proven cells passed it on
     # the same vertex set), so every element it finds is a fresh cell: anything else is a bug, not a region.
     not_cells = found["_not_cells"] - mesh.leaf_elements  # indices among the cells
-    if np.any(cell_region[fresh] == NO_REGION) or np.any(not_cells < 0) \
-            or np.any(cell_region[not_cells] == NO_REGION):
+    if np.any(cell_region[fresh] == _NO_REGION) or np.any(not_cells < 0) \
+            or np.any(cell_region[not_cells] == _NO_REGION):
         raise RuntimeError("an element that is not a fresh cell of a region was found not to be a cell")
     failing = set(cell_region[not_cells].tolist())
     volumes = [Fraction(0)] * len(wanted)
@@ -413,7 +413,7 @@ def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray
 def _inside(mesh: Mesh, tets: np.ndarray, tet_region: np.ndarray, region: np.ndarray, located: _Locator) -> np.ndarray:
     """Per tetrahedron: its centroid lies in a closed element of its region, of the leaf whose box holds it (exactly).
 
-    ``region``: per leaf element its region, ``NO_REGION`` for the kept ones.  In the leaf's own
+    ``region``: per leaf element its region, ``_NO_REGION`` for the kept ones.  In the leaf's own
     frame (4 x grid units from its lowest corner) node ``s`` sits at ``2 size
     NODE_OFFSETS[s]``; an element holds the point when no face plane has it on the
     side away from the element's vertex centroid.  The numbers are below 100 times

@@ -59,8 +59,8 @@ from ..core.polyhedron import measure
 from ..errors import InputError
 from .octree import distinct
 
-__all__ = ["Dual", "ElementPieces", "boundary_areas", "delaunay_tetrahedra", "dual_summary", "element_pieces", "mesh_dual",
-           "tetrahedral_counts"]
+__all__ = ["Dual", "ElementPieces", "TETRAHEDRAL_LIMIT", "boundary_areas", "delaunay_tetrahedra", "dual_summary",
+           "element_pieces", "mesh_dual", "tetrahedral_counts"]
 
 Point = tuple[Fraction, Fraction, Fraction]
 

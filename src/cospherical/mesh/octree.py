@@ -38,7 +38,7 @@ BALANCES = ("vertex", "edge")
 # Peak memory of `cospherical mesh` with every check, per leaf: 1.5 kB measured at 131,258
 # leaves (plane:1,1,1,1.5, levels 7); rounded up.
 BYTES_PER_LEAF = 2048
-SHAPE_FORMS = {
+_SHAPE_FORMS = {
     "sphere": ("X,Y,Z,R", 4),
     "plane": ("NX,NY,NZ,D", 4),
     "point": ("X,Y,Z", 3),
@@ -78,12 +78,12 @@ def parse_shape(text: str) -> Shape:
     """
     kind, sep, rest = str(text).partition(":")
     kind = kind.strip().lower()
-    forms = ", ".join(f"{k}:{form}" for k, (form, _) in SHAPE_FORMS.items())
+    forms = ", ".join(f"{k}:{form}" for k, (form, _) in _SHAPE_FORMS.items())
     forms = forms.replace(", box", " or box")
-    if not sep or kind not in SHAPE_FORMS:
+    if not sep or kind not in _SHAPE_FORMS:
         what = f"unknown kind {kind!r}" if sep else "no kind"
         raise InputError(f"refine shape {text!r}: {what}; write {forms}")
-    form, count = SHAPE_FORMS[kind]
+    form, count = _SHAPE_FORMS[kind]
     parts = [p for p in rest.split(",")]
     if len(parts) != count:
         raise InputError(f"refine shape {text!r}: {kind} needs {count} numbers {form}, got {len(parts)}")
@@ -269,7 +269,7 @@ def distinct(keys: np.ndarray) -> np.ndarray:
     return keys[np.r_[True, keys[1:] != keys[:-1]]] if len(keys) else keys
 
 
-def keys_of(level: int, cells: np.ndarray) -> np.ndarray:
+def _keys_of(level: int, cells: np.ndarray) -> np.ndarray:
     """Linear keys of positions (n x 3) at ``level``."""
     n = np.int64(1 << level)
     cells = cells.astype(np.int64)
@@ -294,14 +294,14 @@ def _neighbours(level: int, cells: np.ndarray, offsets: np.ndarray) -> np.ndarra
     n = 1 << level
     near = (cells[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
     near = near[np.all((near >= 0) & (near < n), axis=1)]
-    return distinct(keys_of(level, near))
+    return distinct(_keys_of(level, near))
 
 
 def _children(level: int, keys: np.ndarray) -> np.ndarray:
     """Keys at ``level + 1`` of the eight children of cells at ``level``."""
     cells = cells_of(level, keys) * 2
     kids = (cells[:, None, :] + np.array(list(product((0, 1), repeat=3)))[None]).reshape(-1, 3)
-    return np.sort(keys_of(level + 1, kids))
+    return np.sort(_keys_of(level + 1, kids))
 
 
 # ---------------------------------------------------------------------------
@@ -398,7 +398,7 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
     for level in range(levels - 1, 0, -1):
         # every neighbour of a split cell must exist: its parent must be split
         need = _neighbours(level, cells_of(level, split[level]), offsets)
-        parents = distinct(keys_of(level - 1, cells_of(level, need) // 2))
+        parents = distinct(_keys_of(level - 1, cells_of(level, need) // 2))
         split[level - 1] = np.union1d(split[level - 1], parents)
     levels_, positions = _leaves_from_splits(split)
     check_leaf_count(len(levels_), f"--levels {levels}: balanced, the tree has", max_leaves)
@@ -442,7 +442,7 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
         raise InputError(f"{where}: leaf {i}: position {' '.join(map(str, positions[i]))} is outside the domain "
                          f"at level {levels[i]} (0..{(1 << levels[i]) - 1})")
     depth = int(levels.max())
-    keys = {level: keys_of(level, positions[levels == level]) for level in range(depth + 1)}
+    keys = {level: _keys_of(level, positions[levels == level]) for level in range(depth + 1)}
     index = {level: np.flatnonzero(levels == level) for level in range(depth + 1)}
     for level in range(depth + 1):
         order = np.argsort(keys[level], kind="stable")
@@ -455,7 +455,7 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
     # split[l]: the cells of level l that are ancestors of a leaf; a leaf must not be one
     split = []
     for level in range(depth):
-        deeper = [keys_of(level, cells_of(d, keys[d]) >> (d - level)) for d in range(level + 1, depth + 1)]
+        deeper = [_keys_of(level, cells_of(d, keys[d]) >> (d - level)) for d in range(level + 1, depth + 1)]
         split.append(distinct(np.concatenate(deeper)) if deeper else np.zeros(0, dtype=np.int64))
         clash = np.isin(keys[level], split[level])
         if clash.any():
@@ -477,13 +477,13 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
     offsets = _offsets("edge")
     for level in range(1, depth):
         need = _neighbours(level, cells_of(level, split[level]), offsets)
-        parents = keys_of(level - 1, cells_of(level, need) // 2)
+        parents = _keys_of(level - 1, cells_of(level, need) // 2)
         lacking = np.flatnonzero(~np.isin(parents, split[level - 1]))
         if len(lacking):
             cell = cells_of(level, need[lacking[:1]])[0]
             # the leaf holding that cell is coarser than its parent: find it by its ancestors
             for coarse in range(level - 1, -1, -1):
-                key = keys_of(coarse, (cell >> (level - coarse))[None])[0]
+                key = _keys_of(coarse, (cell >> (level - coarse))[None])[0]
                 hit = np.flatnonzero(keys[coarse] == key)
                 if len(hit):
                     i = index[coarse][hit[0]]
@@ -513,5 +513,5 @@ def leaf_list_order(levels: Sequence[int], positions: Sequence[Sequence[int]]) -
     keys = np.zeros(len(levels), dtype=np.int64)
     for level in np.unique(levels).tolist():
         at = levels == level
-        keys[at] = keys_of(level, positions[at])
+        keys[at] = _keys_of(level, positions[at])
     return np.lexsort((keys, levels))

@@ -19,7 +19,7 @@ from .assembly import PAPER_FINAL, Mesh, _type_info
 
 __all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "statistics", "uniform_study"]
 
-BISECTION_CONFIGURATIONS = 4096
+_BISECTION_CONFIGURATIONS = 4096
 
 
 def uniform_study(box: Box, catalogue: dict) -> dict:
@@ -86,7 +86,7 @@ def statistics(type_counts: Counter, configurations: dict[str, dict], total_leav
     ``catalogue`` names the types met nowhere else."""
     configurations = sorted(({
         "code": c["code"], "leaves": c["leaves"], "share": _share(c["leaves"], total_leaves),
-        "uniform_share": _share(1, BISECTION_CONFIGURATIONS) if c["in_bisection_family"] else None,
+        "uniform_share": _share(1, _BISECTION_CONFIGURATIONS) if c["in_bisection_family"] else None,
         "elements_per_leaf": c["elements_per_leaf"], "fvm_adequate": c["fvm_adequate"],
         "tessellated_on_the_fly": c["tessellated_on_the_fly"]} for c in configurations.values()),
         key=lambda c: (-c["leaves"], c["code"]))
@@ -113,7 +113,7 @@ def statistics(type_counts: Counter, configurations: dict[str, dict], total_leav
     }
     if uniform:
         uniform_final = sum(r["uniform_count"] for r in rows if r["paper_class"] in PAPER_FINAL)
-        result["uniform"] = {"study": "bisection", "face_points": "octree", "configurations": BISECTION_CONFIGURATIONS,
+        result["uniform"] = {"study": "bisection", "face_points": "octree", "configurations": _BISECTION_CONFIGURATIONS,
                              "elements": int(uniform_total), "paper_final_share": _share(uniform_final, uniform_total)}
     return result
 

@@ -24,7 +24,7 @@ from ..core.shapes import mask_codes, standard_shape
 from ..core.symmetry import Symmetry
 from ..core.tessellation import Element, Tessellation
 
-__all__ = ["Study", "TypeCount", "bisection_codes", "map_tessellation", "run_study"]
+__all__ = ["Progress", "Study", "TypeCount", "bisection_codes", "map_tessellation", "run_study"]
 
 Progress = Callable[[int], None]
 

@@ -27,7 +27,7 @@ from ..core.tessellation import tessellate
 from ..errors import InputError
 from .engine import bisection_codes
 
-__all__ = ["Ray", "code_pieces", "ray_profile"]
+__all__ = ["Ray", "Step", "code_pieces", "profile_summary", "ray_profile"]
 
 
 @dataclass(frozen=True)
@@ -59,14 +59,14 @@ class Ray:
         return tuple(1 if s else 0 for s in self.scaled)
 
 
-class Critical(Exception):
+class _Critical(Exception):
     """The probed value of u is itself a root: probe elsewhere."""
 
 
 def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int]], tuple]:
     """The linear forms a + b*u whose signs hold the tessellation at u, and its state there.
 
-    Raises :class:`Critical` when u is a root of one of them (a degenerate value).
+    Raises :class:`_Critical` when u is a root of one of them (a degenerate value).
     """
     cfg = Configuration.from_code(code, ray.box(u))
     tess = tessellate(cfg)
@@ -82,7 +82,7 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
             a, b = s0.side(f0.lifted[x]), s1.side(f1.lifted[x])
             if x in members:
                 if a or b:  # co-spherical only at this u
-                    raise Critical
+                    raise _Critical
             else:
                 forms.append((a, b))
         # circumcenter between the box faces: 0 <= -N_axis(u) <= 2 w_axis(u) N_L D
@@ -100,7 +100,7 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
                     forms.append((f0.real_dot(e, e2), f1.real_dot(e, e2)))
     for a, b in forms:
         if b and Fraction(-a, b) == u:
-            raise Critical
+            raise _Critical
     state = (tess.fvm_adequate, frozenset(e.type.id for e in tess.elements))
     return forms, state
 
@@ -136,7 +136,7 @@ def code_pieces(code: str, ray: Ray, u_lo: Fraction, u_hi: Fraction) -> tuple:
         while True:
             try:
                 forms, state = _linear_forms(code, ray, probe)
-            except Critical:
+            except _Critical:
                 probe = (pos + probe) / 2
                 continue
             lo, hi = _interval(forms, probe)
