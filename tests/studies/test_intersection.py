@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import json
-import random
-import re
 import subprocess
 import sys
 import zlib
 
 import numpy as np
 import pytest
+from sampling import sampled_table
 
 from cospherical import Box
 from cospherical.studies.engine import bisection_codes
@@ -240,24 +239,12 @@ def r4_table(pool_run, tmp_path_factory):
 def test_a_pattern_table_at_resolution_4_passes_check(r4_table, full, tmp_path):
     # Every type of the intersection studies is in the shipped catalogue, so `check`
     # (known types, node counts, exact tiling, recomputed types and circumcenters) passes their
-    # tables. All 32,077 entries take 30 CPU-s (--full); by default every entry that brings a type
-    # the entries before it did not (so each type of the table is checked) and a seeded 1 in 8.
-    # The R = 2 table is checked whole, as YAML and as a store, in test_pattern_table_of_the_representatives.
+    # tables. All 32,077 entries take 30 CPU-s (--full); by default a sample (sampling.py) with
+    # every type of the table and a seeded 1 in 8 of the other entries. The R = 2 table is
+    # checked whole, as YAML and as a store, in test_pattern_table_of_the_representatives.
     from cospherical.cli import main
 
-    path = r4_table[0]
-    if not full:
-        lines = path.read_text().split("\n")
-        start = lines.index("configurations:") + 1
-        chance, seen, sample = random.Random(4), set(), []
-        for line in lines[start:-1]:
-            types = set(re.findall(r'"type": "([^"]+)"', line))
-            if not types <= seen or chance.random() < 1 / 8:
-                sample.append(line)
-                seen |= types
-        assert seen and len(sample) < len(lines) // 4
-        path = tmp_path / "sample.yaml"
-        path.write_text("\n".join(lines[:start] + sample + lines[-1:]))
+    path = r4_table[0] if full else sampled_table(r4_table[0], tmp_path / "sample.yaml", 1 / 8, seed=4)
     assert main(["check", str(path)]) == 0
 
 
