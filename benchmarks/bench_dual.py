@@ -64,12 +64,12 @@ def measure(args) -> dict:
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     negative = dual.negative_coefficients()
     print(f"leaves {len(tree):,}  vertices {len(mesh.vertices):,}  elements {len(mesh):,}  edges {len(dual.edges):,}  "
-          f"configurations {len(mesh.patterns)}  volume sum {dual.volume_sum()}  negative coefficients "
+          f"configurations {len(mesh.tessellations)}  volume sum {dual.volume_sum()}  negative coefficients "
           f"{negative['interior']} interior, {negative['boundary']} boundary")
     for name, (wall, cpu) in clock.items():
         print(f"{name:42s} {wall:8.2f} s wall {cpu:8.2f} s cpu")
     print(f"peak {dual_peak:.2f} GB after the duals, {peak:.2f} GB after the laplacian", flush=True)
-    return {"tree": f"{len(tree):,} leaves, {len(dual.edges):,} edges, {len(mesh.patterns)} configurations",
+    return {"tree": f"{len(tree):,} leaves, {len(dual.edges):,} edges, {len(mesh.tessellations)} configurations",
             "clock": clock, "dual_peak": dual_peak, "peak": peak}
 
 

@@ -94,7 +94,7 @@ def measure(args, record) -> None:
     stage("global: statistics", lambda: mesh_statistics(whole))
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     print(f"leaves {len(tree):,}  vertices {len(mesh.vertices):,}  elements {len(mesh):,}  "
-          f"configurations {len(mesh.patterns)}  on the fly {sum(p.on_the_fly for p in mesh.patterns)}")
+          f"configurations {len(mesh.tessellations)}  on the fly {sum(p.on_the_fly for p in mesh.tessellations)}")
     for name, (wall, cpu) in clock.items():
         print(f"{name:34s} {wall:8.2f} s wall {cpu:8.2f} s cpu")
     wall = clock["assembly"][0]
@@ -116,7 +116,7 @@ def measure(args, record) -> None:
           f"{global_cpu:.1f} s cpu: {global_mode / leaf_mode:.2f}x wall, {global_cpu / leaf_cpu:.2f}x cpu")
     record.add(f"sphere tree {' x '.join(args.domain)}, L {args.levels}, R {args.radius}",
                f"{len(tree):,} leaves, {len(mesh.vertices):,} vertices, {len(mesh):,} elements, "
-               f"{len(mesh.patterns)} configurations")
+               f"{len(mesh.tessellations)} configurations")
     for name, (wall, cpu) in clock.items():
         record.add(name, f"{cpu:.2f} s CPU, {wall:.2f} s wall")
     record.add("leaf mode (assembly, checks, statistics) vs global mode", f"{leaf_cpu:.1f} s vs {global_cpu:.1f} s CPU: "

@@ -80,7 +80,7 @@ def test_vtk_reads_the_same_cells_node_orders_and_data(tmp_path):
             grid.GetFaceStream(c, stream)
             got = [stream.GetId(i) for i in range(stream.GetNumberOfIds())]
             leaf, local = int(mesh.element_leaf[e]), int(mesh.element_local[e])
-            faces = mesh.patterns[mesh.leaf_pattern[leaf]].elements[local].faces
+            faces = mesh.tessellations[mesh.leaf_tessellation[leaf]].elements[local].faces
             want = [len(faces)] + [x for f in faces for x in (len(f), *mesh.slots[leaf, list(f)].tolist())]
             assert got == want
     assert (cell_array(grid, "leaf") == mesh.element_leaf[element]).all()
@@ -113,7 +113,8 @@ def test_vtk_finds_every_cell_valid_and_the_volumes_exact(tmp_path):
     volume = vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume"))
     element = cell_array(grid, "element")
     leaf = mesh.element_leaf[element]
-    exact = [float(mesh.patterns[mesh.leaf_pattern[i]].elements[j].unit_volume / 8 ** int(mesh.tree.levels[i]))
+    exact = [float(mesh.tessellations[mesh.leaf_tessellation[i]].elements[j].unit_volume
+                   / 8 ** int(mesh.tree.levels[i]))
              for i, j in zip(leaf.tolist(), mesh.element_local[element].tolist())]
     assert np.allclose(volume, exact, rtol=1e-12, atol=0)
     assert abs(volume.sum() - 1) < 1e-12
@@ -273,8 +274,8 @@ def test_a_table_of_orbit_representatives_serves_every_configuration_of_an_orbit
     table = load(representatives_store)
     tree = build_octree(CUBE, 3, [parse_shape("plane:1,2,3,2")])  # standard cells and polyhedra
     mesh = assemble(tree, table_lookup(table, "optimal", CUBE))
-    mapped = [p for p in mesh.patterns if p.mapped_from is not None]
-    assert mapped and not any(p.on_the_fly for p in mesh.patterns)
+    mapped = [p for p in mesh.tessellations if p.mapped_from is not None]
+    assert mapped and not any(p.on_the_fly for p in mesh.tessellations)
     assert all(p.mapped_from.split("+")[0] in table.configurations for p in mapped)  # the bare code, its policy's
     # element for element what tessellating each configuration gives, and a valid mesh
     assert element_sets(mesh) == element_sets(assemble(tree))

@@ -48,13 +48,13 @@ def small_table(path, box, codes):
 
 
 def bare_codes(mesh) -> set[str]:
-    return {p.code.split("+")[0] for p in mesh.patterns}
+    return {p.code.split("+")[0] for p in mesh.tessellations}
 
 
 def test_one_leaf():
     mesh = assemble(build_octree(CUBE, 0, []))
     assert (len(mesh.tree), len(mesh.vertices), len(mesh)) == (1, 8, 1)
-    assert mesh.patterns[0].code == "000000000000+f"
+    assert mesh.tessellations[0].code == "000000000000+f"
     found = checks(mesh)
     assert found["volume_ok"] and found["nonconforming_faces"] == 0 and found["boundary_faces"] == 6
     assert found["delaunay_violations"] == 0 and found["leaves_not_fvm_adequate"] == 0
@@ -64,11 +64,11 @@ def test_one_refined_octant_by_hand():
     mesh = assemble(octant_tree())
     # 27 points of the level-1 grid, and the octant's own 27 points of which its 8 corners are shared
     assert (len(mesh.tree), len(mesh.vertices)) == (15, 46)
-    codes = sorted(p.code for p in mesh.patterns)
+    codes = sorted(p.code for p in mesh.tessellations)
     # the three face neighbours see a face point and four edge points, the three edge neighbours one edge point,
     # the corner neighbour and the small leaves nothing
     assert "000000000000+f" in codes and len(codes) == 1 + 3 + 3
-    face_leaf = [p for p in mesh.patterns if "+f" in p.code and p.code.endswith(tuple("012345"))]
+    face_leaf = [p for p in mesh.tessellations if "+f" in p.code and p.code.endswith(tuple("012345"))]
     assert len(face_leaf) == 3 and all(p.code.count("8") == 4 for p in face_leaf)
     found = checks(mesh)
     assert found["volume_ok"] and found["volume"] == "1"
@@ -85,7 +85,7 @@ def test_table_equals_tessellating_every_leaf(tmp_path):
     fly = assemble(tree)
     table = small_table(tmp_path / "t.yaml", BRICK, bare_codes(fly))
     mesh = assemble(tree, table_lookup(table, "optimal", BRICK))
-    assert not any(p.on_the_fly for p in mesh.patterns) and all(p.on_the_fly for p in fly.patterns)
+    assert not any(p.on_the_fly for p in mesh.tessellations) and all(p.on_the_fly for p in fly.tessellations)
     assert np.array_equal(mesh.connectivity()[0], fly.connectivity()[0])
     assert mesh.element_types()[0] == fly.element_types()[0]
     assert np.array_equal(mesh.element_types()[1], fly.element_types()[1])
@@ -98,7 +98,7 @@ def test_missing_configurations_are_tessellated_and_counted(tmp_path):
     codes = sorted(bare_codes(fly))
     table = small_table(tmp_path / "t.yaml", CUBE, codes[:2])
     mesh = assemble(tree, table_lookup(table, "optimal", CUBE))
-    assert sum(p.on_the_fly for p in mesh.patterns) == len(fly.patterns) - 2
+    assert sum(p.on_the_fly for p in mesh.tessellations) == len(fly.tessellations) - 2
 
 
 class Broken:

@@ -35,8 +35,8 @@ from ..errors import InputError
 from ..paper import paper_class
 from .octree import Octree, distinct
 
-__all__ = ["CellShape", "Cells", "LocalElement", "LocalPattern", "Mesh", "NODE_OFFSETS", "assemble", "distinct", "local_pattern",
-           "vertex_keys"]
+__all__ = ["CellShape", "Cells", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "NODE_OFFSETS", "PAPER_FINAL",
+           "assemble", "distinct", "local_tessellation", "vertex_keys"]
 
 # Twice the unit coordinates of the 27 nodes (corners, edge midpoints, face centres, body).
 NODE_OFFSETS = np.array(
@@ -75,8 +75,12 @@ class LocalElement:
 
 
 @dataclass(frozen=True)
-class LocalPattern:
-    """The elements of one configuration, with the frame they were measured in."""
+class LocalTessellation:
+    """A leaf's elements in its local node numbering (0..26), measured exactly, with the frame they were measured in.
+
+    One per configuration that occurs in a mesh, shared by the leaves that have it; the
+    elements come from a pattern table (the product) or are tessellated on the fly.
+    """
 
     code: str
     configuration: Configuration
@@ -92,15 +96,16 @@ class LocalPattern:
         return all(e.center_in_leaf for e in self.elements)
 
 
-def local_pattern(configuration: Configuration, elements: Iterable[tuple[str, Iterable[int]]],
-                  on_the_fly: bool = False, mapped_from: str | None = None) -> LocalPattern:
+def local_tessellation(configuration: Configuration, elements: Iterable[tuple[str, Iterable[int]]],
+                       on_the_fly: bool = False, mapped_from: str | None = None) -> LocalTessellation:
     """Measure a configuration's elements (type id, node ids) exactly, trusting nothing but the node lists.
 
     Examples
     --------
-    >>> pattern = local_pattern(Configuration.from_code("000000000000", faces=[]),
-    ...                         [("v8f6-c3cb81", range(8))])
-    >>> pattern.elements[0].unit_volume, pattern.elements[0].center, len(pattern.elements[0].faces)
+    >>> tessellation = local_tessellation(Configuration.from_code("000000000000", faces=[]),
+    ...                               [("v8f6-c3cb81", range(8))])
+    >>> element = tessellation.elements[0]
+    >>> element.unit_volume, element.center, len(element.faces)
     (Fraction(1, 1), (Fraction(1, 2), Fraction(1, 2), Fraction(1, 2)), 6)
     """
     nodes = configuration.nodes()
@@ -119,7 +124,7 @@ def local_pattern(configuration: Configuration, elements: Iterable[tuple[str, It
         measured.append(LocalElement(
             type_id, element_nodes, tuple(tuple(frame.ids[i] for i in c) for c in element.cycles),
             element.unit_volume, element.sphere, element.center))
-    return LocalPattern(configuration.point_set_code or "", configuration, tuple(measured), frame.scale,
+    return LocalTessellation(configuration.point_set_code or "", configuration, tuple(measured), frame.scale,
                         frame.weights, on_the_fly, mapped_from)
 
 
@@ -179,9 +184,9 @@ class Mesh:
 
     Vertices are integer points of the grid of spacing half the finest leaf
     (``grid`` intervals per domain side): ``vertices`` (n x 3).  Leaf ``i`` has
-    configuration ``patterns[leaf_pattern[i]]`` and its node ``s`` (0..26) at vertex
+    configuration ``tessellations[leaf_tessellation[i]]`` and its node ``s`` (0..26) at vertex
     ``slots[i, s]`` (-1: no point there).  Elements are listed leaf by leaf, in each
-    leaf in its pattern's order: element ``e`` is element ``element_local[e]`` of
+    leaf in its tessellation's order: element ``e`` is element ``element_local[e]`` of
     leaf ``element_leaf[e]``; ``element_offsets[i]`` is the first element of leaf ``i``.
     Leaves marked in ``replaced`` contribute no elements: their part of the domain
     is tiled by ``cells``, listed after every leaf element (``element_local`` -1,
@@ -192,8 +197,8 @@ class Mesh:
     grid: int
     vertices: np.ndarray
     slots: np.ndarray
-    leaf_pattern: np.ndarray
-    patterns: list[LocalPattern]
+    leaf_tessellation: np.ndarray
+    tessellations: list[LocalTessellation]
     element_offsets: np.ndarray
     element_leaf: np.ndarray
     element_local: np.ndarray
@@ -220,21 +225,21 @@ class Mesh:
         return (self.grid >> self.tree.levels.astype(np.int64)).astype(np.int64)
 
     def groups(self, all_leaves: bool = False):
-        """Yield ``(pattern index, pattern, leaf indices)`` for every configuration that occurs, in order.
+        """Yield ``(tessellation index, tessellation, leaf indices)`` for every configuration that occurs, in order.
 
         The leaves are those whose elements are in the mesh; ``all_leaves`` also
         yields the replaced ones (for counting configurations).
         """
         if self._groups is None:  # every check walks the groups: sort the leaves once
-            order = np.argsort(self.leaf_pattern, kind="stable")
-            counts = np.bincount(self.leaf_pattern, minlength=len(self.patterns))
+            order = np.argsort(self.leaf_tessellation, kind="stable")
+            counts = np.bincount(self.leaf_tessellation, minlength=len(self.tessellations))
             starts = np.r_[0, np.cumsum(counts)]
-            groups = [order[starts[p]:starts[p + 1]] for p in range(len(self.patterns))]
+            groups = [order[starts[p]:starts[p + 1]] for p in range(len(self.tessellations))]
             kept = groups if self.replaced is None else [g[~self.replaced[g]] for g in groups]
             self._groups = [groups, kept]
         for p, leaves in enumerate(self._groups[0 if all_leaves else 1]):
             if len(leaves) or all_leaves:
-                yield p, self.patterns[p], leaves
+                yield p, self.tessellations[p], leaves
 
     def blocks(self):
         """Yield ``(element indices, global vertex ids (elements x nodes), faces, type id)`` per kind of element.
@@ -242,9 +247,9 @@ class Mesh:
         One block per element of a configuration (over its leaves) and per cell
         shape; ``faces`` are cycles of column indices into the vertex ids.
         """
-        for _, pattern, leaves in self.groups():
+        for _, tessellation, leaves in self.groups():
             first = self.element_offsets[leaves]
-            for j, element in enumerate(pattern.elements):
+            for j, element in enumerate(tessellation.elements):
                 column = {n: i for i, n in enumerate(element.nodes)}
                 yield (first + j, self.slots[np.ix_(leaves, element.nodes)],
                        tuple(tuple(column[n] for n in cycle) for cycle in element.faces), element.type_id)
@@ -258,16 +263,16 @@ class Mesh:
                        shape.type_id)
 
     def element_nodes(self, elements: np.ndarray) -> np.ndarray:
-        """Global vertex ids of the given leaf elements, in their pattern's node order, padded with -1."""
-        width = max((len(e.nodes) for p in self.patterns for e in p.elements), default=1)
-        widest = max((len(p.elements) for p in self.patterns), default=1)
-        # (pattern, element) -> local nodes, padded with slot 26 (the body centre: never a vertex, so -1)
-        local = np.full((len(self.patterns), widest, width), 26, dtype=np.int64)
-        for p, pattern in enumerate(self.patterns):
-            for j, element in enumerate(pattern.elements):
+        """Global vertex ids of the given leaf elements, in their tessellation's node order, padded with -1."""
+        width = max((len(e.nodes) for p in self.tessellations for e in p.elements), default=1)
+        widest = max((len(p.elements) for p in self.tessellations), default=1)
+        # (tessellation, element) -> local nodes, padded with slot 26 (the body centre: never a vertex, so -1)
+        local = np.full((len(self.tessellations), widest, width), 26, dtype=np.int64)
+        for p, tessellation in enumerate(self.tessellations):
+            for j, element in enumerate(tessellation.elements):
                 local[p, j, :len(element.nodes)] = element.nodes
         leaf = self.element_leaf[elements]
-        return self.slots[leaf[:, None], local[self.leaf_pattern[leaf], self.element_local[elements]]]
+        return self.slots[leaf[:, None], local[self.leaf_tessellation[leaf], self.element_local[elements]]]
 
     def connectivity(self) -> tuple[np.ndarray, np.ndarray]:
         """Global vertex ids of every element: (elements x widest) int32 padded with -1, and the sizes."""
@@ -293,9 +298,9 @@ class Mesh:
     def element_fvm(self) -> np.ndarray:
         """Per element: its circumcenter lies in its closed leaf (exact; a cell's leaf is its first leaf)."""
         flags = np.zeros(len(self), dtype=bool)
-        for _, pattern, leaves in self.groups():
+        for _, tessellation, leaves in self.groups():
             first = self.element_offsets[leaves]
-            for j, element in enumerate(pattern.elements):
+            for j, element in enumerate(tessellation.elements):
                 flags[first + j] = element.center_in_leaf
         if self.cells is not None:
             flags[self.leaf_elements:] = self.cell_center_in_leaf()
@@ -387,7 +392,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     (dicts with ``type`` and ``nodes``) or ``None`` when the table lacks it; a
     configuration without table elements is tessellated on the fly (and marked so), its
     elements split by the catalogue's kept types when ``criterion`` is not ``optimal``.
-    ``cache`` ((code, criterion) -> :class:`LocalPattern`) may be shared between runs.
+    ``cache`` ((code, criterion) -> :class:`LocalTessellation`) may be shared between runs.
     ``progress(n)`` is told as leaves are assembled.  ``vertices``: the grid and vertex keys
     (:func:`vertex_keys`) of a whole tree of which ``tree`` is a part: the part's
     configurations and vertex ids are then the whole tree's.  ``catalogue``: the element
@@ -428,36 +433,36 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     value = edges | faces << 12  # < 2**18: count instead of sorting
     seen = np.bincount(value, minlength=1 << 18) > 0
     distinct = np.flatnonzero(seen)
-    leaf_pattern = (np.cumsum(seen) - 1)[value]
-    patterns, types = [], {}
+    leaf_tessellation = (np.cumsum(seen) - 1)[value]
+    tessellations, types = [], {}
     for value in distinct.tolist():
         code = _leaf_code(value & 0xFFF, value >> 12)
         if (code, criterion) not in cache:
-            cache[code, criterion] = _pattern(Configuration.from_code(code, tree.box), lookup, types, criterion,
-                                              catalogue)
-        patterns.append(cache[code, criterion])
-    for pattern in patterns:
-        for element in pattern.elements:
+            cache[code, criterion] = _leaf_tessellation(Configuration.from_code(code, tree.box), lookup, types,
+                                                        criterion, catalogue)
+        tessellations.append(cache[code, criterion])
+    for tessellation in tessellations:
+        for element in tessellation.elements:
             if element.type_id not in types:
                 types[element.type_id] = _type_info(element.type_id, None, catalogue)
-    counts = np.array([len(p.elements) for p in patterns], dtype=np.int64)[leaf_pattern]
+    counts = np.array([len(p.elements) for p in tessellations], dtype=np.int64)[leaf_tessellation]
     offsets = np.zeros(len(tree) + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
     element_leaf = np.repeat(np.arange(len(tree), dtype=np.int32), counts)
     element_local = (np.arange(offsets[-1], dtype=np.int64) - offsets[:-1][element_leaf]).astype(np.int16)
     if progress:
         progress(len(tree) - len(tree) // 2)
-    return Mesh(tree, grid, vertices, slots, leaf_pattern.astype(np.int32).reshape(-1), patterns, offsets,
+    return Mesh(tree, grid, vertices, slots, leaf_tessellation.astype(np.int32).reshape(-1), tessellations, offsets,
                 element_leaf, element_local, types, catalogue=catalogue)
 
 
-def _pattern(configuration: Configuration, lookup: Lookup | None, types: dict, criterion: str,
-             catalogue: dict) -> LocalPattern:
+def _leaf_tessellation(configuration: Configuration, lookup: Lookup | None, types: dict, criterion: str,
+                       catalogue: dict) -> LocalTessellation:
     elements = lookup(configuration) if lookup is not None else None
     if elements is not None:
-        return local_pattern(configuration, [(e["type"], e["nodes"]) for e in elements],
-                             mapped_from=next((e["mapped_from"] for e in elements if "mapped_from" in e), None))
+        return local_tessellation(configuration, [(e["type"], e["nodes"]) for e in elements],
+                                  mapped_from=next((e["mapped_from"] for e in elements if "mapped_from" in e), None))
     tess = apply_catalogue_criterion(tessellate(configuration), criterion, catalogue)
     for element in tess.elements:
         types.setdefault(element.type.id, _type_info(element.type.id, element.type, catalogue))
-    return local_pattern(configuration, [(e.type.id, e.nodes) for e in tess.elements], on_the_fly=True)
+    return local_tessellation(configuration, [(e.type.id, e.nodes) for e in tess.elements], on_the_fly=True)

@@ -54,11 +54,11 @@ def check_volume(mesh: Mesh) -> dict:
     depth = mesh.tree.depth
     total = Fraction(0)
     flat = 0
-    for _, pattern, leaves in mesh.groups():
+    for _, tessellation, leaves in mesh.groups():
         per_level = np.bincount(mesh.tree.levels[leaves].astype(np.int64), minlength=depth + 1)
         weight = sum(int(count) * 8 ** (depth - level) for level, count in enumerate(per_level.tolist()))
-        total += sum((e.unit_volume for e in pattern.elements), Fraction(0)) * weight
-        flat += sum(e.unit_volume <= 0 for e in pattern.elements) * len(leaves)
+        total += sum((e.unit_volume for e in tessellation.elements), Fraction(0)) * weight
+        flat += sum(e.unit_volume <= 0 for e in tessellation.elements) * len(leaves)
     share = total / 8 ** depth
     if mesh.cells is not None:
         per_shape = np.bincount(mesh.cells.shape, minlength=len(mesh.cells.shapes)).tolist()
@@ -216,10 +216,10 @@ def check_circumcenters(mesh: Mesh) -> dict:
     control volumes need the circumcenter inside, as the paper says.
     """
     outside = leaves_bad = not_spherical = 0
-    for _, pattern, leaves in mesh.groups():
-        outside += sum(not e.center_in_leaf for e in pattern.elements) * len(leaves)
-        not_spherical += sum(e.sphere is None for e in pattern.elements) * len(leaves)
-        if not pattern.fvm_adequate:
+    for _, tessellation, leaves in mesh.groups():
+        outside += sum(not e.center_in_leaf for e in tessellation.elements) * len(leaves)
+        not_spherical += sum(e.sphere is None for e in tessellation.elements) * len(leaves)
+        if not tessellation.fvm_adequate:
             leaves_bad += len(leaves)
     if mesh.cells is not None:
         outside += int((~mesh.cell_center_in_leaf()).sum())
@@ -233,9 +233,9 @@ def _outside_domain(mesh: Mesh) -> int:
     grid = mesh.grid
     size = mesh.leaf_size()
     outside = 0
-    for _, pattern, leaves in mesh.groups():
+    for _, tessellation, leaves in mesh.groups():
         low = mesh.tree.positions[leaves].astype(np.int64) * size[leaves, None]
-        for element in pattern.elements:
+        for element in tessellation.elements:
             if element.center is None:
                 continue
             # the centre in grid units is low + c * size, for c = p / q: compare q * low + p * size with 0 and q * grid,
@@ -276,28 +276,28 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     levels = mesh.tree.levels.astype(np.int64)
     size = grid >> levels
     origin = mesh.tree.positions.astype(np.int64) * size[:, None]
-    rows_pattern, rows_local, rows_leaf, centres, radii, n_nodes = [], [], [], [], [], []
+    rows_tessellation, rows_local, rows_leaf, centres, radii, n_nodes = [], [], [], [], [], []
     # A table element that is not co-spherical (a table may hold one) has no sphere to test, and
     # is not a cell of the Delaunay subdivision: it joins the elements that are not cells.
     without_sphere = [np.zeros(0, dtype=np.int64)]
     cells = mesh.cells
     # the leaf elements kept beside re-tessellated cells, and the cells marked proven, passed this very
     # check on the same vertex set when they were chosen: only the other cells are tested again
-    for p, pattern, leaves in (mesh.groups() if cells is None else ()):
-        for j, element in enumerate(pattern.elements):
+    for p, tessellation, leaves in (mesh.groups() if cells is None else ()):
+        for j, element in enumerate(tessellation.elements):
             if element.sphere is None:  # reported by check_circumcenters as not co-spherical
                 without_sphere.append(mesh.element_offsets[leaves].astype(np.int64) + j)
                 continue
             centre = (origin[leaves] + np.array([float(x) for x in element.center])[None] * size[leaves, None]) * scale
             first = points[mesh.slots[leaves, element.nodes[0]]]
-            rows_pattern.append(np.full(len(leaves), p, dtype=np.int32))
+            rows_tessellation.append(np.full(len(leaves), p, dtype=np.int32))
             rows_local.append(np.full(len(leaves), j, dtype=np.int16))
             rows_leaf.append(leaves.astype(np.int64))
             centres.append(centre)
             radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(leaves), len(element.nodes), dtype=np.int64))
     if cells is not None and len(cells):
-        # a cell is a row of pattern -1 whose "leaf" is its index among the cells
+        # a cell is a row of tessellation -1 whose "leaf" is its index among the cells
         fresh = np.flatnonzero(~cells.proven)
         fresh = fresh[np.argsort(cells.shape[fresh], kind="stable")]
         starts = np.searchsorted(cells.shape[fresh], np.arange(len(cells.shapes) + 1))
@@ -305,7 +305,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
             rows = fresh[starts[s]:starts[s + 1]]
             centre = (cells.anchor[rows] + np.array([float(x) for x in shape.center])[None]) * scale
             first = points[cells.nodes[rows, 0]]
-            rows_pattern.append(np.full(len(rows), -1, dtype=np.int32))
+            rows_tessellation.append(np.full(len(rows), -1, dtype=np.int32))
             rows_local.append(np.full(len(rows), s, dtype=np.int16))
             rows_leaf.append(rows.astype(np.int64))
             centres.append(centre)
@@ -317,7 +317,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         return {"_leaves": np.zeros(0, dtype=np.int64), "_elements": np.zeros(0, dtype=np.int64),
                 "_not_cells": np.sort(np.concatenate(without_sphere)), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
                 "delaunay_ties": 0, "delaunay_exact_tests": 0}
-    rows_pattern, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_pattern, rows_local, rows_leaf))
+    rows_tessellation, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_tessellation, rows_local, rows_leaf))
     centres, radii, n_nodes = np.concatenate(centres), np.concatenate(radii), np.concatenate(n_nodes)
     reach = radii * (1 + 1e-9) + 1e-12 * float(np.abs(points).max())
     # Only vertices in the box around every reach can be within one: the rest are left out of the
@@ -364,7 +364,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     pair_row = np.concatenate(pairs_row) if pairs_row else np.zeros(0, dtype=np.int64)
     pair_vertex = np.concatenate(pairs_vertex) if pairs_vertex else np.zeros(0, dtype=np.int64)
     # drop each element's own nodes
-    is_cell = rows_pattern[pair_row] < 0
+    is_cell = rows_tessellation[pair_row] < 0
     own = np.zeros(len(pair_row), dtype=bool)
     leafy = np.flatnonzero(~is_cell)
     leaf_of_pair = rows_leaf[pair_row[leafy]]
@@ -377,29 +377,29 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     sides = np.zeros(len(pair_row), dtype=np.int8)
     weights = _weights(mesh)
     for i, (row, vertex) in enumerate(zip(pair_row.tolist(), pair_vertex.tolist())):
-        if rows_pattern[row] < 0:
+        if rows_tessellation[row] < 0:
             shape = cells.shapes[rows_local[row]]
             x = [int(v) - int(o) for v, o in zip(mesh.vertices[vertex], cells.anchor[rows_leaf[row]])]
             side = shape.sphere.side_at(x, weights)
         else:
-            pattern = mesh.patterns[rows_pattern[row]]
-            element = pattern.elements[rows_local[row]]
+            tessellation = mesh.tessellations[rows_tessellation[row]]
+            element = tessellation.elements[rows_local[row]]
             leaf = rows_leaf[row]
             m = int(size[leaf])
-            x = [pattern.scale * (int(v) - int(o)) for v, o in zip(mesh.vertices[vertex], origin[leaf])]
-            side = element.sphere.side_at(x, pattern.weights, m)
+            x = [tessellation.scale * (int(v) - int(o)) for v, o in zip(mesh.vertices[vertex], origin[leaf])]
+            side = element.sphere.side_at(x, tessellation.weights, m)
         sides[i] = (side > 0) - (side < 0)
     inside = sides < 0
     bad_rows = distinct(pair_row[inside])
 
     def elements(rows: np.ndarray) -> np.ndarray:
-        cell = rows_pattern[rows] < 0
+        cell = rows_tessellation[rows] < 0
         return np.sort(np.where(cell, mesh.leaf_elements + rows_leaf[rows],
                                 mesh.element_offsets[np.where(cell, 0, rows_leaf[rows])] + rows_local[rows])
                        ).astype(np.int64)
 
-    leaf_rows = bad_rows[rows_pattern[bad_rows] >= 0]
-    bad_leaves = distinct(np.r_[rows_leaf[leaf_rows], cells.leaf[rows_leaf[bad_rows[rows_pattern[bad_rows] < 0]]]
+    leaf_rows = bad_rows[rows_tessellation[bad_rows] >= 0]
+    bad_leaves = distinct(np.r_[rows_leaf[leaf_rows], cells.leaf[rows_leaf[bad_rows[rows_tessellation[bad_rows] < 0]]]
                                  if cells is not None else np.zeros(0, dtype=np.int64)])
     return {"_leaves": bad_leaves, "_elements": elements(bad_rows), "_not_cells": np.sort(np.r_[elements(distinct(pair_row[sides <= 0])), np.concatenate(without_sphere)]),
             "delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),

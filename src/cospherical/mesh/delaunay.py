@@ -251,12 +251,12 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
 def _region_volumes(mesh: Mesh, elements: np.ndarray, part: np.ndarray, regions: int) -> list[Fraction]:
     """Per region, the exact volume of its elements in grid cells."""
     leaf = mesh.element_leaf[elements]
-    kind = mesh.leaf_pattern[leaf].astype(np.int64) * 65536 + mesh.element_local[elements]
+    kind = mesh.leaf_tessellation[leaf].astype(np.int64) * 65536 + mesh.element_local[elements]
     size = (mesh.grid >> mesh.tree.levels[leaf].astype(np.int64)).astype(object) ** 3
     volumes = [Fraction(0)] * regions
-    # elements of one pattern element and one region: one Fraction product per pair
+    # elements of one local element (tessellation, element in it) and one region: one Fraction product per pair
     for (r, k), total in _sums(part * (int(kind.max()) + 1) + kind, size, int(kind.max()) + 1):
-        element = mesh.patterns[k // 65536].elements[k % 65536]
+        element = mesh.tessellations[k // 65536].elements[k % 65536]
         volumes[r] += element.unit_volume * total
     return volumes
 
@@ -299,13 +299,13 @@ def _failing_regions(mesh: Mesh, found: dict, vertex_region: np.ndarray, wanted:
 def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict) -> Mesh:
     """``mesh`` with the elements of the marked leaves replaced by ``cells`` (whose ``leaf`` indexes its leaves);
     ``types``: the element types of the result."""
-    counts = np.array([len(p.elements) for p in mesh.patterns], dtype=np.int64)[mesh.leaf_pattern]
+    counts = np.array([len(p.elements) for p in mesh.tessellations], dtype=np.int64)[mesh.leaf_tessellation]
     counts[bad] = 0
     offsets = np.zeros(len(mesh.tree) + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
     element_leaf = np.repeat(np.arange(len(mesh.tree), dtype=np.int32), counts)
     element_local = (np.arange(offsets[-1], dtype=np.int64) - offsets[:-1][element_leaf]).astype(np.int16)
-    return Mesh(mesh.tree, mesh.grid, mesh.vertices, mesh.slots, mesh.leaf_pattern, mesh.patterns, offsets,
+    return Mesh(mesh.tree, mesh.grid, mesh.vertices, mesh.slots, mesh.leaf_tessellation, mesh.tessellations, offsets,
                 np.r_[element_leaf, cells.leaf.astype(np.int32)], np.r_[element_local, np.full(len(cells), -1,
                                                                                               dtype=np.int16)],
                 types, replaced=bad, cells=cells, catalogue=mesh.catalogue)
@@ -427,10 +427,10 @@ def _inside(mesh: Mesh, tets: np.ndarray, tet_region: np.ndarray, region: np.nda
     size = mesh.leaf_size()[leaf]
     local = quad - 4 * mesh.tree.positions[leaf].astype(np.int64) * size[:, None]
     first = mesh.element_offsets[leaf]
-    pattern = mesh.leaf_pattern[leaf]
+    which = mesh.leaf_tessellation[leaf]
     inside = np.zeros(len(tets), dtype=bool)
-    order = np.argsort(pattern, kind="stable")
-    starts = np.searchsorted(pattern[order], np.arange(len(mesh.patterns) + 1))
+    order = np.argsort(which, kind="stable")
+    starts = np.searchsorted(which[order], np.arange(len(mesh.tessellations) + 1))
     for p, element_planes in enumerate(_planes(mesh)):
         rows = order[starts[p]:starts[p + 1]]
         for j, planes in enumerate(element_planes):
@@ -445,11 +445,11 @@ def _inside(mesh: Mesh, tets: np.ndarray, tet_region: np.ndarray, region: np.nda
 
 
 def _planes(mesh: Mesh) -> list[list[list[tuple[np.ndarray, np.ndarray, int]]]]:
-    """Per pattern, per element, its face planes in the node grid: (normal, a point, sign of the inside)."""
+    """Per tessellation, per element, its face planes in the node grid: (normal, a point, sign of the inside)."""
     planes = []
-    for pattern in mesh.patterns:
+    for tessellation in mesh.tessellations:
         planes.append([])
-        for element in pattern.elements:
+        for element in tessellation.elements:
             centroid = NODE_OFFSETS[list(element.nodes)].sum(axis=0)
             faces = []
             for cycle in element.faces:

@@ -281,7 +281,7 @@ def _integers(values: list[Fraction], denominator: int) -> np.ndarray:
 def mesh_dual(mesh, elements: tuple[np.ndarray, np.ndarray] | None = None) -> Dual:
     """The exact dual of a mesh.
 
-    By default the elements are the mesh's leaf pattern elements, and their pieces
+    By default the elements are the elements of the mesh's leaf tessellations, and their pieces
     are computed once per configuration, and the cells that replace leaves (global
     Delaunay mode) once per shape.  ``elements`` (``(connectivity, sizes)`` as
     :meth:`Mesh.connectivity` gives them, global vertex ids) takes any element list
@@ -462,13 +462,13 @@ def _leaf_groups(mesh, squared):
     origin = mesh.tree.positions.astype(np.int64) * sizes[:, None]
     centers = np.zeros((len(mesh), 3))
     groups = []
-    for _, pattern, leaves in mesh.groups():
+    for _, tessellation, leaves in mesh.groups():
         first, low, size = mesh.element_offsets[leaves], origin[leaves], sizes[leaves, None]
-        for j, element in enumerate(pattern.elements):
+        for j, element in enumerate(tessellation.elements):
             if element.center is None:
-                raise InputError(f"configuration {pattern.code}: element {j} is not co-spherical: it has no dual")
+                raise InputError(f"configuration {tessellation.code}: element {j} is not co-spherical: it has no dual")
             centers[first + j] = (low + np.array([float(x) for x in element.center]) * size) * (lengths / mesh.grid)
-        groups.append((_pattern_shape(pattern, squared), mesh.slots, leaves, sizes[leaves]))
+        groups.append((_tessellation_shape(tessellation, squared), mesh.slots, leaves, sizes[leaves]))
     return groups, centers
 
 
@@ -491,14 +491,14 @@ def _cell_groups(mesh, squared, centers: np.ndarray):
 _SHAPES: dict[tuple, _Shape] = {}
 
 
-def _pattern_shape(pattern, squared) -> _Shape:
+def _tessellation_shape(tessellation, squared) -> _Shape:
     """A configuration's pieces, remembered by its code, box and element node lists (meshes share them)."""
-    key = (pattern.code, squared, tuple(e.nodes for e in pattern.elements))
+    key = (tessellation.code, squared, tuple(e.nodes for e in tessellation.elements))
     shape = _SHAPES.get(key)
     if shape is None:
-        points = pattern.configuration.nodes()
+        points = tessellation.configuration.nodes()
         shape = _SHAPES[key] = _Shape([element_pieces({n: points[n] for n in e.nodes}, e.faces, e.center, squared)
-                                       for e in pattern.elements])
+                                       for e in tessellation.elements])
     return shape
 
 

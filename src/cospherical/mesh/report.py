@@ -79,12 +79,12 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
         found.pop("_not_cells")
         figures.update(found)
         # the point of counting them: a leaf can be fvm_adequate on its own and still not globally Delaunay
-        fvm = np.array([p.fvm_adequate for p in mesh.patterns], dtype=bool)[mesh.leaf_pattern[bad_leaves]]
+        fvm = np.array([p.fvm_adequate for p in mesh.tessellations], dtype=bool)[mesh.leaf_tessellation[bad_leaves]]
         figures["delaunay_violating_fvm_leaves"] = int(fvm.sum())
     start("statistics")
     figures["type_counts"], figures["configurations"] = occurrences(mesh)
     kept = {p.code for _, p, _ in mesh.groups()}
-    figures["mapped"] = sorted(p.code for p in mesh.patterns if p.mapped_from is not None and p.code in kept)
+    figures["mapped"] = sorted(p.code for p in mesh.tessellations if p.mapped_from is not None and p.code in kept)
     figures["leaves_tessellated_on_the_fly"] = int(sum(
         len(leaves) for _, p, leaves in mesh.groups(all_leaves=True) if p.on_the_fly))
     figures["types"] = dict(mesh.types)

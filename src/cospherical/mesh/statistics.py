@@ -68,14 +68,14 @@ def occurrences(mesh: Mesh) -> tuple[Counter, dict[str, dict]]:
         if len(rows):
             type_counts[type_id] += len(rows)
     configurations = {}
-    for _, pattern, leaves in mesh.groups(all_leaves=True):
-        configurations[pattern.code] = {
-            "code": pattern.code,
+    for _, tessellation, leaves in mesh.groups(all_leaves=True):
+        configurations[tessellation.code] = {
+            "code": tessellation.code,
             "leaves": int(len(leaves)),
-            "in_bisection_family": in_bisection_family(pattern.configuration),
-            "elements_per_leaf": len(pattern.elements),
-            "fvm_adequate": pattern.fvm_adequate,
-            "tessellated_on_the_fly": pattern.on_the_fly,
+            "in_bisection_family": in_bisection_family(tessellation.configuration),
+            "elements_per_leaf": len(tessellation.elements),
+            "fvm_adequate": tessellation.fvm_adequate,
+            "tessellated_on_the_fly": tessellation.on_the_fly,
         }
     return type_counts, configurations
 
