@@ -156,7 +156,7 @@ def test_cuboid_diagram_numbers_the_nodes_as_the_code_does():
 
 
 def test_edge_table_is_the_code_s():
-    from cospherical.core.configuration import EDGES, edge_axis
+    from cospherical.core.shapes import EDGES, edge_axis
 
     rows = re.findall(r"^\| (\d+) \| (\d+)-(\d+) \| ([xyz]) \| node (\d+) \|$", PAGES["concepts/conventions.md"], re.M)
     assert [(int(a), int(b)) for _, a, b, _, _ in rows] == list(EDGES)

@@ -138,7 +138,8 @@ def test_the_cuboid_is_a_standard_shape(box):
     """The standard cuboid is the box with the cuboid's numbering (VTK hexahedron: corners, edges,
     face f carrying node 20 + f), and its isometries are exactly the box's symmetries: the same
     node maps and edge maps (48, 16 or 8 of them)."""
-    from cospherical.core.configuration import CORNERS, EDGES, FACES, Box
+    from cospherical.core.configuration import Box
+    from cospherical.core.shapes import CORNERS, EDGES, FACES
     from cospherical.core.symmetry import box_symmetries
 
     shape = standard_shape("cuboid", box)

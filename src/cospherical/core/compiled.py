@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit
 
 from ..caches import cached
-from .configuration import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
+from .shapes import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
 
 __all__ = ["buffers", "cube_batch", "cube_tables", "fits", "orbit_keys", "walk"]
 

@@ -18,22 +18,10 @@ from typing import Iterable, Mapping
 from ..errors import InputError
 from .codes import digit_parameters, edge_code_pattern, parameter_digits, parse_point_suffix, point_suffix
 from .exact import parse_rational
-from .shapes import CORNERS, EDGES, FACE_EDGES, FACES, Box, Point, Shape, edge_axis, standard_shape
+from .shapes import Box, Point, Shape, standard_shape
 
-__all__ = [
-    "Box",
-    "CORNERS",
-    "Configuration",
-    "EDGES",
-    "FACES",
-    "FACE_EDGES",
-    "FACE_POINT_SOURCES",
-    "POINT_POLICIES",
-    "edge_axis",
-    "parse_point_suffix",
-    "point_suffix",
-    "steiner_parameters",
-]
+# Box: the type of a configuration's box (Configuration.box), public here with the class that takes it
+__all__ = ["Box", "Configuration", "FACE_POINT_SOURCES", "POINT_POLICIES", "steiner_parameters"]
 
 POINT_POLICIES = ("octree", "none")
 FACE_POINT_SOURCES = (*POINT_POLICIES, "explicit")

@@ -25,10 +25,10 @@ if TYPE_CHECKING:
 
 from ..caches import cached
 from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, point_suffix
-from .configuration import CORNERS, EDGES, FACES, Box, Configuration
+from .configuration import Box, Configuration
 from .geometry import cross, determinant, sub, tetra_six_volume
 from .polyhedron import Polyhedron
-from .shapes import Point, Shape, standard_shape
+from .shapes import CORNERS, EDGES, FACES, Point, Shape, standard_shape
 
 __all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
            "orbit_point_keys", "orbit_representatives", "shape_symmetries"]

@@ -26,9 +26,10 @@ import numpy as np
 
 from ..catalogue import apply_catalogue_criterion, shipped_catalogue
 from ..core.codes import mask_code, point_suffix
-from ..core.configuration import CORNERS, EDGES, FACES, Box, Configuration
+from ..core.configuration import Box, Configuration
 from ..core.element_types import ElementType
 from ..core.polyhedron import measure
+from ..core.shapes import CORNERS, EDGES, FACES
 from ..core.geometry import Frame, Sphere, in_closed_box
 from ..core.tessellation import tessellate
 from ..errors import InputError

@@ -22,7 +22,8 @@ from typing import Sequence
 
 from ..catalogue import CRITERIA
 from ..core.codes import point_suffix
-from ..core.configuration import FACE_EDGES, Box
+from ..core.configuration import Box
+from ..core.shapes import FACE_EDGES
 from .engine import Progress, Study, bisection_codes, run_study
 
 __all__ = ["leaf_codes", "run_leaves"]

@@ -24,7 +24,8 @@ from itertools import combinations, product
 
 import numpy as np
 
-from ...core.configuration import Box, edge_axis
+from ...core.configuration import Box
+from ...core.shapes import edge_axis
 from ...core.symmetry import box_symmetries, orbit_keys
 from ...errors import InputError
 from ..insertion import INSERTION_ORDERS
