@@ -26,8 +26,10 @@ DOCS = ROOT / "docs"
 PAGES = {path.relative_to(DOCS).as_posix(): path.read_text() for path in sorted(DOCS.rglob("*.md"))}
 README_LINES = set(shell_examples((ROOT / "README.md").read_text()))
 # Not run here, and why: the set-up made this environment; the site build and the compiled
-# store reader are run by the tests below (test_site_builds_strict, test_c_reader_...).
-NOT_RUN = ("scripts/setup.sh", "mkdocs ", "./lookup")
+# store reader are run by the tests below (test_site_builds_strict, test_c_reader_...); the leaf
+# study of the 1 x 2 x 4 box, the same command, by cli/test_study.py (test_study_leaves_json_and_tables),
+# which checks its output.
+NOT_RUN = ("scripts/setup.sh", "mkdocs ", "./lookup", "cospherical study leaves --box 1 2 4 --format json --out ")
 MKDOCS = Path(sys.executable).parent / "mkdocs"
 
 
