@@ -16,7 +16,7 @@ from cospherical.core.delaunay import delaunay_cells
 from cospherical.core.geometry import Frame
 from cospherical.core.incremental_delaunay import delaunay_tetrahedra
 from cospherical.mesh.assembly import assemble
-from cospherical.mesh.checks import _weights
+from cospherical.mesh.checks import grid_weights
 from cospherical.mesh.octree import build_octree, parse_shape
 
 
@@ -84,7 +84,7 @@ def test_bad_input():
 def test_octree_vertices_equal_qhull_merged_exactly(domain, levels, shape):
     leaf = assemble(build_octree(Box.parse(domain), levels, [parse_shape(shape)], "vertex"))
     points = [tuple(int(x) for x in v) for v in leaf.vertices]
-    assert cells_of(points, _weights(leaf))[0] == oracle_cells(leaf)
+    assert cells_of(points, grid_weights(leaf))[0] == oracle_cells(leaf)
 
 
 @pytest.mark.parametrize("domain", [["1e-12", "1", "3e9"], ["sqrt(2)", "1e-12", "1"]])
@@ -93,7 +93,7 @@ def test_extreme_boxes_equal_the_projects_walk(domain):
     box = Box.parse(domain)
     leaf = assemble(build_octree(box, 3, [parse_shape("point:0,0,0")], "vertex"))
     points = [tuple(int(x) for x in v) for v in leaf.vertices]
-    weights = _weights(leaf)
+    weights = grid_weights(leaf)
     walk = {frozenset(cell.nodes) for cell in delaunay_cells(Frame.build(dict(enumerate(points)), weights))}
     assert cells_of(points, weights)[0] == walk
     assert len(walk) > 1

@@ -37,7 +37,7 @@ from ..paper import paper_class
 from .octree import Octree, distinct
 
 __all__ = ["CellShape", "Cells", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "NODE_OFFSETS", "PAPER_FINAL",
-           "assemble", "distinct", "local_tessellation", "vertex_keys"]
+           "assemble", "distinct", "local_tessellation", "type_info", "vertex_keys"]
 
 # Twice the unit coordinates of the 27 nodes (corners, edge midpoints, face centres, body).
 NODE_OFFSETS = np.array(
@@ -337,7 +337,7 @@ class Mesh:
         low = self.tree.positions[self.cells.leaf].astype(num.dtype) * size[:, None]
         return in_closed_box(num, den[:, None], low, low + size[:, None]).astype(bool)
 
-def _type_info(type_id: str, etype: ElementType | None, catalogue: dict) -> dict:
+def type_info(type_id: str, etype: ElementType | None, catalogue: dict) -> dict:
     """Name, paper class, VTK cell and size of a type: from the catalogue, else from the type itself."""
     for entry in catalogue["types"]:
         if entry["id"] == type_id:
@@ -445,7 +445,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     for tessellation in tessellations:
         for element in tessellation.elements:
             if element.type_id not in types:
-                types[element.type_id] = _type_info(element.type_id, None, catalogue)
+                types[element.type_id] = type_info(element.type_id, None, catalogue)
     counts = np.array([len(p.elements) for p in tessellations], dtype=np.int64)[leaf_tessellation]
     offsets = np.zeros(len(tree) + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
@@ -465,5 +465,5 @@ def _leaf_tessellation(configuration: Configuration, lookup: Lookup | None, type
                                   mapped_from=next((e["mapped_from"] for e in elements if "mapped_from" in e), None))
     tess = apply_catalogue_criterion(tessellate(configuration), criterion, catalogue)
     for element in tess.elements:
-        types.setdefault(element.type.id, _type_info(element.type.id, element.type, catalogue))
+        types.setdefault(element.type.id, type_info(element.type.id, element.type, catalogue))
     return local_tessellation(configuration, [(e.type.id, e.nodes) for e in tess.elements], on_the_fly=True)

@@ -34,7 +34,7 @@ from .octree import distinct
 _MAX_EXACT_TESTS = 1 << 24
 _PAIR_CHUNK = 1 << 22
 
-__all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "match_seams"]
+__all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "grid_weights", "match_seams"]
 
 
 def check_volume(mesh: Mesh) -> dict:
@@ -375,7 +375,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         own[celly] = (cells.nodes[rows_leaf[pair_row[celly]]] == pair_vertex[celly, None]).any(axis=1)
     pair_row, pair_vertex = pair_row[~own], pair_vertex[~own]
     sides = np.zeros(len(pair_row), dtype=np.int8)
-    weights = _weights(mesh)
+    weights = grid_weights(mesh)
     for i, (row, vertex) in enumerate(zip(pair_row.tolist(), pair_vertex.tolist())):
         if rows_tessellation[row] < 0:
             shape = cells.shapes[rows_local[row]]
@@ -413,7 +413,7 @@ def _morton_order(points: np.ndarray, low: np.ndarray, high: np.ndarray, bits: i
     return np.argsort(morton_codes(cell.astype(np.int64)), kind="stable")
 
 
-def _weights(mesh: Mesh) -> tuple[int, int, int]:
+def grid_weights(mesh: Mesh) -> tuple[int, int, int]:
     """The box's squared lengths as integers in one ratio: the weights of the grid frame."""
     squared = mesh.box.squared
     den = math.lcm(*(w.denominator for w in squared))

@@ -120,8 +120,8 @@ from ..core.geometry import Frame, area_vector, circumcentres, six_volumes, sphe
 from ..core.incremental_delaunay import delaunay_tetrahedra
 from ..core.tessellation import tessellation_elements
 from ..errors import InputError
-from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, _type_info, distinct
-from .checks import _weights, check_delaunay
+from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, distinct, type_info
+from .checks import check_delaunay, grid_weights
 
 __all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
@@ -227,7 +227,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
         every = np.concatenate(tets)
         every = every[_inside(mesh, every, tet_region, region, located)]
         try:
-            cells = _cells(mesh, _members(_same_sphere(mesh, every, _weights(mesh)), every, len(mesh.vertices)),
+            cells = _cells(mesh, _members(_same_sphere(mesh, every, grid_weights(mesh)), every, len(mesh.vertices)),
                            proven, located, types)
         except NotOneCell:  # no cell to name a region by: no proof per region
             failing = set(range(regions))
@@ -374,7 +374,7 @@ def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull", propo
         simplices = _qhull_proposal(mesh, coords, proposal)
         if simplices is not None:
             return ids[simplices]
-    return ids[np.array(delaunay_tetrahedra(coords.tolist(), _weights(mesh)), dtype=np.int64).reshape(-1, 4)]
+    return ids[np.array(delaunay_tetrahedra(coords.tolist(), grid_weights(mesh)), dtype=np.int64).reshape(-1, 4)]
 
 
 def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray | None:
@@ -405,7 +405,7 @@ def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray
     pick = solid[far]
     near, far = near[pick], far[pick]
     across = simplices[far, np.argmax(triangulation.neighbors[far] == near[:, None], axis=1)]
-    if len(near) and sphere_sides(p[near], coords[across], _weights(mesh)).min() < 0:
+    if len(near) and sphere_sides(p[near], coords[across], grid_weights(mesh)).min() < 0:
         return None
     return simplices[solid]
 
@@ -558,7 +558,7 @@ def _shape(offsets: list[tuple[int, int, int]], squared, types: dict, catalogue:
     if len(elements) != 1 or len(elements[0].nodes) != len(offsets):
         raise NotOneCell(f"merged tetrahedra are not one co-spherical cell: {offsets}")
     element = elements[0]
-    types.setdefault(element.type.id, _type_info(element.type.id, element.type, catalogue))
+    types.setdefault(element.type.id, type_info(element.type.id, element.type, catalogue))
     order = list(element.nodes)
     at = {n: i for i, n in enumerate(order)}
     frame = Frame.build({i: points[n] for i, n in enumerate(order)}, squared)

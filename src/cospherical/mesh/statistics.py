@@ -15,7 +15,7 @@ import numpy as np
 
 from ..core.configuration import Box, Configuration
 from ..studies.engine import bisection_codes, run_study
-from .assembly import PAPER_FINAL, Mesh, _type_info
+from .assembly import PAPER_FINAL, Mesh, type_info
 
 __all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "statistics", "uniform_study"]
 
@@ -27,7 +27,7 @@ def uniform_study(box: Box, catalogue: dict) -> dict:
     the types named by ``catalogue``."""
     study = run_study("bisection", box, bisection_codes(), "octree", criteria=("optimal",))
     counts = {tc.type.id: tc.count for tc in study.type_counts("optimal")}
-    info = {tc.type.id: _type_info(tc.type.id, tc.type, catalogue) for tc in study.type_counts("optimal")}
+    info = {tc.type.id: type_info(tc.type.id, tc.type, catalogue) for tc in study.type_counts("optimal")}
     return {"counts": counts, "types": info, "elements": study.total("optimal")}
 
 
@@ -97,7 +97,7 @@ def statistics(type_counts: Counter, configurations: dict[str, dict], total_leav
     info.update(types)
     rows = []
     for type_id in sorted(set(type_counts) | set(uniform_counts), key=lambda t: (-type_counts[t], t)):
-        entry = info.get(type_id) or _type_info(type_id, None, catalogue)
+        entry = info.get(type_id) or type_info(type_id, None, catalogue)
         rows.append({
             "id": type_id, "name": entry["name"], "paper_class": entry["paper_class"], "vtk": entry["vtk"],
             "count": int(type_counts[type_id]), "share": _share(type_counts[type_id], total),
