@@ -218,7 +218,7 @@ class Mesh:
 
     @property
     def leaf_elements(self) -> int:
-        """How many elements come from the leaves' patterns (the cells follow them)."""
+        """How many elements come from the leaves' tessellations (the cells follow them)."""
         return len(self) - (len(self.cells) if self.cells is not None else 0)
 
     def leaf_size(self) -> np.ndarray:
