@@ -364,13 +364,13 @@ def boundary_areas(exact: np.ndarray, denominator: int, factors_squared) -> np.n
     return (exact.astype(np.float64) * factors).sum(axis=1) / denominator
 
 
-CHUNK = 1 << 21  # instances per block of work: its temporaries stay small and the allocator reuses them
+_CHUNK = 1 << 21  # instances per block of work: its temporaries stay small and the allocator reuses them
 PACKED_BITS = 63  # an edge instance's key and payload share one int64 while they fit in these bits
 
 
 def _chunks(count: int, width: int):
-    """Slices of ``range(count)`` of about :data:`CHUNK` / ``width`` rows each."""
-    step = max(1, CHUNK // max(width, 1))
+    """Slices of ``range(count)`` of about ``_CHUNK`` / ``width`` rows each."""
+    step = max(1, _CHUNK // max(width, 1))
     for start in range(0, count, step):
         yield slice(start, min(start + step, count))
 
@@ -440,7 +440,7 @@ def _edge_sums(groups, n_vertices: int, cden: int, dtype) -> tuple[np.ndarray, n
     powers = np.array([1 << k for k in range(max_shift + 1)], dtype=dtype)
     sums = np.empty(len(first), dtype=dtype)
     # blocks of whole runs, so that each run is summed within one block
-    bounds = np.unique(np.r_[np.searchsorted(first, np.arange(0, total, CHUNK)), len(first)])
+    bounds = np.unique(np.r_[np.searchsorted(first, np.arange(0, total, _CHUNK)), len(first)])
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         start, stop = first[lo], first[hi] if hi < len(first) else total
         payload = payloads[start:stop] & ((1 << payload_bits) - 1)

@@ -276,7 +276,7 @@ def _keys_of(level: int, cells: np.ndarray) -> np.ndarray:
     return (cells[:, 0] * n + cells[:, 1]) * n + cells[:, 2]
 
 
-def cells_of(level: int, keys: np.ndarray) -> np.ndarray:
+def _cells_of(level: int, keys: np.ndarray) -> np.ndarray:
     """Positions (n x 3) of linear keys at ``level``."""
     n = np.int64(1 << level)
     keys = keys.astype(np.int64)
@@ -299,7 +299,7 @@ def _neighbours(level: int, cells: np.ndarray, offsets: np.ndarray) -> np.ndarra
 
 def _children(level: int, keys: np.ndarray) -> np.ndarray:
     """Keys at ``level + 1`` of the eight children of cells at ``level``."""
-    cells = cells_of(level, keys) * 2
+    cells = _cells_of(level, keys) * 2
     kids = (cells[:, None, :] + np.array(list(product((0, 1), repeat=3)))[None]).reshape(-1, 3)
     return np.sort(_keys_of(level + 1, kids))
 
@@ -336,7 +336,7 @@ def _leaves_from_splits(split: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray
         here = split[level] if level < len(split) else np.zeros(0, dtype=np.int64)
         leaves = existing[~np.isin(existing, here, assume_unique=True)]
         levels.append(np.full(len(leaves), level, dtype=np.int8))
-        positions.append(cells_of(level, leaves))
+        positions.append(_cells_of(level, leaves))
         if level < len(split):
             existing = _children(level, here)
     return np.concatenate(levels), np.concatenate(positions)
@@ -386,7 +386,7 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
     split: list[np.ndarray] = []
     existing = np.zeros(1, dtype=np.int64)
     for level in range(levels):
-        cells = cells_of(level, existing)
+        cells = _cells_of(level, existing)
         hit = np.zeros(len(cells), dtype=bool)
         for shape in shapes:
             hit |= _meets(shape, box, level, cells)
@@ -397,8 +397,8 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
     offsets = _offsets(balance)
     for level in range(levels - 1, 0, -1):
         # every neighbour of a split cell must exist: its parent must be split
-        need = _neighbours(level, cells_of(level, split[level]), offsets)
-        parents = distinct(_keys_of(level - 1, cells_of(level, need) // 2))
+        need = _neighbours(level, _cells_of(level, split[level]), offsets)
+        parents = distinct(_keys_of(level - 1, _cells_of(level, need) // 2))
         split[level - 1] = np.union1d(split[level - 1], parents)
     levels_, positions = _leaves_from_splits(split)
     check_leaf_count(len(levels_), f"--levels {levels}: balanced, the tree has", max_leaves)
@@ -455,7 +455,7 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
     # split[l]: the cells of level l that are ancestors of a leaf; a leaf must not be one
     split = []
     for level in range(depth):
-        deeper = [_keys_of(level, cells_of(d, keys[d]) >> (d - level)) for d in range(level + 1, depth + 1)]
+        deeper = [_keys_of(level, _cells_of(d, keys[d]) >> (d - level)) for d in range(level + 1, depth + 1)]
         split.append(distinct(np.concatenate(deeper)) if deeper else np.zeros(0, dtype=np.int64))
         clash = np.isin(keys[level], split[level])
         if clash.any():
@@ -468,7 +468,7 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
         here = np.union1d(keys[level], split[level] if level < depth else np.zeros(0, dtype=np.int64))
         missing = existing[~np.isin(existing, here)]
         if len(missing):
-            cell = cells_of(level, missing[:1])[0]
+            cell = _cells_of(level, missing[:1])[0]
             raise InputError(f"{where}: no leaf covers the cell at level {level}, position "
                              f"{' '.join(map(str, cell))}")
         if level < depth:
@@ -476,11 +476,11 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
     # 1-irregular: every face or edge neighbour of a split cell exists
     offsets = _offsets("edge")
     for level in range(1, depth):
-        need = _neighbours(level, cells_of(level, split[level]), offsets)
-        parents = _keys_of(level - 1, cells_of(level, need) // 2)
+        need = _neighbours(level, _cells_of(level, split[level]), offsets)
+        parents = _keys_of(level - 1, _cells_of(level, need) // 2)
         lacking = np.flatnonzero(~np.isin(parents, split[level - 1]))
         if len(lacking):
-            cell = cells_of(level, need[lacking[:1]])[0]
+            cell = _cells_of(level, need[lacking[:1]])[0]
             # the leaf holding that cell is coarser than its parent: find it by its ancestors
             for coarse in range(level - 1, -1, -1):
                 key = _keys_of(coarse, (cell >> (level - coarse))[None])[0]
