@@ -24,6 +24,13 @@ from commands import cospherical
         (["tessellate", "--box", "1", "1", "1", "--face-points", "all"], "face-points"),
         (["tessellate", "--box", "1", "1", "1", "--code", "800000000000", "--steiner", "0:1/2"], "not allowed"),
         (["tessellate"], "--box"),
+        # numbers past int()'s 4,300 digits: its ValueError was a traceback, the value shown cut short
+        (["tessellate", "--box", "1", "1", "1", "--steiner", "9" * 5000 + ":1/2"], "not an edge number"),
+        (["tessellate", "--box", "1", "1", "1", "--element", "prism", "--code", "888888888", "--faces", "9" * 5000],
+         "not a face number"),
+        # Path("") is the current folder: the outputs went wherever the command ran
+        (["mesh", "--domain", "1", "1", "1", "--levels", "2", "--out", ""], "an empty path"),
+        (["study", "bisection", "--out", " "], "an empty path"),
         (["frobnicate"], "frobnicate"),
         ([], "command"),
     ],
@@ -35,6 +42,7 @@ def test_usage_errors_are_one_line_exit_2(args, needle):
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
     assert needle in lines[0] and "Traceback" not in result.stderr
+    assert len(lines[0]) < 300  # the input is named, not echoed whole
 
 
 def test_main_freezes_the_collector_only_as_the_process_command(monkeypatch, capsys):

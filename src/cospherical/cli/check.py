@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..catalogue import catalogue_path, load_catalogue
 from ..formats.check import check_catalogue, check_patterns, read_document_file
+from .output import path_argument
 
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -19,10 +20,10 @@ DESCRIPTION = ("Validate catalogues (schema, unique ids, consistent faces, known
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("files", nargs="+", type=Path, metavar="FILE",
+    parser.add_argument("files", nargs="+", type=path_argument, metavar="FILE",
                         help="catalogues and pattern tables, checked in order (about 10-20 s per 4096-configuration "
                         "pattern table: every configuration is recomputed)")
-    parser.add_argument("--catalogue", type=Path, metavar="FILE",
+    parser.add_argument("--catalogue", type=path_argument, metavar="FILE",
                         help="catalogue that pattern tables refer to (default: the shipped one)")
     parser.add_argument("--no-tiling", action="store_true", help="skip the geometric tiling check (faster)")
 

@@ -20,6 +20,7 @@ from ..mesh.delaunay import MODES, delaunay_mesh
 from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, build_octree, leaf_list_order, leaves_octree, parse_shape
 from ..mesh.report import mesh_report
 from .progress import stage_bars
+from .output import path_argument
 
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -40,7 +41,7 @@ def add_arguments(parser) -> None:
     tree.add_argument("--refine", action="append", metavar="SHAPE",
                       help="split cells whose closed box meets SHAPE, down to --levels: sphere:X,Y,Z,R (its surface), "
                       "plane:NX,NY,NZ,D, point:X,Y,Z or box:X0,Y0,Z0,X1,Y1,Z1, in domain units (repeatable)")
-    tree.add_argument("--leaves", type=Path, metavar="FILE",
+    tree.add_argument("--leaves", type=path_argument, metavar="FILE",
                       help="the leaves as a list of 'level i j k' (text, one per line) or JSON "
                       '{"leaves": [[level, i, j, k], ...]}; checked to tile the domain and be 1-irregular; '
                       "mesh.vtu's cell data leaf is the index in this list")
@@ -51,11 +52,11 @@ def add_arguments(parser) -> None:
     parser.add_argument("--balance", choices=BALANCES, default="vertex",
                         help="2:1 balance across faces, edges and corners (vertex, default) or faces and edges "
                         "(edge); across faces alone is not offered: it is not 1-irregular")
-    parser.add_argument("--patterns", type=Path, metavar="FILE",
+    parser.add_argument("--patterns", type=path_argument, metavar="FILE",
                         help="pattern table of the domain's box (configurations it lacks are tessellated); "
                         "without it every configuration is tessellated")
     parser.add_argument("--criterion", choices=CRITERIA, default="optimal", help="which elements of the table")
-    parser.add_argument("--out", type=Path, metavar="DIR",
+    parser.add_argument("--out", type=path_argument, metavar="DIR",
                         help="write mesh.vtu, report.json and mesh.png here (and dual.npz with --dual)")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="text (default): the main figures; json: the whole report on stdout")

@@ -2,16 +2,26 @@
 
 from __future__ import annotations
 
+import argparse
 import functools
 import sys
+from pathlib import Path
 
 from ..files.jsontext import dump, to_json
 from ..files.outputs import FolderLock
 
-__all__ = ["FACE_POINTS_HELP", "FORMATS", "dump", "emit", "holding_out", "to_json"]
+__all__ = ["FACE_POINTS_HELP", "FORMATS", "dump", "emit", "holding_out", "path_argument", "to_json"]
 
 FORMATS = ("json", "yaml")
 FACE_POINTS_HELP = "octree (default): add face and body points of refined neighbours; none: corners and edge points only"
+
+
+def path_argument(text: str) -> Path:
+    """The argparse type of every file and folder option: ``Path("")`` would be the current folder, so
+    ``--out ""`` wrote into wherever the command ran; an empty path is refused instead."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path: name a file or folder")
+    return Path(text)
 
 
 def emit(data, fmt: str) -> None:

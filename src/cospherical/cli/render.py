@@ -14,7 +14,7 @@ from ..files.yamlio import load_yaml, validate
 from ..outputs.latex import render_tables
 from ..studies.engine import bisection_codes, run_study
 from ..studies.summary import study_summary
-from .output import FACE_POINTS_HELP
+from .output import FACE_POINTS_HELP, path_argument
 from .progress import progress_bar
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -30,7 +30,7 @@ DESCRIPTION = ("Render the element, frequency, FVM and paper-comparison tables o
 def add_arguments(parser) -> None:
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--study", choices=["bisection"], help="run this study first")
-    source.add_argument("--summary", nargs="+", type=Path, metavar="FILE",
+    source.add_argument("--summary", nargs="+", type=path_argument, metavar="FILE",
                         help="study summaries written by 'cospherical study --out' or 'reproduce'")
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), help="box of the study (with --study)")
     # None by default so that one given with --summary (where it would do nothing) can be refused
@@ -38,7 +38,7 @@ def add_arguments(parser) -> None:
                         help="base element of the study (with --study; default cuboid)")
     parser.add_argument("--face-points", choices=POINT_POLICIES, default=None,
                         help="with --study: " + FACE_POINTS_HELP)
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR",
+    parser.add_argument("--out", type=path_argument, required=True, metavar="DIR",
                         help="folder for the .tex files (created; locked for the run; a file an earlier render "
                         "wrote there and this one does not is removed, nothing else)")
     parser.add_argument("--pdf", action="store_true",

@@ -7,6 +7,7 @@ from pathlib import Path
 from ..outputs.reproduce import reproduce
 from ..studies.reproduce import paper_studies_total
 from .progress import progress_bar
+from .output import path_argument
 
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -19,7 +20,7 @@ DESCRIPTION = ("Run the bisection studies of the paper's boxes A (1,1,1), B (1,2
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("--root", type=Path, default=Path("."), metavar="DIR",
+    parser.add_argument("--root", type=path_argument, default=Path("."), metavar="DIR",
                         help="where catalogue/, patterns/ and results/ go (default: the current folder)")
 
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from pathlib import Path
 
 from ..catalogue import shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
@@ -18,7 +17,7 @@ from ..studies.engine import bisection_codes, run_study
 from ..studies.insertion import INSERTION_ORDERS
 from ..studies.leaves import leaf_codes, run_leaves
 from ..studies.summary import compared_with, study_summary
-from .output import FACE_POINTS_HELP, dump, emit, holding_out
+from .output import FACE_POINTS_HELP, dump, emit, holding_out, path_argument
 from .progress import progress_bar, stage_bars
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -97,7 +96,7 @@ def _add_family(parser, family: str) -> None:
            help="the pattern table as yaml, store or both (default auto: both while the YAML stays small "
            "enough to read, up to R = 4; the store alone above, where it is over a GB)")
     option("--face-points", choices=POINT_POLICIES, default="octree", only=("bisection",), help=FACE_POINTS_HELP)
-    option("--out", type=Path, metavar="DIR",
+    option("--out", type=path_argument, metavar="DIR",
            help="also write the summary (JSON) and the pattern table into DIR")
     option("--format", choices=("text", "json"), default="text",
            help="text (default): the frequency table; json: the summary as data")

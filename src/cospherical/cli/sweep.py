@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 from ..core.exact import parse_rational
 from ..errors import InputError
@@ -12,7 +11,7 @@ from ..outputs.figures import heatmap_png, heatmap_tex, steps_png, steps_tex
 from ..outputs.latex import environment
 from ..studies.ray import Ray, profile_summary, ray_profile
 from ..studies.sweep import grid_values, sweep
-from .output import dump, emit, holding_out
+from .output import dump, emit, holding_out, path_argument
 from .progress import progress_bar
 
 
@@ -30,7 +29,7 @@ def add_arguments(parser) -> None:
     mode.add_argument("--ray", metavar="1,r,r", help="a ray of boxes: three lengths, each 1 or r")
     parser.add_argument("--range", default="1:4", metavar="R_MIN:R_MAX", help="range of r along the ray (default 1:4)")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="processes for the grid (default: all cores)")
-    parser.add_argument("--out", type=Path, metavar="DIR", help="also write JSON, PNG and pgfplots figures into DIR")
+    parser.add_argument("--out", type=path_argument, metavar="DIR", help="also write JSON, PNG and pgfplots figures into DIR")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="text (default): a table; json: the counts as data")
 

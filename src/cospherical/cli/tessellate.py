@@ -12,7 +12,7 @@ from ..core.tessellation import tessellate
 from ..errors import FormatError, InputError
 from ..files.yamlio import load_yaml
 from ..formats.tessellation import tessellation_data
-from .output import FACE_POINTS_HELP, FORMATS, emit
+from .output import FACE_POINTS_HELP, FORMATS, emit, path_argument
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
 
@@ -48,7 +48,7 @@ def add_arguments(parser) -> None:
     element.add_argument("--element", choices=ELEMENTS, default="cuboid",
                          help="the base element in the box (default cuboid): prism (half the box), pyramid (on the "
                          "bottom face, apex at the centre) or tetrahedron (at the corner); node numbering: the documentation's Conventions page")
-    element.add_argument("--shape", type=Path, metavar="FILE",
+    element.add_argument("--shape", type=path_argument, metavar="FILE",
                          help="any convex base element: a YAML file with corners (unit coordinates, exact: 0, 1/2), "
                          "edges and faces (corner numbers), checked exactly")
     parser.add_argument("--box", nargs=3, metavar=("A", "B", "C"), required=True,
@@ -70,7 +70,7 @@ def add_arguments(parser) -> None:
                         help="optimal (default): largest co-spherical elements; internal_faces / "
                         "internal_edges_and_faces: split the types the catalogue does not keep for that criterion")
     parser.add_argument("--format", choices=FORMATS, default="json", help="json (default) or yaml, on stdout")
-    parser.add_argument("--vtu", type=Path, metavar="FILE", help="also write the tessellation as a VTU mesh (ParaView)")
+    parser.add_argument("--vtu", type=path_argument, metavar="FILE", help="also write the tessellation as a VTU mesh (ParaView)")
 
 
 def _shape_file(path: Path, box) -> Shape:
