@@ -42,13 +42,10 @@ def steiner_parameters(steiner: Mapping | Iterable | None, edges: int = 12,
     """
     params: list[Fraction | None] = [None] * edges
     for edge, value in (steiner.items() if isinstance(steiner, Mapping) else steiner or ()):
-        text = str(edge).strip(" \t")
-        # isascii: str.isdigit() also accepts digits such as '²' or '٣' that are not ours
-        if isinstance(edge, bool) or not isinstance(edge, (int, str)) or not (text.isascii() and text.isdigit()) \
-                or int(text) >= edges:
-            raise InputError(f"edge {edge!r}: not an edge number 0..{edges - 1}"
+        k = None if isinstance(edge, bool) or not isinstance(edge, (int, str)) else _index(str(edge).strip(" \t"), edges)
+        if k is None:
+            raise InputError(f"edge {_shown(edge)}: not an edge number 0..{edges - 1}"
                              + ("" if element == "cuboid" else f" of the {element}"))
-        k = int(text)
         if params[k] is not None:
             raise InputError(f"edge {edge!r}: edge {k} is given twice")
         t = parse_rational(value, f"Steiner parameter on edge {k}")
@@ -62,16 +59,35 @@ def _face_numbers(faces: Iterable, shape: Shape, where: str) -> frozenset[int]:
     numbers = []
     last = len(shape.faces) - 1
     for face in faces:
-        text = str(face).strip()
-        # isascii: str.isdigit() also accepts digits such as '²' that int() refuses
-        if isinstance(face, bool) or not isinstance(face, (int, str)) or not (text.isascii() and text.isdigit()) \
-                or int(text) > last:
-            raise InputError(f"{where}: face {face!r}: not a face number 0..{last}"
+        number = None if isinstance(face, bool) or not isinstance(face, (int, str)) else _index(str(face).strip(), last + 1)
+        if number is None:
+            raise InputError(f"{where}: face {_shown(face)}: not a face number 0..{last}"
                              + ("" if shape.name == "cuboid" else f" of the {shape.name}"))
-        if int(text) in numbers:
-            raise InputError(f"{where}: face {int(text)} given twice")
-        numbers.append(int(text))
+        if number in numbers:
+            raise InputError(f"{where}: face {number} given twice")
+        numbers.append(number)
     return frozenset(numbers)
+
+
+def _index(text: str, count: int) -> int | None:
+    """The number 0..count-1 that ``text`` writes in ASCII digits, else None.
+
+    isascii: str.isdigit() also accepts digits such as '²' or '٣' that are not ours; the length is
+    bounded before int(), which refuses over 4,300 digits with a ValueError of its own.
+
+    >>> _index("007", 12), _index("12", 12), _index("9" * 5000, 12), _index("\u0663", 12)
+    (7, None, None, None)
+    """
+    digits = text.lstrip("0") or "0"
+    if not (text.isascii() and text.isdigit()) or len(digits) > len(str(count)):
+        return None
+    return int(digits) if int(digits) < count else None
+
+
+def _shown(value) -> str:
+    """A value as an error line shows it: its repr, cut at 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:40] + "..."
 
 
 def _shape(shape: Shape | None, box) -> Shape:
