@@ -414,6 +414,25 @@ def test_a_damaged_checkpoint_is_computed_again_never_counted(intersection_run, 
     assert path.read_bytes() == original  # rewritten whole, the same bytes
 
 
+@pytest.mark.parametrize("stage", ["cells", "elements"])
+def test_a_fifo_in_a_checkpoints_place_is_noted_not_waited_on(intersection_run, stage):
+    """open() and read() of a FIFO block until a writer comes: --resume hung for ever. Now it is noted as
+    damaged, and the checkpoint is not written over a special file the user put there (one line, exit 2)."""
+    out, args, _ = intersection_run
+    path = sorted((out / "checkpoints").glob(f"*-{stage}-*"))[0]
+    original = path.read_bytes()
+    path.unlink()
+    os.mkfifo(path)
+    try:
+        status, _, err = run(*args)
+    finally:
+        path.unlink()
+        path.write_bytes(original)
+    assert status == 2 and "Traceback" not in err, err
+    assert f"damaged checkpoint {path.name} (not a regular file)" in err, err
+    assert err.strip().splitlines()[-1].endswith("not a regular file: not replacing it"), err
+
+
 def test_a_store_with_a_long_code_is_refused_without_reading_it(tmp_path):
     """length() of a text reads it whole: a 150 MB code took as much memory to refuse as it is long."""
     import sqlite3

@@ -17,7 +17,9 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import os
 import re
+import stat
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Callable
@@ -174,7 +176,12 @@ def _checkpoint_bytes(payload: bytes) -> bytes:
 
 def _checked_payload(path: Path, most: int) -> bytes:
     """A checkpoint's content after its checksum, at most ``most`` bytes; ValueError says why not."""
-    with open(path, "rb") as handle:
+    # opened without blocking, then required to be a regular file: a FIFO put in a checkpoint's place
+    # would block open() or read() for ever
+    descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    with open(descriptor, "rb") as handle:
+        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
+            raise ValueError("not a regular file")
         data = handle.read(most + 100)
     if len(data) > most + 100:
         raise ValueError(f"over {most:,} bytes")
