@@ -186,6 +186,13 @@ def test_a_resigned_edit_that_keeps_every_sum_is_refused_naming_the_edge(dual_ru
         arrays["element_nodes"][2, 1] = arrays["element_nodes"][2, 0]
         return ["element_nodes"]
 
+    def an_element_twice(arrays):  # in another vertex order: refused in bulk, before the recomputation
+        size = int(arrays["element_sizes"][4])
+        arrays["element_nodes"][1] = -1
+        arrays["element_nodes"][1, :size] = arrays["element_nodes"][4, :size][::-1]
+        arrays["element_sizes"][1] = size
+        return ["element_nodes", "element_sizes"]
+
     def a_vertex_moved_onto_another(arrays):  # an element with an edge of length 0: a ZeroDivisionError before
         arrays["grid_vertices"][dual.element_nodes[0, 1]] = arrays["grid_vertices"][dual.element_nodes[0, 0]]
         return ["grid_vertices"]
@@ -196,11 +203,12 @@ def test_a_resigned_edit_that_keeps_every_sum_is_refused_naming_the_edge(dual_ru
                          (balanced_volumes, "member volume_exact: vertex 0 "),
                          (a_float_alone, f"member coefficient: edge {dual.edges[b, 0]}-{dual.edges[b, 1]} "),
                          (a_vertex_twice, "member element_nodes: element 2 names a vertex twice"),
+                         (an_element_twice, "member element_nodes: elements 1 and 4 have the same vertices"),
                          (a_vertex_moved_onto_another, f"member grid_vertices: vertices {first} and {second} are "
                                                        "one grid point")):
         target = tmp_path / f"{edit.__name__}.npz"
         _edited(good, target, edit)
-        if edit is not a_vertex_twice:  # the reader refuses that one itself
+        if edit not in (a_vertex_twice, an_element_twice):  # the reader refuses those itself
             again = read_dual(target)
             assert again.volume_sum() == 1 and again.boundary_area_sums() == (2, 2, 2)
         capsys.readouterr()
