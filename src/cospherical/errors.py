@@ -13,7 +13,7 @@ Examples
 
 from __future__ import annotations
 
-__all__ = ["CosphericalError", "FormatError", "InputError", "UsageError"]
+__all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "shown"]
 
 
 class CosphericalError(Exception):
@@ -30,3 +30,14 @@ class FormatError(InputError):
 
 class UsageError(CosphericalError):
     """A command-line usage error: a missing, conflicting or malformed option."""
+
+
+def shown(value, most: int = 40) -> str:
+    """A value as an error line names it: its repr, cut after ``most`` characters (a hostile input of
+    megabytes is named, not echoed).
+
+    >>> shown("8" * 12), shown("x" * 100)
+    ("'888888888888'", "'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...")
+    """
+    text = repr(value)
+    return text if len(text) <= most else text[:most] + "..."

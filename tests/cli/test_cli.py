@@ -28,6 +28,8 @@ from commands import cospherical
         (["tessellate", "--box", "1", "1", "1", "--steiner", "9" * 5000 + ":1/2"], "not an edge number"),
         (["tessellate", "--box", "1", "1", "1", "--element", "prism", "--code", "888888888", "--faces", "9" * 5000],
          "not a face number"),
+        (["tessellate", "--box", "1", "1", "1", "--element", "prism", "--code", "888888888+" + "x" * 50_000],
+         "malformed point suffix"),
         # Path("") is the current folder: the outputs went wherever the command ran
         (["mesh", "--domain", "1", "1", "1", "--levels", "2", "--out", ""], "an empty path"),
         (["study", "bisection", "--out", " "], "an empty path"),

@@ -26,7 +26,7 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Iterable, Sequence
 
 from ..caches import cached
-from ..errors import InputError
+from ..errors import InputError, shown
 
 if TYPE_CHECKING:
     import numpy as np
@@ -81,15 +81,15 @@ def parse_point_suffix(code: str, suffix: str) -> tuple[frozenset[int], bool]:
     """
     match = _SUFFIX.match(suffix)
     if not match:
-        raise InputError(f"configuration code {code!r}: malformed point suffix {'+' + suffix!r}: write +f, then "
+        raise InputError(f"configuration code {shown(code)}: malformed point suffix {shown('+' + suffix)}: write +f, then "
                          "the faces carrying a point (0..5 on a cuboid, increasing), then b for the body point, "
                          "e.g. +f04")
     digits = match["faces"]
     if len(set(digits)) != len(digits):
-        raise InputError(f"configuration code {code!r}: a face is given twice in the suffix")
+        raise InputError(f"configuration code {shown(code)}: a face is given twice in the suffix")
     if list(digits) != sorted(digits):
         # one point set, one code: pattern tables are looked up by the code's text
-        raise InputError(f"configuration code {code!r}: list the faces of the suffix in increasing order "
+        raise InputError(f"configuration code {shown(code)}: list the faces of the suffix in increasing order "
                          f"(+f{''.join(sorted(digits))})")
     return frozenset(int(d) for d in digits), bool(match["body"])
 

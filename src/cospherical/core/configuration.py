@@ -15,7 +15,7 @@ from fractions import Fraction
 from functools import cached_property
 from typing import Iterable, Mapping
 
-from ..errors import InputError
+from ..errors import InputError, shown
 from .codes import digit_parameters, edge_code_pattern, parameter_digits, parse_point_suffix, point_suffix
 from .exact import parse_rational
 from .shapes import Box, Point, Shape, standard_shape
@@ -44,7 +44,7 @@ def steiner_parameters(steiner: Mapping | Iterable | None, edges: int = 12,
     for edge, value in (steiner.items() if isinstance(steiner, Mapping) else steiner or ()):
         k = None if isinstance(edge, bool) or not isinstance(edge, (int, str)) else _index(str(edge).strip(" \t"), edges)
         if k is None:
-            raise InputError(f"edge {_shown(edge)}: not an edge number 0..{edges - 1}"
+            raise InputError(f"edge {shown(edge)}: not an edge number 0..{edges - 1}"
                              + ("" if element == "cuboid" else f" of the {element}"))
         if params[k] is not None:
             raise InputError(f"edge {edge!r}: edge {k} is given twice")
@@ -61,7 +61,7 @@ def _face_numbers(faces: Iterable, shape: Shape, where: str) -> frozenset[int]:
     for face in faces:
         number = None if isinstance(face, bool) or not isinstance(face, (int, str)) else _index(str(face).strip(), last + 1)
         if number is None:
-            raise InputError(f"{where}: face {_shown(face)}: not a face number 0..{last}"
+            raise InputError(f"{where}: face {shown(face)}: not a face number 0..{last}"
                              + ("" if shape.name == "cuboid" else f" of the {shape.name}"))
         if number in numbers:
             raise InputError(f"{where}: face {number} given twice")
@@ -83,11 +83,6 @@ def _index(text: str, count: int) -> int | None:
         return None
     return int(digits) if int(digits) < count else None
 
-
-def _shown(value) -> str:
-    """A value as an error line shows it: its repr, cut at 40 characters."""
-    text = repr(value)
-    return text if len(text) <= 40 else text[:40] + "..."
 
 
 def _shape(shape: Shape | None, box) -> Shape:
