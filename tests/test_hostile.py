@@ -401,9 +401,11 @@ def test_full_disk_is_one_line_and_leaves_nothing(tmp_path):
     assert not list(tmp_path.rglob(".*.tmp"))
 
 
-def test_stdout_on_a_full_device_is_one_line():
+@pytest.mark.parametrize("args", [["tessellate", "--box", "1", "1", "1"],
+                                  ["--help"], ["mesh", "--help"], ["--version"]])  # argparse swallowed these
+def test_stdout_on_a_full_device_is_one_line(args):
     with open("/dev/full", "w") as full:
-        result = subprocess.run([sys.executable, "-m", "cospherical", "tessellate", "--box", "1", "1", "1"],
+        result = subprocess.run([sys.executable, "-m", "cospherical", *args],
                                 stdout=full, stderr=subprocess.PIPE, text=True, timeout=60)
     one_line(result.returncode, result.stderr)
 

@@ -31,6 +31,14 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str):
         raise UsageError(f"{self.prog}: error: {message}")
 
+    # argparse drops a failed write of --help or --version (a closed stdout, /dev/full) and exits 0;
+    # written and flushed here, the failure reaches main's one line and exit 2 like any other output's.
+    def _print_message(self, message: str, file=None) -> None:
+        if message:
+            stream = file or sys.stderr
+            stream.write(message)
+            stream.flush()
+
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The whole command's parser; ``only``: with that one subcommand alone.
