@@ -15,7 +15,7 @@ from tests.core.test_delaunay import check_canonical_codes
 
 from cospherical import Configuration, InputError, Shape, standard_shape, tessellate
 from cospherical.core.geometry import Frame
-from cospherical.core.shapes import STANDARD_SHAPES, mask_codes
+from cospherical.core.shapes import EDGES, STANDARD_SHAPES, mask_codes
 from cospherical.core.symmetry import orbit_representatives, shape_symmetries
 
 SHAPES = sorted(set(STANDARD_SHAPES) - {"cuboid"})  # the shapes besides the cuboid, whose tests are their own
@@ -122,9 +122,8 @@ def test_a_parallelepiped_has_a_body_point():
     # A sheared box: every face carrying its point (octree policy), the body point where the three
     # cut planes cross, node 26 as in the cuboid; the tessellation is Qhull's.
     corners = [(0, 0, 0), (1, 0, 0), (2, 1, 0), (1, 1, 0), (0, 0, 1), (1, 0, 1), (2, 1, 1), (1, 1, 1)]
-    edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
     faces = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7), (0, 1, 2, 3), (4, 5, 6, 7)]
-    shape = Shape.from_vertices([[Fraction(x, 2) for x in p] for p in corners], edges, faces)
+    shape = Shape.from_vertices([[Fraction(x, 2) for x in p] for p in corners], EDGES, faces)  # the cuboid's edges
     cfg = Configuration.from_code("888888888888", shape=shape)
     assert cfg.point_faces == set(range(6)) and cfg.has_body_point
     assert cfg.nodes()[26] == (Fraction(1, 2), Fraction(1, 4), Fraction(1, 4))
@@ -139,7 +138,7 @@ def test_the_cuboid_is_a_standard_shape(box):
     face f carrying node 20 + f), and its isometries are exactly the box's symmetries: the same
     node maps and edge maps (48, 16 or 8 of them)."""
     from cospherical.core.configuration import Box
-    from cospherical.core.shapes import CORNERS, EDGES, FACES
+    from cospherical.core.shapes import CORNERS, FACES
     from cospherical.core.symmetry import box_symmetries
 
     shape = standard_shape("cuboid", box)
@@ -202,9 +201,8 @@ def test_bad_vertices_are_refused(vertices, edges, faces, message):
 def test_general_quadrilateral_face_point():
     # A trapezoid face: the face point is where the two cut lines cross, not the corners' mean.
     corners = [(0, 0, 0), (4, 0, 0), (3, 2, 0), (1, 2, 0), (0, 0, 1), (4, 0, 1), (3, 2, 1), (1, 2, 1)]
-    edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
     faces = [(0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
-    shape = Shape.from_vertices([[Fraction(x, 4) for x in p] for p in corners], edges, faces)
+    shape = Shape.from_vertices([[Fraction(x, 4) for x in p] for p in corners], EDGES, faces)  # the cuboid's edges
     cfg = Configuration.from_steiner(steiner={0: "1/2", 1: "1/2", 2: "1/2", 3: "1/2"}, shape=shape)
     assert cfg.point_faces == {0}
     assert cfg.nodes()[20 + 0] == (Fraction(1, 2), Fraction(1, 4), 0)
