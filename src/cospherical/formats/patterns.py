@@ -26,7 +26,7 @@ from ..caches import cached
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..core.tessellation import Tessellation, element_entry
-from ..errors import FormatError, InputError
+from ..errors import FormatError, InputError, shown
 from ..files.data import data_path
 from ..files.flowyaml import decode_entry, mapping_line, split_section
 from ..files.yamlio import atomic_write, parse_yaml, read_text, validate, yaml_text
@@ -195,7 +195,7 @@ class Entries(Mapping):
         # the schema's syntax, matched whole (a store's keys are any text, newlines too,
         # and the schema's "$" lets a trailing newline through).
         if not isinstance(code, str) or not _code_syntax().fullmatch(code):
-            raise FormatError(f"{self._name}: configurations: {str(code)[:40]!r} is not a configuration code")
+            raise FormatError(f"{self._name}: configurations: {shown(str(code))} is not a configuration code")
 
     def __len__(self) -> int:
         return len(self._texts)
