@@ -4,7 +4,8 @@ Above the studies it uses (the leaf family, the catalogue's criteria) and below 
 formats that read and write its results: ``octree`` builds or reads the tree,
 ``assembly`` meshes its leaves, ``checks`` decides conformity, volume and the Delaunay
 property exactly, ``dual`` gives its finite-volume dual (control volumes, coupling
-coefficients, the box method's matrix), ``statistics`` and ``report`` summarise the mesh.
+coefficients, the box method's matrix), ``tetrahedra`` splits the elements into conforming
+tetrahedra for solvers that read only simplices, ``statistics`` and ``report`` summarise the mesh.
 """
 
 __all__: list[str] = []  # nothing re-exported: the public names are each module's __all__
