@@ -105,6 +105,31 @@ def test_a_full_disk_names_the_users_file_not_the_staging_one(tmp_path, limit):
     assert not out.exists()  # nothing of the failed run is left
 
 
+def test_a_forged_manifest_or_a_folder_named_like_staging_loses_no_file_of_the_users(tmp_path, capsys):
+    """The manifest is a file anyone may have edited: naming the user's files with their SHA-256 under
+    each command never makes ``mesh --out`` or ``render --out`` remove them; nor is a folder of the user's
+    removed because its name starts like a staging folder's."""
+    import hashlib
+    import json
+
+    out = tmp_path / "out"
+    out.mkdir()
+    files = {"notes.txt": "notes", "thesis.tex": "thesis", "mesh.vtk": "a mesh of mine", "data.json": "{}"}
+    for name, text in files.items():
+        (out / name).write_text(text)
+    for name in (".cospherical-staging.", ".cospherical-staging.mine", ".cospherical-staging.a1b2c3d4"):
+        (out / name).mkdir()
+        (out / name / "kept.txt").write_text(name)
+    forged = {name: hashlib.sha256(text.encode()).hexdigest() for name, text in files.items()}
+    for argv in (MESH, ["render", "--summary", str(SUMMARY)]):
+        (out / MANIFEST).write_text(json.dumps({"mesh": forged, "render": forged}))
+        assert main([*argv, "--out", str(out)]) == 0
+        capsys.readouterr()
+        assert {name: (out / name).read_text() for name in files} == files
+        for name in (".cospherical-staging.", ".cospherical-staging.mine", ".cospherical-staging.a1b2c3d4"):
+            assert (out / name / "kept.txt").read_text() == name
+
+
 # --- render: pdflatex in a private folder, the user's files kept ----------------------------------------------
 
 @pytest.mark.oracle_pdflatex

@@ -7,12 +7,17 @@ import errno
 import hashlib
 import json
 import os
+import re
+import shutil
 from pathlib import Path
 
 import pytest
 
 from cospherical.errors import InputError
+from cospherical.cli.mesh import _writes as MESH_WRITES
 from cospherical.files.outputs import MANIFEST, OutputFolder
+from cospherical.mesh.partition import MAX_PARTITIONS
+from cospherical.outputs.latex import _RENDERED
 
 
 def victim(tmp_path: Path) -> Path:
@@ -45,16 +50,20 @@ def test_output_folder_moves_files_in_only_when_the_run_succeeds(tmp_path):
     assert (out / "a.txt").read_text() == "new" and sorted(listing(out)) == [MANIFEST, "a.txt"]
 
 
+TEX = re.compile(r"[a-z]+\.tex").fullmatch
+RENDER_WRITES = _RENDERED.fullmatch
+
+
 def test_only_unchanged_files_of_the_same_command_are_removed(tmp_path):
     out = tmp_path / "out"
-    with OutputFolder(out, "render") as folder:
+    with OutputFolder(out, "render", writes=TEX) as folder:
         for name in ("kept.tex", "stale.tex", "edited.tex"):
             folder.path(name).write_text(name)
-    with OutputFolder(out, "mesh") as folder:
+    with OutputFolder(out, "mesh", writes=MESH_WRITES) as folder:
         folder.path("mesh.vtu").write_text("mesh")
     (out / "edited.tex").write_text("the user changed it")
     (out / "frequencies-my-notes.tex").write_text("notes")
-    with OutputFolder(out, "render") as folder:
+    with OutputFolder(out, "render", writes=TEX) as folder:
         folder.path("kept.tex").write_text("kept.tex")
     # stale.tex: ours, unchanged -> removed; edited.tex, the notes: the user's; mesh.vtu: another command's
     assert sorted(listing(out)) == [MANIFEST, "edited.tex", "frequencies-my-notes.tex", "kept.tex", "mesh.vtu"]
@@ -67,11 +76,11 @@ def test_a_hostile_manifest_cannot_remove_anything_outside(tmp_path):
     digest = hashlib.sha256(target.read_bytes()).hexdigest()
     (out / MANIFEST).write_text(json.dumps({"render": {"../victim.txt": digest, str(target): digest,
                                                         ".hidden": digest}}))
-    with OutputFolder(out, "render") as folder:
+    with OutputFolder(out, "render", writes=TEX) as folder:
         folder.path("a.tex").write_text("A")
     assert target.read_text() == "the user's own file\n"
     (out / MANIFEST).write_text("[" * 100_000)  # damaged: read as empty, never a traceback
-    with OutputFolder(out, "render") as folder:
+    with OutputFolder(out, "render", writes=TEX) as folder:
         folder.path("a.tex").write_text("A")
     assert json.loads((out / MANIFEST).read_text()) == {"render": {"a.tex": hashlib.sha256(b"A").hexdigest()}}
 
@@ -83,3 +92,79 @@ def test_a_writer_failing_on_a_staged_file_names_the_users_file(tmp_path):
             staged = out.path("table.dat")
             raise OSError(errno.ENOSPC, "No space left on device", str(staged))
     assert str(raised.value) == f"{tmp_path / 'out' / 'table.dat'}: cannot write: No space left on device"
+
+
+# A manifest anyone may have edited, naming files of the user's in the folder with their true SHA-256:
+# (writer, the name the manifest vouches for, the writer's names). None is removed: a name the writer
+# never writes, another command's name, a file when the writer says no names at all.
+FORGED = [("mesh", "notes.txt", MESH_WRITES), ("mesh", "thesis.tex", MESH_WRITES),
+          ("mesh", "document.pdf", MESH_WRITES), ("mesh", "mesh-01.vtu", MESH_WRITES),
+          ("mesh", f"mesh-{MAX_PARTITIONS}.vtu", MESH_WRITES), ("mesh", "mesh.vtk", MESH_WRITES),
+          ("render", "thesis.tex", RENDER_WRITES), ("render", "mesh.vtu", RENDER_WRITES),
+          ("render", "frequencies-my-notes.tex", RENDER_WRITES), ("render", "document.aux", RENDER_WRITES),
+          ("render", "Document.pdf", RENDER_WRITES), ("example", "a.txt", None)]
+
+
+@pytest.mark.parametrize("writer, name, writes", FORGED, ids=[f"{w}-{n}" for w, n, _ in FORGED])
+def test_a_forged_manifest_never_removes_a_file_the_command_does_not_write(tmp_path, writer, name, writes):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / name).write_text("the user's own file\n")
+    digest = hashlib.sha256(b"the user's own file\n").hexdigest()
+    (out / MANIFEST).write_text(json.dumps({writer: {name: digest}, "mesh": {name: digest},
+                                            "render": {name: digest}}))
+    with OutputFolder(out, writer, writes=writes) as folder:
+        folder.path("report.json").write_text("{}")
+    assert (out / name).read_text() == "the user's own file\n"
+
+
+def test_the_names_a_command_writes_are_its_only_stale_files_removed(tmp_path):
+    # the other half: an earlier run's file under a name the command writes, unchanged, still goes
+    out = tmp_path / "out"
+    for writer, names, writes in (("mesh", ["dual.npz", "mesh-0.vtu", f"mesh-{MAX_PARTITIONS - 1}.vtu"],
+                                   MESH_WRITES),
+                                  ("render", ["document.pdf", "document.log",
+                                              "comparison-bisection-1x2x4-internal_edges_and_faces.tex"],
+                                   RENDER_WRITES)):
+        with OutputFolder(out, writer, writes=writes) as folder:
+            for name in names:
+                folder.path(name).write_text(name)
+        with OutputFolder(out, writer, writes=writes) as folder:
+            folder.path("report.json" if writer == "mesh" else "document.tex").write_text("")
+        assert not any((out / name).exists() for name in names), writer
+
+
+def _killed_run(out: Path) -> Path:
+    """The staging folder of a run killed mid-way (SIGKILL: no clean-up, the lock gone with the process)."""
+    folder = OutputFolder(out, "mesh")
+    folder.__enter__()
+    folder.path("mesh.vtu").write_text("half")
+    folder._lock.release(failed=False)
+    return folder.staging
+
+
+def test_a_folder_of_the_users_named_like_a_staging_folder_is_never_removed(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    users = {}
+    for name in (".cospherical-staging.", ".cospherical-staging.abcd1234", ".cospherical-staging.my notes"):
+        (out / name).mkdir()
+        (out / name / "data.txt").write_text(name)
+        users[name] = name
+    # a real staging folder's mark copied into another folder (cp -r, an archive): not that folder's own
+    stale = _killed_run(tmp_path / "elsewhere")
+    shutil.copytree(stale, out / ".cospherical-staging.copied")
+    (out / ".cospherical-staging.copied" / "data.txt").write_text("copied")
+    users[".cospherical-staging.copied"] = "copied"
+    (out / ".cospherical-staging.forged").mkdir()
+    (out / ".cospherical-staging.forged" / ".cospherical-staging").write_text("0 0\n")
+    (out / ".cospherical-staging.forged" / "data.txt").write_text("forged")
+    users[".cospherical-staging.forged"] = "forged"
+    (out / ".cospherical-staging.link").symlink_to(tmp_path / "elsewhere")  # a link to a marked folder
+    killed = _killed_run(out)  # a killed run's own folder, beside them: the only one that goes
+    with OutputFolder(out, "mesh", writes=MESH_WRITES) as folder:
+        folder.path("mesh.vtu").write_text("mesh")
+    assert not killed.exists()
+    for name, text in users.items():
+        assert (out / name / "data.txt").read_text() == text, name
+    assert (out / ".cospherical-staging.link").is_symlink() and stale.is_dir()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -156,6 +157,14 @@ def _text(value) -> str:
 _OUTPUTS = ("mesh.vtu", "report.json", "mesh.png")
 
 
+def _writes(name: str) -> bool:
+    """Whether a mesh run writes a file of this name: the only files of an earlier run it may remove."""
+    from ..mesh.partition import MAX_PARTITIONS
+
+    piece = re.fullmatch(r"mesh-(0|[1-9][0-9]{0,9})\.vtu", name)
+    return name in (*_OUTPUTS, "dual.npz", "mesh.pvtu") or piece is not None and int(piece[1]) < MAX_PARTITIONS
+
+
 def run(args) -> int:
     pieces = _pieces(args)
     if args.out is None:
@@ -164,7 +173,7 @@ def run(args) -> int:
         names = ("mesh.pvtu", "report.json", *(_piece_name(k) for k in range(pieces)))
     else:
         names = _OUTPUTS + (("dual.npz",) if args.dual else ())
-    with OutputFolder(args.out, "mesh", names) as out:  # locked from the start; every file or none
+    with OutputFolder(args.out, "mesh", names, writes=_writes) as out:  # locked from the start; every file or none
         return _run(args, out)
 
 

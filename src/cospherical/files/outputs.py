@@ -18,8 +18,13 @@ symbolic link, a folder, a FIFO, a device): the run is refused with one line
 and the link's target is never touched.  A folder keeps a manifest of what each
 command wrote there (name and SHA-256); a later run of that command removes a
 file of its earlier run that it did not write again (another study's table, a
-PDF not made this time) only if the manifest names it and its content is still
-what was written. A file the user put there, or changed, is never removed.
+PDF not made this time) only if the manifest names it, its content is still
+what was written, and its name is one the command writes itself.  The manifest
+is a file on disk like any other, which anyone may have edited: it alone never
+vouches for a file, so a file the user put there, or changed, is never removed,
+whatever the manifest says.  The same for a killed run's staging folder: only a
+folder that carries the mark of the run that made it (its own device and inode,
+which a copied, unpacked or hand-made folder does not share) is removed.
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ import re
 import shutil
 import stat
 import tempfile
+from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -41,6 +47,9 @@ __all__ = ["MANIFEST", "FolderLock", "OutputFolder", "atomic_open", "atomic_path
 
 MANIFEST = ".cospherical-manifest.json"
 _STAGING_PREFIX = ".cospherical-staging."
+# The staging folder's mark: a hidden name, never an output's (outputs are plain names).
+_STAGING_MARK = ".cospherical-staging"
+_MAX_MARK_BYTES = 200
 _MAX_MANIFEST_BYTES = 1 << 20
 # A name an output folder holds: one plain file name, never a path and never hidden.
 _PLAIN_NAME = re.compile(r"[0-9A-Za-z][0-9A-Za-z._-]*")
@@ -185,6 +194,10 @@ class OutputFolder:
     names : iterable of str, optional
         Outputs known from the start: refused at once if their names are taken
         by a link, a folder or a special file, before any long work.
+    writes : callable, optional
+        Whether this command can write a file of the given name: the only names
+        under which a file of an earlier run is removed.  Without it nothing is
+        removed.
 
     Examples
     --------
@@ -196,9 +209,10 @@ class OutputFolder:
     ['.cospherical-manifest.json', 'a.txt']
     """
 
-    def __init__(self, folder: str | Path, writer: str, names=()):
+    def __init__(self, folder: str | Path, writer: str, names=(), writes: Callable[[str], object] | None = None):
         self.folder = Path(folder)
         self.writer = writer
+        self._writes = writes
         self.staging: Path | None = None
         self._names = list(names)
         self._staged: list[str] = []
@@ -213,6 +227,7 @@ class OutputFolder:
             refuse_special(self.folder / MANIFEST)  # the manifest is written last: refuse a link there before any work
             self._remove_stale_staging()
             self.staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=self.folder))
+            _mark_staging(self.staging)
         except BaseException:
             self._release(failed=True)
             raise
@@ -246,9 +261,14 @@ class OutputFolder:
         refuse_special(self.folder / name)
 
     def _remove_stale_staging(self) -> None:
-        # The folder is locked: any staging folder in it is a killed run's.
-        for path in self.folder.iterdir():
-            if path.name.startswith(_STAGING_PREFIX) and path.is_dir() and not path.is_symlink():
+        # The folder is locked: a staging folder that carries its mark is a killed run's. A folder of the
+        # user's under a name like it (made by hand, copied, unpacked) has no mark of its own and stays.
+        try:
+            paths = list(self.folder.iterdir())
+        except OSError as error:
+            raise _output_error(self.folder, error) from None
+        for path in paths:
+            if path.name.startswith(_STAGING_PREFIX) and _is_marked_staging(path):
                 shutil.rmtree(path, ignore_errors=True)
 
     def _read_manifest(self) -> dict:
@@ -289,7 +309,7 @@ class OutputFolder:
                 os.chmod(self.staging / name, mode)  # files made by mkstemp or pdflatex: ordinary permissions
                 os.replace(self.staging / name, self.folder / name)
             for name, digest in sorted(earlier.items()):
-                if name not in ours:
+                if name not in ours and self._writes is not None and self._writes(name):
                     self._remove_if_ours(self.folder / name, digest)
         except OSError as error:
             raise _output_error(error.filename or self.folder, error) from None
@@ -309,6 +329,40 @@ class OutputFolder:
             shutil.rmtree(self.staging, ignore_errors=True)
             self.staging = None
         self._lock.release(failed)
+
+
+def _identity(path_stat: os.stat_result) -> str:
+    return f"{path_stat.st_dev} {path_stat.st_ino}\n"
+
+
+def _mark_staging(staging: Path) -> None:
+    """Write into a new staging folder its own identity (device and inode): the proof, for a later run,
+    that a run of the tool made it and that it is not a folder of the user's under the same name."""
+    fd = os.open(staging / _STAGING_MARK, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+    with os.fdopen(fd, "w", encoding="ascii") as handle:
+        handle.write(_identity(os.stat(staging)))
+
+
+def _is_marked_staging(path: Path) -> bool:
+    """Whether ``path`` is a staging folder that a run of the tool made, by its mark (see :func:`_mark_staging`)."""
+    try:
+        folder_fd = os.open(path, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
+    except OSError:
+        return False  # gone, a link, not a folder, unreadable
+    try:
+        folder = os.fstat(folder_fd)
+        if folder.st_uid != os.getuid():
+            return False
+        fd = os.open(_STAGING_MARK, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK, dir_fd=folder_fd)
+        try:
+            mark = os.read(fd, _MAX_MARK_BYTES) if stat.S_ISREG(os.fstat(fd).st_mode) else b""
+        finally:
+            os.close(fd)
+    except OSError:
+        return False
+    finally:
+        os.close(folder_fd)
+    return mark == _identity(folder).encode("ascii")
 
 
 class FolderLock:

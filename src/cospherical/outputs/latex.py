@@ -19,6 +19,7 @@ import jinja2
 
 from ..core.element_types import face_summary
 from ..core.geometry import cross, plane_normal
+from ..core.split import CRITERIA
 from ..errors import InputError
 from ..files.data import data_path
 from ..files.outputs import OutputFolder, atomic_open
@@ -185,7 +186,7 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str,
     it, unchanged since.
     """
     known = ("document.tex", "document.pdf", "document.log") if pdf else ("document.tex",)
-    with OutputFolder(out, "render", known) as folder:  # a link at a known name is refused before the work
+    with OutputFolder(out, "render", known, writes=_RENDERED.fullmatch) as folder:  # a link at a known name is refused before the work
         names = _write_tables(summaries, catalogue, folder, title)
         if pdf:
             names += _compile_pdf(folder, out)
@@ -245,8 +246,11 @@ def _write_tables(summaries: list[dict], catalogue: dict, folder: OutputFolder, 
     return written
 
 
-# The names of the files render_tables writes.
+# The names of the files render_tables writes: a table's, checked as it is written, and every name of a
+# render (the only files of an earlier render it may remove).
 _OUR_NAME = re.compile(r"[0-9a-z][0-9a-z._-]*\.tex")
+_RENDERED = re.compile(r"(?:elements|fvm|document)\.tex|document\.(?:pdf|log)"
+                       rf"|(?:frequencies|comparison)-[0-9a-z][0-9a-z._-]*-(?:{'|'.join(CRITERIA)})\.tex")
 
 
 # pdfTeX stamps the time of the run into the PDF (dates and the file id) unless told a fixed one.
