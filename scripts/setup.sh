@@ -15,6 +15,12 @@ command -v chromium >/dev/null 2>&1 || packages+=(chromium)  # the docs site's p
 command -v cc >/dev/null 2>&1 || packages+=(gcc)  # the docs' C reader of the pattern-table store, compiled in the tests
 [ -e /usr/include/sqlite3.h ] || packages+=(libsqlite3-dev)
 [ -e /usr/include/zlib.h ] || packages+=(zlib1g-dev)
+# The gmsh wheel's library links these (ldd libgmsh.so): present on a desktop, not on a bare server
+for pair in libGLU.so.1:libglu1-mesa libGL.so.1:libgl1 libXrender.so.1:libxrender1 libXcursor.so.1:libxcursor1 \
+    libXfixes.so.3:libxfixes3 libXext.so.6:libxext6 libXft.so.2:libxft2 libfontconfig.so.1:libfontconfig1 \
+    libXinerama.so.1:libxinerama1 libX11.so.6:libx11-6 libgomp.so.1:libgomp1; do
+  grep -q "${pair%%:*}" < <(ldconfig -p 2>/dev/null) || packages+=("${pair##*:}")
+done
 python3 -c "import ensurepip, venv" >/dev/null 2>&1 || packages+=(python3-venv)  # stock Ubuntu lacks it
 if [ ${#packages[@]} -gt 0 ]; then
   # Wait up to 10 minutes for another apt-get or dpkg (unattended upgrades on a fresh

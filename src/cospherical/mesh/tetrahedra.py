@@ -50,7 +50,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BoundaryTriangles", "Tetrahedra", "boundary_triangles", "fan_triangles", "split_tetrahedra"]
+__all__ = ["SIDES", "BoundaryTriangles", "SimplexMesh", "Tetrahedra", "boundary_triangles", "fan_triangles", "real_points",
+           "simplex_mesh", "split_tetrahedra"]
 
 
 @dataclass(frozen=True)
@@ -163,3 +164,37 @@ def boundary_triangles(mesh) -> BoundaryTriangles:
     nodes, parent, side = np.concatenate(parts), np.concatenate(parents), np.concatenate(sides)
     order = np.lexsort((parent, side))  # side by side, element by element: deterministic
     return BoundaryTriangles(nodes[order], parent[order], side[order])
+
+
+@dataclass(frozen=True)
+class SimplexMesh:
+    """A mesh as a solver that reads simplices takes it: tetrahedra in named volumes, triangles in named surfaces.
+
+    ``points``: (n x 3) real coordinates of the mesh's vertices (same ids);
+    ``tetrahedra`` (t x 4) with ``volume`` (t,) indices into ``volumes`` (the region
+    names); ``triangles`` (f x 3, counter-clockwise seen from outside the domain or
+    from the surface's first region) with ``surface`` (f,) indices into ``surfaces``.
+    A mesh of one region has the volume ``domain`` and the six sides of the box as
+    surfaces (:data:`SIDES`), where a solver puts its boundary conditions.
+    """
+
+    points: np.ndarray
+    tetrahedra: np.ndarray
+    volume: np.ndarray
+    volumes: tuple[str, ...]
+    triangles: np.ndarray
+    surface: np.ndarray
+    surfaces: tuple[str, ...]
+
+
+def real_points(mesh) -> np.ndarray:
+    """The mesh's vertices in the domain's units (floats)."""
+    return np.asarray(mesh.vertices, dtype=np.float64) * (np.array(mesh.box.to_float()) / int(mesh.grid))
+
+
+def simplex_mesh(mesh, tetrahedra: Tetrahedra | None = None) -> SimplexMesh:
+    """The mesh's tetrahedra per region and its named surfaces (see :class:`SimplexMesh`)."""
+    tets = split_tetrahedra(mesh) if tetrahedra is None else tetrahedra
+    outer = boundary_triangles(mesh)
+    return SimplexMesh(real_points(mesh), tets.nodes, tets.region, ("domain",), outer.nodes,
+                       outer.side.astype(np.int32), SIDES)
