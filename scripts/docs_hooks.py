@@ -5,6 +5,12 @@ Nothing generated is typed into ``docs/``: a page holds a marker such as
 the parser itself, the tables are ``results/*.json`` as ``cospherical reproduce``
 last wrote them, and the gallery is whatever pictures ``results/elements/`` holds.
 The JSON Schemas and the pictures are added to the site from where they live.
+
+What a record, a summary or a report says, and the names of the files in
+``results/``, are data from files anyone may have edited: each is written for the
+place it lands (:func:`_text` in Markdown and HTML, :func:`_code_block` in a code
+block, :func:`_url` in a link), never read as markup; a file that is not what its
+writer writes stops the build with one line naming it.
 """
 
 from __future__ import annotations
@@ -14,7 +20,9 @@ import json
 import os
 import re
 from pathlib import Path
+from urllib.parse import quote
 
+from mkdocs.exceptions import PluginError
 from mkdocs.structure.files import File
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -50,9 +58,21 @@ def on_page_markdown(markdown, page, config, files):
 
     def generated(match):
         name, argument = match.groups()
-        return GENERATORS[name](up, argument) if argument else GENERATORS[name](up)
+        try:
+            return GENERATORS[name](up, argument) if argument else GENERATORS[name](up)
+        except _MALFORMED as error:
+            # a damaged record or summary: one line naming the page, the marker and the file, no traceback
+            raise PluginError(f"{page.file.src_uri}: {match.group(0)}: {_one_line(error)}") from None
 
     return MARKER.sub(generated, markdown)
+
+
+def _one_line(error: BaseException, most: int = 300) -> str:
+    """An error as one printable line: every control character and line break escaped, cut to ``most``."""
+    text = f"{type(error).__name__}: {error}" if isinstance(error, (KeyError, IndexError, TypeError,
+                                                                    AttributeError)) else str(error)
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    return text if len(text) <= most else text[:most] + "..."
 
 
 # --- the CLI reference, from the parser ---------------------------------------------------------
@@ -117,12 +137,26 @@ def cli_reference(up: str) -> str:
 
 # --- results tables, from results/*.json ---------------------------------------------------------
 
+def _json(path: Path):
+    """A results file read by the readers' one JSON parser (bounded size, nesting and digits)."""
+    from cospherical.files.yamlio import parse_json, read_text
+
+    return parse_json(read_text(path), str(path), max_digits=1000)
+
+
 def _summaries() -> list[tuple[str, dict]]:
-    return [(path.stem, json.loads(path.read_text())) for path in sorted(RESULTS.glob("*.json"))]
+    return [(path.stem, _json(path)) for path in sorted(RESULTS.glob("*.json"))]
+
+
+def _figure(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"  # as the report and the command's summary say it
+    return "-" if value is None else f"{value:,}" if isinstance(value, int) else str(value)
 
 
 def _n(value) -> str:
-    return "-" if value is None else f"{value:,}" if isinstance(value, int) else str(value)
+    """A figure of a summary or report, shown literally in a table cell or a line of text."""
+    return "-" if value is None else _text(_figure(value))
 
 
 def studies_table(up: str) -> str:
@@ -139,11 +173,11 @@ def studies_table(up: str) -> str:
             optimal = paper_comparison(summary, key)
             paper = " / ".join(_n(x) for x in (optimal["total"]["paper"], optimal["classes"]["paper"],
                                                optimal["fvm_adequate"]["paper"]))
-        criteria = [f"{_n(summary['criteria'][c]['total'])} / {summary['criteria'][c]['types_count']}"
+        criteria = [f"{_n(summary['criteria'][c]['total'])} / {_n(summary['criteria'][c]['types_count'])}"
                     for c in CRITERIA]
         element = summary.get("element", "cuboid")
-        study = summary["study"] + ("" if element == "cuboid" else f" ({element})")
-        rows.append(f"| {study} | {' x '.join(summary['box'])} | {summary['face_points']} | "
+        study = _text(summary["study"]) + ("" if element == "cuboid" else f" ({_text(element)})")
+        rows.append(f"| {study} | {' x '.join(map(_text, summary['box']))} | {_text(summary['face_points'])} | "
                     f"{_n(summary['configurations'])} ({_n(summary['orbits'])}) | "
                     f"{_n(summary['fvm_adequate'])} / {_n(summary['fvm_adequate_open'])} | "
                     + " | ".join(criteria) + f" | {paper} |")
@@ -164,11 +198,11 @@ def paper_tables(up: str) -> str:
             if criterion not in paper_studies()[key]:
                 continue
             table = paper_comparison(summary, key, criterion)
-            out += [f"### {stem}: {criterion.replace('_', ' ')} (paper: {key})", ""]
+            out += [f"### {_text(stem)}: {criterion.replace('_', ' ')} (paper: {_text(key)})", ""]
             out += ["| paper class | paper | ours | |", "|---|---:|---:|---|"]
             for row in table["rows"]:
                 mark = "" if row["paper"] == row["ours"] else "differs"
-                out.append(f"| {row['class']} | {_n(row['paper'])} | {_n(row['ours'])} | {mark} |")
+                out.append(f"| {_text(row['class'])} | {_n(row['paper'])} | {_n(row['ours'])} | {mark} |")
             total = table["total"]
             out.append(f"| **total** | {_n(total['paper'])} | {_n(total['ours'])} | "
                        f"{'' if total['paper'] == total['ours'] else 'differs'} |")
@@ -181,13 +215,13 @@ def intersection_table(up: str) -> str:
 
     tables = {}
     for path in sorted(RESULTS.glob("intersection/*/intersection-r*-*.json")):
-        summary = json.loads(path.read_text())
+        summary = _json(path)
         tables[summary["insertion_order"]] = (summary, paper_comparison(summary, "intersection_cube"))
     if not tables:
         return "*(no intersection results in results/intersection/)*"
     orders = list(tables)
     first = tables[orders[0]][1]
-    rows = ["| paper class | paper | " + " | ".join(f"ours, order `{o}`" for o in orders) + " |",
+    rows = ["| paper class | paper | " + " | ".join(f"ours, order <code>{_text(o)}</code>" for o in orders) + " |",
             "|---|---:|" + "---:|" * len(orders)]
     labels = [row["class"] for row in first["rows"]]
     for order in orders[1:]:
@@ -195,18 +229,19 @@ def intersection_table(up: str) -> str:
     for label in labels:
         paper = next((r["paper"] for r in first["rows"] if r["class"] == label), None)
         ours = [next((r["ours"] for r in tables[o][1]["rows"] if r["class"] == label), None) for o in orders]
-        rows.append(f"| {label} | {_n(paper)} | " + " | ".join(_n(x) for x in ours) + " |")
+        rows.append(f"| {_text(label)} | {_n(paper)} | " + " | ".join(_n(x) for x in ours) + " |")
     rows.append("| **total elements** | " + _n(first["total"]["paper"]) + " | "
                 + " | ".join(_n(tables[o][1]["total"]["ours"]) for o in orders) + " |")
     rows.append("| configurations (orbits) | - | "
                 + " | ".join(f"{_n(tables[o][0]['configurations'])} ({_n(tables[o][0]['orbits'])})" for o in orders)
                 + " |")
     rows.append("| element types (of the paper's classes) | 38 classes | " + " | ".join(
-        f"{tables[o][0]['criteria']['optimal']['types_count']} ({tables[o][0]['criteria']['optimal'].get('paper_classes_count', '-')})"
+        f"{_n(tables[o][0]['criteria']['optimal']['types_count'])} "
+        f"({_n(tables[o][0]['criteria']['optimal'].get('paper_classes_count'))})"
         for o in orders) + " |")
     for criterion in CRITERIA[1:]:
         rows.append(f"| {criterion.replace('_', ' ')}: elements, types | - | " + " | ".join(
-            f"{_n(tables[o][0]['criteria'][criterion]['total'])}, {tables[o][0]['criteria'][criterion]['types_count']}"
+            f"{_n(tables[o][0]['criteria'][criterion]['total'])}, {_n(tables[o][0]['criteria'][criterion]['types_count'])}"
             for o in orders) + " |")
     rows.append("| FVM-adequate, closed / open | - | "
                 + " | ".join(f"{_n(tables[o][0]['fvm_adequate'])} / {_n(tables[o][0]['fvm_adequate_open'])}"
@@ -226,41 +261,50 @@ MESH_ROWS = [("delaunay_mode", "mode (--delaunay; - : made before the choice, ea
              ("boundary_circumcenters_outside", "circumcenters outside the domain"),
              (lambda r: (r.get("leaf_mesh") or {}).get("elements_replaced"), "leaf elements replaced (global mode)"),
              ("largest_region_vertices", "largest region (vertices)"),
-             (lambda r: (lambda n: n and f"{_n(n['interior'])} / {_n(n['boundary'])}")(r.get("negative_coefficients")),
+             (lambda r: (lambda n: n and f"{_figure(n['interior'])} / {_figure(n['boundary'])}")(
+                 r.get("negative_coefficients")),
               "negative box-method coefficients, interior / boundary (--dual)"),
              ("configurations", "distinct configurations"), ("tessellated_on_the_fly", "tessellated on the fly"),
              ("paper_final_share", "share of the paper's seven final elements")]
 
 
+def _reports() -> list[tuple[str, dict]]:
+    return [(path.parent.name, _json(path)) for path in sorted(RESULTS.glob("mesh/*/report.json"))]
+
+
 def mesh_table(up: str) -> str:
-    reports = [(path.parent.name, json.loads(path.read_text())) for path in sorted(RESULTS.glob("mesh/*/report.json"))]
-    rows = ["| | " + " | ".join(f"`{name}`" for name, _ in reports) + " |", "|---|" + "---:|" * len(reports)]
+    reports = _reports()
+    rows = ["| | " + " | ".join(f"<code>{_text(name)}</code>" for name, _ in reports) + " |",
+            "|---|" + "---:|" * len(reports)]
     rows.append("| tree | " + " | ".join(
-        f"{' x '.join(r['domain'])}, levels {r['tree'].get('levels', r['tree'].get('depth'))}, "
-        + ", ".join(f"`{s}`" for s in r["tree"].get("refine", [])) for _, r in reports) + " |")
+        f"{' x '.join(map(_text, r['domain']))}, levels {_n(r['tree'].get('levels', r['tree'].get('depth')))}, "
+        + ", ".join(f"<code>{_text(s)}</code>" for s in r["tree"].get("refine", [])) for _, r in reports) + " |")
     for key, label in MESH_ROWS:
         value = key if callable(key) else (lambda r, key=key: r.get(key))
         rows.append(f"| {label} | " + " | ".join(_n(value(r)) for _, r in reports) + " |")
-    pictures = [f"![{name}]({up}figures/mesh/{name}.png)" for name, _ in reports]
+    pictures = [f"![{_text(name)}]({up}figures/mesh/{_url(name)}.png)" for name, _ in reports]
     return "\n".join(rows) + "\n\n" + "\n\n".join(pictures)
 
 
 def dual_table(up: str) -> str:
     """The mixed mesh beside the tetrahedral Delaunay mesh of its vertices, per report made with --dual."""
-    reports = [(path.parent.name, json.loads(path.read_text())) for path in sorted(RESULTS.glob("mesh/*/report.json"))]
-    reports = [(name, r) for name, r in reports if r.get("dual", {}).get("tetrahedral")]
+    reports = [(name, r) for name, r in _reports() if r.get("dual", {}).get("tetrahedral")]
     if not reports:
         return "*(no report in results/mesh/ was made with --dual)*"
-    rows = ["| | " + " | ".join(f"`{name}`" for name, _ in reports) + " |", "|---|" + "---:|" * len(reports)]
+    rows = ["| | " + " | ".join(f"<code>{_text(name)}</code>" for name, _ in reports) + " |",
+            "|---|" + "---:|" * len(reports)]
     for key in ("elements", "edges", "faces", "nonzeros"):
         cells = []
         for _, r in reports:
             mixed, tetrahedral = r["dual"]["mixed"][key], r["dual"]["tetrahedral"][key]
+            if not all(isinstance(x, int) and not isinstance(x, bool) and x > 0 for x in (mixed, tetrahedral)):
+                raise ValueError(f"report of {_figure(mixed)[:40]!r} / {_figure(tetrahedral)[:40]!r} {key}: "
+                                 "not counts")
             cells.append(f"{mixed:,} / {tetrahedral:,} ({mixed / tetrahedral:.2f})")
         rows.append(f"| {key}: mixed / tetrahedral | " + " | ".join(cells) + " |")
     rows.append("| negative coefficients, interior / boundary | " + " | ".join(
-        f"{r['negative_coefficients']['interior']:,} / {r['negative_coefficients']['boundary']:,}" for _, r in reports)
-        + " |")
+        f"{_n(r['negative_coefficients']['interior'])} / {_n(r['negative_coefficients']['boundary'])}"
+        for _, r in reports) + " |")
     rows.append("| mode (`--delaunay`) | " + " | ".join(_n(r.get("delaunay_mode")) for _, r in reports) + " |")
     return "\n".join(rows)
 
@@ -278,17 +322,17 @@ def gallery(up: str) -> str:
            f"({len(types)} types), by number of vertices, then faces.", ""]
     for path in pictures:
         entry = types.get(path.stem, {})
-        name = entry.get("name", "(not in the catalogue)")
-        faces = ", ".join(f"{n} {kind}" for kind, n in sorted(entry.get("face_kinds", {}).items()))
+        name = _text(entry.get("name", "(not in the catalogue)"))
+        faces = ", ".join(f"{_n(n)} {_text(kind)}" for kind, n in sorted(entry.get("face_kinds", {}).items()))
         out += ['<figure class="element" markdown>', "",
-                f'![{name}]({up}figures/elements/{path.name}){{ width="160" }}', "",
-                f"<figcaption><b>{name}</b><br><code>{path.stem}</code> V {entry.get('vertices')}, "
-                f"E {entry.get('edges')}, F {entry.get('faces')}: {faces}</figcaption>", "</figure>", ""]
+                f'![{name}]({up}figures/elements/{_url(path.name)}){{ width="160" }}', "",
+                f"<figcaption><b>{name}</b><br><code>{_text(path.stem)}</code> V {_n(entry.get('vertices'))}, "
+                f"E {_n(entry.get('edges'))}, F {_n(entry.get('faces'))}: {faces}</figcaption>", "</figure>", ""]
     return '<div class="gallery" markdown>\n\n' + "\n".join(out) + "\n</div>"
 
 
 def sweep_figures(up: str) -> str:
-    return "\n\n".join(f"![{path.stem}]({up}figures/sweep/{path.name})"
+    return "\n\n".join(f"![{_text(path.stem)}]({up}figures/sweep/{_url(path.name)})"
                        for path in sorted((RESULTS / "sweep").glob("*.png")))
 
 
@@ -369,20 +413,39 @@ def _text(value) -> str:
     as the character.
     """
     return "".join(c if (c.isascii() and c.isalnum()) or c in " .,:;/()%=+'\"" else f"&#{ord(c)};"
-                   for c in str(value).replace("\n", " "))
+                   for c in " ".join(str(value).splitlines()))
+
+
+def _url(name: str) -> str:
+    """A file name of ``results/`` as a link's path: every character but letters, digits and ``._-`` quoted."""
+    return quote(name, safe="")
 
 
 # a line the snippets extension would read as an inclusion (``--8<-- "file"``), as in its own syntax
 _SNIPPET_LINE = re.compile(r"^([ \t]*)(;*-+8<-+)")
 
 
+def _code_block(lines, indent: str = "") -> list[str]:
+    """Lines shown literally in a fenced code block, each indented by ``indent`` (inside an admonition).
+
+    Every line break a reader may see is one: a CR, a form feed, NEL, LS and PS
+    (what :meth:`str.splitlines` splits at) start a new line of the block, indented
+    like the others, so that none can end the block early and put what follows
+    outside it as markup. The fence is longer than any run of backticks inside.
+    """
+    shown = [piece for line in lines for piece in (str(line).splitlines() or [""])]
+    fence = "`" * max([3] + [len(run) + 1 for line in shown for run in re.findall("`+", line)])
+    return [f"{indent}{fence}text", *(indent + _SNIPPET_LINE.sub(r"\1;\2", line) for line in shown),
+            f"{indent}{fence}"]
+
+
 def _recorded_run(path: Path) -> list[str]:
     """One benchmark run as its script recorded it: the command, the machine and its load, the figures."""
-    from cospherical.files.yamlio import parse_json
+    from cospherical.errors import FormatError
 
     # the readers' JSON parser: bounded nesting and digits, no repeated key; a record that is not
     # one stops the build with one line naming the file and what is wrong
-    run = parse_json(path.read_text(), str(path), max_digits=1000)
+    run = _json(path)
     try:
         machine, load = run["machine"], run["load_average"]
         lines = [f"Last run: <code>{_text(run['command'])}</code>, {_text(run['date'])} (commit "
@@ -400,15 +463,13 @@ def _recorded_run(path: Path) -> list[str]:
             lines += ["| " + " | ".join(map(_text, table["columns"])) + " |", "|" + "---|" * len(table["columns"])]
             lines += ["| " + " | ".join(map(_text, row)) + " |" for row in table["rows"]]
             lines.append("")
-        output = [str(line).replace("\n", " ") for line in run["output"]]
-    except (KeyError, TypeError, ValueError, AttributeError) as error:
-        raise ValueError(f"{path}: not a benchmark record as benchmarks/record.py writes it: "
-                         f"{type(error).__name__}: {error}") from None
-    # a fence longer than any run of backticks in the output, so that no line of it ends the block
-    fence = "`" * max([3] + [len(run) + 1 for line in output for run in re.findall("`+", line)])
-    lines += ['??? note "Everything it printed"', "", f"    {fence}text"]
-    lines += ["    " + _SNIPPET_LINE.sub(r"\1;\2", line) for line in output] + [f"    {fence}", ""]
-    return lines
+        if not isinstance(run["output"], list):
+            raise TypeError(f"output is {type(run['output']).__name__}, not a list of lines")
+        output = run["output"]
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError) as error:
+        raise FormatError(f"{path}: not a benchmark record as benchmarks/record.py writes it: "
+                          f"{_one_line(error)}") from None
+    return lines + ['??? note "Everything it printed"', "", *_code_block(output, "    "), ""]
 
 
 def benchmarks(up: str) -> str:
@@ -419,7 +480,7 @@ def benchmarks(up: str) -> str:
     for path in sorted((ROOT / "benchmarks").glob("bench_*.py")):
         text = ast.get_docstring(ast.parse(path.read_text())) or ""
         first, _, rest = text.partition("\n")
-        out += [f"## `benchmarks/{path.name}`", "", first, "", "```text", rest.strip("\n"), "```", ""]
+        out += [f"## `benchmarks/{path.name}`", "", first, "", *_code_block(rest.strip("\n").split("\n")), ""]
         runs = sorted((RESULTS / "benchmarks").glob(f"{path.stem}*.json"))
         for run in runs:
             out += _recorded_run(run)
@@ -444,6 +505,9 @@ def module_doc(up: str, module: str) -> str:
     text = importlib.import_module(module).__doc__ or ""
     return f"From the docstring of `{module}`:\n\n```text\n{text.strip()}\n```"
 
+
+# What a damaged results file raises on its way through a generator: one line, never a traceback.
+_MALFORMED = (KeyError, IndexError, TypeError, ValueError, AttributeError, ArithmeticError, OSError)
 
 GENERATORS = {
     "module-doc": module_doc,

@@ -272,3 +272,194 @@ def test_a_benchmark_run_is_recorded_with_its_machine_and_rendered_from_its_file
     hostile.write_text('{"command": "x"}')
     with pytest.raises(ValueError, match="not a benchmark record as benchmarks/record.py writes it: KeyError"):
         hooks._recorded_run(hostile)
+
+
+# --- the generated parts from hostile records, summaries and reports ----------------------------------------------
+
+def _hooks():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("docs_hooks_under_attack", ROOT / "scripts" / "docs_hooks.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _as_the_site_renders(text: str) -> str:
+    """Markdown to HTML with the site's own extensions and their settings (mkdocs.yml)."""
+    import markdown
+    import yaml
+
+    class Loader(yaml.SafeLoader):  # mkdocs.yml's !!python/name tags are not used by the markdown part
+        pass
+
+    config = yaml.load((ROOT / "mkdocs.yml").read_text(), Loader=Loader)
+    names, settings = [], {}
+    for entry in config["markdown_extensions"]:
+        name, options = next(iter(entry.items())) if isinstance(entry, dict) else (entry, {})
+        names.append(name)
+        settings[name] = {**(options or {}), **({"base_path": [str(ROOT)]} if name == "pymdownx.snippets" else {})}
+    return markdown.markdown(text, extensions=names, extension_configs=settings)
+
+
+# What a hostile value tries: a tag, a tag after each kind of line break, the end of a code span or block,
+# an attribute list, a table cell's end, a snippet inclusion, an entity the browser would decode.
+BREAKS = ["\r", "\n", "\r\n", "\x0b", "\x0c", "\x1c", "\x1d", "\x1e", "\x85", "\u2028", "\u2029"]
+HOSTILE = ["<script>alert(1)</script>", *(f"x{b}<script>alert(2)</script>" for b in BREAKS),
+           "`` ` <img src=x onerror=alert(3)>", "x\r```\r<img src=x onerror=alert(5)>",
+           "{: onclick=alert(4) }", "a | b", '--8<-- "pyproject.toml"', "&lt;script&gt;alert(6)&lt;/script&gt;",
+           "\x1b[31mred"]
+ALLOWED_TAGS = {"p", "table", "thead", "tbody", "tr", "th", "td", "code", "pre", "span", "div", "details", "summary",
+                "h2", "h3", "a", "img", "figure", "figcaption", "b", "br", "em", "strong"}
+
+
+def _markup(html: str) -> tuple[list[tuple[str, list]], str]:
+    """The tags of a page and the text a browser shows of it."""
+    from html.parser import HTMLParser
+
+    class Parser(HTMLParser):
+        def __init__(self):
+            super().__init__(convert_charrefs=True)
+            self.tags, self.text = [], []
+
+        def handle_starttag(self, tag, attrs):
+            self.tags.append((tag, attrs))
+
+        def handle_data(self, data):
+            self.text.append(data)
+
+    parser = Parser()
+    parser.feed(html)
+    return parser.tags, "".join(parser.text)
+
+
+def _assert_shown_never_markup(html: str, values) -> None:
+    tags, shown = _markup(html)
+    assert {tag for tag, _ in tags} <= ALLOWED_TAGS, sorted({tag for tag, _ in tags} - ALLOWED_TAGS)
+    for tag, attrs in tags:
+        assert not [name for name, _ in attrs if name.startswith("on")], (tag, attrs)
+        for name, value in attrs:
+            assert name not in ("src", "href") or not value.startswith(("x", "javascript")), (tag, attrs)
+    assert "[project]" not in shown  # no snippet of pyproject.toml pulled in
+    def seen(text: str) -> str:  # a browser shows no control character, and its line breaks as white space
+        return " ".join("".join(c for c in text if c.isprintable() or c.isspace()).split())
+
+    for value in values:  # each value is there, shown as it is written
+        assert seen(value) in seen(shown), value
+
+
+@pytest.mark.parametrize("value", HOSTILE, ids=[repr(v)[1:25] for v in HOSTILE])
+def test_a_hostile_benchmark_record_is_shown_never_read_as_markup(tmp_path, value):
+    hooks = _hooks()
+    record = {"command": f"python benchmarks/bench_x.py {value}", "date": value, "commit": value,
+              "machine": {"cores": 2, "memory_gib": 7.8, "cpu": value},
+              "load_average": {"before": [0.5, value, 1], "after": [1, 1, 1]}, "cpu_seconds": 1.5,
+              "wall_seconds": value, "peak_memory_gib": 0.1, "rows": [[value, value]],
+              "tables": [{"columns": [value, "b"], "rows": [[value, 1]]}],
+              "output": ["before", value, f"{value}{value}", "after"]}
+    path = tmp_path / "bench_x.json"
+    path.write_text(json.dumps(record))
+    _assert_shown_never_markup(_as_the_site_renders("\n".join(hooks._recorded_run(path))), [value])
+
+
+def _hostile_results(folder: Path, value: str) -> None:
+    """results/ with every value a page shows from a summary, a report and an intersection summary hostile."""
+    folder.mkdir()
+    summary = json.loads((ROOT / "results" / "bisection-1x2x4.json").read_text())
+    summary["face_points"] = "octree"  # the paper's tables are shown for these only
+    optimal = summary["criteria"]["optimal"]
+    first = next(iter(optimal["types"]))
+    optimal["types"][first]["paper_class"] = value
+    optimal["types_count"] = value
+    (folder / f"bisection-{value[:3].strip()}.json").write_text(json.dumps(summary))
+    other = dict(summary, study=value, box=[value, "2", "4"], face_points=value, configurations=value,
+                 element=value)
+    (folder / "other.json").write_text(json.dumps(other))
+    order = folder / "intersection" / "x"
+    order.mkdir(parents=True)
+    source = next((ROOT / "results" / "intersection").glob("*/intersection-r*-*.json"))
+    intersection = json.loads(source.read_text())
+    intersection["insertion_order"] = value
+    intersection["configurations"] = value
+    (order / "intersection-r16-x.json").write_text(json.dumps(intersection))
+    report = json.loads((ROOT / "results" / "mesh" / "sphere-1x2x4-L5" / "report.json").read_text())
+    report["domain"] = [value, "2", "4"]
+    report["tree"]["refine"] = [value]
+    report["delaunay_mode"] = value
+    report["negative_coefficients"]["interior"] = value
+    (folder / "mesh" / "m").mkdir(parents=True)
+    (folder / "mesh" / "m" / "report.json").write_text(json.dumps(report))
+
+
+@pytest.mark.parametrize("value", HOSTILE[:2] + HOSTILE[3:4] + HOSTILE[-7:],
+                         ids=[repr(v)[1:25] for v in HOSTILE[:2] + HOSTILE[3:4] + HOSTILE[-7:]])
+def test_hostile_summaries_and_reports_are_shown_never_read_as_markup(tmp_path, value):
+    hooks = _hooks()
+    hooks.RESULTS = tmp_path / "results"
+    _hostile_results(hooks.RESULTS, value)
+    for name in ("studies", "paper", "intersection", "meshes", "dual"):
+        html = _as_the_site_renders(hooks.GENERATORS[name]("../"))
+        _assert_shown_never_markup(html, [value] if name != "dual" else [])
+
+
+def _page(uri: str):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(file=SimpleNamespace(src_uri=uri))
+
+
+@pytest.mark.parametrize("case, text", [
+    ("not JSON", "{"), ("a list", "[1, 2]"), ("output a string", None), ("a key with an ESC and a newline", None),
+    ("not UTF-8", b"\xff\xfe{"), ("deep", "[" * 100_000), ("a huge number", '{"cpu_seconds": 1' + "0" * 5000 + "}"),
+    ("rows of numbers", None)])
+def test_a_malformed_benchmark_record_stops_the_build_with_one_line(tmp_path, case, text):
+    from mkdocs.exceptions import PluginError
+
+    hooks = _hooks()
+    hooks.RESULTS = tmp_path
+    (tmp_path / "benchmarks").mkdir()
+    record = json.loads((ROOT / "results" / "benchmarks" / "bench_patterns.json").read_text())
+    if case == "output a string":
+        record["output"] = "one line"
+    elif case == "a key with an ESC and a newline":
+        record = {"\x1b[2J\nfake: line": 1}
+    elif case == "rows of numbers":
+        record["rows"] = [1, 2]
+    path = tmp_path / "benchmarks" / "bench_x.json"
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(text if text is not None else json.dumps(record))
+    with pytest.raises(PluginError) as raised:
+        hooks.on_page_markdown("a\n<!-- generated: benchmark:bench_x -->\n", _page("results/x.md"), None, None)
+    message = str(raised.value)
+    assert len(message.splitlines()) == 1 and message.isprintable() and len(message) < 500, message
+    assert message.startswith("results/x.md: <!-- generated: benchmark:bench_x -->: ") and "bench_x.json" in message
+
+
+@pytest.mark.parametrize("case", ["a box of numbers", "counts as text", "a report not an object", "no criteria"])
+def test_a_malformed_summary_or_report_stops_the_build_with_one_line(tmp_path, case):
+    from mkdocs.exceptions import PluginError
+
+    hooks = _hooks()
+    hooks.RESULTS = tmp_path
+    summary = json.loads((ROOT / "results" / "bisection-1x2x4.json").read_text())
+    report = json.loads((ROOT / "results" / "mesh" / "sphere-1x2x4-L5" / "report.json").read_text())
+    marker = "studies"
+    if case == "a box of numbers":
+        summary["box"] = 5
+    elif case == "no criteria":
+        del summary["criteria"]
+    elif case == "counts as text":
+        report["dual"]["mixed"]["edges"] = "many"
+        marker = "dual"
+    else:
+        report = ["not", "an", "object"]
+        marker = "meshes"
+    (tmp_path / "s.json").write_text(json.dumps(summary))
+    (tmp_path / "mesh" / "m").mkdir(parents=True)
+    (tmp_path / "mesh" / "m" / "report.json").write_text(json.dumps(report))
+    with pytest.raises(PluginError) as raised:
+        hooks.on_page_markdown(f"<!-- generated: {marker} -->", _page("index.md"), None, None)
+    message = str(raised.value)
+    assert len(message.splitlines()) == 1 and message.startswith(f"index.md: <!-- generated: {marker} -->: "), message
