@@ -46,12 +46,13 @@ Examples
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = ["SIDES", "BoundaryTriangles", "SimplexMesh", "Tetrahedra", "boundary_triangles", "fan_triangles", "real_points",
-           "simplex_mesh", "split_tetrahedra"]
+           "dual_simplex_mesh", "element_blocks", "simplex_mesh", "split_tetrahedra"]
 
 
 @dataclass(frozen=True)
@@ -115,10 +116,14 @@ def _regions(mesh) -> np.ndarray:
     return np.zeros(len(mesh), dtype=np.int32) if region is None else np.asarray(region, dtype=np.int32)
 
 
-def split_tetrahedra(mesh) -> Tetrahedra:
-    """Every element of ``mesh`` split into tetrahedra (see the module's docstring for the rule)."""
+def split_tetrahedra(mesh, blocks=None) -> Tetrahedra:
+    """Every element of ``mesh`` split into tetrahedra (see the module's docstring for the rule).
+
+    ``blocks``: the elements as :meth:`~cospherical.mesh.assembly.Mesh.blocks` gives them
+    (default: the mesh's own), for example :func:`element_blocks` of an element list.
+    """
     parts, parents = [], []
-    for rows, nodes, faces, _ in mesh.blocks():
+    for rows, nodes, faces, _ in (mesh.blocks() if blocks is None else blocks):
         nodes = np.asarray(nodes, dtype=np.int64)
         apex = nodes.min(axis=1)
         for cycle in faces:
@@ -139,12 +144,43 @@ def split_tetrahedra(mesh) -> Tetrahedra:
     return Tetrahedra(tets[order], parent, _regions(mesh)[parent])
 
 
-def boundary_triangles(mesh) -> BoundaryTriangles:
+def element_blocks(grid_vertices: np.ndarray, squared, nodes: np.ndarray, sizes: np.ndarray) -> list:
+    """Blocks (as :meth:`~cospherical.mesh.assembly.Mesh.blocks` gives them) of an element list on grid vertices.
+
+    For elements known only by their vertices (a ``dual.npz``): each distinct shape, up to
+    translation and scaling by powers of two, gets its faces from its exact hull once.
+    """
+    from fractions import Fraction
+
+    from ..core.geometry import Frame
+    from ..core.polyhedron import measure
+    from ..errors import InputError
+
+    verts = np.asarray(grid_vertices, dtype=np.int64)
+    by_shape: dict[tuple, list] = {}
+    for e in range(len(nodes)):
+        ids = np.asarray(nodes[e, :int(sizes[e])], dtype=np.int64)
+        rel = verts[ids] - verts[ids].min(axis=0)
+        scale = math.gcd(*(int(x) for x in rel.reshape(-1)))
+        scale = scale & -scale
+        by_shape.setdefault(tuple(map(tuple, (rel // scale).tolist())), []).append(e)
+    blocks = []
+    for key, rows in by_shape.items():
+        points = {n: tuple(Fraction(int(x)) for x in p) for n, p in enumerate(key)}
+        element = measure(Frame.build(points, squared), range(len(key)))
+        if not element.cycles:
+            raise InputError(f"element {rows[0]} is flat: it has no tetrahedra")
+        rows = np.array(rows, dtype=np.int64)
+        blocks.append((rows, np.asarray(nodes)[rows, :len(key)].astype(np.int64), element.cycles, None))
+    return blocks
+
+
+def boundary_triangles(mesh, blocks=None) -> BoundaryTriangles:
     """The triangles of the element faces that lie in the domain's sides (the outer surface, split conformingly)."""
     grid = int(mesh.grid)
-    vertices = np.asarray(mesh.vertices, dtype=np.int64)
+    vertices = np.asarray(mesh.grid_vertices if hasattr(mesh, "grid_vertices") else mesh.vertices, dtype=np.int64)
     parts, parents, sides = [], [], []
-    for rows, nodes, faces, _ in mesh.blocks():
+    for rows, nodes, faces, _ in (mesh.blocks() if blocks is None else blocks):
         nodes = np.asarray(nodes, dtype=np.int64)
         for cycle in faces:
             face = nodes[:, list(cycle)]
@@ -194,7 +230,27 @@ def real_points(mesh) -> np.ndarray:
 
 def simplex_mesh(mesh, tetrahedra: Tetrahedra | None = None) -> SimplexMesh:
     """The mesh's tetrahedra per region and its named surfaces (see :class:`SimplexMesh`)."""
-    tets = split_tetrahedra(mesh) if tetrahedra is None else tetrahedra
-    outer = boundary_triangles(mesh)
+    blocks = list(mesh.blocks())
+    tets = split_tetrahedra(mesh, blocks) if tetrahedra is None else tetrahedra
+    outer = boundary_triangles(mesh, blocks)
     return SimplexMesh(real_points(mesh), tets.nodes, tets.region, ("domain",), outer.nodes,
                        outer.side.astype(np.int32), SIDES)
+
+
+def dual_simplex_mesh(dual) -> SimplexMesh:
+    """:func:`simplex_mesh` of the elements a :class:`~cospherical.mesh.dual.Dual` holds (a ``dual.npz``)."""
+    blocks = element_blocks(dual.grid_vertices, dual.box.squared, dual.element_nodes, dual.element_sizes)
+    tets = split_tetrahedra(_ElementList(len(dual.element_sizes)), blocks)
+    outer = boundary_triangles(dual, blocks)
+    return SimplexMesh(np.asarray(dual.vertices, dtype=np.float64), tets.nodes, tets.region, ("domain",), outer.nodes,
+                       outer.side.astype(np.int32), SIDES)
+
+
+class _ElementList:
+    """A mesh of ``count`` elements in one region, for :func:`split_tetrahedra` given its blocks."""
+
+    def __init__(self, count: int):
+        self.count = count
+
+    def __len__(self) -> int:
+        return self.count
