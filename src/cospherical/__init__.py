@@ -51,6 +51,9 @@ _API = {
     "type_name": "cospherical.catalogue",
     "PatternTable": "cospherical.formats.patterns",
     "load_patterns": ("cospherical.formats.patterns", "load"),
+    "build_mesh": "cospherical.api.mesh",
+    "OctreeMesh": "cospherical.api.mesh",
+    "MeshReport": "cospherical.mesh.report",
 }
 
 __all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "__version__", *_API]

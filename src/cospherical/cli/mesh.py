@@ -3,23 +3,23 @@
 from __future__ import annotations
 
 import os
-import re
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
+from ..api.mesh import build_mesh, mesh_writes, output_names, piece_name, tree_source
 from ..catalogue import CRITERIA
 from ..core.configuration import Box
 from ..core.exact import parse_rational
 from ..errors import InputError
 from ..files.outputs import OutputFolder
-from ..formats.mesh import read_leaves, report_json, table_lookup, write_report
-from ..mesh.assembly import assemble
-from ..mesh.delaunay import MODES, delaunay_mesh
-from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, build_octree, leaf_list_order, leaves_octree, parse_shape
-from ..mesh.report import mesh_report
+from ..formats.mesh import report_json, table_lookup, write_report
+from ..mesh.delaunay import MODES
+from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, parse_shape
+from ..mesh.pipeline import TreeSource, delaunay_mode
 from .progress import stage_bars
 from .output import path_argument
 
@@ -127,23 +127,17 @@ _SUMMARY_KEYS = ("delaunay_mode", "leaves", "vertices", "elements", "types", "vo
                 "paper_final_share")
 
 
-def _cut(args, box: Box) -> float:
-    """Where the picture cuts: ``--cut``, else through the first shape's centre, else half height."""
-    if args.cut is not None:
-        value = parse_rational(args.cut, "--cut")
-        if not 0 <= value <= 1:
-            raise InputError(f"--cut {args.cut}: must be a fraction of the domain height, 0..1")
-        if args.out is None or args.partitions is not None:  # no picture is drawn: the option would do nothing
-            raise InputError(f"--cut {args.cut}: places mesh.png's cut, which only --out DIR without --partitions "
-                             "draws")
-        return float(value)
-    if args.refine:
-        shape = parse_shape(args.refine[0])
-        if shape.kind in ("sphere", "point"):
-            return min(1.0, max(0.0, float(shape.values[2]) / float(box.c)))
-        if shape.kind == "box":
-            return min(1.0, max(0.0, float(shape.values[2] + shape.values[5]) / 2 / float(box.c)))
-    return 0.5
+def _cut(args) -> float | None:
+    """``--cut``, checked before the work; ``None``: the picture's own default (through the first shape)."""
+    if args.cut is None:
+        return None
+    value = parse_rational(args.cut, "--cut")
+    if not 0 <= value <= 1:
+        raise InputError(f"--cut {args.cut}: must be a fraction of the domain height, 0..1")
+    if args.out is None or args.partitions is not None:  # no picture is drawn: the option would do nothing
+        raise InputError(f"--cut {args.cut}: places mesh.png's cut, which only --out DIR without --partitions "
+                         "draws")
+    return float(value)
 
 
 def _text(value) -> str:
@@ -154,31 +148,16 @@ def _text(value) -> str:
     return f"{value:,}" if isinstance(value, int) else str(value)
 
 
-_OUTPUTS = ("mesh.vtu", "report.json", "mesh.png")
-
-
-def _writes(name: str) -> bool:
-    """Whether a mesh run writes a file of this name: the only files of an earlier run it may remove."""
-    from ..mesh.partition import MAX_PARTITIONS
-
-    piece = re.fullmatch(r"mesh-(0|[1-9][0-9]{0,9})\.vtu", name)
-    return name in (*_OUTPUTS, "dual.npz", "mesh.pvtu") or piece is not None and int(piece[1]) < MAX_PARTITIONS
-
-
 def run(args) -> int:
     pieces = _pieces(args)
     if args.out is None:
         return _run(args, None)
     if pieces is not None:
-        names = ("mesh.pvtu", "report.json", *(_piece_name(k) for k in range(pieces)))
+        names = ("mesh.pvtu", "report.json", *(piece_name(k) for k in range(pieces)))
     else:
-        names = _OUTPUTS + (("dual.npz",) if args.dual else ())
-    with OutputFolder(args.out, "mesh", names, writes=_writes) as out:  # locked from the start; every file or none
+        names = output_names(args.dual)
+    with OutputFolder(args.out, "mesh", names, writes=mesh_writes) as out:  # locked from the start; every file or none
         return _run(args, out)
-
-
-def _piece_name(k: int) -> str:
-    return f"mesh-{k}.vtu"
 
 
 def _pieces(args) -> int | None:
@@ -202,101 +181,29 @@ def _pieces(args) -> int | None:
 
 def _run(args, out: OutputFolder | None) -> int:
     box = Box.parse(args.domain)
-    mode = args.delaunay or ("global" if args.criterion == "optimal" else "leaf")
-    if mode == "global" and args.criterion != "optimal":
-        raise InputError(f"--delaunay global gives the largest co-spherical cells, which --criterion "
-                         f"{args.criterion} splits; use --delaunay leaf with it")
-    at = _cut(args, box)  # before the work: a bad --cut is refused at once
+    delaunay_mode(args.criterion, args.delaunay)  # a contradiction refused before the work
+    at = _cut(args)
     max_leaves = _max_leaves(args.max_leaves)
-    clock = time.perf_counter()
     if args.leaves is not None:
         if args.levels is not None:
             raise InputError("--levels goes with --refine, not with --leaves")
-        levels, positions = read_leaves(args.leaves, max_leaves)
-        tree = leaves_octree(box, levels, positions, where=str(args.leaves))
-        described = {"source": "leaves", "file": args.leaves.name, "depth": tree.depth}
-        listed = leaf_list_order(levels, positions)  # cell data leaf: the file's numbering
+        given = {"leaves": args.leaves}
     else:
         shapes = [parse_shape(text) for text in args.refine]
-        listed = None  # cell data leaf: the tree's order
-        levels = _levels(args.levels)
-        tree = build_octree(box, levels, shapes, args.balance, max_leaves)
-        described = {"source": "refine", "levels": levels, "refine": [s.text for s in shapes],
-                     "balance": args.balance, "depth": tree.depth}
-    timings = {"tree": time.perf_counter() - clock}
-    clock = time.perf_counter()
-    table = lookup = None
-    if args.patterns is not None:
-        from ..formats.patterns import load
-
-        table = (load(args.patterns), args.criterion, box, str(args.patterns))
-        if args.partitions is None:
-            lookup = table_lookup(*table)
-        timings["table"] = time.perf_counter() - clock
-        clock = time.perf_counter()
+        given = {"levels": _levels(args.levels), "refine": shapes, "balance": args.balance}
     if args.partitions is not None:
-        return _in_pieces(args, tree, described, table, mode, out, listed)
-    large = len(tree) > 50_000  # bars on large trees only (and only on a terminal: tqdm's disable=None)
-    bars = {"assembly": (len(tree), "assembling", "leaf"), "regions": (None, "Delaunay check (leaf mesh)", "element"),
-            "delaunay": (None, "Delaunay check", "element")}
-    with stage_bars(bars) as advance:
-        mesh = assemble(tree, lookup, progress=(lambda n: advance("assembly", n)) if large else None,
-                        criterion=args.criterion)
-        timings["assembly"] = time.perf_counter() - clock
-        clock = time.perf_counter()
-        bars["regions"] = (len(mesh), "Delaunay check (leaf mesh)", "element")
-        mesh, leaf_mesh, checked = delaunay_mesh(mesh, mode,
-                                                 progress=(lambda n: advance("regions", n)) if large else None)
-        if leaf_mesh is not None:
-            timings["global Delaunay"] = time.perf_counter() - clock
-            clock = time.perf_counter()
-        bars["delaunay"] = (len(mesh), "Delaunay check", "element")  # read when its bar opens
-        stages = []
-
-        def stage(name: str) -> None:
-            nonlocal clock
-            if stages:
-                timings[stages[-1]] = time.perf_counter() - clock
-            stages.append(name)
-            clock = time.perf_counter()
-
-        violating: list = []
-        report = mesh_report(mesh, described, args.patterns.name if args.patterns else None, args.criterion,
-                             uniform=not args.no_uniform, delaunay=not args.no_delaunay, stage=stage,
-                             progress=(lambda n: advance("delaunay", n)) if large else None, violating=violating,
-                             leaf_mesh=leaf_mesh, checked=checked)
-        dual = None
-        if args.dual:
-            from ..mesh.dual import dual_summary, mesh_dual
-
-            stage("dual")
-            dual = mesh_dual(mesh)
-            report.update(dual_summary(dual, len(mesh), report["interior_faces"] + report["boundary_faces"]))
-    stage("outputs")
+        return _in_pieces(args, tree_source(box, **given, max_leaves=max_leaves), out)
+    with _bars() as progress:
+        mesh = build_mesh(box, **given, patterns=args.patterns, criterion=args.criterion, delaunay=args.delaunay,
+                          dual=args.dual, max_leaves=max_leaves, check_delaunay=not args.no_delaunay,
+                          uniform=not args.no_uniform, progress=progress)
+    clock = time.perf_counter()
     if out is not None:
-        from ..formats.mesh import write_vtu
-        from ..outputs.mesh_picture import cut_png
-
-        point_data, cell_data = {}, {}
-        if dual is not None:
-            from ..formats.dual import write_dual
-
-            write_dual(dual, out.path("dual.npz"))
-            point_data = {"control_volume": dual.control_volume, "boundary_area": dual.boundary_area}
-            cell_data = {"circumcenter": dual.element_circumcenter}
-            if violating:
-                ok = np.ones(len(mesh), dtype=np.int8)
-                ok[violating[0]] = 0
-                cell_data["delaunay_ok"] = ok
-        write_vtu(mesh, out.path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=listed)
-        shapes = ", ".join(described.get("refine", [])) or described.get("file", "")
-        cut_png(mesh, out.path("mesh.png"), at=at,
-                title=f"{' x '.join(box.texts)}: {shapes}; {report['leaves']:,} leaves, {report['elements']:,} "
-                      f"elements, {report['types']} types (cut at z = {at * float(box.c):.4g})")
-        write_report(report, out.path("report.json"))
-    timings["outputs"] = time.perf_counter() - clock
+        mesh.write_files(out.path, at)
+    timings = {**mesh.report.timings, "outputs": time.perf_counter() - clock}
+    report = mesh.report.to_dict()
     _print(args, report)
-    if dual is not None and args.format != "json":
+    if args.dual and args.format != "json":
         negative = report["negative_coefficients"]
         sys.stdout.write(f"dual_edges: {report['dual']['edges']:,}\n"
                          f"negative_coefficients: {negative['interior']:,} interior, {negative['boundary']:,} "
@@ -304,6 +211,30 @@ def _run(args, out: OutputFolder | None) -> int:
     if sys.stderr.isatty():
         print("cospherical mesh: seconds " + ", ".join(f"{k} {v:.2f}" for k, v in timings.items()), file=sys.stderr)
     return 0
+
+
+# The bars of the pipeline's long stages: label and unit; drawn on large trees only (and only on a terminal)
+_BARS = {"assembly": ("assembling", "leaf"), "regions": ("Delaunay check (leaf mesh)", "element"),
+         "delaunay": ("Delaunay check", "element")}
+_LARGE_TREE = 50_000
+
+
+@contextmanager
+def _bars():
+    """Yield the pipeline's ``progress(stage, total, advance)``: a bar per stage once the tree proves large."""
+    stages: dict[str, tuple[int | None, str, str]] = {}
+    large = False
+
+    with stage_bars(stages) as advance:
+        def progress(stage: str, total: int | None, n: int) -> None:
+            nonlocal large
+            if stage == "assembly" and stage not in stages:
+                large = total is not None and total > _LARGE_TREE
+            if large:
+                stages.setdefault(stage, (total, *_BARS[stage]))  # read when its bar opens
+                advance(stage, n)
+
+        yield progress
 
 
 def _print(args, report: dict) -> None:
@@ -320,18 +251,25 @@ def _write_listed_piece(listed: np.ndarray, mesh, path, leaves: np.ndarray) -> N
     write_piece(mesh, path, listed[leaves])
 
 
-def _in_pieces(args, tree, described: dict, table: tuple | None, mode: str, out: OutputFolder | None,
-               listed: np.ndarray | None) -> int:
+def _in_pieces(args, source: TreeSource, out: OutputFolder | None) -> int:
     """``--partitions N``: the pieces meshed, checked and written by tasks, mesh.pvtu and the report here."""
     from functools import partial
 
     from ..formats.mesh import write_piece, write_pvtu
     from ..mesh.partition import mesh_in_pieces
 
+    tree, described, listed = source.tree, source.described, source.leaf_order
+    mode = delaunay_mode(args.criterion, args.delaunay)
+    table = None
+    if args.patterns is not None:
+        from ..formats.patterns import load
+
+        table = (load(args.patterns), args.criterion, tree.box, str(args.patterns))
+
     write = write_piece if listed is None else partial(_write_listed_piece, listed)
 
     pieces = int(args.partitions)
-    paths = [str(out.path(_piece_name(k))) for k in range(pieces)] if out is not None else None
+    paths = [str(out.path(piece_name(k))) for k in range(pieces)] if out is not None else None
     report = mesh_in_pieces(tree, pieces, (table_lookup, table) if table is not None else None, args.criterion,
                             mode, described, args.patterns.name if args.patterns else None,
                             uniform=not args.no_uniform, delaunay=not args.no_delaunay,

@@ -8,9 +8,11 @@ mesh in one piece goes the same way (:func:`mesh_report`), so the two cannot dri
 
 from __future__ import annotations
 
+import copy
 from collections import Counter
+from dataclasses import dataclass, field, fields
 from fractions import Fraction
-from typing import Callable
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
@@ -20,7 +22,7 @@ from .checks import check_circumcenters, check_conformity, check_delaunay, check
 from .octree import Octree
 from .statistics import level_counts, occurrences, statistics, uniform_study
 
-__all__ = ["merged_report", "mesh_figures", "mesh_report", "outside_catalogue"]
+__all__ = ["MeshReport", "merged_report", "mesh_figures", "mesh_report", "outside_catalogue"]
 
 # Figures of the pieces that the whole's report adds up.
 _SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_faces", "circumcenters_outside_leaf",
@@ -204,3 +206,92 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     cells = (mesh.cells.regions, mesh.cells.largest_region) if mesh.cells is not None else (0, 0)
     return merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
                          leaf_mesh, cells, catalogue=mesh.catalogue)
+
+
+# The report's keys that are left out, rather than written as null, when they were not computed:
+# the details of the global Delaunay check (only with the check), the uniform study (only when asked)
+# and the dual's figures (only with the dual).
+_ABSENT_WHEN_NONE = frozenset({"delaunay_violating_pairs", "delaunay_violating_leaves", "delaunay_ties",
+                               "delaunay_exact_tests", "delaunay_violating_fvm_leaves", "uniform",
+                               "negative_coefficients", "dual"})
+
+
+@dataclass(frozen=True)
+class MeshReport:
+    """What the mesher found on one mesh: its sizes, the exact checks, the frequencies, and the time each stage took.
+
+    The fields are the keys of ``schemas/mesh-report.schema.json``, in the order
+    ``report.json`` writes them; :meth:`to_dict` gives that JSON object exactly and
+    :meth:`from_dict` reads it back (``MeshReport.from_dict(r.to_dict()) == r``).
+    Counts are ``int``; the nested figures (``tree``, ``leaf_mesh``, the frequency
+    tables, ``dual``) are the report's own JSON values, read-only by convention.
+    ``delaunay_violations`` is ``None`` when the global Delaunay check was skipped;
+    the fields that default to ``None`` are absent from the JSON when not computed.
+    ``timings``: seconds per stage of the run (``tree``, ``assembly``, ``volume``, ...,
+    ``dual``), not part of ``report.json`` (a rerun's file is byte-identical).
+    """
+
+    schema_version: int
+    generator: str
+    domain: tuple[str, str, str]
+    tree: Mapping[str, Any]
+    patterns: str | None
+    criterion: str
+    leaves: int
+    leaves_per_level: Mapping[str, int]
+    vertices: int
+    elements: int
+    types: int
+    delaunay_mode: str
+    leaf_mesh: Mapping[str, Any] | None
+    cells_spanning_leaves: int
+    regions_retessellated: int
+    largest_region_vertices: int
+    types_outside_catalogue: list[dict]
+    volume_ok: bool
+    volume: str
+    flat_elements: int
+    nonconforming_faces: int
+    interior_faces: int
+    boundary_faces: int
+    nonconforming_examples: list
+    circumcenters_outside_leaf: int
+    leaves_not_fvm_adequate: int
+    elements_not_cospherical: int
+    boundary_circumcenters_outside: int
+    delaunay_violations: int | None
+    delaunay_violating_pairs: int | None = None
+    delaunay_violating_leaves: int | None = None
+    delaunay_ties: int | None = None
+    delaunay_exact_tests: int | None = None
+    delaunay_violating_fvm_leaves: int | None = None
+    configurations: int = 0
+    configurations_from_table: int = 0
+    configurations_mapped: int = 0
+    tessellated_on_the_fly: int = 0
+    leaves_tessellated_on_the_fly: int = 0
+    paper_final_share: float = 0.0
+    leaves_in_bisection_family: int = 0
+    type_frequencies: list[dict] = field(default_factory=list)
+    configuration_frequencies: list[dict] = field(default_factory=list)
+    uniform: Mapping[str, Any] | None = None
+    negative_coefficients: Mapping[str, int] | None = None
+    dual: Mapping[str, Any] | None = None
+    timings: Mapping[str, float] = field(default_factory=dict, compare=False)
+
+    def to_dict(self) -> dict:
+        """The report as ``report.json`` holds it (a new dict, deep-copied: changing it changes nothing here)."""
+        result = {}
+        for item in fields(self):
+            value = getattr(self, item.name)
+            if item.name == "timings" or (value is None and item.name in _ABSENT_WHEN_NONE):
+                continue
+            result[item.name] = list(value) if item.name == "domain" else copy.deepcopy(value)
+        return result
+
+    @classmethod
+    def from_dict(cls, report: Mapping[str, Any], timings: Mapping[str, float] | None = None) -> "MeshReport":
+        """The report of a ``report.json`` object (or :func:`mesh_report`'s dict); an unknown key raises ``TypeError``."""
+        values = {key: value for key, value in report.items()}
+        values["domain"] = tuple(values["domain"])
+        return cls(**values, timings=dict(timings or {}))

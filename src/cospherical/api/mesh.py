@@ -1,0 +1,370 @@
+"""A mesh of an octree in one call: :func:`build_mesh` and the object it returns, :class:`OctreeMesh`.
+
+The call runs the mesher's one pipeline (:mod:`cospherical.mesh.pipeline`): the tree
+(refined at shapes, a leaf list, or an :class:`~cospherical.mesh.octree.Octree`), each
+leaf's elements from a pattern table (or tessellated), the exact Delaunay subdivision
+where the leaves' elements are not Delaunay, the exact checks and the report, and on
+request the finite-volume dual.  ``cospherical mesh`` is this call with a command line
+around it, and :meth:`OctreeMesh.write` writes the files ``mesh --out`` writes, byte for
+byte.
+
+Examples
+--------
+>>> import cospherical
+>>> m = cospherical.build_mesh(domain=(1, 1, 1), levels=2, refine=["point:0.1,0.1,0.1"], uniform=False)
+>>> m.vertices.shape, len(m.elements), m.report.volume_ok, m.report.delaunay_violations
+((46, 3), 48, True, 0)
+>>> m.dual.volume_sum()  # the control volumes, exactly: the whole domain
+Fraction(1, 1)
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any, Callable, NamedTuple, Sequence
+
+import numpy as np
+
+from ..core.configuration import Box
+from ..errors import InputError
+from ..files.outputs import OutputFolder
+from ..mesh.assembly import Lookup, Mesh
+from ..mesh.dual import Dual, mesh_dual
+from ..mesh.octree import Octree, Shape
+from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode, run_pipeline, tree_from_leaves,
+                             tree_from_octree, tree_from_refine)
+from ..mesh.report import MeshReport
+
+__all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "mesh_writes", "output_names",
+           "pattern_lookup", "piece_name", "tree_source"]
+
+
+def output_names(dual: bool) -> tuple[str, ...]:
+    """The files a mesh writes into its folder (``mesh --out``, :meth:`OctreeMesh.write`), known before the work.
+
+    The output folder is locked and these names checked before the mesh is made,
+    and its manifest lists them afterwards (a later run removes a file of this one
+    that it did not write again).
+    """
+    return ("mesh.vtu", "report.json", "mesh.png") + (("dual.npz",) if dual else ())
+
+
+def piece_name(k: int) -> str:
+    """The file of piece ``k`` of a partitioned mesh (``mesh --partitions N``)."""
+    return f"mesh-{k}.vtu"
+
+
+def mesh_writes(name: str) -> bool:
+    """Whether a mesh run writes a file of this name: the only files of an earlier run its folder may remove."""
+    from ..mesh.partition import MAX_PARTITIONS
+
+    piece = re.fullmatch(r"mesh-(0|[1-9][0-9]{0,9})\.vtu", name)
+    return name in (*output_names(True), "mesh.pvtu") or piece is not None and int(piece[1]) < MAX_PARTITIONS
+
+
+def default_cut(shapes: Sequence[Shape], box: Box) -> float:
+    """Where ``mesh.png`` cuts, as a fraction of the domain's height: through the first shape's centre, else half way."""
+    if shapes:
+        shape = shapes[0]
+        if shape.kind in ("sphere", "point"):
+            return min(1.0, max(0.0, float(shape.values[2]) / float(box.c)))
+        if shape.kind == "box":
+            return min(1.0, max(0.0, float(shape.values[2] + shape.values[5]) / 2 / float(box.c)))
+    return 0.5
+
+
+def tree_source(box: Box, levels: int | None = None, refine: Sequence[str | Shape] | None = None, *,
+                leaves: str | Path | Sequence[Sequence[int]] | np.ndarray | None = None, tree: Octree | None = None,
+                balance: str = "vertex", max_leaves: int | None = None) -> TreeSource:
+    """The tree to mesh, from exactly one of ``refine`` (with ``levels``), ``leaves`` or ``tree``.
+
+    ``leaves``: a leaf list file (text ``level i j k`` lines or JSON, see
+    :func:`cospherical.formats.mesh.read_leaves`) or its rows ``(level, i, j, k)``.
+    """
+    given = [name for name, value in (("refine", refine), ("leaves", leaves), ("tree", tree)) if value is not None]
+    if len(given) != 1:
+        raise InputError("give the tree one way: refine= (with levels=), leaves= or tree="
+                         + (f", not {' and '.join(given)}" if given else ""))
+    if refine is not None:
+        if isinstance(refine, (str, Shape)):
+            refine = [refine]
+        if levels is None:
+            raise InputError("refine= needs levels=")
+        return tree_from_refine(box, levels, refine, balance, max_leaves)
+    if levels is not None:
+        raise InputError(f"levels= goes with refine=, not with {given[0]}=")
+    if tree is not None:
+        if not isinstance(tree, Octree):
+            raise InputError(f"tree=: an Octree, not {type(tree).__name__}")
+        return tree_from_octree(tree)
+    if isinstance(leaves, (str, Path)):
+        from ..formats.mesh import read_leaves
+
+        level_list, positions = read_leaves(leaves, max_leaves)
+        return tree_from_leaves(box, level_list, positions, where=str(leaves), file=Path(leaves).name)
+    rows = np.asarray(leaves, dtype=np.int64)
+    if rows.ndim != 2 or rows.shape[1] != 4:
+        raise InputError(f"leaves=: rows of (level, i, j, k), not an array of shape {rows.shape}")
+    from ..mesh.octree import check_leaf_count
+
+    check_leaf_count(len(rows), "leaves=:", max_leaves)
+    return tree_from_leaves(box, rows[:, 0], rows[:, 1:])
+
+
+def pattern_lookup(patterns: Any, criterion: str, box: Box) -> tuple[Lookup | None, str | None]:
+    """The lookup of a pattern table (a path, or a table :func:`cospherical.load_patterns` read) and its name for the report."""
+    if patterns is None:
+        return None, None
+    from ..formats.mesh import table_lookup
+    from ..formats.patterns import PatternTable, load
+
+    if isinstance(patterns, PatternTable):  # read by the caller: named by its study, it has no file name here
+        return table_lookup(patterns, criterion, box), f"{patterns.header.get('study', 'pattern')} table"
+    path = Path(patterns)
+    return table_lookup(load(path), criterion, box, str(path)), path.name
+
+
+class ExactVertices(NamedTuple):
+    """The vertices exactly: ``coordinates[i, k] * length_k / intervals`` is vertex ``i``'s coordinate along axis ``k``.
+
+    ``coordinates`` (n x 3, int64) are points of the grid of ``intervals`` steps per
+    domain side (half the finest leaf), ``box`` the domain with its exact lengths
+    (``box.texts``; ``box.squared`` their exact squares, rational also for ``sqrt(2)``
+    sides).  :meth:`fractions` gives each coordinate as a fraction of its side.
+    """
+
+    coordinates: np.ndarray
+    intervals: int
+    box: Box
+
+    def fractions(self) -> list[list[Any]]:
+        """Each vertex as three exact :class:`~fractions.Fraction` of the domain's sides (Python lists; slow on big meshes)."""
+        from fractions import Fraction
+
+        return [[Fraction(int(x), self.intervals) for x in row] for row in self.coordinates.tolist()]
+
+
+@dataclass(frozen=True)
+class Elements:
+    """The elements of a mesh as flat arrays, in the mesh's element order.
+
+    Element ``e`` is of type ``type_ids[types[e]]`` (named ``type_names[...]``; its VTK
+    cell ``vtk_cells[...]``: ``tetra``, ``pyramid``, ``wedge``, ``hexahedron`` with nodes
+    in VTK order, or ``None`` for a general polyhedron) and has the vertices
+    ``connectivity[offsets[e]:offsets[e + 1]]`` (indices into the mesh's vertices, in
+    the type's reference order); ``leaf[e]`` is the leaf it lies in (a cell of the
+    global Delaunay step that spans leaves: its first leaf), numbered as the tree's
+    source numbers them (the leaf list's order when one was given).
+    """
+
+    type_ids: tuple[str, ...]
+    type_names: tuple[str, ...]
+    vtk_cells: tuple[str | None, ...]
+    types: np.ndarray
+    connectivity: np.ndarray
+    offsets: np.ndarray
+    leaf: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.types)
+
+    def nodes(self, element: int) -> np.ndarray:
+        """The vertex ids of one element."""
+        return self.connectivity[self.offsets[element]:self.offsets[element + 1]]
+
+    def sizes(self) -> np.ndarray:
+        """Vertices per element."""
+        return np.diff(self.offsets)
+
+
+class OctreeMesh:
+    """A meshed octree: vertices, elements, the exact report, the dual, and its files and conversions.
+
+    Made by :func:`build_mesh`.  ``vertices``
+    are floats; ``exact_vertices`` the same points exactly (:class:`ExactVertices`);
+    ``elements`` an :class:`Elements` view; ``report`` a frozen
+    :class:`~cospherical.mesh.report.MeshReport`; ``dual`` the exact finite-volume
+    dual (:class:`~cospherical.mesh.dual.Dual`), computed on first use unless the
+    mesh was built with ``dual=True``; ``assembled`` the mesher's own
+    :class:`~cospherical.mesh.assembly.Mesh` (leaf by leaf, for the lower-level functions).
+    """
+
+    def __init__(self, result: PipelineResult) -> None:
+        self._result = result
+        self._dual = result.dual
+
+    def __repr__(self) -> str:
+        r = self.report
+        return (f"OctreeMesh({' x '.join(r.domain)}: {r.leaves:,} leaves, {r.vertices:,} vertices, "
+                f"{r.elements:,} elements, {r.types} types)")
+
+    @property
+    def assembled(self) -> Mesh:
+        return self._result.mesh
+
+    @property
+    def tree(self) -> Octree:
+        return self._result.source.tree
+
+    @property
+    def box(self) -> Box:
+        return self.tree.box
+
+    @property
+    def report(self) -> MeshReport:
+        return self._result.report
+
+    @cached_property
+    def vertices(self) -> np.ndarray:
+        """(n, 3) float64: the vertices' coordinates (the same numbers as ``mesh.vtu``'s points)."""
+        mesh = self.assembled
+        return mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+
+    @property
+    def exact_vertices(self) -> ExactVertices:
+        mesh = self.assembled
+        return ExactVertices(np.asarray(mesh.vertices, dtype=np.int64), int(mesh.grid), mesh.box)
+
+    @cached_property
+    def elements(self) -> Elements:
+        mesh = self.assembled
+        conn, sizes = mesh.connectivity()
+        ids, element_type = mesh.element_types()
+        offsets = np.zeros(len(mesh) + 1, dtype=np.int64)
+        np.cumsum(sizes, out=offsets[1:])
+        order = self._result.source.leaf_order
+        return Elements(tuple(ids), tuple(mesh.types.get(t, {}).get("name") or t for t in ids),
+                        tuple(mesh.types.get(t, {}).get("vtk") for t in ids), element_type,
+                        conn[conn >= 0].astype(np.int64), offsets,
+                        (mesh.element_leaf if order is None else order[mesh.element_leaf]).astype(np.int64))
+
+    @property
+    def dual(self) -> Dual:
+        """The exact finite-volume dual (control volumes, edges, areas, coefficients, ``laplacian()``)."""
+        if self._dual is None:
+            self._dual = mesh_dual(self.assembled)
+        return self._dual
+
+    @property
+    def violating(self) -> np.ndarray | None:
+        """The elements whose circumsphere strictly holds a vertex (``None``: the check was skipped)."""
+        return self._result.violating
+
+    def write(self, folder: str | Path, cut: float | None = None) -> None:
+        """Write ``mesh.vtu``, ``report.json``, ``mesh.png`` (and ``dual.npz`` when built with ``dual=True``) into ``folder``.
+
+        The files of ``cospherical mesh --out folder``, byte for byte: all of them
+        or, on an error, none (the folder is locked and its files renamed into place
+        together).  ``cut``: the height of ``mesh.png``'s cut as a fraction of the
+        domain's (default :func:`default_cut`).
+        """
+        with OutputFolder(folder, "mesh", output_names(self.report.dual is not None), writes=mesh_writes) as out:
+            self.write_files(out.path, cut)
+
+    def write_files(self, path: Callable[[str], Path], cut: float | None = None) -> None:
+        """Write the outputs, each to ``path(name)`` (an :class:`~cospherical.files.outputs.OutputFolder`'s ``path``)."""
+        from ..formats.mesh import write_report, write_vtu
+        from ..outputs.mesh_picture import cut_png
+
+        mesh, report, source = self.assembled, self.report, self._result.source
+        point_data, cell_data = {}, {}
+        if report.dual is not None:
+            from ..formats.dual import write_dual
+
+            dual = self.dual
+            write_dual(dual, path("dual.npz"))
+            point_data = {"control_volume": dual.control_volume, "boundary_area": dual.boundary_area}
+            cell_data = {"circumcenter": dual.element_circumcenter}
+            if self.violating is not None:
+                ok = np.ones(len(mesh), dtype=np.int8)
+                ok[self.violating] = 0
+                cell_data["delaunay_ok"] = ok
+        write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=source.leaf_order)
+        at = default_cut(source.shapes, self.box) if cut is None else cut
+        shapes = ", ".join(source.described.get("refine", [])) or source.described.get("file", "")
+        cut_png(mesh, path("mesh.png"), at=at,
+                title=f"{' x '.join(self.box.texts)}: {shapes}; {report.leaves:,} leaves, {report.elements:,} "
+                      f"elements, {report.types} types (cut at z = {at * float(self.box.c):.4g})")
+        write_report(report.to_dict(), path("report.json"))
+
+
+def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = None,
+               refine: Sequence[str | Shape] | str | None = None, *,
+               leaves: str | Path | Sequence[Sequence[int]] | np.ndarray | None = None, tree: Octree | None = None,
+               patterns: Any = None, criterion: str = "optimal", delaunay: str | None = None,
+               balance: str = "vertex", dual: bool = False, device: Any = None, max_leaves: int | None = None,
+               check_delaunay: bool = True, uniform: bool = True, progress: Progress | None = None) -> OctreeMesh:
+    """Mesh an octree: each leaf's elements, globally Delaunay, checked exactly, reported; the dual on request.
+
+    Parameters
+    ----------
+    domain
+        The root cell's three lengths, exact: ints, or strings such as ``"1.4142"``,
+        ``"3/2"``, ``"sqrt(2)"`` (floats are refused: give the text), or a
+        :class:`~cospherical.Box`.  Not needed with ``tree`` (the tree has its box).
+    levels, refine
+        Split every cell whose closed box meets a shape down to ``levels``:
+        ``sphere:X,Y,Z,R`` (its surface), ``plane:NX,NY,NZ,D``, ``point:X,Y,Z``,
+        ``box:X0,Y0,Z0,X1,Y1,Z1`` in domain units; then 2:1 ``balance`` (``vertex``
+        across faces, edges and corners, or ``edge``).
+    leaves
+        Instead: a leaf list file, or its rows ``(level, i, j, k)``; checked to tile
+        the domain and be 1-irregular.  The mesh numbers the leaves as listed.
+    tree
+        Instead: an :class:`~cospherical.mesh.octree.Octree` already built.
+    patterns
+        A pattern table of the domain's box (a path, or a table
+        :func:`cospherical.load_patterns` read); configurations it lacks, and all
+        of them without it, are tessellated.
+    criterion
+        ``optimal`` (largest co-spherical elements), ``internal_faces`` or ``internal_edges_and_faces``.
+    delaunay
+        ``global`` (default with ``optimal``: the exact Delaunay subdivision of the
+        vertices) or ``leaf`` (default with a split criterion: each leaf's elements).
+    dual
+        Compute the exact dual now: the report gets its figures and :meth:`OctreeMesh.write`
+        writes ``dual.npz`` (otherwise ``m.dual`` computes it on first use).
+    device
+        Regions and contacts of a device; not supported yet (a given value is refused).
+    max_leaves
+        Refuse a tree of more leaves (default: what half this machine's memory holds).
+    check_delaunay, uniform
+        Run the global empty-sphere check; add the uniform bisection study to the report.
+    progress
+        ``progress(stage, total, advance)`` as long stages go (see :mod:`cospherical.mesh.pipeline`).
+
+    Examples
+    --------
+    >>> m = build_mesh(domain=(1, 2, 4), levels=2, refine=["sphere:0.5,1,2,0.3"], uniform=False)
+    >>> m.report.leaves, m.report.volume_ok, m.report.nonconforming_faces, m.report.delaunay_violations
+    (64, True, 0, 0)
+    """
+    if device is not None:
+        raise InputError("device=: regions and contacts are not supported by build_mesh yet")
+    if isinstance(domain, Box):
+        box = domain
+    elif domain is not None:
+        if isinstance(domain, str) or len(domain) != 3:
+            raise InputError(f"domain={domain!r}: three lengths, such as (1, 2, 4)")
+        box = Box.parse(list(domain))
+    elif tree is not None:
+        box = tree.box
+    else:
+        raise InputError("domain=: the root cell's three lengths, such as (1, 2, 4)")
+    if tree is not None and tree.box != box:
+        raise InputError(f"tree=: its domain {' x '.join(tree.box.texts)} is not domain= {' x '.join(box.texts)}")
+    delaunay_mode(criterion, delaunay)  # a contradiction refused before the work
+    clock = time.perf_counter()
+    source = tree_source(box, levels, refine, leaves=leaves, tree=tree, balance=balance, max_leaves=max_leaves)
+    timings = {"tree": time.perf_counter() - clock}
+    clock = time.perf_counter()
+    lookup, name = pattern_lookup(patterns, criterion, box)
+    if patterns is not None:
+        timings["table"] = time.perf_counter() - clock
+    return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,
+                                   check_delaunay=check_delaunay, uniform=uniform, dual=dual, progress=progress,
+                                   timings=timings))

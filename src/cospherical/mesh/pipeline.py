@@ -1,0 +1,191 @@
+"""The one mesh pipeline: an octree in, the mesh, its exact checks, its report and (on request) its dual out.
+
+Every way of making a mesh of a whole tree goes through here, the library's
+:func:`cospherical.build_mesh` and the command ``cospherical mesh`` alike, so the two
+cannot drift apart::
+
+    tree (refine shapes | a leaf list | an Octree)      -> TreeSource
+      -> assembly (each leaf's elements: table lookup, else tessellated)
+      -> global Delaunay (the leaves whose elements are not Delaunay, re-tessellated)
+      -> checks (volume, conformity, circumcenters, empty spheres) and statistics
+      -> report (MeshReport) and, with ``dual=True``, the exact dual
+
+Reading files (a pattern table, a leaf list) and writing them are the formats' job,
+one layer up: :func:`run_pipeline` takes the table's ``lookup`` already made, and
+the caller writes what it returns.  ``progress(stage, total, advance)`` is told as a
+long stage goes (``assembly`` through the leaves, ``regions`` through the leaf
+mesh's elements in the global Delaunay step, ``delaunay`` through the elements in
+the final check), ``total`` the stage's size, so a command line can draw a bar per
+stage and a library user can pass nothing.
+
+Examples
+--------
+>>> from cospherical.core.configuration import Box
+>>> source = tree_from_refine(Box.parse([1, 1, 1]), 2, ["point:0.1,0.1,0.1"])
+>>> result = run_pipeline(source, uniform=False)
+>>> result.report.leaves, result.report.elements, result.report.volume_ok, result.report.delaunay_violations
+(15, 48, True, 0)
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..core.configuration import Box
+from ..errors import InputError
+from .assembly import Lookup, Mesh, assemble
+from .delaunay import MODES, delaunay_mesh
+from .dual import Dual, dual_summary, mesh_dual
+from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape
+from .report import MeshReport, mesh_report
+
+__all__ = ["PipelineResult", "Progress", "TreeSource", "delaunay_mode", "run_pipeline", "tree_from_leaves",
+           "tree_from_octree", "tree_from_refine"]
+
+Progress = Callable[[str, "int | None", int], None]
+"""``progress(stage, total, advance)``: ``advance`` more items of ``stage`` done, out of ``total``."""
+
+
+@dataclass(frozen=True)
+class TreeSource:
+    """The octree to mesh and where it came from.
+
+    ``described`` is the report's ``tree`` object (``source``: ``refine`` or
+    ``leaves``, with the levels, shapes and balance, or the leaf file's name, and
+    the depth); ``leaf_order`` numbers the leaves as the user listed them (the
+    ``leaf`` cell data of ``mesh.vtu``), ``None`` for the tree's own order;
+    ``shapes`` the refinement shapes (the picture cuts through the first one).
+    """
+
+    tree: Octree
+    described: dict
+    leaf_order: np.ndarray | None = None
+    shapes: tuple[Shape, ...] = ()
+
+
+def tree_from_refine(box: Box, levels: int, refine: Sequence[str | Shape], balance: str = "vertex",
+                     max_leaves: int | None = None) -> TreeSource:
+    """The tree refined at ``refine`` (shape texts such as ``sphere:0.5,0.5,0.5,0.3``, or :class:`Shape`) down to ``levels``."""
+    shapes = tuple(s if isinstance(s, Shape) else parse_shape(s) for s in refine)
+    tree = build_octree(box, levels, shapes, balance, max_leaves)
+    return TreeSource(tree, {"source": "refine", "levels": levels, "refine": [s.text for s in shapes],
+                             "balance": balance, "depth": tree.depth}, None, shapes)
+
+
+def tree_from_leaves(box: Box, levels: Sequence[int], positions: Sequence[Sequence[int]], where: str = "leaves",
+                     file: str | None = None) -> TreeSource:
+    """The tree of a leaf list (``levels[i]``, ``positions[i]``), checked to tile the domain and be 1-irregular.
+
+    The mesh numbers the leaves as the list does; ``file`` (the list's file name) goes in the report.
+    """
+    tree = leaves_octree(box, levels, positions, where=where)
+    described = {"source": "leaves", **({"file": file} if file is not None else {}), "depth": tree.depth}
+    return TreeSource(tree, described, leaf_list_order(levels, positions))
+
+
+def tree_from_octree(tree: Octree) -> TreeSource:
+    """A tree already built (by :func:`~cospherical.mesh.octree.build_octree` or :func:`~cospherical.mesh.octree.leaves_octree`)."""
+    return TreeSource(tree, {"source": "leaves", "depth": tree.depth})
+
+
+def delaunay_mode(criterion: str, delaunay: str | None) -> str:
+    """The Delaunay mode asked for, or the criterion's default (``global`` for ``optimal``, else ``leaf``)."""
+    mode = delaunay or ("global" if criterion == "optimal" else "leaf")
+    if mode not in MODES:
+        raise InputError(f"--delaunay {mode!r}: write global or leaf")
+    if mode == "global" and criterion != "optimal":
+        raise InputError(f"--delaunay global gives the largest co-spherical cells, which --criterion "
+                         f"{criterion} splits; use --delaunay leaf with it")
+    return mode
+
+
+@dataclass(frozen=True)
+class PipelineResult:
+    """What :func:`run_pipeline` made: the mesh, its report, its dual (or ``None``) and the non-Delaunay elements.
+
+    ``violating``: the elements whose circumsphere strictly holds a vertex (``None``
+    when the check was skipped); ``source``: the tree it meshed.
+    """
+
+    source: TreeSource
+    mesh: Mesh
+    report: MeshReport
+    dual: Dual | None = field(default=None, repr=False)
+    violating: np.ndarray | None = field(default=None, repr=False)
+
+
+class _Clock:
+    """Seconds per stage, in the order the stages ran."""
+
+    def __init__(self, timings: dict[str, float]) -> None:
+        self.timings = timings
+        self.current: str | None = None
+        self.start = time.perf_counter()
+
+    def stage(self, name: str | None) -> None:
+        now = time.perf_counter()
+        if self.current is not None:
+            self.timings[self.current] = now - self.start
+        self.current, self.start = name, now
+
+
+def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: str | None = None,
+                 criterion: str = "optimal", delaunay: str | None = None, check_delaunay: bool = True,
+                 uniform: bool = True, dual: bool = False, progress: Progress | None = None,
+                 timings: dict[str, float] | None = None) -> PipelineResult:
+    """Mesh ``source``'s tree, check it exactly, report it and, with ``dual``, compute its finite-volume dual.
+
+    Parameters
+    ----------
+    source
+        The tree (:func:`tree_from_refine`, :func:`tree_from_leaves`, :func:`tree_from_octree`).
+    lookup
+        A pattern table's elements per configuration
+        (:func:`cospherical.formats.mesh.table_lookup`); ``None``: every configuration tessellated.
+    patterns
+        The table's name, for the report.
+    criterion
+        ``optimal``, ``internal_faces`` or ``internal_edges_and_faces``: which elements of the table.
+    delaunay
+        ``global`` (the exact Delaunay subdivision of the vertices) or ``leaf`` (each
+        leaf's elements as the table has them); ``None``: the criterion's default
+        (:func:`delaunay_mode`).
+    check_delaunay
+        Run the global empty-sphere check (``False``: ``delaunay_violations`` is ``None``).
+    uniform
+        Add the uniform-weight bisection study beside the mesh's frequencies.
+    dual
+        Compute the exact dual now (the report then holds its figures).
+    progress
+        ``progress(stage, total, advance)``, see the module's docstring.
+    timings
+        Seconds of stages run before (the tree, the table), put first in the report's timings.
+    """
+    mode = delaunay_mode(criterion, delaunay)
+    timings = dict(timings or {})
+    clock = _Clock(timings)
+    tree = source.tree
+
+    def told(stage: str, total: int) -> Callable[[int], None] | None:
+        return (lambda n: progress(stage, total, n)) if progress is not None else None
+
+    clock.stage("assembly")
+    mesh = assemble(tree, lookup, progress=told("assembly", len(tree)), criterion=criterion)
+    clock.stage("global Delaunay" if mode == "global" else None)
+    mesh, leaf_mesh, checked = delaunay_mesh(mesh, mode, progress=told("regions", len(mesh)))
+    violating: list = []
+    report = mesh_report(mesh, source.described, patterns, criterion, uniform=uniform, delaunay=check_delaunay,
+                         stage=clock.stage, progress=told("delaunay", len(mesh)), violating=violating,
+                         leaf_mesh=leaf_mesh, checked=checked)
+    found = None
+    if dual:
+        clock.stage("dual")
+        found = mesh_dual(mesh)
+        report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"]))
+    clock.stage(None)
+    return PipelineResult(source, mesh, MeshReport.from_dict(report, timings), found,
+                          violating[0] if violating else None)

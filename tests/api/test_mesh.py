@@ -1,0 +1,99 @@
+"""The library's one call: ``cospherical.build_mesh`` as the docs write it, its object, and the CLI on top of it."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+
+import numpy as np
+import pytest
+
+import cospherical
+from cospherical.cli import main
+from cospherical.errors import InputError
+from cospherical.files.yamlio import validate
+from cospherical.mesh.report import MeshReport
+
+
+def _digests(folder) -> dict[str, str]:
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())}
+
+
+def test_the_snippet_runs_as_written():
+    m = cospherical.build_mesh(domain=(1, 2, 4), levels=5,
+                               refine=["sphere:0.5,1,2,0.3"])
+    r = m.report
+    assert (r.leaves, r.volume_ok, r.nonconforming_faces, r.delaunay_violations) == (2024, True, 0, 0)
+    assert m.vertices.shape == (r.vertices, 3) and m.vertices.dtype == np.float64
+    exact = m.exact_vertices
+    # the floats are the exact grid points scaled: x = g * a / intervals
+    assert np.array_equal(m.vertices, exact.coordinates * (np.array([1.0, 2.0, 4.0]) / exact.intervals))
+    assert len(m.elements) == r.elements and len(m.elements.offsets) == r.elements + 1
+    assert m.elements.sizes().min() >= 4 and m.elements.connectivity.max() == r.vertices - 1
+    assert sorted(m.elements.type_ids) == sorted(t["id"] for t in r.type_frequencies if t["count"])
+    # the dual, computed on first use: control volumes tile the domain exactly, a linear function is harmonic
+    dual = m.dual
+    assert dual.volume_sum() == 1
+    K = dual.laplacian()
+    interior = ~dual.boundary
+    assert np.abs((K @ m.vertices[:, 0])[interior]).max() < 1e-9
+    assert m.report.dual is None  # asked for after the build: the report stays as built
+
+
+def test_report_round_trip_and_schema():
+    m = cospherical.build_mesh(domain=(1, 1, 1), levels=2, refine="point:0.1,0.1,0.1", uniform=False, dual=True)
+    data = m.report.to_dict()
+    validate(data, "mesh-report", "mesh report")
+    assert MeshReport.from_dict(data) == m.report
+    assert MeshReport.from_dict(json.loads(json.dumps(data))).to_dict() == data
+    assert "timings" not in data and {"assembly", "volume", "dual"} <= set(m.report.timings)
+    data["leaves"] = -1  # a copy: the report does not change
+    assert m.report.leaves == 15
+    with pytest.raises(AttributeError):
+        m.report.leaves = 3  # frozen
+
+
+@pytest.mark.parametrize("argv, kwargs", [
+    (["--domain", "1", "2", "4", "--levels", "3", "--refine", "sphere:0.5,1,2,0.6", "--patterns",
+      "patterns/leaves-1x2x4.yaml", "--dual", "--no-uniform"],
+     dict(domain=(1, 2, 4), levels=3, refine=["sphere:0.5,1,2,0.6"], patterns="patterns/leaves-1x2x4.yaml",
+          dual=True, uniform=False)),
+    (["--domain", "1", "1", "1", "--leaves", "examples/leaves.txt", "--delaunay", "leaf", "--no-delaunay"],
+     dict(domain=("1", "1", "1"), leaves="examples/leaves.txt", delaunay="leaf", check_delaunay=False)),
+])
+def test_the_cli_writes_what_write_writes(tmp_path, capsys, argv, kwargs):
+    assert main(["mesh", *argv, "--out", str(tmp_path / "cli")]) == 0
+    capsys.readouterr()
+    cospherical.build_mesh(**kwargs).write(tmp_path / "api")
+    cli, api = _digests(tmp_path / "cli"), _digests(tmp_path / "api")
+    assert set(cli) == {".cospherical-manifest.json", "mesh.vtu", "report.json", "mesh.png"} | (
+        {"dual.npz"} if kwargs.get("dual") else set())
+    assert cli == api
+
+
+def test_a_leaf_list_in_memory_is_numbered_as_listed():
+    rows = [[1, i >> 2, (i >> 1) & 1, i & 1] for i in range(8)][::-1]
+    m = cospherical.build_mesh(domain=(1, 1, 1), leaves=rows, uniform=False)
+    # every element lies in the leaf its number names
+    low = np.array(rows)[m.elements.leaf, 1:] * 0.5
+    for e in range(len(m.elements)):
+        points = m.vertices[m.elements.nodes(e)]
+        assert np.all(points >= low[e] - 1e-12) and np.all(points <= low[e] + 0.5 + 1e-12)
+    assert m.report.tree == {"source": "leaves", "depth": 1}
+
+
+@pytest.mark.parametrize("kwargs, needle", [
+    (dict(domain=(1, 1, 1), levels=2), "give the tree one way"),
+    (dict(domain=(1, 1, 1), refine=["point:0,0,0"]), "refine= needs levels="),
+    (dict(domain=(1, 1, 1), levels=2, refine=["point:0,0,0"], leaves=[[0, 0, 0, 0]]), "not refine and leaves"),
+    (dict(domain=(1, 0.5, 1), levels=2, refine=["point:0,0,0"]), "not a float"),
+    (dict(domain=(1, 1), levels=2, refine=["point:0,0,0"]), "three lengths"),
+    (dict(domain=(1, 1, 1), leaves=[[0, 0, 0]]), "rows of (level, i, j, k)"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], criterion="internal_faces", delaunay="global"),
+     "use --delaunay leaf"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], device=object()), "not supported"),
+])
+def test_bad_calls_raise_one_input_error(kwargs, needle):
+    with pytest.raises(InputError, match=None) as raised:
+        cospherical.build_mesh(**kwargs)
+    assert needle in str(raised.value) and "\n" not in str(raised.value)
