@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from cospherical.errors import InputError
-from cospherical.cli.mesh import _writes as MESH_WRITES
+from cospherical.api.mesh import mesh_writes as MESH_WRITES
 from cospherical.files.outputs import MANIFEST, OutputFolder
 from cospherical.mesh.partition import MAX_PARTITIONS
 from cospherical.outputs.latex import _RENDERED
