@@ -13,6 +13,7 @@ command -v pdftoppm >/dev/null 2>&1 || packages+=(poppler-utils)  # PDF page -> 
 command -v tetgen >/dev/null 2>&1 || packages+=(tetgen)  # bench_outputs.py and mesh --dual: the tetrahedral mesher beside ours
 command -v chromium >/dev/null 2>&1 || packages+=(chromium)  # the docs site's pages opened headless in the tests
 command -v cc >/dev/null 2>&1 || packages+=(gcc)  # the docs' C reader of the pattern-table store, compiled in the tests
+command -v g++ >/dev/null 2>&1 || packages+=(g++)  # ... and compiled as C++ too
 [ -e /usr/include/sqlite3.h ] || packages+=(libsqlite3-dev)
 [ -e /usr/include/zlib.h ] || packages+=(zlib1g-dev)
 # The gmsh wheel's library links these (ldd libgmsh.so): present on a desktop, not on a bare server

@@ -14,6 +14,7 @@ import json
 import os
 import re
 import shutil
+import sqlite3
 import subprocess
 import sys
 from pathlib import Path
@@ -166,28 +167,142 @@ def test_edge_table_is_the_code_s():
     assert ["xyz"[edge_axis(k)] for k in range(12)] == [axis for *_, axis, _ in rows]
 
 
-def test_c_reader_of_the_store_gives_the_entries_python_gives(tmp_path):
+@pytest.fixture(scope="module")
+def lookup_programs(tmp_path_factory):
+    """examples/lookup.c compiled as C (cc) and as C++ (g++ -x c++), warnings as errors."""
+    folder = tmp_path_factory.mktemp("lookup")
+    programs = {}
+    for language, compiler in (("c", shutil.which("cc") or shutil.which("gcc")), ("c++", shutil.which("g++"))):
+        assert compiler, "scripts/setup.sh installs gcc, g++, libsqlite3-dev and zlib1g-dev"
+        programs[language] = folder / f"lookup-{language}"
+        subprocess.run([compiler, "-Wall", "-Wextra", "-Werror", "-x", language, str(ROOT / "examples" / "lookup.c"),
+                        "-lsqlite3", "-lz", "-o", str(programs[language])], check=True, capture_output=True,
+                       timeout=120)
+    return programs
+
+
+def _store(folder: Path):
+    """A small store written by the library: its path, codes, entry texts and dictionary."""
     from cospherical.formats.patterns import load
     from cospherical.formats.sqlite_store import dictionary_of, pack, write_store
 
-    cc = shutil.which("cc") or shutil.which("gcc")
-    assert cc, "scripts/setup.sh installs gcc, libsqlite3-dev and zlib1g-dev"
-    program = tmp_path / "lookup"
-    subprocess.run([cc, "-Wall", "-Werror", str(ROOT / "examples" / "lookup.c"), "-lsqlite3", "-lz", "-o",
-                    str(program)], check=True, capture_output=True, timeout=120)
     table = load(ROOT / "patterns" / "bisection-tetrahedron-1x1x1.yaml")
     codes = sorted(table.configurations)[:20]
     texts = {code: json.dumps(table.configurations[code]) for code in codes}
     dictionary = dictionary_of(list(texts.values()))
-    store = tmp_path / "t.sqlite"
+    store = folder / "t.sqlite"
     write_store(store, table.header, dictionary, [(code, pack(texts[code], dictionary)) for code in codes])
+    return store, codes, texts, dictionary
+
+
+@pytest.mark.parametrize("language", ["c", "c++"])
+def test_c_reader_of_the_store_gives_the_entries_python_gives(tmp_path, lookup_programs, language):
+    from cospherical.formats.patterns import load
+
+    store, codes, texts, _ = _store(tmp_path)
     for code in codes[::5]:
-        result = subprocess.run([str(program), str(store), code], capture_output=True, text=True, timeout=30)
+        result = subprocess.run([str(lookup_programs[language]), str(store), code], capture_output=True, text=True,
+                                timeout=30)
         assert result.returncode == 0, result.stderr
         assert json.loads(result.stdout) == json.loads(texts[code])
         assert json.loads(result.stdout) == load(store).configurations[code]
-    missing = subprocess.run([str(program), str(store), "fffffffff"], capture_output=True, text=True, timeout=30)
+    missing = subprocess.run([str(lookup_programs[language]), str(store), "fffffffff"], capture_output=True,
+                             text=True, timeout=30)
     assert missing.returncode == 2 and len(missing.stderr.strip().splitlines()) == 1
+
+
+def _sql(*statements):
+    def edit(store: Path, codes, dictionary) -> None:
+        connection = sqlite3.connect(store)
+        for statement in statements:
+            connection.execute(statement)
+        connection.commit()
+        connection.close()
+    return edit
+
+
+def _entry(text: bytes | str):
+    """The first entry replaced by ``text`` packed as the library packs it (bytes: not UTF-8)."""
+    import zlib
+
+    def edit(store: Path, codes, dictionary) -> None:
+        packer = zlib.compressobj(6, zdict=dictionary)
+        data = text if isinstance(text, bytes) else text.encode()
+        connection = sqlite3.connect(store)
+        connection.execute("UPDATE entries SET entry = ? WHERE code = ?", (packer.compress(data) + packer.flush(),
+                                                                            codes[0]))
+        connection.commit()
+        connection.close()
+    return edit
+
+
+def _truncated(store: Path, codes, dictionary) -> None:
+    store.write_bytes(store.read_bytes()[:-4096])
+
+
+def _wal(store: Path, codes, dictionary) -> None:
+    connection = sqlite3.connect(store)
+    connection.execute("PRAGMA journal_mode = WAL")
+    connection.close()
+
+
+MIB = 1 << 20
+# Stores the C reader must refuse as `cospherical check` does: at once, one line, nothing printed.
+HOSTILE_STORES = {
+    "entries a view that never ends": (_sql(
+        "DROP TABLE entries", "CREATE VIEW entries AS WITH RECURSIVE n(k) AS (SELECT 1 UNION ALL SELECT k + 1 FROM n) "
+        "SELECT printf('%012x', k) AS code, zeroblob(10) AS entry FROM n"), "schema"),
+    "dictionary a view of a 900 MB zeroblob": (_sql(
+        "DROP TABLE dictionary", "CREATE VIEW dictionary AS SELECT zeroblob(900000000) AS data"), "schema"),
+    "a trigger": (_sql("CREATE TRIGGER t AFTER UPDATE ON meta BEGIN SELECT 1; END"), "schema"),
+    "another table": (_sql("CREATE TABLE notes (text TEXT)"), "schema"),
+    "an index": (_sql("CREATE INDEX by_data ON dictionary (data)"), "schema"),
+    "entries declared otherwise": (_sql(
+        "CREATE TABLE e2 (code TEXT PRIMARY KEY, entry BLOB)", "INSERT INTO e2 SELECT * FROM entries",
+        "DROP TABLE entries", "ALTER TABLE e2 RENAME TO entries"), "schema"),
+    "an entry of 2 MiB stored": (_sql(f"UPDATE entries SET entry = zeroblob({2 * MIB}) "
+                                     "WHERE code = (SELECT min(code) FROM entries)"), "stored in over"),
+    "a code of 3 MiB": (_sql(f"INSERT INTO entries VALUES (hex(zeroblob({3 * MIB // 2})), x'00')"), "stored in over"),
+    "an entry as text": (_sql("UPDATE entries SET entry = 'abc' WHERE code = (SELECT min(code) FROM entries)"), "not a blob"),
+    "an entry unpacking to 2 MiB": (_entry(b" " * (2 * MIB)), "unpacks to over"),
+    "an entry with ESC and a newline": (_entry('{"a": "\x1b[2J\nfake"}'), "one line of UTF-8"),
+    "an entry not UTF-8": (_entry(b'{"a": "\xff\xfe"}'), "one line of UTF-8"),
+    "an entry with a C1 control (CSI)": (_entry('{"a": "\u009b2J"}'), "one line of UTF-8"),
+    "a dictionary of 100 kB": (_sql("UPDATE dictionary SET data = zeroblob(100000)"), "dictionary"),
+    "two dictionaries": (_sql("INSERT INTO dictionary VALUES (x'00')"), "dictionary"),
+    "a count that is not the entries'": (_sql("UPDATE meta SET value = '21' WHERE key = 'count'"), "count says"),
+    "layout 2": (_sql("UPDATE meta SET value = '2' WHERE key = 'layout'"), "layout 1"),
+    "no header": (_sql("DELETE FROM meta WHERE key = 'header'"), "with a header"),
+    "truncated": (_truncated, "not a complete"),
+    "in WAL mode": (_wal, "not a complete"),
+    "a FIFO in its place": (lambda store, codes, dictionary: store.unlink() or os.mkfifo(store), "not a complete"),
+}
+
+
+@pytest.mark.parametrize("case", list(HOSTILE_STORES))
+def test_c_reader_refuses_what_check_refuses_at_once_in_one_line(tmp_path, lookup_programs, case, capsys):
+    import resource
+    import time
+
+    from cospherical.cli import main
+
+    store, codes, _, dictionary = _store(tmp_path)
+    edit, needle = HOSTILE_STORES[case]
+    edit(store, codes, dictionary)
+    assert main(["check", str(store)]) == 2, case  # the rule the C reader follows
+    capsys.readouterr()
+
+    def limited():  # a reader that read the 900 MB blob would fail here, not fill the machine's memory
+        resource.setrlimit(resource.RLIMIT_AS, (256 * MIB, 256 * MIB))
+
+    for language, program in lookup_programs.items():
+        start = time.monotonic()
+        result = subprocess.run([str(program), str(store), codes[0]], capture_output=True, text=True, timeout=20,
+                                preexec_fn=limited, errors="replace")
+        assert time.monotonic() - start < 5, (language, case)
+        lines = result.stderr.strip().splitlines()
+        assert result.returncode == 2 and len(lines) == 1 and result.stdout == "", (language, case, result)
+        assert lines[0].startswith("lookup: ") and needle in lines[0], (language, case, lines)
 
 
 CONSOLE = re.compile(r":CONSOLE[^\]]*\] (.*)")
