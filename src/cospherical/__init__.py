@@ -53,6 +53,7 @@ _API = {
     "load_patterns": ("cospherical.formats.patterns", "load"),
     "build_mesh": "cospherical.api.mesh",
     "OctreeMesh": "cospherical.api.mesh",
+    "from_treemesh": "cospherical.api.mesh",
     "MeshReport": "cospherical.mesh.report",
 }
 

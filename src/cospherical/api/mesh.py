@@ -39,7 +39,7 @@ from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode
                              tree_from_octree, tree_from_refine)
 from ..mesh.report import MeshReport
 
-__all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "mesh_writes", "output_names",
+__all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "from_treemesh", "mesh_writes", "output_names",
            "pattern_lookup", "piece_name", "tree_source"]
 
 
@@ -193,9 +193,10 @@ class OctreeMesh:
     :class:`~cospherical.mesh.assembly.Mesh` (leaf by leaf, for the lower-level functions).
     """
 
-    def __init__(self, result: PipelineResult) -> None:
+    def __init__(self, result: PipelineResult, origin: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
         self._result = result
         self._dual = result.dual
+        self.origin = tuple(float(x) for x in origin)
 
     def __repr__(self) -> str:
         r = self.report
@@ -220,9 +221,10 @@ class OctreeMesh:
 
     @cached_property
     def vertices(self) -> np.ndarray:
-        """(n, 3) float64: the vertices' coordinates (the same numbers as ``mesh.vtu``'s points)."""
+        """(n, 3) float64: the vertices' coordinates, ``origin`` added (``mesh.vtu``'s points start at 0)."""
         mesh = self.assembled
-        return mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+        points = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+        return points + np.array(self.origin) if any(self.origin) else points
 
     @property
     def exact_vertices(self) -> ExactVertices:
@@ -271,18 +273,12 @@ class OctreeMesh:
         from ..outputs.mesh_picture import cut_png
 
         mesh, report, source = self.assembled, self.report, self._result.source
-        point_data, cell_data = {}, {}
-        if report.dual is not None:
+        with_dual = report.dual is not None
+        if with_dual:
             from ..formats.dual import write_dual
 
-            dual = self.dual
-            write_dual(dual, path("dual.npz"))
-            point_data = {"control_volume": dual.control_volume, "boundary_area": dual.boundary_area}
-            cell_data = {"circumcenter": dual.element_circumcenter}
-            if self.violating is not None:
-                ok = np.ones(len(mesh), dtype=np.int8)
-                ok[self.violating] = 0
-                cell_data["delaunay_ok"] = ok
+            write_dual(self.dual, path("dual.npz"))
+        point_data, cell_data = self._vtu_data(with_dual)
         write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=source.leaf_order)
         at = default_cut(source.shapes, self.box) if cut is None else cut
         shapes = ", ".join(source.described.get("refine", [])) or source.described.get("file", "")
@@ -290,6 +286,47 @@ class OctreeMesh:
                 title=f"{' x '.join(self.box.texts)}: {shapes}; {report.leaves:,} leaves, {report.elements:,} "
                       f"elements, {report.types} types (cut at z = {at * float(self.box.c):.4g})")
         write_report(report.to_dict(), path("report.json"))
+
+    def _vtu_data(self, with_dual: bool) -> tuple[dict, dict]:
+        """The point and cell data ``mesh.vtu`` adds with the dual: control volumes, boundary areas, circumcenters, delaunay_ok."""
+        if not with_dual:
+            return {}, {}
+        dual = self.dual
+        point_data = {"control_volume": dual.control_volume, "boundary_area": dual.boundary_area}
+        cell_data = {"circumcenter": dual.element_circumcenter}
+        if self.violating is not None:
+            ok = np.ones(len(self.assembled), dtype=np.int8)
+            ok[self.violating] = 0
+            cell_data["delaunay_ok"] = ok
+        return point_data, cell_data
+
+    def to_pyvista(self):
+        """The mesh as a ``pyvista.UnstructuredGrid``: ``mesh.vtu``'s grid in memory, polyhedra and data included.
+
+        Standard VTK cells where an element is one, ``VTK_POLYHEDRON`` for the others,
+        sorted by cell type: cell data ``element`` says which element each cell is,
+        ``type`` (into field data ``type_ids``, ``type_names``), ``leaf`` and ``fvm``;
+        point data ``grid_coordinates``; once the dual is computed (``dual=True``, or
+        ``m.dual`` asked for) also ``control_volume``, ``boundary_area``,
+        ``circumcenter`` and ``delaunay_ok``.  Points are :attr:`vertices` (``origin``
+        added).  Needs pyvista: ``pip install 'cospherical[pyvista]'``.
+        """
+        from ..adapters.pyvista import to_pyvista
+
+        point_data, cell_data = self._vtu_data(self._dual is not None)
+        return to_pyvista(self.assembled, point_data, cell_data, self._result.source.leaf_order, self.origin)
+
+    def to_meshio(self):
+        """The mesh split into tetrahedra as a ``meshio.Mesh`` (meshio holds standard cells, not mixed polyhedra).
+
+        Conforming, no new vertex, the exact dual kept (the added edges couple 0):
+        :func:`cospherical.mesh.tetrahedra.split_tetrahedra`.  Cell data ``element``
+        (the parent element), ``type`` (into :attr:`elements`' ``type_ids``), ``leaf``,
+        ``region``.  Write it with ``meshio.write(path, m.to_meshio())``.
+        """
+        from ..adapters.meshio import to_meshio
+
+        return to_meshio(self.assembled, self.vertices, self._result.source.leaf_order)
 
 
 def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = None,
@@ -368,3 +405,32 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
     return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,
                                    check_delaunay=check_delaunay, uniform=uniform, dual=dual, progress=progress,
                                    timings=timings))
+
+
+def from_treemesh(tree_mesh: Any, **options: Any) -> OctreeMesh:
+    """Mesh a ``discretize.TreeMesh`` (3-D, built with ``diagonal_balance=True``): its cells are the leaves.
+
+    The domain is the TreeMesh's (its sides as decimals, its ``origin`` kept in
+    :attr:`OctreeMesh.vertices`); the vertices are every leaf corner, hanging nodes
+    included: discretize's ``total_nodes``.  ``options`` are :func:`build_mesh`'s
+    (``patterns``, ``dual``, ``criterion``, ...); the mesh numbers the leaves as
+    discretize numbers its cells (cell data ``leaf``, :attr:`Elements.leaf`).
+
+    Examples
+    --------
+    >>> import discretize
+    >>> tree_mesh = discretize.TreeMesh([[(1 / 4, 4)]] * 3, diagonal_balance=True)
+    >>> tree_mesh.refine_points([[0.3, 0.6, 0.7]], level=2)
+    >>> m = from_treemesh(tree_mesh, uniform=False)
+    >>> len(m.vertices) == tree_mesh.n_total_nodes, m.report.volume_ok
+    (True, True)
+    """
+    from ..adapters.discretize import treemesh_leaves
+
+    for taken in ("domain", "levels", "refine", "leaves", "tree"):
+        if taken in options:
+            raise InputError(f"from_treemesh: {taken}= is the TreeMesh's own")
+    leaves = treemesh_leaves(tree_mesh)
+    rows = np.column_stack([leaves.levels, leaves.positions])
+    mesh = build_mesh(domain=leaves.lengths, leaves=rows, **options)
+    return OctreeMesh(mesh._result, leaves.origin)

@@ -21,6 +21,7 @@ import itertools
 import json
 import os
 import re
+from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -32,7 +33,7 @@ from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
 
-__all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "vtu_arrays",
+__all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "VtuGrid", "vtu_arrays", "vtu_grid",
            "write_piece", "write_pvtu", "write_report", "write_vtu"]
 
 REPORT_SCHEMA_VERSION = 1
@@ -258,7 +259,34 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
 
     Standard VTK cells (tetra, pyramid, wedge, hexahedron, nodes in VTK order) for
     the elements that are one, ``VTK_POLYHEDRON`` with faces for the others, sorted
-    by cell type; the cell data say which element each cell is.
+    by cell type; the cell data say which element each cell is.  The grid's arrays
+    and data are :func:`vtu_grid`'s (see it for each array).
+    """
+    from .vtu import write_grid
+
+    grid = vtu_grid(mesh, point_data, cell_data, leaves)
+    write_grid(path, grid.points, grid.types, grid.connectivity, grid.offsets, grid.faces, grid.faceoffsets,
+               point_data=grid.point_data, cell_data=grid.cell_data, field_data=grid.field_data)
+
+
+@dataclass(frozen=True)
+class VtuGrid:
+    """A mesh as a VTK unstructured grid's arrays (VTK's layout, see :func:`cospherical.formats.vtu.write_grid`) and data."""
+
+    points: np.ndarray
+    types: np.ndarray
+    connectivity: np.ndarray
+    offsets: np.ndarray
+    faces: np.ndarray | None
+    faceoffsets: np.ndarray | None
+    point_data: dict
+    cell_data: dict
+    field_data: dict
+
+
+def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None = None,
+             leaves: np.ndarray | None = None) -> VtuGrid:
+    """The grid :func:`write_vtu` writes (and the pyvista adapter builds in memory), cells sorted by VTK cell type.
 
     Point data: ``grid_coordinates`` (the exact integer grid point of each vertex),
     then ``point_data`` (one row per vertex, in ``mesh.vertices`` order).
@@ -276,7 +304,7 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
     exact coordinate along an axis is ``grid_coordinates * length / grid_intervals``;
     the ``Points`` are the same as floats.
     """
-    from .vtu import narrow, text_array, write_grid
+    from .vtu import narrow, text_array
 
     arrays = vtu_arrays(mesh)
     order = arrays["order"]
@@ -302,8 +330,8 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
             raise ValueError(f"point data {name!r}: the writer's own")
         points[name] = values
     coordinates = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
-    write_grid(path, coordinates, arrays["types"], arrays["connectivity"], arrays["offsets"], arrays["faces"],
-               arrays["faceoffsets"], point_data=points, cell_data=cells, field_data=fields)
+    return VtuGrid(coordinates, arrays["types"], arrays["connectivity"], arrays["offsets"], arrays["faces"],
+                   arrays["faceoffsets"], points, cells, fields)
 
 
 def report_json(report: dict) -> str:
