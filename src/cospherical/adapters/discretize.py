@@ -36,6 +36,9 @@ def treemesh_leaves(tree_mesh) -> TreeMeshLeaves:
     The sides are the sums of the base cell widths, written as the shortest decimal
     that reads back as the same float (``repr``), which the mesher takes exactly.
     """
+    if not getattr(tree_mesh, "finalized", True):
+        raise InputError("from_treemesh: the TreeMesh is not finalized: call its finalize() (refine_points and the "
+                         "other refine methods do by default)")
     try:
         widths = [np.asarray(h, dtype=np.float64) for h in tree_mesh.h]
         shape = tuple(int(n) for n in tree_mesh.shape_cells)
