@@ -13,7 +13,7 @@ Examples
 
 from __future__ import annotations
 
-__all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "shown"]
+__all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "one_line", "shown"]
 
 
 class CosphericalError(Exception):
@@ -39,5 +39,23 @@ def shown(value, most: int = 40) -> str:
     >>> shown("8" * 12), shown("x" * 100)
     ("'888888888888'", "'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...")
     """
-    text = repr(value)
+    try:
+        text = repr(value)
+    except ValueError:  # an int past Python's 4,300-digit limit of int-to-text conversion
+        return f"an integer of {value.bit_length():,} bits"
     return text if len(text) <= most else text[:most] + "..."
+
+
+def one_line(text: str) -> str:
+    r"""A message as one line that a terminal shows as written: every character that is not
+    printable (a line break of any kind, ESC and the other controls, an invisible format
+    character such as a bidirectional override) written as its Python escape.
+
+    A message names paths and values that came from outside (a file name may hold a newline
+    or an ESC sequence): printed raw, one would split the error line in two, the other
+    would drive the terminal.
+
+    >>> one_line("out\nfake: ok\x1b[2J\u2028\u202e")
+    'out\\nfake: ok\\x1b[2J\\u2028\\u202e'
+    """
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))

@@ -148,3 +148,62 @@ def test_every_option_has_help():
     missing = [f"{name} {action.dest}" for name, sub in subparsers.choices.items() for action in sub._actions
                if not action.help and action.dest != "help"]
     assert missing == []
+
+
+# A file name may hold any byte but / and NUL: line breaks of every kind, ESC sequences, a bell, a
+# bidirectional override. An error line names it escaped: one line, nothing that drives the terminal.
+HOSTILE_NAME = "out\nfake: ok\r\x1b[2J\x85\u2028\u2029\u202e\x07\x0b"
+
+
+def _error_paths(tmp):
+    blocked = tmp / "a-file"  # a file where a folder must be made: the write fails, naming the path
+    blocked.write_text("")
+    missing, under = tmp / HOSTILE_NAME, blocked / HOSTILE_NAME
+    return {
+        "check": ["check", missing], "diff": ["diff", missing, missing],
+        "render": ["render", "--summary", missing, "--out", tmp / "o"],
+        "mesh --leaves": ["mesh", "--domain", "1", "1", "1", "--leaves", missing],
+        "mesh --out": ["mesh", "--domain", "1", "1", "1", "--levels", "1", "--refine", "point:0.5,0.5,0.5",
+                       "--out", under],
+        "tessellate --vtu": ["tessellate", "--box", "1", "1", "1", "--vtu", under / "m.vtu"],
+        "study --out": ["study", "bisection", "--out", under],
+        "sweep --out": ["sweep", "--ray", "1,2,2", "--out", under],
+        "reproduce --root": ["reproduce", "--root", under],
+        "an unknown option": ["check", "x.yaml", "--x\x1b[2J\n\u2028\x85"],
+        "mesh --refine": ["mesh", "--domain", "1", "1", "1", "--levels", "2", "--refine", HOSTILE_NAME],
+        "mesh --refine, long": ["mesh", "--domain", "1", "1", "1", "--levels", "2", "--refine",
+                                "sphere:0.5,0.5,0.5," + "9" * 5000 + HOSTILE_NAME],
+        "mesh --refine, long kind": ["mesh", "--domain", "1", "1", "1", "--levels", "2", "--refine",
+                                     "x" * 5000 + HOSTILE_NAME + ":1"],
+    }
+
+
+@pytest.mark.parametrize("case", [
+    "check", "diff", "render", "mesh --leaves", "mesh --out", "tessellate --vtu", "study --out", "sweep --out",
+    "reproduce --root", "an unknown option", "mesh --refine", "mesh --refine, long", "mesh --refine, long kind"])
+def test_an_error_line_names_a_hostile_path_or_value_on_one_printable_line(tmp_path, capsys, case):
+    from cospherical.cli import main
+
+    argv = [str(word) for word in _error_paths(tmp_path)[case]]
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()  # every kind of line break: NEL, LS and PS too
+    assert len(lines) == 1 and captured.err.endswith("\n"), captured.err
+    assert lines[0].isprintable() and len(lines[0]) < 300, lines[0]
+    assert "\\x1b[2J" in lines[0] or "..." in lines[0], lines[0]  # named, escaped (or cut before it)
+
+
+def test_an_os_error_names_its_file_on_one_printable_line(capsys, monkeypatch):
+    import errno
+
+    import cospherical.cli.check
+    from cospherical.cli import main
+
+    def refused(args):
+        raise OSError(errno.EACCES, "Permission denied", HOSTILE_NAME)
+
+    monkeypatch.setattr(cospherical.cli.check, "run", refused)
+    assert main(["check", "x.yaml"]) == 2
+    line = capsys.readouterr().err
+    assert line.splitlines() == [line[:-1]] and line[:-1].isprintable(), line
+    assert line.startswith("cospherical: error: out\\nfake: ok\\r\\x1b[2J") and "Permission denied" in line

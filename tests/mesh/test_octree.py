@@ -7,11 +7,13 @@ import math
 from fractions import Fraction
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from strategies import BOXES, shapes
 
 from cospherical.core.configuration import Box
+from cospherical.errors import InputError
 from cospherical.mesh import octree
 from cospherical.mesh.octree import build_octree, parse_shape
 
@@ -70,3 +72,12 @@ def test_cell_tests_match_a_brute_force_and_the_size_bound_holds(text, texts, le
         int(octree._meets(shape, box, m, np.array([(i, j, k) for i in range(1 << m) for j in range(1 << m)
                                                    for k in range(1 << m)], dtype=np.int64)).sum())
         for m in range(level))
+
+
+def test_a_shape_text_of_any_length_is_named_cut_short():
+    # from the API as from --refine: a 220 kB shape text was echoed whole in the error
+    for text in ("sphere:" + "1" * 220_000 + ",0,0,1", "x" * 220_000 + ":1", "box:1,1,1,0,0,0" + " " * 220_000,
+                 "plane:0,0,0," + "\n" * 1000 + "1", "sphere:0.5,0.5,0.5,-" + "1" * 90):
+        with pytest.raises(InputError) as raised:
+            parse_shape(text)
+        assert len(str(raised.value)) < 300 and str(raised.value).startswith("refine shape '"), str(raised.value)[:400]

@@ -16,7 +16,7 @@ import signal
 import sys
 import threading
 
-from ..errors import CosphericalError, UsageError
+from ..errors import CosphericalError, UsageError, one_line
 from ..version import __version__
 
 __all__ = ["build_parser", "main"]
@@ -149,10 +149,10 @@ def main(argv: list[str] | None = None) -> int:
             gc.freeze()
         return status
     except UsageError as error:  # the message already names the command
-        print(error, file=sys.stderr)
+        _say(str(error))
         return 2
     except CosphericalError as error:
-        print(f"cospherical: error: {error}", file=sys.stderr)
+        _say(f"cospherical: error: {error}")
         return 2
     except KeyboardInterrupt:
         _stop_workers()
@@ -165,7 +165,7 @@ def main(argv: list[str] | None = None) -> int:
         return 141
     except OSError as error:  # the system refused: a full disk, a missing device, too many files, ...
         where = f"{error.filename}: " if error.filename else ""
-        print(f"cospherical: error: {where}{error.strerror or error}", file=sys.stderr)
+        _say(f"cospherical: error: {where}{error.strerror or error}")
         _silence_stdout()
         return 2
     except MemoryError:  # the tree or table outgrew what this process may allocate (RLIMIT_AS, the machine)
@@ -193,6 +193,12 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         while _redelivery:  # the run has ended as signalled: a held-back signal is not sent again
             _redelivery.pop().cancel()
+
+
+def _say(message: str) -> None:
+    """The one way an error reaches stderr: one line, whatever paths or values it names
+    (their line breaks and control characters escaped, see :func:`cospherical.errors.one_line`)."""
+    print(one_line(message), file=sys.stderr)
 
 
 def _stop_workers() -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 from ..catalogue import build_catalogue, shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
-from ..errors import FormatError, InputError, UsageError
+from ..errors import FormatError, InputError, UsageError, one_line
 from ..files.yamlio import load_yaml, validate
 from ..outputs.latex import render_tables
 from ..studies.engine import bisection_codes, run_study
@@ -105,6 +105,6 @@ def run(args) -> int:
     elif (args.out / "document.pdf").exists():
         # an earlier render's PDF went with the manifest's leave; one still here is not ours to remove, and
         # it does not show these tables
-        print(f"note: {args.out / 'document.pdf'} was kept: not written by an earlier render or changed since; "
-              "it does not show these tables (--pdf makes one that does)", file=sys.stderr)
+        print(one_line(f"note: {args.out / 'document.pdf'} was kept: not written by an earlier render or changed "
+                       "since; it does not show these tables (--pdf makes one that does)"), file=sys.stderr)
     return 0

@@ -9,7 +9,7 @@ import sys
 from ..catalogue import shipped_catalogue
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
-from ..errors import UsageError
+from ..errors import UsageError, one_line
 from ..files.yamlio import atomic_write
 from ..outputs.report import text_report
 from ..paper import paper_comparison, paper_study_key
@@ -183,7 +183,7 @@ def _intersection(args) -> int:
                                    checkpoints=checkpoints if args.resume else None, progress=advance,
                                    chunk=max(1, args.chunk_size), scheduler=args.scheduler,
                                    dask_workers=args.dask_workers, brute_force=args.no_orbits,
-                                   notice=lambda line: print(f"cospherical study: note: {line}", file=sys.stderr))
+                                   notice=lambda line: print(one_line(f"cospherical study: note: {line}"), file=sys.stderr))
     if args.out:
         stem = f"intersection-r{args.resolution}-{args.order}"
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))

@@ -13,7 +13,7 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 
-from ..errors import InputError
+from ..errors import InputError, shown
 
 __all__ = ["Length", "MAX_DIGITS", "NUMBER", "bounded", "parse_rational", "rational_text"]
 
@@ -46,21 +46,21 @@ def parse_rational(text: str | int | Fraction, what: str = "number") -> Fraction
     if isinstance(text, (int, Fraction)) and not isinstance(text, bool):
         return bounded(Fraction(text), what, text)
     if isinstance(text, float):
-        raise InputError(f"{what} {text!r}: give an exact value (a string such as '0.5' or '1/3'), not a float")
+        raise InputError(f"{what} {shown(text)}: give an exact value (a string such as '0.5' or '1/3'), not a float")
     if not isinstance(text, str):
-        raise InputError(f"{what} {text!r}: not a number")
+        raise InputError(f"{what} {shown(text)}: not a number")
     cleaned = text.strip(" \t")
     if len(cleaned) > _MAX_TEXT:
-        raise InputError(f"{what} {text[:20]!r}...: too long ({len(cleaned)} characters; at most {_MAX_TEXT})")
+        raise InputError(f"{what} {shown(text)}: too long ({len(cleaned)} characters; at most {_MAX_TEXT})")
     if not NUMBER.fullmatch(cleaned):
-        raise InputError(f"{what} {text!r}: not an integer, decimal or fraction (ASCII digits)")
+        raise InputError(f"{what} {shown(text)}: not an integer, decimal or fraction (ASCII digits)")
     mantissa, _, exponent = cleaned.lower().partition("e")
     if exponent and abs(int(exponent)) > MAX_DIGITS + _MAX_TEXT:  # before computing 10**exponent
-        raise InputError(f"{what} {text!r}: too large or too small (at most {MAX_DIGITS} digits)")
+        raise InputError(f"{what} {shown(text)}: too large or too small (at most {MAX_DIGITS} digits)")
     try:
         value = Fraction(cleaned)
     except ZeroDivisionError:
-        raise InputError(f"{what} {text!r}: division by zero") from None
+        raise InputError(f"{what} {shown(text)}: division by zero") from None
     return bounded(value, what, text)
 
 
@@ -68,8 +68,7 @@ def bounded(value: Fraction, what: str, text) -> Fraction:
     """``value``, when its numerator and denominator have at most :data:`MAX_DIGITS` digits each."""
     limit = 10**MAX_DIGITS
     if abs(value.numerator) >= limit or value.denominator >= limit:
-        shown = text if len(str(text)) <= 30 else f"{str(text)[:20]}..."
-        raise InputError(f"{what} {shown!r}: too large or too precise (at most {MAX_DIGITS} digits in the "
+        raise InputError(f"{what} {shown(text)}: too large or too precise (at most {MAX_DIGITS} digits in the "
                          "numerator and in the denominator)")
     return value
 

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..core.configuration import Box
 from ..core.exact import parse_rational
-from ..errors import InputError
+from ..errors import InputError, shown
 from ..files.yamlio import machine_memory
 
 __all__ = ["BALANCES", "BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count", "distinct",
@@ -81,19 +81,19 @@ def parse_shape(text: str) -> Shape:
     forms = ", ".join(f"{k}:{form}" for k, (form, _) in _SHAPE_FORMS.items())
     forms = forms.replace(", box", " or box")
     if not sep or kind not in _SHAPE_FORMS:
-        what = f"unknown kind {kind!r}" if sep else "no kind"
-        raise InputError(f"refine shape {text!r}: {what}; write {forms}")
+        what = f"unknown kind {shown(kind)}" if sep else "no kind"
+        raise InputError(f"refine shape {shown(text)}: {what}; write {forms}")
     form, count = _SHAPE_FORMS[kind]
     parts = [p for p in rest.split(",")]
     if len(parts) != count:
-        raise InputError(f"refine shape {text!r}: {kind} needs {count} numbers {form}, got {len(parts)}")
-    values = tuple(parse_rational(p.strip(), f"refine shape {text!r}: number") for p in parts)
+        raise InputError(f"refine shape {shown(text)}: {kind} needs {count} numbers {form}, got {len(parts)}")
+    values = tuple(parse_rational(p.strip(), f"refine shape {shown(text)}: number") for p in parts)
     if kind == "sphere" and values[3] <= 0:
-        raise InputError(f"refine shape {text!r}: the radius must be positive")
+        raise InputError(f"refine shape {shown(text)}: the radius must be positive")
     if kind == "plane" and not any(values[:3]):
-        raise InputError(f"refine shape {text!r}: the normal (NX,NY,NZ) must not be zero")
+        raise InputError(f"refine shape {shown(text)}: the normal (NX,NY,NZ) must not be zero")
     if kind == "box" and any(values[a] > values[a + 3] for a in range(3)):
-        raise InputError(f"refine shape {text!r}: needs X0 <= X1, Y0 <= Y1, Z0 <= Z1")
+        raise InputError(f"refine shape {shown(text)}: needs X0 <= X1, Y0 <= Y1, Z0 <= Z1")
     return Shape(kind, values, str(text))
 
 
@@ -104,7 +104,7 @@ def _rational_lengths(box: Box, shape: Shape) -> tuple[Fraction, Fraction, Fract
         if root * root != length.squared:
             # A sphere or plane over a sqrt length compares sums of unlike square roots:
             # refuse rather than decide with floats.
-            raise InputError(f"refine shape {shape.text!r}: {shape.kind} needs rational domain lengths, "
+            raise InputError(f"refine shape {shown(shape.text)}: {shape.kind} needs rational domain lengths, "
                              f"got {length.text}; use point or box shapes, or --leaves")
         lengths.append(root)
     return tuple(lengths)
@@ -379,9 +379,9 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
         raise InputError("--balance face: balance across faces alone is not 1-irregular "
                          "(an edge can get two Steiner points); use edge or vertex")
     if balance not in BALANCES:
-        raise InputError(f"--balance {balance!r}: choose vertex or edge")
+        raise InputError(f"--balance {shown(balance)}: choose vertex or edge")
     if isinstance(levels, bool) or not isinstance(levels, int) or not 0 <= levels <= MAX_LEVEL:
-        raise InputError(f"--levels {levels!r}: must be an integer from 0 to {MAX_LEVEL}")
+        raise InputError(f"--levels {shown(levels)}: must be an integer from 0 to {MAX_LEVEL}")
     check_leaf_count(estimate_leaves(box, levels, shapes), f"--levels {levels}: an estimated", max_leaves)
     split: list[np.ndarray] = []
     existing = np.zeros(1, dtype=np.int64)
