@@ -52,6 +52,14 @@ def on_files(files, config):
     return files
 
 
+def on_page_content(html, page, config, files):
+    # docstrings rendered by mkdocstrings keep their reST roles (":func:`name`" becomes
+    # ":func:<code>name</code>", or left as typed where Markdown made no code span of it): the
+    # site shows the name alone, as code
+    html = re.sub(r":(?:func|class|mod|meth|data|attr|exc|obj):<code>~?", "<code>", html)
+    return re.sub(r":(?:func|class|mod|meth|data|attr|exc|obj):`~?([^`<>]+)`", r"<code>\1</code>", html)
+
+
 def on_page_markdown(markdown, page, config, files):
     depth = page.file.src_uri.count("/")
     up = "../" * depth  # from the page's folder to the site's root, as MkDocs resolves links
@@ -118,7 +126,8 @@ def _command_section(parser: argparse.ArgumentParser, level: int) -> list[str]:
     lines += ["```text", parser.format_usage().strip(), "```", ""]
     table = _options_table(parser)
     if len(table) > 2:  # a command whose only option is --help has no table
-        lines += table + [""]
+        # the class keeps each option name on one line (extra.css): "--face-points", not "--face-" / "points"
+        lines += ['<div class="cli-options" markdown>', "", *table, "", "</div>", ""]
     for child in _subparsers(parser).values():
         lines += _command_section(child, level + 1)
     return lines
@@ -133,6 +142,45 @@ def cli_reference(up: str) -> str:
     for child in _subparsers(parser).values():
         lines += _command_section(child, 2)
     return "\n".join(lines)
+
+
+# --- the Debian packages of the set-up, from scripts/setup.sh --------------------------------------
+
+def setup_packages() -> list[str]:
+    """Every Debian package ``scripts/setup.sh`` installs on a fresh machine, in its order.
+
+    Its package section is run by bash with every "is it there already?" test failing
+    (``command -v``, ``[ -e ... ]``, ``ldconfig``, ``python3``), so the list is what a
+    machine with none of them gets: whatever way the script finds a package missing.
+    """
+    import subprocess
+
+    script = (ROOT / "scripts" / "setup.sh").read_text()
+    section = script[script.index("packages=()"):script.index("if [ ${#packages[@]}")]
+    absent = ("command() { return 1; }; ldconfig() { :; }; python3() { return 1; }; "
+              "function [ { return 1; }; ")
+    result = subprocess.run(["bash", "-c", absent + section + 'printf "%s\\n" "${packages[@]}"'],
+                            capture_output=True, text=True, check=True, timeout=30)
+    return result.stdout.split()
+
+
+def debian_packages(up: str) -> str:
+    """The set-up's Debian packages as a table, one row per line of setup.sh, with the reason it gives."""
+    script = (ROOT / "scripts" / "setup.sh").read_text()
+    rows, described, above = ["| Debian packages | why |", "|---|---|"], [], ""
+    for line in script[script.index("packages=()"):script.index("if [ ${#packages[@]}")].splitlines():
+        literal = re.search(r"packages\+=\(([^)$]*)\)", line)
+        if line.startswith("#"):
+            above = line.lstrip("# ").strip()
+        elif literal:
+            names = literal.group(1).split()
+            described += names
+            rows.append(f"| {', '.join(f'`{n}`' for n in names)} | {_cell(line.partition('#')[2].strip())} |")
+    # what a loop adds (the libraries of the gmsh wheel), under the comment above it
+    rest = [name for name in setup_packages() if name not in described]
+    if rest:
+        rows.append(f"| {', '.join(f'`{n}`' for n in rest)} | {_cell(above)} |")
+    return "\n".join(rows)
 
 
 # --- results tables, from results/*.json ---------------------------------------------------------
@@ -386,8 +434,13 @@ def _fields(node: dict, schema: dict, path: str, depth: int = 0):
     if isinstance(extra, dict) and depth < 3:
         extra = _resolve(extra, schema)
         where = f"{path}.<key>" if path else "<key>"
-        yield where, _kind(extra, schema), False, extra.get("description", "any key" if not node.get(
-            "propertyNames") else f"keys match `{node['propertyNames'].get('pattern', '')}`")
+        keys = _resolve(node.get("propertyNames", {}), schema)
+        named = "any key"
+        if "pattern" in keys:
+            named = f"keys match `{keys['pattern']}`"
+        elif "enum" in keys:
+            named = "keys: " + ", ".join(f"`{json.dumps(value)}`" for value in keys["enum"])
+        yield where, _kind(extra, schema), False, extra.get("description", named)
         if extra.get("type") == "object":
             yield from _fields(extra, schema, where, depth + 1)
 
@@ -472,6 +525,78 @@ def _recorded_run(path: Path) -> list[str]:
     return lines + ['??? note "Everything it printed"', "", *_code_block(output, "    "), ""]
 
 
+# --- docstrings (reStructuredText) as Markdown ----------------------------------------------------
+
+_ROLE = re.compile(r":(?:func|class|mod|meth|data|attr|exc|obj):`~?([^`]+)`")
+_LITERAL = re.compile(r"``(.+?)``")
+_ITEM = re.compile(r"(?:\([a-z0-9]+\)|-) ")  # (a) or (1) enumerations, and bullets
+_TABLE_RULE = re.compile(r"=+(?: +=+)+")
+
+
+def _inline(text: str) -> str:
+    """reST inline markup as Markdown: ``literal`` and :func:`name` become code spans."""
+    text = _ROLE.sub(lambda m: f"``{m.group(1)}``", " ".join(text.split()))
+    return _LITERAL.sub(lambda m: f"`{m.group(1)}`", text)
+
+
+def _simple_table(lines: list[str]) -> list[str]:
+    """A reST simple table (columns under ``===`` rules) as an HTML table with no header row.
+
+    A line whose first column is blank continues the row above, as in reST; so does one that
+    follows a first cell ending in a comma (a list of names run over two lines).
+    """
+    import html
+
+    spans = [m.span() for m in re.finditer("=+", lines[0])]
+    rows: list[list[str]] = []
+    for line in lines[1:]:
+        if _TABLE_RULE.fullmatch(line.strip()):
+            continue
+        cells = [line[start:(spans[i + 1][0] if i + 1 < len(spans) else None)].strip()
+                 for i, (start, _) in enumerate(spans)]
+        if rows and (not cells[0] or rows[-1][0].endswith(",")):
+            rows[-1] = [f"{a} {b}".strip() for a, b in zip(rows[-1], cells)]
+        else:
+            rows.append(cells)
+
+    def cell(text: str) -> str:
+        parts = re.split(r"`([^`]+)`", _inline(text))  # odd parts were code spans
+        return "".join(f"<code>{html.escape(part)}</code>" if i % 2 else html.escape(part)
+                       for i, part in enumerate(parts))
+
+    body = ["<tr>" + "".join(f"<td>{cell(text)}</td>" for text in row) + "</tr>" for row in rows]
+    # the class keeps a member's name on one line (extra.css)
+    return ['<div class="docstring-table">', "<table>", "<tbody>", *body, "</tbody>", "</table>", "</div>"]
+
+
+def _markdown_of_docstring(text: str) -> str:
+    """A docstring as the site shows it: paragraphs, lists, tables and indented blocks in Markdown.
+
+    The docstrings are reStructuredText (numpy style), which Markdown would show raw: double
+    backticks, roles, enumerations run together into one paragraph. This reads the few
+    constructs they use; an indented block (a usage line) stays preformatted.
+    """
+    out = []
+    for block in re.split(r"\n[ \t]*\n", text.strip("\n")):
+        lines = block.splitlines()
+        if _TABLE_RULE.fullmatch(lines[0].strip()):
+            out += _simple_table(lines)
+        elif all(line.startswith("    ") for line in lines):
+            out += ["```text", *(line[4:] for line in lines), "```"]
+        elif _ITEM.match(lines[0]):
+            items: list[str] = []
+            for line in lines:
+                if _ITEM.match(line):
+                    items.append(line)
+                else:  # an indented continuation of the item above
+                    items[-1] += " " + line.strip()
+            out += [f"- {_inline(item[2:] if item.startswith('- ') else item)}" for item in items]
+        else:
+            out.append(_inline(block))
+        out.append("")
+    return "\n".join(out)
+
+
 def benchmarks(up: str) -> str:
     """Each benchmark script's own docstring, then its last recorded run (results/benchmarks/*.json)."""
     import ast
@@ -480,7 +605,7 @@ def benchmarks(up: str) -> str:
     for path in sorted((ROOT / "benchmarks").glob("bench_*.py")):
         text = ast.get_docstring(ast.parse(path.read_text())) or ""
         first, _, rest = text.partition("\n")
-        out += [f"## `benchmarks/{path.name}`", "", first, "", *_code_block(rest.strip("\n").split("\n")), ""]
+        out += [f"## `benchmarks/{path.name}`", "", _inline(first), "", _markdown_of_docstring(rest)]
         runs = sorted((RESULTS / "benchmarks").glob(f"{path.stem}*.json"))
         for run in runs:
             out += _recorded_run(run)
@@ -499,11 +624,11 @@ def benchmark_run(up: str, name: str) -> str:
 
 
 def module_doc(up: str, module: str) -> str:
-    """A module's docstring as it stands (the specification of its file format), verbatim."""
+    """A module's docstring as it stands (the specification of its file format), as Markdown."""
     import importlib
 
     text = importlib.import_module(module).__doc__ or ""
-    return f"From the docstring of `{module}`:\n\n```text\n{text.strip()}\n```"
+    return f"From the docstring of `{module}`:\n\n{_markdown_of_docstring(text)}"
 
 
 # What a damaged results file raises on its way through a generator: one line, never a traceback.
@@ -515,6 +640,7 @@ GENERATORS = {
     "benchmark": benchmark_run,
     "schema": schema_fields,
     "cli": cli_reference,
+    "debian-packages": debian_packages,
     "studies": studies_table,
     "paper": paper_tables,
     "intersection": intersection_table,

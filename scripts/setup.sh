@@ -8,14 +8,15 @@ sudo=""
 if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
 packages=()
 command -v qdelaunay >/dev/null 2>&1 || packages+=(qhull-bin)   # Qhull's merged Delaunay regions: the oracle
-command -v pdflatex >/dev/null 2>&1 || packages+=(texlive-latex-base texlive-latex-recommended texlive-pictures)
+command -v pdflatex >/dev/null 2>&1 || packages+=(texlive-latex-base texlive-latex-recommended texlive-pictures)  # render --pdf: the LaTeX tables compiled in the tests
 command -v pdftoppm >/dev/null 2>&1 || packages+=(poppler-utils)  # PDF page -> PNG in the tests
 command -v tetgen >/dev/null 2>&1 || packages+=(tetgen)  # bench_outputs.py and mesh --dual: the tetrahedral mesher beside ours
 command -v chromium >/dev/null 2>&1 || packages+=(chromium)  # the docs site's pages opened headless in the tests
+command -v chromedriver >/dev/null 2>&1 || packages+=(chromium-driver)  # selenium drives that chromium through it
 command -v cc >/dev/null 2>&1 || packages+=(gcc)  # the docs' C reader of the pattern-table store, compiled in the tests
-command -v g++ >/dev/null 2>&1 || packages+=(g++)  # ... and compiled as C++ too
-[ -e /usr/include/sqlite3.h ] || packages+=(libsqlite3-dev)
-[ -e /usr/include/zlib.h ] || packages+=(zlib1g-dev)
+command -v g++ >/dev/null 2>&1 || packages+=(g++)  # the same reader compiled as C++
+[ -e /usr/include/sqlite3.h ] || packages+=(libsqlite3-dev)  # the C reader's headers: SQLite
+[ -e /usr/include/zlib.h ] || packages+=(zlib1g-dev)  # the C reader's headers: zlib
 # The gmsh wheel's library links these (ldd libgmsh.so): present on a desktop, not on a bare server
 for pair in libGLU.so.1:libglu1-mesa libGL.so.1:libgl1 libXrender.so.1:libxrender1 libXcursor.so.1:libxcursor1 \
     libXfixes.so.3:libxfixes3 libXext.so.6:libxext6 libXft.so.2:libxft2 libfontconfig.so.1:libfontconfig1 \
