@@ -22,6 +22,7 @@ from cospherical.formats.mesh import read_leaves, table_lookup, write_vtu
 from cospherical.formats.patterns import load
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.octree import build_octree, parse_shape
+from tests.formats.test_check import BROKEN, leaf_entries, leaf_table
 from tests.mesh.test_assembly import OCTANT
 
 CUBE = Box.parse(["1", "1", "1"])
@@ -313,3 +314,59 @@ def test_the_report_says_where_each_configuration_came_from(representatives_stor
     assert report["configurations_mapped"] > 0 and report["tessellated_on_the_fly"] == 0
     assert report["configurations_from_table"] + report["configurations_mapped"] + report["tessellated_on_the_fly"] \
         == report["configurations"]
+
+
+# 15 leaves: among their configurations the cube's and one edge point's, which the broken tables hold
+SMALL_TREE = ("--domain", "1", "1", "1", "--levels", "2", "--refine", "point:0.1,0.1,0.1", "--no-uniform",
+              "--no-delaunay")
+BROKEN_FOR_THE_MESHER = {**BROKEN, "5,000 copies of the cube": (
+    "000000000000+f", lambda e: {**e, "optimal": e["optimal"] * 5000}, "do not fill the box")}
+
+
+@pytest.mark.parametrize("case", BROKEN_FOR_THE_MESHER)
+def test_the_mesher_refuses_a_broken_table_entry_with_checks_line(tmp_path, capsys, case):
+    """A table entry the mesh would use is held to check's rules: the same one line, exit 2, and no mesh."""
+    code, broken, needle = BROKEN_FOR_THE_MESHER[case]
+    entries = leaf_entries("000000000000+f", "800000000000+f")
+    entries[code] = broken(entries[code])
+    path = leaf_table(tmp_path / "broken.yaml", entries)
+    assert main(["check", str(path)]) == 2
+    line = capsys.readouterr().err
+    assert needle in line and f"configurations/{code}" in line
+    # the tree's leaves in one process, the default global mode; or in pieces, each piece's leaves from the table
+    how = ["--partitions", "2", "--jobs", "1"] if "turned" in case else ["--delaunay", "leaf"]
+    out = tmp_path / "out"
+    assert main(["mesh", *SMALL_TREE, *how, "--patterns", str(path), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == line
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_the_good_tables_entries_are_used(tmp_path, capsys):
+    path = leaf_table(tmp_path / "good.yaml", leaf_entries("000000000000+f", "800000000000+f"))
+    assert main(["mesh", *SMALL_TREE, "--delaunay", "leaf", "--patterns", str(path), "--format", "json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["configurations_from_table"] == 2 and report["volume_ok"] and report["nonconforming_faces"] == 0
+
+
+def test_a_store_whose_count_is_not_its_entries_is_refused_by_the_mesher(tmp_path, capsys):
+    import sqlite3
+
+    from cospherical.formats.sqlite_store import dictionary_of, pack, write_store
+
+    good = load(leaf_table(tmp_path / "good.yaml", leaf_entries("000000000000+f", "800000000000+f")))
+    texts = {code: good.configurations.text(code) for code in good.configurations}
+    dictionary = dictionary_of(list(texts.values()))
+    path = tmp_path / "leaves.sqlite"
+    write_store(path, good.header, dictionary, [(code, pack(text, dictionary)) for code, text in sorted(texts.items())])
+    assert main(["mesh", *SMALL_TREE, "--delaunay", "leaf", "--patterns", str(path)]) == 0  # the store as written
+    capsys.readouterr()
+    for count in (1, 3):  # an entry fewer, or one more, than the store holds
+        connection = sqlite3.connect(path)
+        connection.execute("UPDATE meta SET value = ? WHERE key = 'count'", (str(count),))
+        connection.commit()
+        connection.close()
+        assert main(["check", str(path)]) == 2
+        line = capsys.readouterr().err
+        assert f"store damaged: 2 entries, but its count says {count}" in line, line
+        assert main(["mesh", *SMALL_TREE, "--delaunay", "leaf", "--patterns", str(path)]) == 2
+        assert capsys.readouterr().err == line

@@ -314,9 +314,10 @@ def _bomb(connection):
     (lambda c: c.execute("UPDATE meta SET value = ? WHERE key = 'header'", ("{}" + " " * (1 << 20),)), "header"),
     (lambda c: c.execute("UPDATE dictionary SET data = ?", (b"x" * (1 << 24),)), "dictionary"),
     (lambda c: c.execute("UPDATE meta SET value = '-5' WHERE key = 'count'"), "count"),
-    (lambda c: c.execute("UPDATE meta SET value = '5' WHERE key = 'count'"), "count says"),  # found reading all
+    (lambda c: c.execute("UPDATE meta SET value = '5' WHERE key = 'count'"), "count says"),  # found when opened
     (lambda c: c.execute("INSERT INTO dictionary VALUES (x'00')"), "dictionary"),
-    (lambda c: c.execute("INSERT INTO entries VALUES ('000000000048\n', x'00')"), "not a configuration code"),
+    (lambda c: c.executescript("INSERT INTO entries VALUES ('000000000048\n', x'00'); "
+                               "UPDATE meta SET value = value + 1 WHERE key = 'count'"), "not a configuration code"),
     (lambda c: c.execute("PRAGMA journal_mode = WAL"), "WAL"),
     # a view that never ends, where the entries should be
     (lambda c: c.executescript("DROP TABLE entries; CREATE VIEW entries(code, entry) AS WITH RECURSIVE r(n) AS "

@@ -1,23 +1,29 @@
 """Deep checks of catalogue and pattern-table files, beyond their JSON Schemas.
 
 A pattern table's elements are checked against the catalogue (known type ids,
-one node per vertex) and against geometry: every configuration's elements,
-with the nodes its code and the table's base element, box and point policy
-give, must tile the base element (exact volumes adding up to its volume, every
-face shared by two elements or lying on its boundary).
+one node per vertex) and against geometry (:class:`EntryCheck`, one entry at a
+time: ``check`` runs it on every entry, the mesher on each entry it uses): every
+element, measured from the points its code and the table's base element, box and
+point policy give, must be what its entry says (type id, mirror flag,
+circumcenter) in its type's node order (its faces counter-clockwise seen from
+outside), and every configuration's elements must tile the base element (exact
+volumes adding up to its volume, every face met once from each side or once on
+its boundary).
 """
 
 from __future__ import annotations
 
 from collections import Counter
+from dataclasses import dataclass
 from fractions import Fraction
 from math import lcm
 
+from ..caches import cached
 from ..catalogue import catalogue_from_text
 from ..core.base_element import base_element
 from ..core.configuration import Box
 from ..core.element_types import classify_faces
-from ..core.geometry import Frame, six_volume
+from ..core.geometry import Frame
 from ..core.polyhedron import face_kind, measure
 from ..core.shapes import Shape
 from ..errors import FormatError, InputError
@@ -27,7 +33,7 @@ from .diff import document_kind
 from .patterns import entry_elements, load, table_from_data, table_from_text
 from .sqlite_store import is_store
 
-__all__ = ["check_catalogue", "check_patterns", "document_data", "read_document", "read_document_file",
+__all__ = ["EntryCheck", "check_catalogue", "check_patterns", "document_data", "read_document", "read_document_file",
            "validated"]
 
 
@@ -64,144 +70,193 @@ def _check_unique(data: dict, name: str) -> None:
 
 def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True) -> None:
     """Check a loaded :class:`~cospherical.formats.patterns.PatternTable` against the catalogue and geometry."""
-    types = {t["id"]: t for t in catalogue["types"]} if catalogue else None
-    header = table.header
-    try:
-        box = Box.parse(header["box"])
-    except InputError as error:
-        raise FormatError(f"{name}: box: {error}") from None
-    family = base_element(header.get("element", "cuboid"), box, header["face_points"])
-    # The same element (type, nodes, node positions) recurs in many configurations
-    # and criteria of a table: its volume and faces are computed once.
-    geometry: dict[tuple, tuple | None] = {}
-    recomputed: dict[tuple, tuple | None] = {}
+    check = EntryCheck(table.header, catalogue, name, tiling)
     for code, entry in table.configurations.items():
+        check(code, entry)
+
+
+class EntryCheck:
+    """The deep check of a pattern table, one configuration's entry at a time: ``check(code, entry)``.
+
+    ``check`` calls it on every entry of a table; the mesher on each entry it uses, the
+    first time it uses it, so that a table it reads is held to the same rules.  An entry
+    passes when, for every criterion, each element's nodes are points of the
+    configuration and its type is in the catalogue (``catalogue``; without one, only
+    this), and (``geometry``) each element, measured exactly from its points, is a
+    convex polyhedron on one sphere whose recomputed type id, mirror flag and
+    circumcenter are the entry's and whose type's reference faces, through its node
+    list, are its faces counter-clockwise seen from outside (a VTK cell's positive
+    orientation: a hexahedron listed mirrored or upside down, a pyramid with its base
+    clockwise, is refused), and the elements tile the base element: their volumes add
+    up to its volume and every face is met once from each side, or once on the base
+    element's boundary; ``fvm_adequate`` is recomputed too.  The first failure raises
+    :class:`FormatError` naming the table, the configuration and the element.
+
+    An element (its type, mirror flag and points) recurs across a table's configurations
+    and criteria: it is measured once.
+    """
+
+    def __init__(self, header: dict, catalogue: dict | None, name: str, geometry: bool = True):
+        self._types = {t["id"]: t for t in catalogue["types"]} if catalogue else None
+        self._name = name
+        self._geometry = geometry and bool(self._types)
         try:
-            cfg = family.configuration(code)
+            box = Box.parse(header["box"])
         except InputError as error:
-            raise FormatError(f"{name}: configurations/{code}: {error}") from None
+            raise FormatError(f"{name}: box: {error}") from None
+        self._squared = box.squared
+        self._scale = box.to_float()
+        self._criteria = header["criteria"]
+        self._family = base_element(header.get("element", "cuboid"), box, header["face_points"])
+        self._measured: dict[tuple, _Measured | str] = {}
+
+    def __call__(self, code: str, entry: dict) -> None:
+        where = f"{self._name}: configurations/{code}"
+        try:
+            cfg = self._family.configuration(code)
+        except InputError as error:
+            raise FormatError(f"{where}: {error}") from None
         nodes = cfg.nodes()
-        # Positions as integer pairs: they key the geometry cache, and hashing
+        # Positions as integer pairs: they key the cache of measured elements, and hashing
         # Fractions would be most of the check's time.
         positions = {n: tuple((x.numerator, x.denominator) for x in point) for n, point in nodes.items()}
-        checked = []
-        for criterion in header["criteria"]:
-            where = f"{name}: configurations/{code}/{criterion}"
+        checked: list = []
+        centers = []
+        for c, criterion in enumerate(self._criteria):
             elements = entry_elements(entry, criterion)
             if any(elements is other for other in checked):  # a reference to an earlier criterion's elements
                 continue
             checked.append(elements)
-            for k, element in enumerate(elements):
-                missing = [n for n in element["nodes"] if n not in nodes]
-                if missing:
-                    raise FormatError(f"{where}/{k}: node {missing[0]} is not a point of this configuration")
-                if types is not None:
-                    t = types.get(element["type"])
-                    if t is None:
-                        raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
-            if tiling and types:
-                _check_tiling(nodes, positions, box.squared, elements, types, geometry, where, cfg.shape)
-        if tiling and types:
-            _check_recomputed(cfg, positions, box.squared, entry, header["criteria"], f"{name}: configurations/{code}",
-                              recomputed)
-
-
-def _check_recomputed(cfg, positions: dict, squared, entry: dict, criteria, where: str, cache: dict) -> None:
-    """Recompute and compare exactly, element by element: the type label and mirror flag (from the
-    convex hull of the element's points), the circumcenter (the stored float must be the float of the
-    exact one), and ``fvm_adequate`` (every circumcenter of the optimal elements in the closed box;
-    in the base element for another element than the cuboid).  Elements recur across a table, so
-    each distinct one (its points) is computed once."""
-    scale = cfg.box.to_float()
-    centers = []
-    for c, criterion in enumerate(criteria):
-        for k, element in enumerate(entry_elements(entry, criterion)):
-            points = tuple(positions[n] for n in element["nodes"])
-            if points not in cache:
-                # with the float circumcenter: float() of a Fraction is slow, and the scale is the
-                # table's box, the same for every configuration that shares this cache
-                found = _recompute(points, squared)
-                cache[points] = found and (*found, [float(x) * s for x, s in zip(found[2], scale)])
-            if cache[points] is None:
-                raise FormatError(f"{where}/{criterion}/{k}: its nodes are not the vertices of a convex element on one sphere")
-            type_id, mirrored, center, real = cache[points]
-            if element["type"] != type_id:
-                raise FormatError(f"{where}/{criterion}/{k}: type {element['type']}, recomputed {type_id}")
-            if bool(element.get("mirror", False)) != mirrored:
-                raise FormatError(f"{where}/{criterion}/{k}: mirror is {bool(element.get('mirror', False))}, recomputed {mirrored}")
-            if [float(x) for x in element["circumcenter"]] != real:
-                raise FormatError(f"{where}/{criterion}/{k}: circumcenter {element['circumcenter']}, recomputed {real}")
+            measured = self._elements(elements, positions, cfg.shape, f"{where}/{criterion}")
             if c == 0:
-                centers.append(center)
-    adequate = all(cfg.contains(center) for center in centers)
-    if entry["fvm_adequate"] != adequate:
-        raise FormatError(f"{where}: fvm_adequate is {entry['fvm_adequate']}, recomputed {adequate}")
+                centers = [m.center for m in measured]
+        if self._geometry:
+            adequate = all(cfg.contains(center) for center in centers)
+            if entry["fvm_adequate"] != adequate:
+                raise FormatError(f"{where}: fvm_adequate is {entry['fvm_adequate']}, recomputed {adequate}")
+
+    def _elements(self, elements: list, positions: dict, shape: Shape, where: str) -> list[_Measured]:
+        """Check one criterion's elements (see the class); returns them measured."""
+        measured = []
+        total = Fraction(0)
+        faces: Counter = Counter()  # (oriented face, on the boundary) -> the elements that have it
+        for k, element in enumerate(elements):
+            missing = [n for n in element["nodes"] if n not in positions]
+            if missing:
+                raise FormatError(f"{where}/{k}: node {missing[0]} is not a point of this configuration")
+            if self._types is not None and element["type"] not in self._types:
+                raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
+            if not self._geometry:
+                continue
+            found = self._measure(element, tuple(positions[n] for n in element["nodes"]), shape)
+            if isinstance(found, str):
+                raise FormatError(f"{where}/{k}: {found}")
+            if [float(x) for x in element["circumcenter"]] != found.real_center:
+                raise FormatError(f"{where}/{k}: circumcenter {element['circumcenter']}, recomputed "
+                                  f"{found.real_center}")
+            total += found.volume
+            # Every element has a positive volume: past the base element's, the rest cannot tile it
+            # (and a hostile entry of thousands of elements is refused after a few).
+            if total > shape.unit_volume:
+                raise FormatError(f"{where}: the elements do not fill the {_shape_name(shape)}: the first {k + 1} "
+                                  f"already have volume {total} of {shape.unit_volume}")
+            nodes = element["nodes"]
+            for cycle, on_boundary in zip(found.faces, found.on_boundary):
+                faces[_turned(tuple(nodes[p] for p in cycle)), on_boundary] += 1
+            measured.append(found)
+        if not self._geometry:
+            return measured
+        if total != shape.unit_volume:
+            raise FormatError(f"{where}: the elements do not fill the {_shape_name(shape)} "
+                              f"(volume {total} of {shape.unit_volume})")
+        _check_faces(faces, where)
+        return measured
+
+    def _measure(self, element: dict, points: tuple, shape: Shape) -> _Measured | str:
+        key = (element["type"], bool(element.get("mirror")), points)
+        found = self._measured.get(key)
+        if found is None:
+            found = self._measured[key] = _measure_element(element["type"], key[1], points, self._squared,
+                                                           self._types[element["type"]], self._scale, shape)
+        return found
 
 
-def _recompute(points: tuple, squared) -> tuple | None:
-    """(type id, mirrored, exact circumcenter in unit coordinates) of the element with these
-    points, or ``None`` if they are not the vertices of a convex polyhedron on one sphere."""
+@dataclass(frozen=True)
+class _Measured:
+    """An element measured from its points: its unit volume, its faces (cycles of positions in its
+    node list, counter-clockwise seen from outside) and whether each lies on the base element's
+    boundary, its exact and float circumcenters."""
 
+    volume: Fraction
+    faces: tuple[tuple[int, ...], ...]
+    on_boundary: tuple[bool, ...]
+    center: tuple[Fraction, Fraction, Fraction]
+    real_center: list[float]
+
+
+def _measure_element(type_id: str, mirror: bool, points: tuple, squared, catalogued: dict, scale,
+                     shape: Shape) -> _Measured | str:
+    """An element of type ``type_id`` (``catalogued``, its catalogue entry) listed by ``points``
+    (integer pairs of unit coordinates) in the base element ``shape`` of squared lengths ``squared``
+    (``scale``: its lengths as floats), measured; or why it is not one (text)."""
     unit = {i: tuple(Fraction(n, d) for n, d in point) for i, point in enumerate(points)}
-    frame = Frame.build(unit, squared)
+    frame = Frame.build(unit, squared)  # frame index = position in the element's node list
     element = measure(frame, range(len(points)))
-    cycles = sorted(element.cycles)
-    if {i for cycle in cycles for i in cycle} != set(range(len(points))):
-        return None
-    etype, _, mirrored = classify_faces(tuple(cycles), tuple(face_kind(frame, cycle) for cycle in cycles))
-    if element.sphere is None:
-        return None
-    return etype.id, mirrored, element.center
+    cycles = tuple(sorted(element.cycles))
+    if element.sphere is None or {i for cycle in cycles for i in cycle} != set(range(len(points))):
+        return "its nodes are not the vertices of a convex element on one sphere"
+    etype, _, mirrored = classify_faces(cycles, tuple(face_kind(frame, cycle) for cycle in cycles))
+    if type_id != etype.id:
+        return f"type {type_id}, recomputed {etype.id}"
+    if mirror != mirrored:
+        return f"mirror is {mirror}, recomputed {mirrored}"
+    # The type's faces through the node list, turned back for a mirror image, must be the hull's
+    # as they run: the node order gives a positively oriented cell (VTK's order for its cells).
+    reference = {_turned(face["nodes"][::-1] if mirror else face["nodes"]) for face in catalogued["reference_faces"]}
+    if reference != {_turned(cycle) for cycle in cycles}:
+        return (f"the nodes are not in the reference order of type {type_id}: its faces do not run "
+                "counter-clockwise seen from outside (a mirrored, upside-down or reordered element)")
+    return _Measured(element.unit_volume, cycles, _on_boundary(frame, cycles, shape), element.center,
+                     [float(x) * s for x, s in zip(element.center, scale)])
 
 
-def _element_geometry(element: dict, points: tuple, squared, types, shape: Shape) -> tuple | None:
-    """(unit volume, faces as (node set, on the boundary of the base element ``shape``)) of an element,
-    or ``None`` if its nodes do not make a proper element of its type."""
-    frame = Frame.build(dict(enumerate(points)), squared)  # frame index = position in the element's node list
-    cycles = [face["nodes"] for face in types[element["type"]]["reference_faces"]]
-    six = six_volume(frame.coords, cycles)
-    if element.get("mirror"):  # the mirror image: its reference faces run the other way round
-        six = -six
-    if six <= 0:
-        return None
-    nodes, coords, scale = element["nodes"], frame.coords, frame.scale
-    # The shape's face planes, in the frame's integer coordinates (x = coords / scale), with
-    # integer normals: the test runs on integers, as the box's did.
+def _turned(cycle) -> tuple[int, ...]:
+    """A face cycle started at its smallest node, in its own direction: equal for the same oriented face."""
+    start = cycle.index(min(cycle))
+    return tuple(cycle[start:]) + tuple(cycle[:start])
+
+
+def _check_faces(faces: Counter, where: str) -> None:
+    """Elements that meet face to face: every face met once from each side, or once on the base
+    element's boundary (``faces``: (oriented face, on the boundary) -> how many elements have it)."""
+    for (face, on_boundary), count in faces.items():
+        if count > 1:
+            raise FormatError(f"{where}: face {list(face)} belongs to {count} elements on the same side: they overlap")
+        if not on_boundary and faces.get((_turned(face[::-1]), False)) != 1:
+            raise FormatError(f"{where}: face {list(face)} has no element on its other side: the elements do not "
+                              "meet face to face")
+
+
+def _on_boundary(frame: Frame, cycles, shape: Shape) -> tuple[bool, ...]:
+    """Per face cycle (frame indices): whether it lies in a face plane of the base element ``shape``."""
+    coords = frame.coords
+    return tuple(any(all(a * x + b * y + c * z == offset for x, y, z in (coords[p] for p in cycle))
+                     for (a, b, c), offset in _integer_planes(shape, frame.scale)) for cycle in cycles)
+
+
+@cached(maxsize=256)
+def _integer_planes(shape: Shape, scale: int) -> tuple[tuple[tuple[int, int, int], int], ...]:
+    """The face planes of ``shape`` in a frame's integer coordinates (``x = coords / scale``), as integer
+    normals and offsets: the test of a point runs on integers."""
     planes = []
     for normal, offset in shape.planes:
-        common = lcm(*(x.denominator for x in normal))
-        planes.append((tuple(int(x * common) for x in normal), offset * scale * common))
-    faces = []
-    for cycle in cycles:
-        on_boundary = any(all(sum(a * x for a, x in zip(normal, coords[p])) == offset for p in cycle)
-                          for normal, offset in planes)
-        faces.append((frozenset(nodes[p] for p in cycle), on_boundary))
-    return Fraction(six, 6 * scale**3), tuple(faces)
+        common = lcm(*(x.denominator for x in (*normal, offset * scale)))
+        planes.append((tuple(int(x * common) for x in normal), int(offset * scale * common)))
+    return tuple(planes)
 
 
-def _check_tiling(nodes: dict, positions: dict, squared, elements, types, geometry: dict, where: str,
-                  shape: Shape) -> None:
-    """The elements fill the base element ``shape`` exactly and meet face to face."""
-    total = Fraction(0)
-    faces: Counter = Counter()
-    for k, element in enumerate(elements):
-        key = (element["type"], tuple(element["nodes"]), bool(element.get("mirror")),
-               tuple(positions[n] for n in element["nodes"]))
-        found = geometry.get(key, False)
-        if found is False:
-            points = tuple(nodes[n] for n in element["nodes"])
-            found = geometry[key] = _element_geometry(element, points, squared, types, shape)
-        if found is None:
-            raise FormatError(f"{where}/{k}: the nodes do not make a proper element of type {element['type']}")
-        volume, element_faces = found
-        total += volume
-        faces.update(element_faces)
-    if total != shape.unit_volume:
-        raise FormatError(f"{where}: the elements do not fill the {'box' if shape.name == 'cuboid' else shape.name} "
-                          f"(volume {total} of {shape.unit_volume})")
-    for (face, on_boundary), count in faces.items():
-        if count != (1 if on_boundary else 2):
-            raise FormatError(f"{where}: face {sorted(face)} belongs to {count} elements: they do not meet face to face")
+def _shape_name(shape: Shape) -> str:
+    return "box" if shape.name == "cuboid" else shape.name
 
 
 def read_document(text: str, name: str):

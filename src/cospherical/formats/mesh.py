@@ -32,6 +32,7 @@ from ..errors import FormatError, InputError
 from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
+from .check import EntryCheck
 
 __all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "VtuGrid", "vtu_arrays", "vtu_grid",
            "write_piece", "write_pvtu", "write_report", "write_vtu"]
@@ -120,12 +121,18 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table", c
     gives the same point set.  The table's box must have the domain's proportions
     (every leaf is the domain scaled down).  ``catalogue``: the element catalogue
     naming the table's types (default: the shipped one), see :func:`orbit_lookup`.
+
+    The table is data from disk: each entry the lookup uses is held, the first time, to
+    the rules of ``cospherical check`` (:class:`~cospherical.formats.check.EntryCheck`:
+    node order, recomputed types, tiling, faces met from both sides), so a damaged or
+    forged entry raises :class:`FormatError` naming the table and the configuration
+    instead of giving inverted or overlapping cells.
     """
     if catalogue is None:
         from ..catalogue import shipped_catalogue
 
         catalogue = shipped_catalogue()
-    header = getattr(table, "header", None) or {}
+    header = table.header
     element = header.get("element", "cuboid")
     if element != "cuboid":
         raise InputError(f"{name}: a table of {element} elements, but the mesh's leaves are cuboids "
@@ -139,18 +146,28 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table", c
             raise InputError(f"{name}: its box {' x '.join(header['box'])} is not shaped like the domain "
                              f"{' x '.join(box.texts)}: its tessellations are not the leaves'")
     policy = header.get("face_points", "octree")
+    check = EntryCheck(header, catalogue, name)
+    checked: set[str] = set()
+
+    def elements(code: str):
+        """The table's elements of ``code``, its entry checked as ``check`` does the first time (KeyError: none)."""
+        found = table.elements(code, criterion)
+        if code not in checked:
+            check(code, table.configurations[code])
+            checked.add(code)
+        return found
 
     def lookup(configuration: Configuration):
         code = configuration.point_set_code
         try:
-            return table.elements(code, criterion)
+            return elements(code)
         except KeyError:
             pass
         digits = code.split("+")[0]
         if policy in POINT_POLICIES and \
                 Configuration.from_code(digits, configuration.box, policy).point_set_code == code:
             try:
-                return table.elements(digits, criterion)
+                return elements(digits)
             except KeyError:
                 return None
         return None

@@ -56,7 +56,9 @@ _MAX_HEADER = 1 << 16
 # pages and all (a 900 MB entry: 935 MB and 3 CPU-s for 'mesh --patterns' to refuse it).  So
 # the sizes are bounded by one scan when the store is opened (5 ms for 32,077 entries), and
 # again in each query, for a file changed after it was opened.
-_OVERSIZED = f"SELECT 1 FROM entries WHERE length(entry) > {MAX_ENTRY} OR length(code) > {MAX_ENTRY} LIMIT 1"
+# The same scan counts the entries: a store whose count is not its entries' is damaged, and a mesher,
+# which looks a few up, would not find that out otherwise.
+_SCAN = f"SELECT count(*), coalesce(max(length(entry) > {MAX_ENTRY} OR length(code) > {MAX_ENTRY}), 0) FROM entries"
 # length() of a blob reads its size from the record header, but length() of a text (the code) reads
 # the text whole (a 200 MB code: 221 MB to refuse the store).  SQLite's dbstat table gives each
 # page's largest record payload from the cell headers, following overflow chains page by page in
@@ -163,8 +165,12 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
             oversized = connection.execute(_OVERSIZED_RECORD).fetchone() is not None
         except sqlite3.OperationalError:  # an SQLite built without dbstat: the scan below reads a long code whole
             oversized = False
-        if oversized or connection.execute(_OVERSIZED).fetchone() is not None:
+        if not oversized:
+            rows, oversized = connection.execute(_SCAN).fetchone()
+        if oversized:
             raise FormatError(f"{path}: store damaged: an entry is stored in over {MAX_ENTRY} bytes")
+        if rows != count:
+            raise FormatError(f"{path}: store damaged: {rows} entries, but its count says {count}")
     except FormatError:
         raise  # names the store and the place already
     except (sqlite3.Error, KeyError, ValueError, TypeError) as error:
@@ -223,11 +229,6 @@ class StoreEntries(Mapping):
         return self._count
 
     def texts(self):
-        """Every (code, entry text), in code order, streamed; the rows must be as many as the store says
-        (what reads them all, such as ``check``, finds a store whose count is wrong)."""
-        seen = 0
+        """Every (code, entry text), in code order, streamed (:func:`open_store` counted them)."""
         for code, blob in self._rows(f"SELECT code, {_BOUNDED_ENTRY} FROM entries ORDER BY code"):
-            seen += 1
             yield code, self._text(blob)
-        if seen != self._count:
-            raise FormatError(f"{self._name}: store damaged: {seen} entries, but its count says {self._count}")
