@@ -15,7 +15,7 @@ is the type's reference vertex order.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Mapping, Sequence
 
 from ..caches import cached
 
@@ -121,7 +121,8 @@ def _canonical_form(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]) 
     return CanonicalForm(_encode(best, len(best_order)), tuple(best_order), best_mirrored)
 
 
-def _walk(start, rotation, label) -> tuple[list[int], list[int]]:
+def _walk(start: tuple[int, int], rotation: Mapping[tuple[int, int], int],
+          label: Mapping[tuple[int, int], int]) -> tuple[list[int], list[int]]:
     """The walk's list from the dart ``start``, and the vertices in discovery order."""
     v0, w0 = start
     number = {v0: 0}
@@ -145,7 +146,8 @@ def _walk(start, rotation, label) -> tuple[list[int], list[int]]:
 
 
 def _encode(code: list[int], vertices: int) -> str:
-    lists, current = [], []
+    lists: list[str] = []
+    current: list[str] = []
     items = iter(code)
     for x in items:
         if x == _END:

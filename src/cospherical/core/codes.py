@@ -40,7 +40,7 @@ REVERSED_DIGIT = {"%x" % n: "%x" % ((16 - n) % 16) for n in range(16)}
 
 
 @cached(maxsize=16)
-def edge_code_pattern(edges: int) -> re.Pattern:
+def edge_code_pattern(edges: int) -> re.Pattern[str]:
     """The codes of an element with ``edges`` edges: that many digits and an optional point suffix.
 
     >>> edge_code_pattern(6).match("800000+f")["suffix"]

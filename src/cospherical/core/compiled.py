@@ -20,20 +20,25 @@ index, exactly as :func:`cospherical.core.delaunay.hull_faces` orders them.
 from __future__ import annotations
 
 
+from typing import Sequence
+
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
 from ..caches import cached
 from .shapes import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
 
 __all__ = ["buffers", "cube_batch", "cube_tables", "fits", "orbit_keys", "walk"]
 
+_Ints = NDArray[np.int64]  # every array of the kernels: exact int64
+
 _MAX_POINTS = 62
 _MAX_CELLS = 1024
 _MAX_FACES = 8192
 
 
-def fits(coords, weights, scale: int) -> bool:
+def fits(coords: Sequence[Sequence[int]], weights: Sequence[int], scale: int) -> bool:
     """Whether the compiled int64 walk is exact on this frame.
 
     With C >= |every coordinate| and L = 3 W C^2 >= every lifted coordinate:
@@ -53,7 +58,7 @@ def fits(coords, weights, scale: int) -> bool:
 
 
 @njit(cache=True)
-def _sphere(lifted, i, j, k, m):
+def _sphere(lifted: _Ints, i: int, j: int, k: int, m: int) -> tuple[int, int, int, int, int]:
     """(a, b, c, d, offset) of the sphere through four lifted points, d > 0; d = 0 if coplanar."""
     b0, b1, b2, b3 = lifted[i, 0], lifted[i, 1], lifted[i, 2], lifted[i, 3]
     x1, y1, z1, w1 = lifted[j, 0] - b0, lifted[j, 1] - b1, lifted[j, 2] - b2, lifted[j, 3] - b3
@@ -71,12 +76,12 @@ def _sphere(lifted, i, j, k, m):
 
 
 @njit(cache=True)
-def _side(a, b, c, d, offset, lifted, p):
-    return a * lifted[p, 0] + b * lifted[p, 1] + c * lifted[p, 2] + d * lifted[p, 3] - offset
+def _side(a: int, b: int, c: int, d: int, offset: int, lifted: _Ints, p: int) -> int:
+    return a * lifted[p, 0] + b * lifted[p, 1] + c * lifted[p, 2] + d * lifted[p, 3] - offset  # type: ignore[no-any-return]
 
 
 @njit(cache=True)
-def _contains(values, count, key):
+def _contains(values: _Ints, count: int, key: int) -> bool:
     """Whether ``key`` is among ``values[:count]`` (a few dozen: a scan beats a hash set)."""
     for g in range(count):
         if values[g] == key:
@@ -85,7 +90,8 @@ def _contains(values, count, key):
 
 
 @njit(cache=True)
-def _hull(coords, members, count, face_nodes, face_len, face_normal, start):
+def _hull(coords: _Ints, members: _Ints, count: int, face_nodes: _Ints, face_len: _Ints, face_normal: _Ints,
+          start: int) -> int:
     """Append the hull faces of ``members[:count]`` from row ``start``; the new row count, or -1."""
     found = np.zeros(64, dtype=np.int64)
     nfound = 0
@@ -166,7 +172,8 @@ def _hull(coords, members, count, face_nodes, face_len, face_normal, start):
 
 
 @njit(cache=True)
-def walk(coords, lifted, weights, cell_mask, cell_sphere, face_cell, face_nodes, face_len, face_normal):
+def walk(coords: _Ints, lifted: _Ints, weights: _Ints, cell_mask: _Ints, cell_sphere: _Ints, face_cell: _Ints,
+         face_nodes: _Ints, face_len: _Ints, face_normal: _Ints) -> tuple[int, int]:
     """The Delaunay cells of the frame ``coords`` / ``lifted``, into the output arrays.
 
     Returns ``(cells, faces)``, or ``(-1, -1)`` when an output array is too small
@@ -293,7 +300,7 @@ def walk(coords, lifted, weights, cell_mask, cell_sphere, face_cell, face_nodes,
     return ncells, nfaces
 
 
-def buffers(points: int):
+def buffers(points: int) -> tuple[_Ints, _Ints, _Ints, _Ints, _Ints, _Ints]:
     """Output arrays for :func:`walk` on up to ``points`` points."""
     return (
         np.empty(_MAX_CELLS, dtype=np.int64),
@@ -312,7 +319,7 @@ def buffers(points: int):
 
 
 @cached(maxsize=1)  # built once per process, shared by every chunk
-def cube_tables():
+def cube_tables() -> tuple[_Ints, _Ints, _Ints, _Ints, _Ints]:
     """Point tables of the cube in 16ths: corner coordinates, edge start corners and axes, faces' edge pairs."""
     corners = np.array(CORNERS, dtype=np.int64) * 16
     starts = np.array([min((CORNERS[i] for i in EDGES[k])) for k in range(12)], dtype=np.int64) * 16
@@ -324,7 +331,8 @@ def cube_tables():
 
 
 @njit(cache=True)
-def _cube_points(digits, corners, starts, axes, face_edges, face_base, ids, coords, lifted):
+def _cube_points(digits: _Ints, corners: _Ints, starts: _Ints, axes: _Ints, face_edges: _Ints, face_base: _Ints,
+                 ids: _Ints, coords: _Ints, lifted: _Ints) -> int:
     """The octree point set of one configuration (digits in 16ths); returns the point count."""
     n = 0
     for c in range(8):
@@ -359,8 +367,9 @@ def _cube_points(digits, corners, starts, axes, face_edges, face_base, ids, coor
 
 
 @njit(cache=True)
-def cube_batch(codes, corners, starts, axes, face_edges, face_base, tets, closed, open_, polys, poly_mask, poly_code,
-               every_cell=False):
+def cube_batch(codes: _Ints, corners: _Ints, starts: _Ints, axes: _Ints, face_edges: _Ints, face_base: _Ints,
+               tets: _Ints, closed: _Ints, open_: _Ints, polys: _Ints, poly_mask: _Ints, poly_code: _Ints,
+               every_cell: bool = False) -> int:
     """Tessellate the cube configurations ``codes`` (base-16 numbers, 1/16 positions, octree points).
 
     Per configuration: ``tets`` the number of tetrahedra, ``closed``/``open_``
@@ -441,7 +450,8 @@ def cube_batch(codes, corners, starts, axes, face_edges, face_base, tets, closed
 
 
 @njit(cache=True)
-def orbit_keys(digits, targets, reverse, masks, faces):
+def orbit_keys(digits: _Ints, targets: _Ints, reverse: NDArray[np.bool_], masks: _Ints, faces: _Ints
+               ) -> tuple[_Ints, _Ints, _Ints]:
     """Per row of 12 digits and a point mask: the smallest image (code as base 16, then
     mask) under the symmetries, its mask, and the first symmetry reaching it.  Symmetry s
     sends edge k to ``targets[s, k]``, reversed (t -> 1 - t) where ``reverse[s, k]``, and

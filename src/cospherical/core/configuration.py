@@ -13,11 +13,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
-from typing import Iterable, Mapping
+from typing import Iterable, Mapping, Sequence, cast
 
 from ..errors import InputError, shown
 from .codes import digit_parameters, edge_code_pattern, parameter_digits, parse_point_suffix, point_suffix
 from .exact import parse_rational
+from .geometry import Rational
 from .shapes import Box, Point, Shape, standard_shape
 
 # Box: the type of a configuration's box (Configuration.box), public here with the class that takes it
@@ -27,7 +28,7 @@ POINT_POLICIES = ("octree", "none")
 FACE_POINT_SOURCES = (*POINT_POLICIES, "explicit")
 
 
-def steiner_parameters(steiner: Mapping | Iterable | None, edges: int = 12,
+def steiner_parameters(steiner: Mapping[object, object] | Iterable[tuple[object, object]] | None, edges: int = 12,
                        element: str = "cuboid") -> tuple[Fraction | None, ...]:
     """The Steiner parameter of each of ``edges`` edges from ``{edge: t}`` or ``[(edge, t), ...]``.
 
@@ -55,7 +56,7 @@ def steiner_parameters(steiner: Mapping | Iterable | None, edges: int = 12,
     return tuple(params)
 
 
-def _face_numbers(faces: Iterable, shape: Shape, where: str) -> frozenset[int]:
+def _face_numbers(faces: Iterable[object], shape: Shape, where: str) -> frozenset[int]:
     numbers = []
     last = len(shape.faces) - 1
     for face in faces:
@@ -85,7 +86,7 @@ def _index(text: str, count: int) -> int | None:
 
 
 
-def _shape(shape: Shape | None, box) -> Shape:
+def _shape(shape: Shape | None, box: Box | Iterable[str | int | Fraction] | None) -> Shape:
     """The base element of a constructor: ``shape``, or the cuboid in ``box`` (default the cube)."""
     if shape is None:
         return standard_shape("cuboid", ("1", "1", "1") if box is None else box)
@@ -162,10 +163,10 @@ class Configuration:
     @classmethod
     def from_steiner(
         cls,
-        box: Box | Iterable | None = None,
-        steiner: Mapping | Iterable | None = None,
+        box: Box | Iterable[str | int | Fraction] | None = None,
+        steiner: Mapping[object, object] | Iterable[tuple[object, object]] | None = None,
         face_points: str = "octree",
-        faces: Iterable | None = None,
+        faces: Iterable[object] | None = None,
         body: bool = False,
         shape: Shape | None = None,
     ) -> "Configuration":
@@ -182,9 +183,9 @@ class Configuration:
     def from_code(
         cls,
         code: str,
-        box: Box | Iterable | None = None,
+        box: Box | Iterable[str | int | Fraction] | None = None,
         face_points: str = "octree",
-        faces: Iterable | None = None,
+        faces: Iterable[object] | None = None,
         body: bool = False,
         shape: Shape | None = None,
     ) -> "Configuration":
@@ -217,9 +218,10 @@ class Configuration:
         return cls._build(shape, params, face_points, faces, body)
 
     @classmethod
-    def _build(cls, shape, params, face_points, faces, body) -> "Configuration":
+    def _build(cls, shape: Shape, params: tuple[Fraction | None, ...], face_points: str,
+               faces: Iterable[object] | None, body: bool) -> "Configuration":
         if faces is not None or body:  # __post_init__ checks and normalises the faces
-            return cls(shape, params, "explicit", tuple(faces or ()), body)
+            return cls(shape, params, "explicit", cast("frozenset[int]", tuple(faces or ())), body)
         return cls(shape, params, face_points)
 
     @property
@@ -266,7 +268,7 @@ class Configuration:
     @property
     def point_faces(self) -> frozenset[int]:
         """The faces carrying a point, under any policy."""
-        if self.face_points == "explicit":
+        if self.faces is not None:  # exactly when the points are explicit
             return self.faces
         return self.admissible_faces if self.face_points == "octree" else frozenset()
 
@@ -295,22 +297,26 @@ class Configuration:
             nodes[shape.face_nodes[f]] = shape.face_point(f, *self._face_cuts[f])
         if self.has_body_point:
             # every face carries a point, so all the edges of a parallel class are split at one t
-            origin, classes = shape.parallelepiped
-            point = shape.corners[origin]
+            origin, classes = cast("tuple[int, tuple[tuple[tuple[Rational, ...], tuple[int, ...]], ...]]",
+                                   shape.parallelepiped)
+            point: Sequence[Rational] = shape.corners[origin]
             for d, edges in classes:
-                t = self.steiner[edges[0]]
+                t = cast(Fraction, self.steiner[edges[0]])
                 point = tuple(x + t * y if y else x for x, y in zip(point, d))
-            nodes[shape.body_node] = point
+            nodes[cast(int, shape.body_node)] = (point[0], point[1], point[2])
         return nodes
 
     def real_nodes(self) -> dict[int, tuple[float, float, float]]:
         """Node id -> float coordinates in the real box (for output and plotting)."""
         scale = self.box.to_float()
-        return {i: tuple(float(x) * s for x, s in zip(p, scale)) for i, p in self.nodes().items()}
+        return {i: (float(p[0]) * scale[0], float(p[1]) * scale[1], float(p[2]) * scale[2])
+                for i, p in self.nodes().items()}
 
     def _cut_parameters(self, f: int) -> list[Fraction]:
         # the parameters on the sides of Shape.cut_sides, each measured the way its side runs
-        return [self.steiner[k] if forward else 1 - self.steiner[k] for k, forward in self.shape.cut_sides[f]]
+        # every side is split: the caller asked first
+        steiner = cast("tuple[Fraction, ...]", self.steiner)
+        return [steiner[k] if forward else 1 - steiner[k] for k, forward in self.shape.cut_sides[f]]
 
     def _inadmissible(self, face: int) -> str | None:
         """Why face ``face`` cannot carry a point, or ``None`` when it can."""
@@ -328,6 +334,6 @@ class Configuration:
                         f"{self.steiner[p]} and {self.steiner[q]}")
         return None
 
-    def contains(self, point, closed: bool = True) -> bool:
+    def contains(self, point: Sequence[Rational], closed: bool = True) -> bool:
         """Whether a point (unit coordinates) lies in the closed (or open) base element, exactly: the FVM test."""
         return self.shape.contains(point, closed)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from functools import cmp_to_key
 from itertools import combinations
+from typing import Sequence
 
 from .geometry import Frame, Sphere, determinant, dot, plane_normal, sub
 
@@ -89,7 +90,7 @@ def _triangle(points: list[int], above: bool) -> tuple[int, ...]:
     return (i, k, j) if above else (i, j, k)
 
 
-def _counter_clockwise(coords, points: list[int], normal) -> tuple[int, ...]:
+def _counter_clockwise(coords: Sequence[Sequence[int]], points: list[int], normal: Sequence[int]) -> tuple[int, ...]:
     first = min(points)
     origin = coords[first]
 
@@ -172,6 +173,7 @@ def delaunay_cells(frame: Frame, backend: str = "python") -> list[Cell]:
             # = -first(y) / plane(y), so the neighbour's sphere has the largest lam_y.
             i, j, k = cycle[:3]
             first = frame.sphere(i, j, k, beyond[0])
+            assert first is not None, "a point beyond a face's plane is off it: the four span a solid"
             best_h, best_g = 0, 1  # beyond[0] lies on `first`: lam = 0
             for y in beyond[1:]:
                 h = first.side(lifted[y])

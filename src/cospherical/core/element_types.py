@@ -5,10 +5,14 @@ from __future__ import annotations
 import hashlib
 from collections import Counter
 from dataclasses import dataclass
+from typing import Callable, Iterator, Sequence
 
 from ..caches import cached
 from .canonical import canonical_form
 from .polyhedron import Polyhedron
+
+# An element's faces: node cycles, counter-clockwise seen from outside.
+_Faces = Sequence[Sequence[int]]
 
 __all__ = ["ElementType", "classify", "classify_faces", "element_type", "face_summary", "systematic_name"]
 
@@ -67,7 +71,7 @@ def type_id(code: str, vertices: int, faces: int) -> str:
     return f"v{vertices}f{faces}-{hashlib.sha256(code.encode()).hexdigest()[:6]}"
 
 
-def _adjacency(faces) -> dict[int, set[int]]:
+def _adjacency(faces: _Faces) -> dict[int, set[int]]:
     adjacent: dict[int, set[int]] = {}
     for face in faces:
         for i, v in enumerate(face):
@@ -77,7 +81,7 @@ def _adjacency(faces) -> dict[int, set[int]]:
     return adjacent
 
 
-def _is_bipyramid(faces, kinds) -> bool:
+def _is_bipyramid(faces: _Faces, kinds: Sequence[str]) -> bool:
     if any(kind != "triangle" for kind in kinds):
         return False
     adjacent = _adjacency(faces)
@@ -90,7 +94,7 @@ def _is_bipyramid(faces, kinds) -> bool:
     )
 
 
-def _standard(faces, kinds) -> tuple[str | None, str | None]:
+def _standard(faces: _Faces, kinds: Sequence[str]) -> tuple[str | None, str | None]:
     """(name, VTK cell type) where the face structure has a standard one."""
     counts = Counter(kinds)
     vertices = len({v for f in faces for v in f})
@@ -111,7 +115,7 @@ def _standard(faces, kinds) -> tuple[str | None, str | None]:
     return None, None
 
 
-def element_type(code: str, faces, kinds) -> ElementType:
+def element_type(code: str, faces: _Faces, kinds: Sequence[str]) -> ElementType:
     """The element type of a canonical code (faces and kinds of any member).
 
     No registry of types is kept (one would only grow in a long-running process): a type is a
@@ -131,7 +135,7 @@ def systematic_name(vertices: int, face_summary: str) -> str:
     return f"{vertices}-Vertex Polyhedron ({face_summary})"
 
 
-def _vtk_order(vtk: str, faces, kinds) -> tuple[int, ...]:
+def _vtk_order(vtk: str, faces: _Faces, kinds: Sequence[str]) -> tuple[int, ...]:
     """Nodes in VTK order (the first face's right-hand normal points into the cell).
 
     Of the orderings VTK allows, the smallest tuple of node ids is taken, so a
@@ -139,15 +143,16 @@ def _vtk_order(vtk: str, faces, kinds) -> tuple[int, ...]:
     """
     adjacent = _adjacency(faces)
 
-    def orderings(face, top):
+    def orderings(face: Sequence[int], top: Callable[[list[int]], list[int]]) -> Iterator[tuple[int, ...]]:
         cycle = list(reversed(face))  # counter-clockwise from outside, reversed: normal inward
         for i in range(len(cycle)):
             bottom = cycle[i:] + cycle[:i]
             yield (*bottom, *top(bottom))
 
-    def opposite(bottom):
+    def opposite(bottom: list[int]) -> list[int]:
         return [next(w for w in adjacent[v] if w not in bottom) for v in bottom]
 
+    candidates: Iterator[tuple[int, ...]]
     if vtk == "tetra":
         candidates = (o for f in faces for o in orderings(f, lambda b: [v for v in adjacent if v not in b]))
     elif vtk == "pyramid":
@@ -167,14 +172,15 @@ def classify(poly: Polyhedron) -> tuple[ElementType, tuple[int, ...], bool]:
     return _classify(poly.faces, poly.face_kinds)
 
 
-def classify_faces(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]):
+def classify_faces(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]
+                   ) -> tuple[ElementType, tuple[int, ...], bool]:
     """:func:`classify` from a polyhedron's face cycles (counter-clockwise from outside) and face kinds."""
     return _classify(faces, kinds)
 
 
 # A study meets the same cell (same node ids and faces) in many configurations.
 @cached(maxsize=1 << 16)
-def _classify(faces, kinds) -> tuple[ElementType, tuple[int, ...], bool]:
+def _classify(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]) -> tuple[ElementType, tuple[int, ...], bool]:
     # The classification only compares node ids, never reads their values, so
     # it is computed on the ids' ranks and mapped back: cells with other ids in
     # the same order (the same shape elsewhere in the box, or in another
@@ -187,7 +193,8 @@ def _classify(faces, kinds) -> tuple[ElementType, tuple[int, ...], bool]:
 
 
 @cached(maxsize=1 << 16)
-def _classify_ranks(faces, kinds) -> tuple[ElementType, tuple[int, ...], bool]:
+def _classify_ranks(faces: tuple[tuple[int, ...], ...], kinds: tuple[str, ...]
+                    ) -> tuple[ElementType, tuple[int, ...], bool]:
     form = canonical_form(faces, kinds)
     etype = element_type(form.code, faces, kinds)
     if etype.vtk is None:

@@ -29,7 +29,7 @@ MAX_DIGITS = 40
 _MAX_TEXT = 100
 
 
-def parse_rational(text: str | int | Fraction, what: str = "number") -> Fraction:
+def parse_rational(text: object, what: str = "number") -> Fraction:
     """Parse an integer, decimal or fraction exactly (the ASCII grammar :data:`NUMBER`, bounded size).
 
     Examples
@@ -64,7 +64,7 @@ def parse_rational(text: str | int | Fraction, what: str = "number") -> Fraction
     return bounded(value, what, text)
 
 
-def bounded(value: Fraction, what: str, text) -> Fraction:
+def bounded(value: Fraction, what: str, text: object) -> Fraction:
     """``value``, when its numerator and denominator have at most :data:`MAX_DIGITS` digits each."""
     limit = 10**MAX_DIGITS
     if abs(value.numerator) >= limit or value.denominator >= limit:

@@ -36,30 +36,41 @@ import operator
 from dataclasses import dataclass
 from fractions import Fraction
 from itertools import combinations
-from typing import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Mapping, Sequence, TypeVar, cast
 
-__all__ = ["Frame", "Sphere", "area_vector", "circumcentres", "collinear", "cross", "determinant", "dot",
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+
+__all__ = ["Frame", "Rational", "Sphere", "area_vector", "circumcentres", "collinear", "cross", "determinant", "dot",
            "in_closed_box", "plane_normal", "plane_projection", "six_volume", "six_volumes", "sphere_sides", "sub", "tetra_six_volume"]
 
 _Vector = tuple[int, int, int]
+Rational = int | Fraction
+"""An exact scalar: the kernel's functions take integers and Fractions alike."""
+# Integers in, integers out; Fractions in, Fractions out; either kind mixed: either kind out.
+_R = TypeVar("_R", int, Fraction, Rational)
+# The integer 0 starts a sum of either kind (typed Any: a Fraction sum starts from it too).
+_ZERO: Any = 0
 
 
 # ---------------------------------------------------------------------------------------------
 # Predicates: signs, decided exactly
 # ---------------------------------------------------------------------------------------------
 
-def tetra_six_volume(p: Sequence, q: Sequence, r: Sequence, s: Sequence):
+def tetra_six_volume(p: Sequence[_R], q: Sequence[_R], r: Sequence[_R], s: Sequence[_R]) -> _R:
     """Six times the signed volume of the tetrahedron pqrs (zero: the four are coplanar), exact for
     integers and Fractions alike: the orientation predicate (> 0 when right-handed)."""
     return determinant(sub(q, p), sub(r, p), sub(s, p))
 
 
-def collinear(p: Sequence, q: Sequence, r: Sequence) -> bool:
+def collinear(p: Sequence[_R], q: Sequence[_R], r: Sequence[_R]) -> bool:
     """Whether the three points are on one line (or two of them coincide)."""
     return not any(plane_normal(p, q, r))
 
 
-def sphere_sides(tets, points, weights: Sequence[int], python_integers: bool = False):
+def sphere_sides(tets: NDArray[Any], points: NDArray[Any], weights: Sequence[int],
+                 python_integers: bool = False) -> NDArray[np.int8]:
     """Per row, where a point lies against a tetrahedron's circumsphere, in bulk: < 0 strictly inside, 0 on, > 0 outside.
 
     ``tets``: integer array (n, 4, 3) of solid tetrahedra, either orientation;
@@ -93,10 +104,12 @@ def sphere_sides(tets, points, weights: Sequence[int], python_integers: bool = F
     for axis in range(3):
         towards = towards + e[:, axis] * numerators[axis]
     side = (det * (e * e * w).sum(axis=1) - towards) * np.where(det < 0, -1, 1)
-    return np.sign(side).astype(np.int8)
+    signs: NDArray[np.int8] = np.sign(side).astype(np.int8)
+    return signs
 
 
-def in_closed_box(numerators, denominators, low, high):
+def in_closed_box(numerators: NDArray[Any], denominators: NDArray[Any], low: int | NDArray[Any],
+                  high: int | NDArray[Any]) -> NDArray[np.bool_]:
     """Per row of rational points ``numerators / denominators`` (n, 3), in bulk, whether it lies in the
     closed box ``low``..``high`` (broadcast per row or per axis; denominators positive): each numerator
     against the bounds times its denominator, in the arrays' own integers (the caller's bound makes
@@ -106,7 +119,8 @@ def in_closed_box(numerators, denominators, low, high):
     >>> in_closed_box(np.array([[1, 2, 3], [1, 2, 7]]), np.array([[2], [2]]), 0, 3).tolist()
     [True, False]
     """
-    return ((numerators >= low * denominators) & (numerators <= high * denominators)).all(axis=1)
+    inside = (numerators >= low * denominators) & (numerators <= high * denominators)
+    return cast("NDArray[np.bool_]", inside.all(axis=1))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -115,26 +129,27 @@ def in_closed_box(numerators, denominators, low, high):
 
 # map over operator functions, not generators: these run in the inner loops of the
 # Delaunay walk and the split search (about three times faster).
-def sub(p: Sequence[int], q: Sequence[int]) -> tuple[int, ...]:
+def sub(p: Sequence[_R], q: Sequence[_R]) -> tuple[_R, ...]:
     return tuple(map(operator.sub, p, q))
 
 
-def dot(p: Sequence[int], q: Sequence[int]) -> int:
-    return sum(map(operator.mul, p, q))
+def dot(p: Sequence[_R], q: Sequence[_R]) -> _R:
+    total: _R = sum(map(operator.mul, p, q))
+    return total
 
 
-def cross(p: Sequence[int], q: Sequence[int]) -> _Vector:
+def cross(p: Sequence[_R], q: Sequence[_R]) -> tuple[_R, _R, _R]:
     return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
 
 
-def determinant(u: Sequence, v: Sequence, w: Sequence):
+def determinant(u: Sequence[_R], v: Sequence[_R], w: Sequence[_R]) -> _R:
     """The determinant of the rows u, v, w (the triple product u . (v x w)), written out: it runs in
     the inner loops of the dual's pieces and the hull's face order."""
     return (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])
             + u[2] * (v[0] * w[1] - v[1] * w[0]))
 
 
-def plane_normal(p: Sequence, q: Sequence, r: Sequence) -> _Vector:
+def plane_normal(p: Sequence[_R], q: Sequence[_R], r: Sequence[_R]) -> tuple[_R, _R, _R]:
     """(q - p) x (r - p): normal to the plane of p, q, r, right-handed (zero when they are on a line),
     written out: it runs once per point triple of every hull."""
     (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = p, q, r
@@ -142,7 +157,7 @@ def plane_normal(p: Sequence, q: Sequence, r: Sequence) -> _Vector:
     return (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
 
 
-def area_vector(polygon: Sequence[Sequence]) -> _Vector:
+def area_vector(polygon: Sequence[Sequence[_R]]) -> tuple[_R, _R, _R]:
     """Twice the vector area of a closed polygon (Newell's normal): for a planar polygon, normal to
     its plane, right-handed around its order; never zero for a convex one, even with three
     consecutive points on a line (a normal from three points would be).
@@ -151,7 +166,7 @@ def area_vector(polygon: Sequence[Sequence]) -> _Vector:
     (0, 0, 4)
     """
     m = len(polygon)
-    normal = (0, 0, 0)
+    normal: tuple[_R, _R, _R] = (_ZERO, _ZERO, _ZERO)
     for i in range(m):
         p, q = polygon[i], polygon[(i + 1) % m]
         normal = (normal[0] + (p[1] - q[1]) * (p[2] + q[2]), normal[1] + (p[2] - q[2]) * (p[0] + q[0]),
@@ -160,7 +175,7 @@ def area_vector(polygon: Sequence[Sequence]) -> _Vector:
 
 
 def plane_projection(point: Sequence[int], origin: Sequence[int], normal: Sequence[int],
-                     inverse_weights: Sequence[int]) -> tuple[_Vector, int]:
+                     inverse_weights: Sequence[int]) -> tuple[tuple[int, ...], int]:
     """The projection of ``point`` onto the plane through ``origin`` with ``normal`` (frame coordinates),
     orthogonal in the real metric: ``inverse_weights`` proportional to the inverse weights (integers,
     lcm(w) // w_k).  Returns ``(numerators, s)``, the projection being numerators / s with
@@ -174,7 +189,7 @@ def plane_projection(point: Sequence[int], origin: Sequence[int], normal: Sequen
     return tuple(x * s - along * n * v for x, n, v in zip(point, normal, inverse_weights)), s
 
 
-def six_volume(coords, cycles) -> int:
+def six_volume(coords: Sequence[Sequence[_R]], cycles: Sequence[Sequence[int]]) -> _R:
     """Six times the volume of a polyhedron from its face cycles (indices into ``coords``).
 
     With the cycles counter-clockwise seen from outside every fan tetrahedron
@@ -182,7 +197,7 @@ def six_volume(coords, cycles) -> int:
     cycles (a mirror image's faces) give the negative.
     """
     ax, ay, az = coords[cycles[0][0]]
-    total = 0
+    total: _R = _ZERO
     for cycle in cycles:
         x0, y0, z0 = coords[cycle[0]]
         px, py, pz = x0 - ax, y0 - ay, z0 - az
@@ -193,7 +208,7 @@ def six_volume(coords, cycles) -> int:
     return total
 
 
-def six_volumes(tets, python_integers: bool = False):
+def six_volumes(tets: NDArray[Any], python_integers: bool = False) -> NDArray[Any]:
     """Per tetrahedron of an integer array (n, 4, 3), six times its signed volume, in bulk (0: flat).
 
     int64 when |6 E^3| < 2**62 (E the largest edge component from the first vertex: each
@@ -211,10 +226,12 @@ def six_volumes(tets, python_integers: bool = False):
     extent = int(np.abs(d).max()) if len(d) else 0
     if python_integers or 6 * extent ** 3 >= 2**62:
         d = d.astype(object)
-    return np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2]))
+    volumes: NDArray[Any] = np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2]))
+    return volumes
 
 
-def circumcentres(tets, weights: Sequence[int], python_integers: bool = False):
+def circumcentres(tets: NDArray[Any], weights: Sequence[int],
+                  python_integers: bool = False) -> tuple[NDArray[Any], NDArray[Any]]:
     """Per tetrahedron of an integer array (n, 4, 3), its exact circumcentre in the same units, in bulk:
     ``(numerators, denominators)``, each (n, 3), every coordinate a reduced fraction with a positive
     denominator (the tetrahedra solid; ``weights``: the frame's, as in :func:`sphere_sides`).
@@ -253,7 +270,7 @@ def circumcentres(tets, weights: Sequence[int], python_integers: bool = False):
     return np.stack(nums, axis=1), np.stack(dens, axis=1)
 
 
-def _cramer(d, w):
+def _cramer(d: NDArray[Any], w: NDArray[Any]) -> tuple[NDArray[Any], list[NDArray[Any]]]:
     """The sphere through the origin and the rows d1, d2, d3 of ``d`` (n, 3, 3), in bulk: its centre c
     solves 2 W c . d_k = L(d_k) (L the lifted length, ``w`` . d_k^2), so W c = N / (2 det) for M the
     rows d_k, by Cramer's rule in integers.  Returns (det, [N_x, N_y, N_z]) in ``d``'s dtype; the
@@ -324,7 +341,7 @@ class Frame:
     weights: _Vector
 
     @classmethod
-    def build(cls, unit_points: Mapping[int, Sequence[Fraction]], squared_lengths: Sequence[Fraction]) -> "Frame":
+    def build(cls, unit_points: Mapping[int, Sequence[Rational]], squared_lengths: Sequence[Rational]) -> "Frame":
         """Frame for ``{node id: unit coordinates}`` in a box with the given squared lengths."""
         ids = tuple(sorted(unit_points))
         # Integer arithmetic on numerators and denominators: a mesher calls this per configuration.
@@ -335,7 +352,8 @@ class Frame:
         weights = tuple(w.numerator * (weight_den // w.denominator) for w in squared)
         coords = tuple(tuple(x.numerator * (scale // x.denominator) for x in point) for point in points)
         lifted = tuple((*p, weights[0] * p[0] ** 2 + weights[1] * p[1] ** 2 + weights[2] * p[2] ** 2) for p in coords)
-        return cls(ids, coords, lifted, scale, weights)
+        return cls(ids, cast("tuple[_Vector, ...]", coords), cast("tuple[tuple[int, int, int, int], ...]", lifted),
+                   scale, cast(_Vector, weights))
 
     def orient(self, i: int, j: int, k: int, m: int) -> int:
         """Sign-bearing 6x volume of (i, j, k, m), indices into ``coords``; > 0 when right-handed."""
@@ -380,7 +398,8 @@ class Frame:
     def center(self, sphere: Sphere) -> tuple[Fraction, Fraction, Fraction]:
         """Exact unit coordinates of a sphere's center."""
         n = sphere.normal
-        return tuple(Fraction(-n[axis], 2 * self.weights[axis] * n[3] * self.scale) for axis in range(3))
+        return cast("tuple[Fraction, Fraction, Fraction]",
+                    tuple(Fraction(-n[axis], 2 * self.weights[axis] * n[3] * self.scale) for axis in range(3)))
 
     def real_dot(self, u: Sequence[int], v: Sequence[int]) -> int:
         """A positive multiple of the real dot product of two frame vectors."""

@@ -77,7 +77,7 @@ def delaunay_tetrahedra(coords: Sequence[Sequence[int]], weights: Sequence[int])
     return _Triangulation(frame).run(_morton_order(frame.coords))
 
 
-def _morton_order(coords) -> list[int]:
+def _morton_order(coords: Sequence[Sequence[int]]) -> list[int]:
     codes = morton_codes(coords).tolist()
     return sorted(range(len(coords)), key=lambda i: (codes[i], coords[i]))
 
@@ -123,7 +123,7 @@ class _Triangulation:
             elif len(chosen) == 2:
                 ok = not collinear(frame.coords[a], frame.coords[chosen[1]], frame.coords[i])
             else:
-                ok = self.orient(*chosen, i) != 0
+                ok = self.orient(chosen[0], chosen[1], chosen[2], i) != 0
             if ok:
                 chosen.append(i)
                 if len(chosen) == 4:
@@ -152,7 +152,7 @@ class _Triangulation:
         self.last = finite
         for p in rest:
             self._insert(p)
-        return [tuple(v) for v, alive in zip(self.vertices, self.alive) if alive and _INFINITE not in v]
+        return [(v[0], v[1], v[2], v[3]) for v, alive in zip(self.vertices, self.alive) if alive and _INFINITE not in v]
 
     def _link(self, tets: list[tuple[int, int]]) -> None:
         """Join new tetrahedra ``(tetrahedron, index of the new point in it)`` across their faces through the point.
@@ -181,6 +181,7 @@ class _Triangulation:
         sphere = self.spheres[t]
         if sphere is None:
             found = self.frame.sphere(*self.vertices[t])
+            assert found is not None, "a finite tetrahedron of the triangulation is solid"
             sphere = (*found.normal, found.offset)
             self.spheres[t] = sphere
         return sphere
@@ -229,7 +230,7 @@ class _Triangulation:
         """What the walk finds, by looking at every tetrahedron: the walk's guard, should it ever go round in circles."""
         for t, (here, alive) in enumerate(zip(self.vertices, self.alive)):
             if alive and (self._conflict(t, p) if _INFINITE in here else
-                          all(self.orient(*here[:k], p, *here[k + 1:]) >= 0 for k in range(4))):
+                          all(self.orient(*(p if m == k else v for m, v in enumerate(here))) >= 0 for k in range(4))):
                 return t
         raise AssertionError("no tetrahedron holds the point")
 

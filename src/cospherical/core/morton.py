@@ -10,7 +10,10 @@ runs of it.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["MAX_BITS", "morton_codes"]
 
@@ -22,7 +25,7 @@ _SPREAD = ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00
            (2, 0x1249249249249249))
 
 
-def morton_codes(cells) -> np.ndarray:
+def morton_codes(cells: ArrayLike) -> NDArray[Any]:
     """Per row of ``cells`` (n, 3), nonnegative integers, its place on the Z-order curve.
 
     int64 for coordinates below ``2**MAX_BITS``; for larger ones (the exact engine

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Iterable
 
 from .delaunay import Cell, hull_faces
-from .geometry import Frame, Sphere, six_volume
+from .geometry import Frame, Rational, Sphere, six_volume
 
 __all__ = ["FACE_KINDS", "Measured", "Polyhedron", "face_kind", "measure", "polyhedron"]
 
@@ -37,11 +38,11 @@ class Polyhedron:
     faces: tuple[tuple[int, ...], ...]
     face_kinds: tuple[str, ...]
     unit_volume: Fraction
-    center: tuple[Fraction, Fraction, Fraction]
+    center: tuple[Rational, Rational, Rational]
 
     @property
     def edges(self) -> tuple[tuple[int, int], ...]:
-        pairs = {tuple(sorted((f[i], f[(i + 1) % len(f)]))) for f in self.faces for i in range(len(f))}
+        pairs = {(a, b) if a < b else (b, a) for f in self.faces for a, b in zip(f, f[1:] + f[:1])}
         return tuple(sorted(pairs))
 
     @property
@@ -73,7 +74,7 @@ class Measured:
     center: tuple[Fraction, Fraction, Fraction] | None
 
 
-def measure(frame: Frame, members) -> Measured:
+def measure(frame: Frame, members: Iterable[int]) -> Measured:
     """Measure the element whose vertices are ``members`` (indices into the frame), exactly: the one
     place a mesh, a pattern check and the dual get an element's faces, volume and sphere from."""
     members = list(members)

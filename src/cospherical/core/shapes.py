@@ -44,18 +44,20 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
 from itertools import combinations
-from typing import Iterable, Sequence
+from typing import Any, Iterable, Sequence
 
 from ..caches import cached
 from ..errors import InputError
 from .codes import mask_codes
 from .exact import Length, parse_rational
-from .geometry import area_vector, collinear, cross, dot, plane_normal, six_volume, sub, tetra_six_volume
+from .geometry import (Rational, area_vector, collinear, cross, dot, plane_normal, six_volume, sub,
+                       tetra_six_volume)
 
 __all__ = ["Box", "CORNERS", "EDGES", "ELEMENTS", "FACES", "FACE_EDGES", "Point", "STANDARD_SHAPES", "Shape",
            "edge_axis", "mask_codes", "standard_shape"]
 
-Point = tuple[Fraction, Fraction, Fraction]
+Point = tuple[Rational, Rational, Rational]
+"""Exact unit coordinates (s, t, u): integers where they are whole, Fractions elsewhere."""
 
 
 @dataclass(frozen=True)
@@ -73,7 +75,7 @@ class Box:
     c: Length
 
     @classmethod
-    def parse(cls, lengths: Iterable) -> "Box":
+    def parse(cls, lengths: Iterable[str | int | Fraction]) -> "Box":
         values = list(lengths)
         if len(values) != 3:
             raise InputError(f"box {values!r}: needs exactly three lengths A B C")
@@ -89,10 +91,10 @@ class Box:
 
     @property
     def texts(self) -> tuple[str, str, str]:
-        return tuple(length.text for length in self.lengths)
+        return (self.a.text, self.b.text, self.c.text)
 
     def to_float(self) -> tuple[float, float, float]:
-        return tuple(float(length) for length in self.lengths)
+        return (float(self.a), float(self.b), float(self.c))
 
 
 # The cuboid's numbering (VTK hexahedron), shared by every part and file format.
@@ -123,7 +125,8 @@ _H = Fraction(1, 2)
 # order of the VTK quadratic cells, faces as VTK lists them (oriented on building).  The
 # cuboid's numbering is the one of :mod:`cospherical.core.configuration` (face f carries
 # node 20 + f: VTK's triquadratic hexahedron).
-STANDARD_SHAPES: dict[str, tuple[tuple, tuple, tuple]] = {
+STANDARD_SHAPES: dict[str, tuple[tuple[tuple[Rational, ...], ...], tuple[tuple[int, int], ...],
+                                  tuple[tuple[int, ...], ...]]] = {
     "cuboid": (CORNERS, EDGES, FACES),
     "prism": (
         ((0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (0, 1, 1)),
@@ -147,13 +150,14 @@ ELEMENTS = tuple(STANDARD_SHAPES)
 _MAX_CORNERS = 64
 
 
-def _point(value, where: str) -> Point:
+def _point(value: Any, where: str) -> Point:
     if isinstance(value, str) or not hasattr(value, "__len__") or len(value) != 3:
         raise InputError(f"{where} {value!r}: needs three coordinates")
-    return tuple(parse_rational(x, where) for x in value)
+    x, y, z = (parse_rational(x, where) for x in value)
+    return (x, y, z)
 
 
-def _index(value, count: int, where: str) -> int:
+def _index(value: object, count: int, where: str) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < count:
         raise InputError(f"{where}: {value!r} is not a corner number 0..{count - 1}")
     return value
@@ -175,11 +179,11 @@ class Shape:
     corners: tuple[Point, ...]
     edges: tuple[tuple[int, int], ...]
     faces: tuple[tuple[int, ...], ...]
-    planes: tuple[tuple[tuple[Fraction, ...], Fraction], ...] = field(repr=False)
+    planes: tuple[tuple[tuple[Fraction, Fraction, Fraction], Fraction], ...] = field(repr=False)
 
     @classmethod
-    def from_vertices(cls, vertices: Sequence, edges: Sequence, faces: Sequence,
-                      box: Box | Iterable = ("1", "1", "1"), name: str = "element") -> "Shape":
+    def from_vertices(cls, vertices: Sequence[Any], edges: Sequence[Any], faces: Sequence[Any],
+                      box: Box | Iterable[str | int | Fraction] = ("1", "1", "1"), name: str = "element") -> "Shape":
         """A convex polyhedron from its vertices (unit coordinates), edges and faces, checked exactly.
 
         The faces may be given in either orientation; they are turned
@@ -213,7 +217,7 @@ class Shape:
                              "corners of a convex polyhedron can have")
         corners = tuple(_point(v, f"corner {i}") for i, v in enumerate(vertices))
         n = len(corners)
-        first: dict = {}
+        first: dict[Point, int] = {}
         for j, corner in enumerate(corners):
             i = first.setdefault(corner, j)
             if i != j:
@@ -237,7 +241,7 @@ class Shape:
             cycle, plane = _oriented_face(corners, cycle, f, name)
             oriented.append(cycle)
             planes.append(plane)
-        sides = {}
+        sides: dict[frozenset[int], list[int]] = {}
         for f, cycle in enumerate(oriented):
             for a, b in zip(cycle, cycle[1:] + cycle[:1]):
                 sides.setdefault(frozenset((a, b)), []).append(f)
@@ -252,7 +256,7 @@ class Shape:
         for k, edge in enumerate(edges):
             if isinstance(edge, str) or not hasattr(edge, "__len__") or len(edge) != 2:
                 raise InputError(f"{name}: edge {k} {edge!r}: needs two corners")
-            pair = tuple(_index(v, n, f"{name}: edge {k}") for v in edge)
+            pair = (_index(edge[0], n, f"{name}: edge {k}"), _index(edge[1], n, f"{name}: edge {k}"))
             if frozenset(pair) not in sides:
                 raise InputError(f"{name}: edge {k} {list(pair)} is not a side of any face")
             pairs.append(pair)
@@ -274,7 +278,7 @@ class Shape:
     def _hash(self) -> int:
         return hash((self.name, self.box, self.corners, self.edges, self.faces))
 
-    def __getstate__(self) -> dict:
+    def __getstate__(self) -> dict[str, Any]:
         # A string's hash differs from process to process: a pickled shape (a study's pool)
         # computes its hash again where it is unpickled.
         state = dict(self.__dict__)
@@ -293,14 +297,14 @@ class Shape:
         return {f: first + q for q, f in enumerate(self.quad_faces)}
 
     @cached_property
-    def parallelepiped(self) -> tuple[int, tuple[tuple[Point, tuple[int, ...]], ...]] | None:
+    def parallelepiped(self) -> tuple[int, tuple[tuple[tuple[Rational, ...], tuple[int, ...]], ...]] | None:
         """``(corner, ((d0, edges0), (d1, edges1), (d2, edges2)))`` when the shape is a
         parallelepiped: every point is ``corner + x d0 + y d1 + z d2`` for x, y, z in [0, 1],
         each d running along the edges of its class from their lower ends; ``None`` for any
         other shape."""
         if len(self.corners) != 8 or len(self.quad_faces) != 6:
             return None
-        classes: dict[Point, list[int]] = {}
+        classes: dict[tuple[Rational, ...], list[int]] = {}
         for k in range(len(self.edges)):
             d = sub(self.corners[self._edge_end[k]], self.corners[self.edge_start(k)])
             classes.setdefault(d, []).append(k)
@@ -334,7 +338,7 @@ class Shape:
         return tuple(j if i == start else i for (i, j), start in zip(self.edges, self._edge_starts))
 
     @cached_property
-    def _edge_lines(self) -> tuple:
+    def _edge_lines(self) -> tuple[tuple[Point, tuple[tuple[int, Rational], ...]], ...]:
         # Per edge: its start point and the axes along which it runs, with the extent on each.
         lines = []
         for k in range(len(self.edges)):
@@ -348,7 +352,7 @@ class Shape:
         point = list(start)
         for axis, extent in runs:  # the coordinates along which the edge does not run stay
             point[axis] = t if extent == 1 and start[axis] == 0 else start[axis] + t * extent
-        return tuple(point)
+        return (point[0], point[1], point[2])
 
     def face_point(self, f: int, t: Fraction, s: Fraction) -> Point:
         """The point of quadrilateral face f (cycle c0 c1 c2 c3) where its two cut lines cross: the
@@ -364,7 +368,7 @@ class Shape:
                 if along_s:
                     x = s if along_s == 1 and x == 0 else x + s * along_s
                 point[axis] = x
-            return tuple(point)
+            return (point[0], point[1], point[2])
         c = [self.corners[i] for i in self.faces[f]]
         p = [a + t * (b - a) for a, b in zip(c[0], c[1])]
         q = [a + t * (b - a) for a, b in zip(c[3], c[2])]
@@ -377,11 +381,11 @@ class Shape:
             det = d1[i] * -d2[j] + d2[i] * d1[j]
             if det:
                 x = (e[i] * -d2[j] + d2[i] * e[j]) / det
-                return tuple(a + x * b for a, b in zip(p, d1))
+                return (p[0] + x * d1[0], p[1] + x * d1[1], p[2] + x * d1[2])
         raise AssertionError("the cut lines of a convex face cross")  # pragma: no cover
 
     @cached_property
-    def _parallelograms(self) -> dict:
+    def _parallelograms(self) -> dict[int, tuple[Point, tuple[tuple[int, Rational, Rational], ...]]]:
         # Per quadrilateral face that is a parallelogram: c0 and, per coordinate that varies over
         # the face, (axis, its change along c0->c1, along c0->c3); the face points of a
         # configuration are computed from these (the cuboid's coordinates are then t or s alone).
@@ -401,15 +405,19 @@ class Shape:
         return {frozenset(e): k for k, e in enumerate(self.edges)}
 
     @cached_property
-    def _bounds(self) -> tuple:
+    def _bounds(self) -> tuple[tuple[tuple[int, Rational, Rational], ...],
+                               tuple[tuple[tuple[Fraction, Fraction, Fraction], Fraction], ...]]:
         # A face plane normal to an axis bounds that coordinate alone: (axis, lower, upper) per
         # axis bounded on both sides this way (the box's three), and the other planes as they are.
-        lower, upper, axis_planes, others = {}, {}, {}, []
+        lower: dict[int, Rational] = {}
+        upper: dict[int, Rational] = {}
+        axis_planes: dict[int, list[tuple[tuple[Fraction, Fraction, Fraction], Fraction]]] = {}
+        others = []
         for normal, offset in self.planes:
             axes = [a for a in range(3) if normal[a] != 0]
             if len(axes) == 1:
-                bound = offset / normal[axes[0]]
-                bound = int(bound) if bound.denominator == 1 else bound  # ints compare faster
+                quotient = offset / normal[axes[0]]
+                bound = int(quotient) if quotient.denominator == 1 else quotient  # ints compare faster
                 (upper if normal[axes[0]] > 0 else lower)[axes[0]] = bound
                 axis_planes.setdefault(axes[0], []).append((normal, offset))
             else:
@@ -418,7 +426,7 @@ class Shape:
         others += [plane for a, planes in axis_planes.items() if not (a in lower and a in upper) for plane in planes]
         return both, tuple(others)
 
-    def contains(self, point: Sequence[Fraction], closed: bool = True) -> bool:
+    def contains(self, point: Sequence[Rational], closed: bool = True) -> bool:
         """Whether a point (unit coordinates) lies in the closed (or open) element, exactly."""
         axis_bounds, others = self._bounds
         if closed:
@@ -440,7 +448,8 @@ class Shape:
         return sides
 
 
-def _oriented_face(corners, cycle, f, name):
+def _oriented_face(corners: Sequence[Point], cycle: tuple[int, ...], f: int, name: str
+                   ) -> tuple[tuple[int, ...], tuple[tuple[Fraction, Fraction, Fraction], Fraction]]:
     """The cycle counter-clockwise seen from outside and the outward plane, after the checks."""
     pts = [corners[i] for i in cycle]
     m = len(cycle)
@@ -473,11 +482,11 @@ def _oriented_face(corners, cycle, f, name):
         raise InputError(f"{name}: not convex: corners lie on both sides of face {f} {list(cycle)}")
     if above:  # the normal points inwards: turn the face round
         cycle = (cycle[0], *reversed(cycle[1:]))
-        normal, offset = tuple(-x for x in normal), -offset
-    return cycle, (tuple(Fraction(x) for x in normal), Fraction(offset))
+        normal, offset = (-normal[0], -normal[1], -normal[2]), -offset
+    return cycle, ((Fraction(normal[0]), Fraction(normal[1]), Fraction(normal[2])), Fraction(offset))
 
 
-def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
+def standard_shape(name: str, box: Box | Iterable[str | int | Fraction] = ("1", "1", "1")) -> Shape:
     """One of the standard shapes (VTK hexahedron, wedge, pyramid, tetra) in a box A x B x C.
 
     ``cuboid``: the whole box, numbered as VTK's hexahedron (:data:`CORNERS`, :data:`EDGES`, :data:`FACES`);
@@ -497,8 +506,9 @@ def standard_shape(name: str, box: Box | Iterable = ("1", "1", "1")) -> Shape:
     """
     if not isinstance(box, Box):
         lengths = tuple(box)
+        texts = tuple(x for x in lengths if isinstance(x, str))
         # a box given as texts, as most callers give it, is parsed once
-        box = _parsed_box(lengths) if all(isinstance(x, str) for x in lengths) else Box.parse(lengths)
+        box = _parsed_box(texts) if len(texts) == len(lengths) else Box.parse(lengths)
     return _standard_shape(name, box)
 
 

@@ -23,10 +23,19 @@ element exactly once).
 from __future__ import annotations
 
 from itertools import combinations
+from typing import Sequence
 
 from .delaunay import hull_faces
 from .geometry import Frame, dot, plane_normal, six_volume
 from .polyhedron import Polyhedron, face_kind
+
+_Vector = tuple[int, int, int]
+# A face of a piece: its cycle (frame indices), its normal, the element's face it lies in (None: inside).
+_PieceFace = tuple[tuple[int, ...], _Vector, int | None]
+# An allowed piece: its faces and six times its volume (frame units).
+_Piece = tuple[list[_PieceFace], int]
+# The faces a split has left open: point set -> (cycle, normal pointing into the uncovered part).
+_OpenFaces = dict[frozenset[int], tuple[tuple[int, ...], Sequence[int]]]
 
 __all__ = ["CRITERIA", "SPLIT_CRITERIA", "subdivisions"]
 
@@ -56,7 +65,7 @@ class _Element:
         # boundary plane exactly when its first three points are on that face (three
         # points of a face span its plane; the element's vertices on a face plane are
         # that face's vertices).
-        self.face_of_triple = {triple: f for f, face in enumerate(self.faces)
+        self.face_of_triple: dict[tuple[int, ...], int] = {triple: f for f, face in enumerate(self.faces)
                                for triple in combinations(sorted(face), 3)}
         self.edges = {frozenset((f[i], f[(i + 1) % len(f)])) for f in self.faces for i in range(len(f))}
         # Ordered pairs (both ways round) that may be an edge of a piece.
@@ -64,9 +73,9 @@ class _Element:
                         if v != w and self._edge_allowed(frozenset((v, w)))}
         self.points = [(m, *coords[m]) for m in self.members]
         self.six_volume = six_volume(coords, self.faces)
-        self._pieces: dict[frozenset[int], tuple | None] = {}
+        self._pieces: dict[frozenset[int], _Piece | None] = {}
 
-    def _on_boundary_plane(self, cycle) -> int | None:
+    def _on_boundary_plane(self, cycle: Sequence[int]) -> int | None:
         return self.face_of_triple.get(tuple(sorted(cycle[:3])))
 
     def _cuts_boundary(self, points: frozenset[int]) -> bool:
@@ -92,7 +101,7 @@ class _Element:
         # An inner edge must pass through the interior: its ends share no face.
         return not any(edge <= face for face in self.face_sets)
 
-    def piece(self, points: frozenset[int]):
+    def piece(self, points: frozenset[int]) -> _Piece | None:
         """(faces with their kind of contact, 6 x volume) of the hull of ``points``, or None if not allowed."""
         if points in self._pieces:
             return self._pieces[points]
@@ -107,8 +116,8 @@ class _Element:
         self._pieces[points] = result
         return result
 
-    def _check(self, faces):
-        checked = []
+    def _check(self, faces: list[tuple[tuple[int, ...], _Vector]]) -> _Piece | None:
+        checked: list[_PieceFace] = []
         allowed = self.allowed
         for cycle, normal in faces:
             boundary = self._on_boundary_plane(cycle)
@@ -119,7 +128,7 @@ class _Element:
             checked.append((cycle, normal, boundary))
         return checked, six_volume(self.frame.coords, [c for c, _, _ in checked])
 
-    def beyond(self, cycle, normal) -> list[int]:
+    def beyond(self, cycle: Sequence[int], normal: Sequence[int]) -> list[int]:
         nx, ny, nz = normal
         offset = dot(normal, self.frame.coords[cycle[0]])
         return [m for m, x, y, z in self.points if nx * x + ny * y + nz * z > offset]
@@ -135,7 +144,7 @@ def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 20
     element = _Element(frame, poly, criterion)
     found: list[tuple[frozenset[int], ...]] = []
 
-    def grow(pieces: list[frozenset[int]], open_faces: dict, volume: int, covered: frozenset[int]) -> None:
+    def grow(pieces: list[frozenset[int]], open_faces: _OpenFaces, volume: int, covered: frozenset[int]) -> None:
         if len(found) >= limit:
             raise RuntimeError(f"more than {limit} splits: the search was stopped")
         if not open_faces:
@@ -150,7 +159,8 @@ def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 20
                 points = key | frozenset(extra)
                 _try(points, pieces, open_faces, volume, covered)
 
-    def _try(points, pieces, open_faces, volume, covered) -> None:
+    def _try(points: frozenset[int], pieces: list[frozenset[int]], open_faces: _OpenFaces, volume: int,
+             covered: frozenset[int]) -> None:
         piece = element.piece(points)
         if piece is None or points in pieces:
             return
@@ -186,8 +196,10 @@ def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 20
 
 def _piece(element: _Element, points: frozenset[int]) -> Polyhedron:
     frame, poly = element.frame, element.poly
-    faces, six = element.piece(points)
-    faces = sorted(faces, key=lambda face: face[0])
+    piece = element.piece(points)
+    assert piece is not None, "a piece of a split is allowed"
+    faces = sorted(piece[0], key=lambda face: face[0])
+    six = piece[1]
     return Polyhedron(
         nodes=tuple(frame.ids[i] for i in sorted(points)),
         faces=tuple(tuple(frame.ids[i] for i in cycle) for cycle, _, _ in faces),

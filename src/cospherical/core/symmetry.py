@@ -15,7 +15,7 @@ from fractions import Fraction
 from functools import cached_property
 from itertools import combinations, permutations, product
 from operator import itemgetter
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence, cast
 
 if TYPE_CHECKING:
     import numpy as np
@@ -26,12 +26,16 @@ if TYPE_CHECKING:
 from ..caches import cached
 from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, point_suffix
 from .configuration import Box, Configuration
-from .geometry import cross, determinant, sub, tetra_six_volume
+from .geometry import Rational, cross, determinant, sub, tetra_six_volume
 from .polyhedron import Polyhedron
 from .shapes import CORNERS, EDGES, FACES, Point, Shape, standard_shape
 
 __all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
            "orbit_point_keys", "orbit_representatives", "shape_symmetries"]
+
+
+# (coefficient, shift) of a coordinate that a box symmetry keeps (x) or reflects (1 - x)
+_AXIS_MAPS: tuple[tuple[Rational, Rational], ...] = ((1, 0), (-1, 1))
 
 
 @dataclass(frozen=True)
@@ -56,8 +60,8 @@ class Symmetry:
 
     shape: Shape = field(repr=False, compare=False)
     corner_map: tuple[int, ...]
-    linear: tuple[tuple[Fraction, ...], ...] = field(repr=False)
-    shift: tuple[Fraction, ...] = field(repr=False)
+    linear: tuple[tuple[Rational, ...], ...] = field(repr=False)
+    shift: tuple[Rational, ...] = field(repr=False)
 
     @cached_property
     def proper(self) -> bool:
@@ -73,16 +77,18 @@ class Symmetry:
         axes = []
         for row, b in zip(self.linear, self.shift):
             nonzero = [(a, x) for a, x in enumerate(row) if x != 0]
-            if len(nonzero) != 1 or (nonzero[0][1], b) not in ((1, 0), (-1, 1)):
+            if len(nonzero) != 1 or (nonzero[0][1], b) not in _AXIS_MAPS:
                 return None
             axes.append((nonzero[0][0], nonzero[0][1] < 0))
         return tuple(axes)
 
-    def point(self, p):
+    def point(self, p: Sequence[Rational]) -> Point:
         """The image of a point (unit coordinates)."""
         if self._axes is not None:
-            return tuple(1 - p[a] if flip else p[a] for a, flip in self._axes)
-        return tuple(sum(a * x for a, x in zip(row, p)) + b for row, b in zip(self.linear, self.shift))
+            image = [1 - p[a] if flip else p[a] for a, flip in self._axes]
+        else:
+            image = [sum(a * x for a, x in zip(row, p)) + b for row, b in zip(self.linear, self.shift)]
+        return (image[0], image[1], image[2])
 
     @cached_property
     def edge_map(self) -> tuple[tuple[int, bool], ...]:
@@ -120,7 +126,7 @@ class Symmetry:
                 params[image] = 1 - t if reverse else t
         if cfg.face_points != "explicit":
             return Configuration(cfg.shape, tuple(params), cfg.face_points)
-        faces = frozenset(self.face_map[f] for f in cfg.faces)
+        faces = frozenset(self.face_map[f] for f in cfg.point_faces)  # the explicit faces
         return Configuration(cfg.shape, tuple(params), "explicit", faces, cfg.body)
 
     def code(self, code: str) -> str:
@@ -149,7 +155,8 @@ class Symmetry:
                     if all(s.corner_map[self.corner_map[i]] == i for i in range(n)))
 
 
-def map_polyhedron(poly: Polyhedron, nodes, proper: bool, point) -> Polyhedron:
+def map_polyhedron(poly: Polyhedron, nodes: Sequence[int], proper: bool,
+                   point: Callable[[Sequence[Rational]], Point]) -> Polyhedron:
     """The image of a polyhedron under an isometry given by its node map (``nodes[v]``), whether
     it keeps orientation, and its action on unit coordinates; faces normalised as the Delaunay
     stage writes them (shared by the box's symmetries and those of other shapes)."""
@@ -208,11 +215,13 @@ def orbit_point_keys(
     if backend == "compiled":
         from .compiled import orbit_keys as kernel
 
-        return kernel(digits, targets, reverse, masks, faces)
+        keys: tuple[np.ndarray, np.ndarray, np.ndarray] = kernel(digits, targets, reverse, masks, faces)
+        return keys
     return _orbit_keys_numpy(digits, targets, reverse, masks, faces)
 
 
-def _orbit_keys_numpy(digits, targets, reverse, masks, faces):
+def _orbit_keys_numpy(digits: np.ndarray, targets: np.ndarray, reverse: np.ndarray, masks: np.ndarray,
+                      faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     # compiled.orbit_keys, vectorised over the rows: the same smallest image
     # (code as base 16, then mask) and the first symmetry reaching it.
     import numpy as np
@@ -298,7 +307,7 @@ def _mask_suffix(mask: int, body_bit: int) -> str:
 class _Group:
     """What :func:`_orbit_keys_python` needs of a group of symmetries."""
 
-    images: tuple  # per symmetry: picks the image's hex digits from a code's digits and their reversals
+    images: tuple[Callable[[str], tuple[str, ...]], ...]  # per symmetry: picks the image's hex digits from a code's digits and their reversals
     faces: tuple[tuple[int, ...], ...]  # per symmetry: the image of every face
     compose: tuple[tuple[int, ...], ...]  # compose[u][v]: the index of u after v
     inverse: tuple[int, ...]
@@ -320,7 +329,7 @@ def _group(symmetries: tuple[Symmetry, ...]) -> _Group | None:
                 return None
             row.append(image)
         compose.append(tuple(row))
-    inverse = []
+    inverse: list[int | None] = []
     for sym in symmetries:
         back = [0] * len(sym.corner_map)
         for i, c in enumerate(sym.corner_map):
@@ -336,21 +345,24 @@ def _group(symmetries: tuple[Symmetry, ...]) -> _Group | None:
             source[target] = n * reverse + k
         images.append(itemgetter(*source) if n > 1 else (lambda digits, k=source[0]: (digits[k],)))
     shape = symmetries[0].shape
-    return _Group(tuple(images), tuple(sym.face_map for sym in symmetries), tuple(compose), tuple(inverse),
+    return _Group(tuple(images), tuple(sym.face_map for sym in symmetries), tuple(compose), tuple(cast("list[int]", inverse)),
                   len(shape.edges), 1 << len(shape.faces))
 
 
 _REVERSAL = str.maketrans(REVERSED_DIGIT)
 
 
-def _orbit_keys_python(codes, masks, group: _Group):
+def _orbit_keys_python(codes: Sequence[str], masks: Sequence[int], group: _Group
+                       ) -> tuple[list[int], list[int], list[int]]:
     # orbit_point_keys without numpy: the same smallest image (code as base 16, then
     # mask) and first symmetry reaching it, found once per orbit.  The images of an
     # orbit's first code r under every symmetry are its members; a member m = s(r)
     # is taken to the smallest image exactly by the t = u after s^-1 with u(r) smallest.
     edges, body_bit = group.edges, group.body_bit
     answers: dict[tuple[int, int], tuple[int, int, int]] = {}
-    keys, image_masks, sym_index = [], [], []
+    keys: list[int] = []
+    image_masks: list[int] = []
+    sym_index: list[int] = []
     for code, mask in zip(codes, masks):
         row = (int(code[:edges], 16), mask)
         if row not in answers:
@@ -376,7 +388,8 @@ def _orbit_keys_python(codes, masks, group: _Group):
     return keys, image_masks, sym_index
 
 
-def _affine(sources: Sequence[Point], targets: Sequence[Point]):
+def _affine(sources: Sequence[Point], targets: Sequence[Point]
+            ) -> tuple[tuple[tuple[Rational, ...], ...], tuple[Rational, ...]]:
     """The affine map of unit coordinates taking four affinely independent points to four others."""
     # Solve M (s_i - s_0) = (t_i - t_0) for i = 1..3 by Cramer's rule, row by row.
     u = [sub(s, sources[0]) for s in sources[1:]]
@@ -384,7 +397,7 @@ def _affine(sources: Sequence[Point], targets: Sequence[Point]):
     det = determinant(u[0], u[1], u[2])
     # With U the matrix of columns u[i], the rows of det * U^-1 are these cross products.
     inverse_t = [cross(u[1], u[2]), cross(u[2], u[0]), cross(u[0], u[1])]
-    linear = tuple(tuple(sum(v[i][row] * inverse_t[i][col] for i in range(3)) / det for col in range(3))
+    linear = tuple(tuple(Fraction(sum(v[i][row] * inverse_t[i][col] for i in range(3))) / det for col in range(3))
                    for row in range(3))
     shift = tuple(t - sum(a * x for a, x in zip(r, sources[0])) for r, t in zip(linear, targets[0]))
     return linear, shift
@@ -405,7 +418,7 @@ def shape_symmetries(shape: Shape) -> tuple[Symmetry, ...]:
         return _box_isometries(shape)  # the same group, in the box's order (see _box_isometries)
     corners, weights = shape.corners, shape.box.squared
 
-    def distance(i, j):
+    def distance(i: int, j: int) -> Rational:
         return sum(w * (a - b) ** 2 for w, a, b in zip(weights, corners[i], corners[j]))
 
     n = len(corners)
@@ -441,13 +454,13 @@ def _box_isometries(shape: Shape) -> tuple[Symmetry, ...]:
     # (1 - x) where flips[i], permutations (of axes of equal length) first, then the
     # reflections; the order that the study tables' symmetry indices refer to.
     squared = shape.box.squared
-    corner_index = {corner: i for i, corner in enumerate(CORNERS)}
+    corner_index: dict[tuple[Rational, ...], int] = {corner: i for i, corner in enumerate(CORNERS)}
     result = []
     for perm in permutations(range(3)):
         if any(squared[i] != squared[perm[i]] for i in range(3)):
             continue
         for flips in product((False, True), repeat=3):
-            def point(p):
+            def point(p: Sequence[Rational]) -> tuple[Rational, ...]:
                 return tuple(1 - p[a] if f else p[a] for a, f in zip(perm, flips))
             corner_map = tuple(corner_index[point(c)] for c in CORNERS)
             linear = tuple(tuple(Fraction(-1 if f else 1) if col == a else Fraction(0) for col in range(3))

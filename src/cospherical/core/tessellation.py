@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
+from typing import Mapping, Sequence
 
 from .configuration import Configuration
 from .delaunay import delaunay_cells
 from .element_types import ElementType, classify
-from .geometry import Frame
+from .geometry import Frame, Rational
 from .polyhedron import Polyhedron, polyhedron
+from .shapes import Point
 
 __all__ = ["Element", "Tessellation", "element_entry", "tessellate", "tessellation_elements"]
 
@@ -34,10 +35,10 @@ class Element:
         return cls(etype, order, poly, mirrored)
 
 
-def element_entry(element: Element, scale) -> dict:
+def element_entry(element: Element, scale: Sequence[float]) -> dict[str, object]:
     """An element as pattern-table data: type id, nodes in reference order, circumcenter in a
     box of edge lengths ``scale`` (floats), and ``mirror`` where it is its type's mirror image."""
-    entry = {"type": element.type.id, "nodes": list(element.nodes),
+    entry: dict[str, object] = {"type": element.type.id, "nodes": list(element.nodes),
              "circumcenter": [float(x) * s for x, s in zip(element.polyhedron.center, scale)]}
     if element.mirrored:
         entry["mirror"] = True
@@ -49,7 +50,7 @@ class Tessellation:
     """The Delaunay tessellation of one configuration (of a cuboid or another shape), elements sorted by node ids."""
 
     configuration: Configuration
-    nodes: dict[int, tuple[Fraction, Fraction, Fraction]]
+    nodes: dict[int, Point]
     elements: tuple[Element, ...]
 
     @property
@@ -66,7 +67,8 @@ class Tessellation:
     def circumcenter(self, element: Element) -> tuple[float, float, float]:
         """Float circumcenter of an element in the real box."""
         scale = self.configuration.box.to_float()
-        return tuple(float(x) * s for x, s in zip(element.polyhedron.center, scale))
+        center = element.polyhedron.center
+        return (float(center[0]) * scale[0], float(center[1]) * scale[1], float(center[2]) * scale[2])
 
 
 def tessellate(configuration: Configuration, backend: str = "python") -> Tessellation:
@@ -117,7 +119,8 @@ def tessellate(configuration: Configuration, backend: str = "python") -> Tessell
     return Tessellation(configuration, nodes, tessellation_elements(nodes, configuration.box.squared, backend))
 
 
-def tessellation_elements(nodes, squared, backend: str = "python") -> tuple[Element, ...]:
+def tessellation_elements(nodes: Mapping[int, Sequence[Rational]], squared: Sequence[Rational],
+                          backend: str = "python") -> tuple[Element, ...]:
     """The classified Delaunay elements of points ``{node id: unit coordinates}`` in a box
     with these squared lengths: the one pipeline of every base element (cuboid or other shape).
     ``backend``: the Delaunay walk's, as in :func:`tessellate`."""
