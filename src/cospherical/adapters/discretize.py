@@ -58,4 +58,4 @@ def treemesh_leaves(tree_mesh) -> TreeMeshLeaves:
     lengths = tuple(repr(float(h.sum())) for h in widths)
     scale = (1 << levels)[:, None] / np.array([float(length) for length in lengths])
     positions = np.floor((centers - np.array(origin)) * scale).astype(np.int64)
-    return TreeMeshLeaves(lengths, origin, levels, positions)
+    return TreeMeshLeaves((lengths[0], lengths[1], lengths[2]), (origin[0], origin[1], origin[2]), levels, positions)

@@ -409,7 +409,8 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
 # A tree brought as a list of leaves
 
 
-def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[int]], where: str = "leaves") -> Octree:
+def leaves_octree(box: Box, levels: Sequence[int] | np.ndarray, positions: Sequence[Sequence[int]] | np.ndarray,
+                  where: str = "leaves") -> Octree:
     """Check a list of leaves (level, i, j, k) and order it as an :class:`Octree`.
 
     The leaves must tile the domain (no overlap, no gap) and be 1-irregular (leaves
@@ -494,7 +495,7 @@ def leaves_octree(box: Box, levels: Sequence[int], positions: Sequence[Sequence[
     return Octree(box, levels_, positions_)
 
 
-def leaf_list_order(levels: Sequence[int], positions: Sequence[Sequence[int]]) -> np.ndarray:
+def leaf_list_order(levels: Sequence[int] | np.ndarray, positions: Sequence[Sequence[int]] | np.ndarray) -> np.ndarray:
     """For each leaf of ``leaves_octree(box, levels, positions)``, in the tree's order, its index in the list.
 
     The tree sorts its leaves by (level, key); a list that :func:`leaves_octree`

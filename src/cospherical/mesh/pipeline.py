@@ -76,8 +76,8 @@ def tree_from_refine(box: Box, levels: int, refine: Sequence[str | Shape], balan
                              "balance": balance, "depth": tree.depth}, None, shapes)
 
 
-def tree_from_leaves(box: Box, levels: Sequence[int], positions: Sequence[Sequence[int]], where: str = "leaves",
-                     file: str | None = None) -> TreeSource:
+def tree_from_leaves(box: Box, levels: Sequence[int] | np.ndarray, positions: Sequence[Sequence[int]] | np.ndarray,
+                     where: str = "leaves", file: str | None = None) -> TreeSource:
     """The tree of a leaf list (``levels[i]``, ``positions[i]``), checked to tile the domain and be 1-irregular.
 
     The mesh numbers the leaves as the list does; ``file`` (the list's file name) goes in the report.

@@ -170,8 +170,8 @@ def element_blocks(grid_vertices: np.ndarray, squared, nodes: np.ndarray, sizes:
         element = measure(Frame.build(points, squared), range(len(key)))
         if not element.cycles:
             raise InputError(f"element {rows[0]} is flat: it has no tetrahedra")
-        rows = np.array(rows, dtype=np.int64)
-        blocks.append((rows, np.asarray(nodes)[rows, :len(key)].astype(np.int64), element.cycles, None))
+        ids = np.array(rows, dtype=np.int64)
+        blocks.append((ids, np.asarray(nodes)[ids, :len(key)].astype(np.int64), element.cycles, None))
     return blocks
 
 
