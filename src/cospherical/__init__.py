@@ -8,16 +8,19 @@ first use, so ``import cospherical`` stays cheap for the command line.
   (the cuboid, a prism, pyramid, tetrahedron or any convex shape): ``Shape``, ``standard_shape``.
 - The element catalogue: ``shipped_catalogue``, ``load_catalogue``, ``type_name``.
 - Pattern tables: ``load_patterns``, ``PatternTable``.
+- A mesh of an octree in one call: ``build_mesh`` (refine shapes, a leaf list or a tree in,
+  an ``OctreeMesh`` out: vertices, elements, the exact report ``MeshReport``, the dual, its
+  files, ``to_pyvista``, ``to_meshio``) and ``from_treemesh`` (a ``discretize.TreeMesh`` in).
 - Errors: ``CosphericalError`` and its kinds ``InputError``, ``FormatError``, ``UsageError``;
   and ``__version__``.
 
-The mesher's entry points are in its package, :mod:`cospherical.mesh` (``octree.build_octree``,
+The mesher's steps are in its package, :mod:`cospherical.mesh` (``pipeline.run_pipeline``, ``octree.build_octree``,
 ``octree.leaves_octree``, ``assembly.assemble``, ``report.mesh_report``), its files in
 :mod:`cospherical.formats.mesh`; the command line is ``cospherical.cli.main``.  Each module's
 ``__all__`` says what it makes public; a name with a leading underscore is internal.
 
-The layers, top to bottom, each importing only from those below it: ``cli``, ``outputs``,
-``formats``, ``mesh``, ``studies``, ``catalogue``, ``paper``, ``core`` and ``files``, then
+The layers, top to bottom, each importing only from those below it: ``cli``, ``api``, ``outputs``,
+``adapters``, ``formats``, ``mesh``, ``studies``, ``catalogue``, ``paper``, ``core`` and ``files``, then
 ``errors``, ``version`` and ``caches`` (pyproject.toml's import-linter contracts).
 
 Examples

@@ -1,0 +1,67 @@
+"""The one mesh pipeline: trees from every source, progress as told, timings per stage, the report typed."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+
+import numpy as np
+import pytest
+
+from cospherical.core.configuration import Box
+from cospherical.errors import InputError
+from cospherical.mesh.assembly import assemble
+from cospherical.mesh.octree import build_octree, parse_shape
+from cospherical.mesh.pipeline import (delaunay_mode, run_pipeline, tree_from_leaves, tree_from_octree,
+                                       tree_from_refine)
+from cospherical.mesh.report import MeshReport, mesh_report
+
+BOX = Box.parse([1, 2, 4])
+
+
+def test_progress_adds_up_to_each_stage_total_and_timings_follow_the_stages():
+    told = defaultdict(list)
+    source = tree_from_refine(BOX, 3, ["sphere:0.5,1,2,0.6"])
+    result = run_pipeline(source, uniform=False, dual=True,
+                          progress=lambda stage, total, n: told[stage].append((total, n)))
+    assert set(told) == {"assembly", "regions"}  # the final check is the global step's own, not run again
+    for stage, calls in told.items():
+        totals = {total for total, _ in calls}
+        assert len(totals) == 1 and sum(n for _, n in calls) == totals.pop(), stage
+    assert told["assembly"][0][0] == len(source.tree)
+    assert told["regions"][0][0] == result.report.leaf_mesh["elements"]
+    assert list(result.report.timings) == ["assembly", "global Delaunay", "volume", "conformity", "circumcenters",
+                                           "delaunay", "statistics", "dual"]
+    assert all(seconds >= 0 for seconds in result.report.timings.values())
+    assert result.dual is not None and result.report.dual["edges"] == len(result.dual.edges)
+
+
+def test_the_pipeline_in_leaf_mode_is_the_steps_by_hand():
+    tree = build_octree(BOX, 3, [parse_shape("point:0.2,0.3,0.4")])  # 22 leaves, 5 elements not Delaunay
+    by_hand = mesh_report(assemble(tree), {"source": "leaves", "depth": tree.depth}, None, uniform=False)
+    told = defaultdict(int)
+    result = run_pipeline(tree_from_octree(tree), delaunay="leaf", uniform=False,
+                          progress=lambda stage, total, n: told.__setitem__(stage, told[stage] + n))
+    assert isinstance(result.report, MeshReport) and result.report.to_dict() == by_hand
+    assert by_hand["delaunay_violations"] > 0 and len(result.violating) == by_hand["delaunay_violations"]
+    assert dict(told) == {"assembly": len(tree), "delaunay": len(result.mesh)}
+
+
+def test_a_leaf_list_keeps_its_numbering():
+    tree = build_octree(BOX, 2, [parse_shape("point:0.2,0.3,0.4")])
+    shuffled = np.random.default_rng(3).permutation(len(tree))
+    source = tree_from_leaves(BOX, tree.levels[shuffled], tree.positions[shuffled], file="mine.txt")
+    assert np.array_equal(shuffled[source.leaf_order], np.arange(len(tree)))  # tree's leaf i is listed at leaf_order[i]
+    assert source.described == {"source": "leaves", "file": "mine.txt", "depth": 2}
+
+
+@pytest.mark.parametrize("criterion, delaunay, expected", [
+    ("optimal", None, "global"), ("internal_faces", None, "leaf"), ("optimal", "leaf", "leaf")])
+def test_the_delaunay_mode_follows_the_criterion(criterion, delaunay, expected):
+    assert delaunay_mode(criterion, delaunay) == expected
+
+
+def test_a_contradiction_is_refused():
+    with pytest.raises(InputError, match="use --delaunay leaf"):
+        delaunay_mode("internal_edges_and_faces", "global")
+    with pytest.raises(InputError, match="write global or leaf"):
+        delaunay_mode("optimal", "both")
