@@ -34,6 +34,7 @@ from ..core.geometry import Frame, Sphere, in_closed_box
 from ..core.tessellation import tessellate
 from ..errors import InputError
 from ..paper import paper_class
+from .device import Regions
 from .octree import Octree, distinct
 
 __all__ = ["CellShape", "Cells", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "NODE_OFFSETS", "PAPER_FINAL",
@@ -191,7 +192,8 @@ class Mesh:
     leaf ``element_leaf[e]``; ``element_offsets[i]`` is the first element of leaf ``i``.
     Leaves marked in ``replaced`` contribute no elements: their part of the domain
     is tiled by ``cells``, listed after every leaf element (``element_local`` -1,
-    ``element_leaf`` the cell's first leaf).
+    ``element_leaf`` the cell's first leaf).  ``regions``: which region each leaf lies in
+    (a device); ``None`` for a one-box domain.
     """
 
     tree: Octree
@@ -207,6 +209,7 @@ class Mesh:
     replaced: np.ndarray | None = None
     cells: Cells | None = None
     catalogue: dict | None = field(default=None, repr=False, compare=False)  # names the types; from assemble
+    regions: Regions | None = field(default=None, repr=False, compare=False)  # a device's regions
     _groups: list | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -215,6 +218,20 @@ class Mesh:
 
     def __len__(self) -> int:
         return len(self.element_leaf)
+
+    @property
+    def element_region(self) -> np.ndarray | None:
+        """Per element, the index of its region (its leaf's; a cell's first leaf's), or ``None`` without regions."""
+        return None if self.regions is None else self.regions.leaf_region[self.element_leaf]
+
+    @property
+    def domain_share(self) -> Fraction:
+        """The domain's volume as a fraction of the root box's (1 but for a device whose boxes leave holes)."""
+        layout = self.regions.layout if self.regions is not None else None
+        if layout is None:
+            return Fraction(1)
+        lengths = [high - low for low, high in layout.device.bounds]
+        return sum(layout.region_volumes, Fraction(0)) / (lengths[0] * lengths[1] * lengths[2])
 
     @property
     def leaf_elements(self) -> int:

@@ -25,6 +25,7 @@ from ..core.geometry import in_closed_box
 from ..core.morton import morton_codes
 from ..errors import InputError
 from .assembly import Mesh
+from .device import domain_boundary
 from .octree import distinct
 
 # Vertices found near spheres and tested exactly, at most: each test is a few microseconds of
@@ -65,7 +66,7 @@ def check_volume(mesh: Mesh) -> dict:
         share += sum((shape.grid_volume * n for shape, n in zip(mesh.cells.shapes, per_shape)), Fraction(0)) \
             / mesh.grid ** 3
         flat += sum(n for shape, n in zip(mesh.cells.shapes, per_shape) if shape.grid_volume <= 0)
-    return {"volume_ok": share == 1 and flat == 0, "volume": str(share), "flat_elements": int(flat)}
+    return {"volume_ok": share == mesh.domain_share and flat == 0, "volume": str(share), "flat_elements": int(flat)}
 
 
 def _faces(mesh: Mesh) -> dict[int, list[np.ndarray]]:
@@ -120,9 +121,12 @@ def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -
         interior += pairs
         points = mesh.vertices[turned[single]]  # (n, size, 3)
         on_boundary = np.zeros(len(single), dtype=bool)
-        for axis in range(3):
-            for side in (0, grid):
-                on_boundary |= np.all(points[:, :, axis] == side, axis=1)
+        if mesh.regions is not None and mesh.regions.layout is not None:
+            on_boundary = domain_boundary(mesh.regions.layout, points, grid)
+        else:
+            for axis in range(3):
+                for side in (0, grid):
+                    on_boundary |= np.all(points[:, :, axis] == side, axis=1)
         ok[single[on_boundary]] = True
         boundary += int(on_boundary.sum())
         if seams is not None:

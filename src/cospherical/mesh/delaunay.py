@@ -308,7 +308,7 @@ def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict) -> Mesh:
     return Mesh(mesh.tree, mesh.grid, mesh.vertices, mesh.slots, mesh.leaf_tessellation, mesh.tessellations, offsets,
                 np.r_[element_leaf, cells.leaf.astype(np.int32)], np.r_[element_local, np.full(len(cells), -1,
                                                                                               dtype=np.int16)],
-                types, replaced=bad, cells=cells, catalogue=mesh.catalogue)
+                types, replaced=bad, cells=cells, catalogue=mesh.catalogue, regions=mesh.regions)
 
 
 def _regions(nodes: np.ndarray, vertices: int) -> tuple[np.ndarray, int]:

@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass
 from fractions import Fraction
 from itertools import product
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -356,7 +356,8 @@ def check_leaf_count(count: int, what: str, max_leaves: int | None = None) -> No
 
 
 def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = "vertex",
-                 max_leaves: int | None = None) -> Octree:
+                 max_leaves: int | None = None,
+                 must_split: Callable[[int, np.ndarray], np.ndarray] | None = None, resolve: int = 0) -> Octree:
     """Refine every cell whose closed box meets a shape down to ``levels``, then 2:1 balance (coarsest).
 
     ``balance``: ``vertex`` (leaves touching across a face, an edge or a corner
@@ -364,6 +365,9 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
     Face-only balance is refused: it is not 1-irregular (an edge can get two points).
     A tree whose estimated leaves (:func:`estimate_leaves`) exceed ``max_leaves``
     (default :func:`leaf_bound`) is refused before any cell is visited.
+    ``must_split(level, cells)`` (cells n x 3 at ``level``): which cells are split
+    whatever the shapes say, at every level below ``max(levels, resolve)`` (a device's
+    region boundaries, :mod:`cospherical.mesh.device`).
 
     Examples
     --------
@@ -385,17 +389,20 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
     check_leaf_count(estimate_leaves(box, levels, shapes), f"--levels {levels}: an estimated", max_leaves)
     split: list[np.ndarray] = []
     existing = np.zeros(1, dtype=np.int64)
-    for level in range(levels):
+    deepest = max(levels, resolve)
+    for level in range(deepest):
         cells = _cells_of(level, existing)
         hit = np.zeros(len(cells), dtype=bool)
-        for shape in shapes:
+        for shape in shapes if level < levels else ():
             hit |= _meets(shape, box, level, cells)
+        if must_split is not None:
+            hit |= must_split(level, cells)
         split.append(existing[hit])
         # every cell of the next level is or holds a leaf: the estimate's guard, before the children exist
         check_leaf_count(8 * len(split[-1]), f"--levels {levels}: level {level + 1} has at least", max_leaves)
         existing = _children(level, split[-1])
     offsets = _offsets(balance)
-    for level in range(levels - 1, 0, -1):
+    for level in range(deepest - 1, 0, -1):
         # every neighbour of a split cell must exist: its parent must be split
         need = _neighbours(level, _cells_of(level, split[level]), offsets)
         parents = distinct(_keys_of(level - 1, _cells_of(level, need) // 2))

@@ -96,14 +96,16 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
 def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dict, patterns: str | None,
                   criterion: str = "optimal", uniform: bool = True, delaunay: bool = True,
                   leaf_mesh: dict | None = None, cells: tuple[int, int] = (0, 0), seams: list | None = None,
-                  vertex_points: Callable | None = None, grid: int = 1, *, catalogue: dict) -> dict:
+                  vertex_points: Callable | None = None, grid: int = 1, *, catalogue: dict,
+                  domain_share: Fraction = Fraction(1)) -> dict:
     """The report of a mesh from the :func:`mesh_figures` of its pieces (one piece: the whole mesh).
 
     ``catalogue``: the element catalogue the pieces were assembled with (it names the types).
 
     ``cells``: the regions re-tessellated and the largest one's vertices; ``seams``:
     the faces the pieces left open, paired here (``vertex_points(ids)`` gives their
-    grid points, for the examples).
+    grid points, for the examples).  ``domain_share``: the domain's volume as a fraction of the
+    root box's (a device's boxes can leave part of their bounding box out).
     """
     summed = {key: sum(part[key] for part in parts) for key in _SUMMED if all(key in part for part in parts)}
     report = {
@@ -134,7 +136,7 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
         "types_outside_catalogue": sorted(outside.values(), key=lambda e: (-e["count"], e["id"])),
     })
     volume = sum((part["volume"] for part in parts), Fraction(0))
-    report.update({"volume_ok": volume == 1 and summed["flat_elements"] == 0, "volume": str(volume),
+    report.update({"volume_ok": volume == domain_share and summed["flat_elements"] == 0, "volume": str(volume),
                    "flat_elements": summed["flat_elements"]})
     examples = [e for part in parts for e in part["nonconforming_examples"]]
     conformity = {key: summed[key] for key in ("nonconforming_faces", "interior_faces", "boundary_faces")}
@@ -205,7 +207,7 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
         violating.append(figures["_violating"])
     cells = (mesh.cells.regions, mesh.cells.largest_region) if mesh.cells is not None else (0, 0)
     return merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
-                         leaf_mesh, cells, catalogue=mesh.catalogue)
+                         leaf_mesh, cells, catalogue=mesh.catalogue, domain_share=mesh.domain_share)
 
 
 # The report's keys that are left out, rather than written as null, when they were not computed:

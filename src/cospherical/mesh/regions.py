@@ -1,0 +1,234 @@
+"""A device's mesh: elements in regions, the exact Delaunay subdivision box by box, contacts and interfaces.
+
+Each leaf of a device's tree lies in one box of one region
+(:mod:`cospherical.mesh.device`), so each leaf element does.  In the global
+Delaunay mode the elements of each **box of the device file** are the exact Delaunay
+subdivision of the vertices on that closed box (the largest co-spherical cells),
+built as the whole-domain mode builds it (:mod:`cospherical.mesh.delaunay`, whose
+proof holds word for word with the box as the domain: the box is convex, tiled by
+its leaves, and its vertices are the corners of its leaves).  So:
+
+- every element lies in one box, hence in one region, and a cell never crosses an
+  interface, the domain's boundary, or a face between two boxes of one region;
+- within a box the elements are exactly the Delaunay subdivision of the box's
+  vertices: each element's circumsphere holds no vertex of the box strictly inside,
+  and none on it but the element's own nodes.  A vertex *outside* the box may lie
+  inside an element's sphere (behind an interface, across a notch of a non-convex
+  domain): the box method's coefficients of such elements can be negative, and the
+  report counts the negative interior coefficients per region;
+- across a face between two boxes both sides are cut by the Delaunay subdivision of
+  the points on the face; the report's exact conformity check says whether they
+  match (``nonconforming_faces``).  Where they do not, the mesh falls back to the
+  leaf elements in the boxes concerned (each leaf's exact Delaunay subdivision,
+  conforming by construction) and says so (``delaunay_mode``).
+
+A device of one box is meshed exactly as a one-box domain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from .assembly import Cells, Lookup, Mesh, assemble, vertex_keys
+from .checks import check_conformity
+from .delaunay import delaunay_mesh, with_cells
+from .device import DeviceLayout, Regions, leaf_owner
+from .octree import Octree
+
+__all__ = ["RegionFaces", "contact_areas", "device_mesh", "region_faces"]
+
+
+def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, lookup: Lookup | None = None,
+                criterion: str = "optimal", mode: str = "global", progress=None,
+                cache: dict | None = None) -> tuple[Mesh, dict | None, dict | None]:
+    """Mesh a device's tree: the leaf mesh, then in ``global`` mode the exact Delaunay subdivision box by box.
+
+    Returns what :func:`~cospherical.mesh.delaunay.delaunay_mesh` returns: the mesh,
+    what the check found on the leaf mesh (summed over the boxes), and the check of
+    the result (the boxes' checks summed; each against its own box's vertices).
+    """
+    device = layout.device
+    regions = Regions(tuple(r.name for r in device.regions), tuple(r.material for r in device.regions),
+                      leaf_region, layout)
+    cache = {} if cache is None else cache
+    mesh = assemble(tree, lookup, criterion=criterion, cache=cache)
+    mesh.regions = regions
+    boxes = sum(len(r.boxes) for r in device.regions)
+    if mode != "global" or boxes == 1:
+        return delaunay_mesh(mesh, mode, progress=progress)
+    leaf_box = leaf_owner(layout, tree.levels, tree.positions, boxes=True)
+    grid, keys = vertex_keys(tree)
+    n = np.int64(grid + 1)
+    points = np.stack([keys // (n * n), (keys // n) % n, keys % n], axis=1)
+    factor = grid // layout.steps
+    bounds = _box_bounds(layout) * factor
+    parts, found, checks, types = [], [], [], dict(mesh.types)
+    bad = np.zeros(len(tree), dtype=bool)
+    for b in range(boxes):
+        leaves = np.flatnonzero(leaf_box == b)
+        low, high = bounds[b, :3], bounds[b, 3:]
+        ids = np.flatnonzero(np.all((points >= low) & (points <= high), axis=1))
+        sub = assemble(Octree(tree.box, tree.levels[leaves], tree.positions[leaves]), lookup, cache=cache,
+                       criterion=criterion, vertices=(grid, keys[ids]), catalogue=mesh.catalogue)
+        result, leaf, checked = delaunay_mesh(sub, "global")
+        found.append(leaf)
+        checks.append(checked)
+        if result.cells is None:
+            continue
+        types.update(result.types)
+        bad[leaves[result.replaced]] = True
+        cells = result.cells
+        nodes = np.where(cells.nodes >= 0, ids[np.maximum(cells.nodes, 0)], -1).astype(np.int32)
+        parts.append(Cells(cells.shapes, cells.shape, cells.anchor, nodes, leaves[cells.leaf], cells.spanning,
+                           cells.proven, cells.regions, cells.largest_region))
+    leaf = {key: sum(f[key] for f in found) for key in found[0]}
+    checked = {key: (sum(c[key] for c in checks) if not key.startswith("_") else np.zeros(0, dtype=np.int64))
+               for key in checks[0]}
+    if not parts:
+        return mesh, leaf, checked
+    merged = _merged(parts)
+    result = with_cells(mesh, bad, merged, types)
+    if check_conformity(result, examples=0)["nonconforming_faces"]:
+        # the boxes' subdivisions do not meet face to face: the leaf mesh, conforming by construction
+        return mesh, dict(leaf, fallback="leaf elements: the boxes' Delaunay subdivisions do not meet face to face"), \
+            None
+    return result, leaf, checked
+
+
+def _box_bounds(layout: DeviceLayout) -> np.ndarray:
+    """Every box of the device (file order over the regions) in steps of the resolving level, (boxes x 6)."""
+    device = layout.device
+    bounds = device.bounds
+    rows = []
+    for region in device.regions:
+        for box in region.boxes:
+            rows.append([int((box[i] - bounds[i % 3][0]) / (bounds[i % 3][1] - bounds[i % 3][0]) * layout.steps)
+                         for i in range(6)])
+    return np.array(rows, dtype=np.int64).reshape(-1, 6)
+
+
+def _merged(parts: list[Cells]) -> Cells:
+    """The cells of several boxes as one :class:`Cells` (shape indices shifted past the earlier boxes' shapes)."""
+    shapes, shape, offset = [], [], 0
+    for cells in parts:
+        shapes.extend(cells.shapes)
+        shape.append(cells.shape + offset)
+        offset += len(cells.shapes)
+    width = max(c.nodes.shape[1] for c in parts)
+    nodes = np.concatenate([np.pad(c.nodes, ((0, 0), (0, width - c.nodes.shape[1])), constant_values=-1)
+                            for c in parts])
+    return Cells(shapes, np.concatenate(shape).astype(np.int32), np.concatenate([c.anchor for c in parts]), nodes,
+                 np.concatenate([c.leaf for c in parts]), np.concatenate([c.spanning for c in parts]),
+                 np.concatenate([c.proven for c in parts]), sum(c.regions for c in parts),
+                 max(c.largest_region for c in parts))
+
+
+@dataclass(frozen=True)
+class RegionFaces:
+    """A device mesh's named face sets: contacts and interfaces (polygons of global vertex ids, -1 padded).
+
+    Contact faces: ``contact_nodes`` (f x w), counter-clockwise seen from outside their
+    element ``contact_element``, on contact ``contact_face_contact`` (index into the
+    device's contacts).  Interface faces, once each: ``interface_nodes``, oriented out
+    of ``interface_element[:, 0]`` (the element of the lower region index) into
+    ``interface_element[:, 1]``; ``interface_face_interface`` indexes ``interfaces``,
+    the pairs of touching regions ``(a, b)``, ``a < b``, named ``"name_a|name_b"``.
+    """
+
+    contact_nodes: np.ndarray
+    contact_element: np.ndarray
+    contact_face_contact: np.ndarray
+    interfaces: np.ndarray
+    interface_names: tuple[str, ...]
+    interface_nodes: np.ndarray
+    interface_element: np.ndarray
+    interface_face_interface: np.ndarray
+
+    def contact_vertices(self, contact: int) -> np.ndarray:
+        """The distinct vertices of a contact's faces, increasing."""
+        nodes = self.contact_nodes[self.contact_face_contact == contact]
+        return np.unique(nodes[nodes >= 0])
+
+
+def region_faces(mesh: Mesh) -> RegionFaces:
+    """The contact and interface faces of a device mesh (see :class:`RegionFaces`).
+
+    Faces are paired by their sorted global vertex ids; a face met once lies on a
+    contact when it is flat in the contact's plane and its vertices lie in the
+    contact's closed rectangle (a face of a conforming mesh lies in one leaf face,
+    which lies inside or outside the contact: the tree was refined so).
+    """
+    regions = mesh.regions
+    layout = regions.layout
+    element_region = mesh.element_region
+    rows, polygons, sizes = [], [], []
+    width = 0
+    for element_rows, nodes, faces, _ in mesh.blocks():
+        for cycle in faces:
+            rows.append(element_rows)
+            polygons.append(nodes[:, list(cycle)])
+            width = max(width, len(cycle))
+    if not rows:
+        empty = np.zeros((0, 0), dtype=np.int32)
+        return RegionFaces(empty, np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros((0, 2), np.int32), (),
+                           empty, np.zeros((0, 2), np.int64), np.zeros(0, np.int32))
+    element = np.concatenate(rows).astype(np.int64)
+    face = np.concatenate([np.pad(p, ((0, 0), (0, width - p.shape[1])), constant_values=-1) for p in polygons])
+    key = np.sort(np.where(face < 0, np.iinfo(np.int32).max, face), axis=1)
+    order = np.lexsort(key.T[::-1])
+    key, element, face = key[order], element[order], face[order]
+    same = np.all(key[1:] == key[:-1], axis=1)
+    first = np.r_[True, ~same]
+    last = np.r_[~same, True]
+    single = first & last
+    paired = np.flatnonzero(first & ~last)  # the first of each pair (a conforming mesh has no more)
+    # interfaces: pairs of elements of different regions
+    ra, rb = element_region[element[paired]], element_region[element[paired + 1]]
+    across = ra != rb
+    pa, pb = paired[across], paired[across] + 1
+    swap = element_region[element[pa]] > element_region[element[pb]]
+    lower = np.where(swap, pb, pa)
+    upper = np.where(swap, pa, pb)
+    pairs = np.stack([element_region[element[lower]], element_region[element[upper]]], axis=1)
+    interfaces, which = (np.unique(pairs, axis=0, return_inverse=True) if len(pairs)
+                         else (np.zeros((0, 2), np.int64), np.zeros(0, np.int64)))
+    names = tuple(f"{regions.names[a]}|{regions.names[b]}" for a, b in interfaces.tolist())
+    # contacts: faces met once, flat in the contact's plane, inside its rectangle
+    ones = np.flatnonzero(single)
+    points = mesh.vertices.astype(np.int64)[np.maximum(face[ones], 0)]
+    valid = face[ones] >= 0
+    factor = mesh.grid // layout.steps
+    contact_of = np.full(len(ones), -1, dtype=np.int64)
+    for c, (axis, value, (p0, p1), (q0, q1)) in enumerate(layout.contacts):
+        b, d = (axis + 1) % 3, (axis + 2) % 3
+        on = np.all(~valid | (points[:, :, axis] == value * factor), axis=1)
+        on &= np.all(~valid | ((points[:, :, b] >= p0 * factor) & (points[:, :, b] <= p1 * factor)
+                               & (points[:, :, d] >= q0 * factor) & (points[:, :, d] <= q1 * factor)), axis=1)
+        region = [r.name for r in layout.device.regions].index(layout.device.contacts[c].region)
+        on &= element_region[element[ones]] == region
+        contact_of[on & (contact_of < 0)] = c
+    hit = contact_of >= 0
+    return RegionFaces(face[ones[hit]].astype(np.int32), element[ones[hit]], contact_of[hit].astype(np.int32),
+                       interfaces.astype(np.int32), names, face[lower].astype(np.int32),
+                       np.stack([element[lower], element[upper]], axis=1), which.astype(np.int32).reshape(-1))
+
+
+def contact_areas(mesh: Mesh, faces: RegionFaces) -> list[Fraction]:
+    """Each contact's area from its faces, exactly, in device units (the polygons' shoelace areas)."""
+    layout = mesh.regions.layout
+    lengths = [high - low for low, high in layout.device.bounds]
+    areas = [Fraction(0)] * len(layout.contacts)
+    vertices = mesh.vertices.astype(np.int64)
+    for c, (axis, _, _, _) in enumerate(layout.contacts):
+        b, d = (axis + 1) % 3, (axis + 2) % 3
+        twice = 0
+        for polygon in faces.contact_nodes[faces.contact_face_contact == c]:
+            p = vertices[polygon[polygon >= 0]]
+            x, y = p[:, b], p[:, d]
+            twice += abs(int((x * np.roll(y, -1) - np.roll(x, -1) * y).sum()))
+        areas[c] = Fraction(twice, 2 * mesh.grid ** 2) * lengths[b] * lengths[d]
+    return areas
+
