@@ -59,7 +59,7 @@ from ..core.polyhedron import measure
 from ..errors import InputError
 from .octree import distinct
 
-__all__ = ["Dual", "ElementPieces", "TETRAHEDRAL_LIMIT", "boundary_areas", "delaunay_tetrahedra", "dual_summary",
+__all__ = ["Dual", "ElementPieces", "RegionParts", "TETRAHEDRAL_LIMIT", "boundary_areas", "delaunay_tetrahedra", "dual_summary",
            "element_pieces", "mesh_dual", "tetrahedral_counts"]
 
 Point = tuple[Fraction, Fraction, Fraction]
@@ -194,6 +194,7 @@ class Dual:
     element_circumcenter: np.ndarray = field(repr=False)
     element_nodes: np.ndarray = field(repr=False)
     element_sizes: np.ndarray = field(repr=False)
+    regions: "RegionParts | None" = field(default=None, repr=False)
 
     def laplacian(self):
         """The box method's matrix: ``K[i, j] = -coefficient``, ``K[i, i]`` the row's sum (scipy.sparse CSR).
@@ -242,6 +243,68 @@ class Dual:
         for side in (0, self.grid):
             on_plane |= np.any((a == side) & (b == side), axis=1)
         return {"interior": int((negative & ~on_plane).sum()), "boundary": int((negative & on_plane).sum())}
+
+
+@dataclass
+class RegionParts:
+    """A device's dual split per region, and its contacts' areas per vertex, exactly.
+
+    ``names``/``materials`` of the regions, ``element_region`` (per element, mesh order).
+    Control-volume parts, one row per (vertex, region) pair, sorted:
+    ``volume_vertex``, ``volume_region``, ``volume_exact`` over ``volume_denominator``
+    (times the dual's ``volume_factor``, like its control volumes).  Coupling parts, one
+    row per (edge, region): ``coupling_edge`` (index into the dual's edges),
+    ``coupling_region``, ``coupling_exact`` over ``coupling_denominator`` (times
+    ``volume_factor``, like the coefficients).  Contacts: ``contact_names``,
+    ``contact_regions``, ``contact_boxes`` (exact texts, device units), the faces
+    (``contact_face_nodes``, -1 padded, ``contact_face_contact``), and the area parts per
+    (vertex, contact): ``contact_vertex``, ``contact_contact``, ``contact_exact`` over
+    ``contact_denominator``, in device units (a device's lengths are rational).
+    """
+
+    names: tuple[str, ...]
+    materials: tuple[str, ...]
+    element_region: np.ndarray
+    volume_vertex: np.ndarray
+    volume_region: np.ndarray
+    volume_exact: np.ndarray
+    volume_denominator: int
+    coupling_edge: np.ndarray
+    coupling_region: np.ndarray
+    coupling_exact: np.ndarray
+    coupling_denominator: int
+    contact_names: tuple[str, ...]
+    contact_regions: tuple[int, ...]
+    contact_boxes: tuple[tuple[str, ...], ...]
+    contact_face_nodes: np.ndarray
+    contact_face_contact: np.ndarray
+    contact_vertex: np.ndarray
+    contact_contact: np.ndarray
+    contact_exact: np.ndarray
+    contact_denominator: int
+    volume_factor: float
+
+    @property
+    def volume_part(self) -> np.ndarray:
+        return _scaled(self.volume_exact, self.volume_denominator, self.volume_factor)
+
+    @property
+    def coupling_part(self) -> np.ndarray:
+        return _scaled(self.coupling_exact, self.coupling_denominator, self.volume_factor)
+
+    @property
+    def contact_part(self) -> np.ndarray:
+        return _scaled(self.contact_exact, self.contact_denominator, 1.0)
+
+    def region_volumes(self) -> list[Fraction]:
+        """Each region's control-volume parts summed, as exact multiples of ``volume_factor``."""
+        return [Fraction(int(np.sum(self.volume_exact[self.volume_region == r].astype(object))),
+                         self.volume_denominator) for r in range(len(self.names))]
+
+    def contact_areas(self) -> list[Fraction]:
+        """Each contact's area parts summed, exactly (device units)."""
+        return [Fraction(int(np.sum(self.contact_exact[self.contact_contact == c].astype(object))),
+                         self.contact_denominator) for c in range(len(self.contact_names))]
 
 
 def _lcm_denominator(values) -> int:

@@ -27,6 +27,7 @@ A device of one box is meshed exactly as a one-box domain.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -35,10 +36,11 @@ import numpy as np
 from .assembly import Cells, Lookup, Mesh, assemble, vertex_keys
 from .checks import check_conformity
 from .delaunay import delaunay_mesh, with_cells
+from .dual import Dual, RegionParts, mesh_dual
 from .device import DeviceLayout, Regions, leaf_owner
 from .octree import Octree
 
-__all__ = ["RegionFaces", "contact_areas", "device_mesh", "region_faces"]
+__all__ = ["RegionFaces", "contact_areas", "device_mesh", "mesh_region_parts", "region_faces", "region_parts"]
 
 
 def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, lookup: Lookup | None = None,
@@ -232,3 +234,140 @@ def contact_areas(mesh: Mesh, faces: RegionFaces) -> list[Fraction]:
         areas[c] = Fraction(twice, 2 * mesh.grid ** 2) * lengths[b] * lengths[d]
     return areas
 
+
+
+@dataclass(frozen=True)
+class _Vertices:
+    """What :func:`~cospherical.mesh.dual.mesh_dual` reads of a mesh when it is given the elements."""
+
+    box: object
+    grid: int
+    vertices: np.ndarray
+
+
+def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_region: np.ndarray,
+                 names: tuple[str, ...], materials: tuple[str, ...], contacts: tuple = (),
+                 contact_face_nodes: np.ndarray | None = None, contact_face_contact: np.ndarray | None = None,
+                 lengths: tuple[Fraction, Fraction, Fraction] | None = None) -> RegionParts:
+    """The dual of each region's elements alone (exact), as parts of ``dual`` (see :class:`RegionParts`).
+
+    A region's part of a control volume or of a coupling is the dual of its own
+    elements (:func:`~cospherical.mesh.dual.mesh_dual` on them): the box method's
+    element pieces add up, so the parts of every vertex and edge sum to its total
+    exactly.  ``contacts``: per contact ``(name, region index, box texts, axis)``, with
+    its faces; a face's area goes to its vertices as the box method's boundary pieces
+    do (the triangles between each vertex, its edges' midpoints and the face's circle
+    centre), exactly; ``lengths``: the bounding box's rational lengths.
+    """
+    keys = dual.edges[:, 0].astype(np.int64) * len(vertices) + dual.edges[:, 1]
+    mesh = _Vertices(box, grid, vertices)
+    vv, vr, ve, ce, cr, cx, vden, cden = [], [], [], [], [], [], [], []
+    for r in range(len(names)):
+        rows = np.flatnonzero(element_region == r)
+        part = mesh_dual(mesh, (dual.element_nodes[rows], dual.element_sizes[rows]))
+        used = np.flatnonzero(np.asarray(part.volume_exact != 0) | _used(dual.element_nodes[rows], len(vertices)))
+        vv.append(used)
+        vr.append(np.full(len(used), r, dtype=np.int32))
+        ve.append(part.volume_exact[used])
+        vden.append(part.volume_denominator)
+        edge = np.searchsorted(keys, part.edges[:, 0].astype(np.int64) * len(vertices) + part.edges[:, 1])
+        ce.append(edge)
+        cr.append(np.full(len(edge), r, dtype=np.int32))
+        cx.append(part.coefficient_exact)
+        cden.append(part.coefficient_denominator)
+    volume_denominator, coupling_denominator = math.lcm(*vden), math.lcm(*cden)
+    volume_exact = _common(ve, vden, volume_denominator)
+    coupling_exact = _common(cx, cden, coupling_denominator)
+    vv, vr = np.concatenate(vv), np.concatenate(vr)
+    order = np.lexsort((vr, vv))
+    ce, cr = np.concatenate(ce), np.concatenate(cr)
+    corder = np.lexsort((cr, ce))
+    if contact_face_nodes is None:
+        contact_face_nodes = np.zeros((0, 3), dtype=np.int32)
+        contact_face_contact = np.zeros(0, dtype=np.int32)
+    shares = _contact_shares(vertices, grid, contact_face_nodes, contact_face_contact,
+                             [c[3] for c in contacts], lengths)
+    pairs = sorted(shares)
+    contact_denominator = math.lcm(1, *(q.denominator for q in shares.values()))
+    return RegionParts(
+        tuple(names), tuple(materials), element_region.astype(np.int32), vv[order].astype(np.int64),
+        vr[order], volume_exact[order], volume_denominator, ce[corder].astype(np.int64), cr[corder],
+        coupling_exact[corder], coupling_denominator, tuple(c[0] for c in contacts), tuple(c[1] for c in contacts),
+        tuple(tuple(c[2]) for c in contacts), contact_face_nodes.astype(np.int32),
+        contact_face_contact.astype(np.int32), np.array([v for v, _ in pairs], dtype=np.int64).reshape(-1),
+        np.array([c for _, c in pairs], dtype=np.int32).reshape(-1),
+        _narrow([int(shares[p] * contact_denominator) for p in pairs]), contact_denominator, dual.volume_factor)
+
+
+def _used(nodes: np.ndarray, count: int) -> np.ndarray:
+    used = np.zeros(count, dtype=bool)
+    used[nodes[nodes >= 0]] = True
+    return used
+
+
+def _narrow(values: list[int]) -> np.ndarray:
+    """Integers as int64 when they fit with room for sums, else Python integers (object)."""
+    fits = all(abs(v) < 2**62 // max(1, len(values)) for v in values)
+    return np.array(values, dtype=np.int64 if fits else object).reshape(-1)
+
+
+def _common(parts: list[np.ndarray], denominators: list[int], common: int) -> np.ndarray:
+    """Numerators over their own denominators, brought over one ``common`` denominator (exact)."""
+    values = [int(x) * (common // d) for part, d in zip(parts, denominators) for x in part.tolist()]
+    return _narrow(values)
+
+
+def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: np.ndarray, axes: list[int],
+                    lengths) -> dict[tuple[int, int], Fraction]:
+    """Per (vertex, contact), its part of the contact's faces' area, exactly (device units).
+
+    A co-circular face gives each vertex the triangles between it, the midpoints of
+    its two edges and the face's circle centre (signed: they add up to the face's
+    area whatever the shape); computed once per face shape up to translation.
+    """
+    shares: dict[tuple[int, int], Fraction] = {}
+    cache: dict = {}
+    for face, c in zip(faces.tolist(), which.tolist()):
+        ids = [v for v in face if v >= 0]
+        axis = axes[c]
+        b, d = (axis + 1) % 3, (axis + 2) % 3
+        points = vertices[ids][:, [b, d]].astype(np.int64)
+        key = (axis, (points - points[0]).tobytes())
+        if key not in cache:
+            scale = (Fraction(lengths[b]) / grid, Fraction(lengths[d]) / grid)
+            p = [(Fraction(int(x)) * scale[0], Fraction(int(y)) * scale[1]) for x, y in (points - points[0])]
+            cache[key] = _polygon_shares(p)
+        for v, q in zip(ids, cache[key]):
+            shares[v, c] = shares.get((v, c), Fraction(0)) + q
+    return shares
+
+
+def _polygon_shares(p: list[tuple[Fraction, Fraction]]) -> list[Fraction]:
+    """Each vertex's share of a co-circular polygon's area (circle centre, edge midpoints), exactly."""
+    (x0, y0), (x1, y1), (x2, y2) = p[:3]
+    # the circle's centre: equidistant from the first three points
+    a1, b1, c1 = 2 * (x1 - x0), 2 * (y1 - y0), x1 * x1 - x0 * x0 + y1 * y1 - y0 * y0
+    a2, b2, c2 = 2 * (x2 - x0), 2 * (y2 - y0), x2 * x2 - x0 * x0 + y2 * y2 - y0 * y0
+    det = a1 * b2 - a2 * b1
+    fx, fy = (c1 * b2 - c2 * b1) / det, (a1 * c2 - a2 * c1) / det
+    n = len(p)
+    twice = sum(p[i][0] * p[(i + 1) % n][1] - p[(i + 1) % n][0] * p[i][1] for i in range(n))
+    sign = 1 if twice > 0 else -1
+    shares = [Fraction(0)] * n
+    for i in range(n):
+        (ux, uy), (vx, vy) = p[i], p[(i + 1) % n]
+        half = sign * ((vx - ux) * (fy - uy) - (vy - uy) * (fx - ux)) / 4  # half the triangle (u, v, f)
+        shares[i] += half
+        shares[(i + 1) % n] += half
+    return shares
+
+
+def mesh_region_parts(mesh: Mesh, dual: Dual, faces: RegionFaces) -> RegionParts:
+    """:func:`region_parts` of a device mesh, its contacts from ``faces``."""
+    layout = mesh.regions.layout
+    device = layout.device
+    names = [r.name for r in device.regions]
+    contacts = tuple((c.name, names.index(c.region), tuple(str(x) for x in c.box), c.axis) for c in device.contacts)
+    lengths = tuple(high - low for low, high in device.bounds)
+    return region_parts(mesh.box, mesh.grid, mesh.vertices, dual, mesh.element_region, mesh.regions.names,
+                        mesh.regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths)
