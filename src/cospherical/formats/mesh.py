@@ -35,6 +35,7 @@ from ..mesh.octree import check_leaf_count, leaf_bound
 from .check import EntryCheck
 
 __all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "VtuGrid", "vtu_arrays", "vtu_grid",
+           "write_faces_vtu",
            "write_piece", "write_pvtu", "write_report", "write_vtu"]
 
 REPORT_SCHEMA_VERSION = 1
@@ -271,7 +272,7 @@ def vtu_arrays(mesh: Mesh) -> dict:
 
 
 def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell_data: dict | None = None,
-              leaves: np.ndarray | None = None) -> None:
+              leaves: np.ndarray | None = None, field_data: dict | None = None, origin=None) -> None:
     """Write the mesh as one compressed binary VTU grid, atomically (a complete new file or the old one).
 
     Standard VTK cells (tetra, pyramid, wedge, hexahedron, nodes in VTK order) for
@@ -281,7 +282,7 @@ def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell
     """
     from .vtu import write_grid
 
-    grid = vtu_grid(mesh, point_data, cell_data, leaves)
+    grid = vtu_grid(mesh, point_data, cell_data, leaves, field_data, origin)
     write_grid(path, grid.points, grid.types, grid.connectivity, grid.offsets, grid.faces, grid.faceoffsets,
                point_data=grid.point_data, cell_data=grid.cell_data, field_data=grid.field_data)
 
@@ -302,7 +303,7 @@ class VtuGrid:
 
 
 def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None = None,
-             leaves: np.ndarray | None = None) -> VtuGrid:
+             leaves: np.ndarray | None = None, field_data: dict | None = None, origin=None) -> VtuGrid:
     """The grid :func:`write_vtu` writes (and the pyvista adapter builds in memory), cells sorted by VTK cell type.
 
     Point data: ``grid_coordinates`` (the exact integer grid point of each vertex),
@@ -319,7 +320,9 @@ def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None 
     ``type_names`` (one per line, in ``type`` order), ``domain`` (the lengths as
     given), ``domain_squared`` (their exact squares), and ``grid_intervals``: a point's
     exact coordinate along an axis is ``grid_coordinates * length / grid_intervals``;
-    the ``Points`` are the same as floats.
+    the ``Points`` are the same as floats.  ``field_data``: more of them (text as
+    above); ``origin``: the real point of grid point 0 (a device's bounding box's low
+    corner; default the origin).
     """
     from .vtu import narrow, text_array
 
@@ -346,7 +349,13 @@ def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None 
         if name in points:
             raise ValueError(f"point data {name!r}: the writer's own")
         points[name] = values
+    for name, values in (field_data or {}).items():
+        if name in fields:
+            raise ValueError(f"field data {name!r}: the writer's own")
+        fields[name] = values
     coordinates = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+    if origin is not None:
+        coordinates = coordinates + np.array([float(x) for x in origin])
     return VtuGrid(coordinates, arrays["types"], arrays["connectivity"], arrays["offsets"], arrays["faces"],
                    arrays["faceoffsets"], points, cells, fields)
 
@@ -426,3 +435,43 @@ def write_pvtu(path: str | Path, pieces: list[Path]) -> None:
            *(f"<Piece Source={quoteattr(Path(piece).name)}/>" for piece in pieces),
            "</PUnstructuredGrid>", "</VTKFile>"]
     atomic_write(path, "\n".join(xml) + "\n")
+
+
+def write_faces_vtu(mesh: Mesh, faces, path: str | Path, origin=None) -> None:
+    """Write a device's contact and interface faces as one VTU of polygons, atomically.
+
+    Cells: every contact face (cell data ``contact``: its index in the field data
+    ``contact_names``, ``interface`` -1), then every interface face (``interface``: its
+    index in ``interface_names``, ``contact`` -1), each polygon counter-clockwise seen
+    from outside its element (an interface face: from outside its first region's
+    element).  Points: only the vertices the faces use, point data ``global_id`` (the
+    vertex's index in ``mesh.vtu``) and ``grid_coordinates``.
+    """
+    from .vtu import narrow, text_array, write_grid
+
+    polygons = np.concatenate(_padded(faces.contact_nodes, faces.interface_nodes))
+    used = polygons >= 0
+    ids = np.unique(polygons[used])
+    local = np.searchsorted(ids, np.where(used, polygons, ids[0] if len(ids) else 0))
+    connectivity = local[used].astype(np.int64)
+    offsets = np.cumsum(used.sum(axis=1), dtype=np.int64)
+    n_contact = len(faces.contact_nodes)
+    contact = np.r_[faces.contact_face_contact, np.full(len(faces.interface_nodes), -1)].astype(np.int32)
+    interface = np.r_[np.full(n_contact, -1), faces.interface_face_interface].astype(np.int32)
+    coordinates = mesh.vertices[ids] * (np.array(mesh.box.to_float()) / mesh.grid)
+    if origin is not None:
+        coordinates = coordinates + np.array([float(x) for x in origin])
+    device = mesh.regions.layout.device
+    fields = {"contact_names": text_array("\n".join(c.name for c in device.contacts)),
+              "interface_names": text_array("\n".join(faces.interface_names)),
+              "grid_intervals": np.array([mesh.grid], dtype=np.int64)}
+    write_grid(path, coordinates, np.full(len(polygons), 7, dtype=np.uint8), connectivity, offsets,
+               point_data={"global_id": ids.astype(np.int64), "grid_coordinates": narrow(mesh.vertices[ids])},
+               cell_data={"contact": contact, "interface": interface}, field_data=fields)
+
+
+def _padded(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two -1 padded arrays of rows brought to one width."""
+    width = max(a.shape[1] if a.ndim == 2 else 0, b.shape[1] if b.ndim == 2 else 0, 1)
+    return tuple(np.pad(x.reshape(len(x), -1), ((0, 0), (0, width - x.reshape(len(x), -1).shape[1])),
+                        constant_values=-1) for x in (a, b))

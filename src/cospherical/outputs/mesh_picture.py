@@ -21,8 +21,14 @@ WHITE, BLACK, GREY = (255, 255, 255), (0, 0, 0), (204, 204, 204)
 _OVER = 3  # over-sampling of the polygons: their outlines a third of a pixel wide, as thin as matplotlib's
 
 
-def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[str]]:
+# the picture's axes (horizontal, vertical) for a cut across each axis: x-y for z, x-z for y, y-z for x
+_PLANES = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
+
+
+def cut_polygons(mesh: Mesh, at: float = 0.5, axis: int = 2) -> tuple[list[np.ndarray], list[str]]:
     """The sections of the elements by the plane z = ``at`` (fraction of the domain height), in real x, y.
+
+    ``axis``: the cut's normal (2: z, the default; 1: a cut y = ``at`` drawn in x, z; 0: in y, z).
 
     The plane is moved by a third of the finest grid step off ``at`` so that no face
     lies in it (a section is then always a proper convex polygon, its corners where
@@ -30,24 +36,33 @@ def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[st
     element on all its leaves, a cell shape): those whose edges cross alike share one array.
     Returns the polygons and each one's element type id.
     """
+    polygons, types, _ = _sections(mesh, at, axis)
+    return polygons, types
+
+
+def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[str], list[int]]:
+    """:func:`cut_polygons`, and each polygon's element."""
     grid = mesh.grid
+    across = (*_PLANES[axis], axis)
     z0 = round(at * grid) + 1 / 3
-    scale = np.array(mesh.box.to_float()) / grid
-    polygons, types = [], []
+    scale = np.array(mesh.box.to_float())[list(across)] / grid
+    polygons, types, elements = [], [], []
     # a leaf's elements lie in its box: only the leaves the plane crosses can hold a section (a cell of
     # the global Delaunay subdivision may reach beyond its first leaf: cells are always looked at)
-    low = mesh.tree.positions[:, 2].astype(np.int64) * mesh.leaf_size()
+    low = mesh.tree.positions[:, axis].astype(np.int64) * mesh.leaf_size()
     near = (low < z0) & (low + mesh.leaf_size() > z0)
-    for rows, nodes, faces, type_id in mesh.blocks():
-        nodes = nodes[near[mesh.element_leaf[rows]] | (mesh.element_local[rows] < 0)]
-        z = mesh.vertices[nodes, 2]  # (elements, nodes)
+    vertices = mesh.vertices[:, list(across)]  # the picture's two axes, then the cut's
+    for element_rows, nodes, faces, type_id in mesh.blocks():
+        keep = near[mesh.element_leaf[element_rows]] | (mesh.element_local[element_rows] < 0)
+        nodes, element_rows = nodes[keep], element_rows[keep]
+        z = vertices[nodes, 2]  # (elements, nodes)
         crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
         if not len(crossing):
             continue
         edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in faces for i in range(len(c))})
         a = nodes[np.ix_(crossing, [p for p, _ in edges])]  # (crossing elements, edges): vertex ids
         b = nodes[np.ix_(crossing, [q for _, q in edges])]
-        pa, pb = mesh.vertices[a].astype(float), mesh.vertices[b].astype(float)  # (elements, edges, 3)
+        pa, pb = vertices[a].astype(float), vertices[b].astype(float)  # (elements, edges, 3)
         za, zb = pa[..., 2] - z0, pb[..., 2] - z0
         cut = za * zb < 0
         masks = (cut.astype(np.int64) << np.arange(len(edges))).sum(axis=1)
@@ -62,11 +77,16 @@ def cut_polygons(mesh: Mesh, at: float = 0.5) -> tuple[list[np.ndarray], list[st
             xy = np.take_along_axis(xy, np.argsort(angle, axis=1)[..., None], axis=1) * scale[:2]
             polygons.extend(xy)
             types.extend([type_id] * len(rows))
-    return polygons, types
+            elements.extend(element_rows[crossing[rows]].tolist())
+    return polygons, types, elements
 
 
-def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: int = 10) -> None:
+def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: int = 10, axis: int = 2,
+            by_region: bool = False) -> None:
     """Write the cut through the mesh at z = ``at`` as PNG, elements coloured by type (legend: the commonest).
+
+    ``axis``: the cut's normal (see :func:`cut_polygons`); ``by_region``: colour the
+    sections by the element's region (a device's; the legend names them) instead.
 
     Drawn with Pillow from the section polygons (a few thousand): the polygons
     three times over-sampled and averaged down, outlined in black, in axes with
@@ -75,13 +95,17 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
     """
     from PIL import Image, ImageDraw, ImageFont
 
-    polygons, types = cut_polygons(mesh, at)
+    polygons, types, elements = _sections(mesh, at, axis)
+    if by_region:
+        regions = mesh.element_region
+        types = [mesh.regions.names[r] for r in regions[np.array(elements, dtype=np.int64)].tolist()]
     counts: dict[str, int] = {}
     for t in types:
         counts[t] = counts.get(t, 0) + 1
     order = sorted(counts, key=lambda t: (-counts[t], t))
     colour = {t: TAB20[i % len(TAB20)] for i, t in enumerate(order)}
-    a, b, _ = mesh.box.to_float()
+    lengths = mesh.box.to_float()
+    a, b = (lengths[k] for k in _PLANES[axis])
     width, height, x0, y0, scale = frame(a, b)
     w, h = max(1, round(scale * a)), max(1, round(scale * b))  # a 1e-12 x 1 section is one pixel wide, not empty
     image = Image.new("RGB", (width, height), WHITE)
@@ -102,8 +126,9 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
         y = y0 + h - value * scale
         draw.line((x0 - 7, y, x0 - 1, y), fill=BLACK)
         draw.text((x0 - 10, y), text, font=ticks, fill=BLACK, anchor="rm")
-    draw.text((x0 + w / 2, y0 + h + 34), "x", font=label, fill=BLACK, anchor="mt")
-    draw.text((x0 - 10 - ticks.getlength(_ticks(b)[-1][1]) - 14, y0 + h / 2), "y", font=label, fill=BLACK,
+    draw.text((x0 + w / 2, y0 + h + 34), "xyz"[_PLANES[axis][0]], font=label, fill=BLACK, anchor="mt")
+    draw.text((x0 - 10 - ticks.getlength(_ticks(b)[-1][1]) - 14, y0 + h / 2), "xyz"[_PLANES[axis][1]], font=label,
+              fill=BLACK,
               anchor="rm")
     small = ImageFont.load_default(14)
     lines = _wrap(title or f"cut at z = {at:g} of the domain height", small, width - 40)
@@ -112,7 +137,8 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
     shown = order[:legend]
     if shown:
         font = ImageFont.load_default(13)
-        rows = ["element type (sections)"] + [f"{mesh.types.get(t, {}).get('name', t)} ({counts[t]})" for t in shown]
+        heading = "region (sections)" if by_region else "element type (sections)"
+        rows = [heading] + [f"{t if by_region else mesh.types.get(t, {}).get('name', t)} ({counts[t]})" for t in shown]
         box_width = 12 + 28 + 8 + max(int(font.getlength(r)) for r in rows) + 12
         lx, ly = x0 + w + 12, y0
         draw.rectangle((lx, ly, lx + box_width, ly + 10 + 20 * len(rows)), fill=WHITE, outline=GREY)
