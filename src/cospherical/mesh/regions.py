@@ -40,7 +40,8 @@ from .dual import Dual, RegionParts, mesh_dual
 from .device import DeviceLayout, Regions, leaf_owner
 from .octree import Octree
 
-__all__ = ["RegionFaces", "contact_areas", "device_mesh", "mesh_region_parts", "region_faces", "region_parts"]
+__all__ = ["RegionFaces", "contact_areas", "device_mesh", "device_report", "mesh_region_parts", "region_faces", "region_parts",
+           "region_volumes"]
 
 
 def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, lookup: Lookup | None = None,
@@ -148,6 +149,7 @@ class RegionFaces:
     interface_nodes: np.ndarray
     interface_element: np.ndarray
     interface_face_interface: np.ndarray
+    boundary_edges: np.ndarray
 
     def contact_vertices(self, contact: int) -> np.ndarray:
         """The distinct vertices of a contact's faces, increasing."""
@@ -176,7 +178,7 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     if not rows:
         empty = np.zeros((0, 0), dtype=np.int32)
         return RegionFaces(empty, np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros((0, 2), np.int32), (),
-                           empty, np.zeros((0, 2), np.int64), np.zeros(0, np.int32))
+                           empty, np.zeros((0, 2), np.int64), np.zeros(0, np.int32), np.zeros(0, np.int64))
     element = np.concatenate(rows).astype(np.int64)
     face = np.concatenate([np.pad(p, ((0, 0), (0, width - p.shape[1])), constant_values=-1) for p in polygons])
     key = np.sort(np.where(face < 0, np.iinfo(np.int32).max, face), axis=1)
@@ -213,9 +215,14 @@ def region_faces(mesh: Mesh) -> RegionFaces:
         on &= element_region[element[ones]] == region
         contact_of[on & (contact_of < 0)] = c
     hit = contact_of >= 0
+    outer = face[ones]
+    following = np.where(np.roll(outer, -1, axis=1) >= 0, np.roll(outer, -1, axis=1), outer[:, :1])
+    lo, hi = np.minimum(outer, following), np.maximum(outer, following)
+    keys = (lo.astype(np.int64) * len(mesh.vertices) + hi)[outer >= 0]
     return RegionFaces(face[ones[hit]].astype(np.int32), element[ones[hit]], contact_of[hit].astype(np.int32),
                        interfaces.astype(np.int32), names, face[lower].astype(np.int32),
-                       np.stack([element[lower], element[upper]], axis=1), which.astype(np.int32).reshape(-1))
+                       np.stack([element[lower], element[upper]], axis=1), which.astype(np.int32).reshape(-1),
+                       np.unique(keys))
 
 
 def contact_areas(mesh: Mesh, faces: RegionFaces) -> list[Fraction]:
@@ -371,3 +378,85 @@ def mesh_region_parts(mesh: Mesh, dual: Dual, faces: RegionFaces) -> RegionParts
     lengths = tuple(high - low for low, high in device.bounds)
     return region_parts(mesh.box, mesh.grid, mesh.vertices, dual, mesh.element_region, mesh.regions.names,
                         mesh.regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths)
+
+
+def region_volumes(mesh: Mesh) -> list[Fraction]:
+    """Each region's elements' volume, exactly, as a fraction of the root box's volume."""
+    count = len(mesh.regions.names)
+    depth = mesh.tree.depth
+    volumes = [Fraction(0)] * count
+    leaf_region = mesh.regions.leaf_region
+    for _, tessellation, leaves in mesh.groups():
+        unit = sum((e.unit_volume for e in tessellation.elements), Fraction(0))
+        weight = 8 ** (depth - mesh.tree.levels[leaves].astype(np.int64))
+        for r, total in enumerate(np.bincount(leaf_region[leaves], weights=None, minlength=count).tolist()):
+            if total:
+                volumes[r] += unit * int(weight[leaf_region[leaves] == r].sum()) / 8 ** depth
+    if mesh.cells is not None:
+        cell_region = leaf_region[mesh.cells.leaf]
+        for s, shape in enumerate(mesh.cells.shapes):
+            for r in np.unique(cell_region[mesh.cells.shape == s]).tolist():
+                n = int(((mesh.cells.shape == s) & (cell_region == r)).sum())
+                volumes[r] += shape.grid_volume * n / mesh.grid ** 3
+    return volumes
+
+
+def device_report(mesh: Mesh, faces: RegionFaces, parts: RegionParts | None = None,
+                  dual: Dual | None = None) -> dict:
+    """The report's ``device`` section: per region its elements, nodes, volume (exact) and, with the dual,
+    its negative coefficients (interior: off the domain's boundary); per contact its faces, nodes, area;
+    per interface its faces and nodes."""
+    layout = mesh.regions.layout
+    device = layout.device
+    lengths = [high - low for low, high in device.bounds]
+    box_volume = lengths[0] * lengths[1] * lengths[2]
+    element_region = mesh.element_region
+    conn, _ = mesh.connectivity()
+    volumes = region_volumes(mesh)
+    negative = None
+    if parts is not None:
+        keys = dual.edges[parts.coupling_edge, 0].astype(np.int64) * len(mesh.vertices) + \
+            dual.edges[parts.coupling_edge, 1]
+        on_boundary = np.isin(keys, faces.boundary_edges)
+        below = np.asarray(parts.coupling_exact < 0)
+        negative = [{"interior": int((below & ~on_boundary & (parts.coupling_region == r)).sum()),
+                     "boundary": int((below & on_boundary & (parts.coupling_region == r)).sum())}
+                    for r in range(len(device.regions))]
+    regions = []
+    for r, region in enumerate(device.regions):
+        rows = conn[element_region == r]
+        entry = {"name": region.name, "material": region.material, "elements": int(len(rows)),
+                 "nodes": int(len(np.unique(rows[rows >= 0]))), "volume": str(volumes[r] * box_volume),
+                 "volume_ok": volumes[r] * box_volume == layout.region_volumes[r]}
+        if negative is not None:
+            entry["negative_coefficients"] = negative[r]
+            entry["control_volume_sum"] = str(parts.region_volumes()[r] * _factor(dual))
+        regions.append(entry)
+    areas = contact_areas(mesh, faces)
+    contacts = []
+    for c, contact in enumerate(device.contacts):
+        box = contact.box
+        axis = contact.axis
+        b, d = (axis + 1) % 3, (axis + 2) % 3
+        expected = (box[b + 3] - box[b]) * (box[d + 3] - box[d])
+        entry = {"name": contact.name, "region": contact.region,
+                 "faces": int((faces.contact_face_contact == c).sum()),
+                 "nodes": int(len(faces.contact_vertices(c))), "area": str(areas[c]), "area_ok": areas[c] == expected}
+        if parts is not None:
+            entry["area_parts_sum"] = str(parts.contact_areas()[c])
+        contacts.append(entry)
+    interfaces = []
+    for i, name in enumerate(faces.interface_names):
+        nodes = faces.interface_nodes[faces.interface_face_interface == i]
+        interfaces.append({"name": name, "faces": int(len(nodes)), "nodes": int(len(np.unique(nodes[nodes >= 0])))})
+    return {"name": device.name, "resolving_level": layout.resolving_level, "depth": mesh.tree.depth,
+            "origin": [str(x) for x in device.origin], "regions": regions, "contacts": contacts,
+            "interfaces": interfaces}
+
+
+def _factor(dual: Dual) -> Fraction:
+    """The dual's volume factor ``a*b*c`` as an exact fraction (a device's lengths are rational)."""
+    squared = Fraction(dual.volume_factor_squared)
+    root = Fraction(math.isqrt(squared.numerator), math.isqrt(squared.denominator))
+    assert root * root == squared
+    return root
