@@ -39,18 +39,20 @@ from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode
                              tree_from_octree, tree_from_refine)
 from ..mesh.report import MeshReport
 
-__all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "from_treemesh", "mesh_writes", "output_names",
+__all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "device_cut_axis", "from_treemesh",
+           "mesh_writes", "output_names",
            "pattern_lookup", "piece_name", "tree_source"]
 
 
-def output_names(dual: bool) -> tuple[str, ...]:
+def output_names(dual: bool, device: bool = False) -> tuple[str, ...]:
     """The files a mesh writes into its folder (``mesh --out``, :meth:`OctreeMesh.write`), known before the work.
 
     The output folder is locked and these names checked before the mesh is made,
     and its manifest lists them afterwards (a later run removes a file of this one
     that it did not write again).
     """
-    return ("mesh.vtu", "report.json", "mesh.png") + (("dual.npz",) if dual else ())
+    return ("mesh.vtu", "report.json", "mesh.png") + (("dual.npz",) if dual else ()) + \
+        (("contacts.vtu",) if device else ())
 
 
 def piece_name(k: int) -> str:
@@ -63,7 +65,7 @@ def mesh_writes(name: str) -> bool:
     from ..mesh.partition import MAX_PARTITIONS
 
     piece = re.fullmatch(r"mesh-(0|[1-9][0-9]{0,9})\.vtu", name)
-    return name in (*output_names(True), "mesh.pvtu") or piece is not None and int(piece[1]) < MAX_PARTITIONS
+    return name in (*output_names(True, True), "mesh.pvtu") or piece is not None and int(piece[1]) < MAX_PARTITIONS
 
 
 def default_cut(shapes: Sequence[Shape], box: Box) -> float:
@@ -264,7 +266,8 @@ class OctreeMesh:
         together).  ``cut``: the height of ``mesh.png``'s cut as a fraction of the
         domain's (default :func:`default_cut`).
         """
-        with OutputFolder(folder, "mesh", output_names(self.report.dual is not None), writes=mesh_writes) as out:
+        names = output_names(self.report.dual is not None, self._result.source.device is not None)
+        with OutputFolder(folder, "mesh", names, writes=mesh_writes) as out:
             self.write_files(out.path, cut)
 
     def write_files(self, path: Callable[[str], Path], cut: float | None = None) -> None:
@@ -279,6 +282,9 @@ class OctreeMesh:
 
             write_dual(self.dual, path("dual.npz"))
         point_data, cell_data = self._vtu_data(with_dual)
+        if source.device is not None:
+            self._write_device(path, cut, point_data, cell_data)
+            return
         write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=source.leaf_order)
         at = default_cut(source.shapes, self.box) if cut is None else cut
         shapes = ", ".join(source.described.get("refine", [])) or source.described.get("file", "")
@@ -329,6 +335,40 @@ class OctreeMesh:
         return to_meshio(self.assembled, self.vertices, self._result.source.leaf_order)
 
 
+    def _write_device(self, path: Callable[[str], Path], cut: float | None, point_data: dict,
+                      cell_data: dict) -> None:
+        """A device's files: ``mesh.vtu`` with cell data ``region`` (names and materials in field data),
+        ``contacts.vtu`` (its contact and interface faces), ``mesh.png`` coloured by region, ``report.json``."""
+        from ..formats.mesh import write_faces_vtu, write_report, write_vtu
+        from ..formats.vtu import text_array
+        from ..outputs.mesh_picture import cut_png
+
+        mesh, report, layout = self.assembled, self.report, self._result.source.device
+        regions = mesh.regions
+        device = layout.device
+        fields = {"region_names": text_array("\n".join(regions.names)),
+                  "region_materials": text_array("\n".join(regions.materials)),
+                  "origin": text_array(" ".join(str(x) for x in device.origin))}
+        write_vtu(mesh, path("mesh.vtu"), point_data=point_data,
+                  cell_data={"region": mesh.element_region.astype(np.int32), **cell_data}, field_data=fields,
+                  origin=device.origin)
+        write_faces_vtu(mesh, self._result.faces, path("contacts.vtu"), origin=device.origin)
+        axis = device_cut_axis(device)
+        at = 0.5 if cut is None else cut
+        low, high = device.bounds[axis]
+        cut_png(mesh, path("mesh.png"), at=at, axis=axis, by_region=True,
+                title=f"{device.name}: {len(regions.names)} regions, {report.leaves:,} leaves, "
+                      f"{report.elements:,} elements (cut at {'xyz'[axis]} = {float(low + (high - low) * at):.4g})")
+        write_report(report.to_dict(), path("report.json"))
+
+
+def device_cut_axis(device) -> int:
+    """The axis ``mesh.png`` cuts a device across: the one its region boxes cut least (y first, then x, then z)."""
+    counts = [len({b[a] for r in device.regions for b in r.boxes} | {b[a + 3] for r in device.regions
+                                                                     for b in r.boxes}) for a in range(3)]
+    return min((1, 0, 2), key=lambda a: counts[a])
+
+
 def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = None,
                refine: Sequence[str | Shape] | str | None = None, *,
                leaves: str | Path | Sequence[Sequence[int]] | np.ndarray | None = None, tree: Octree | None = None,
@@ -366,7 +406,10 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         Compute the exact dual now: the report gets its figures and :meth:`OctreeMesh.write`
         writes ``dual.npz`` (otherwise ``m.dual`` computes it on first use).
     device
-        Regions and contacts of a device; not supported yet (a given value is refused).
+        Instead of a domain and a tree: a device (a device file's path, or a
+        :class:`~cospherical.mesh.device.Device`): regions of boxes, contacts and
+        refinement shapes (:mod:`cospherical.formats.device_file`).  The tree covers
+        its bounding box; each element lies in one region.
     max_leaves
         Refuse a tree of more leaves (default: what half this machine's memory holds).
     check_delaunay, uniform
@@ -381,7 +424,25 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
     (64, True, 0, 0)
     """
     if device is not None:
-        raise InputError("device=: regions and contacts are not supported by build_mesh yet")
+        given = [name for name, value in (("domain", domain), ("levels", levels), ("refine", refine),
+                                          ("leaves", leaves), ("tree", tree)) if value is not None]
+        if given:
+            raise InputError(f"device=: its file gives the domain and the tree, not {given[0]}=")
+        delaunay_mode(criterion, delaunay)
+        clock = time.perf_counter()
+        from ..mesh.device import Device
+        from ..mesh.pipeline import tree_from_device
+
+        if not isinstance(device, Device):
+            from ..formats.device_file import read_device
+
+            device = read_device(device)
+        source = tree_from_device(device, max_leaves)
+        timings = {"tree": time.perf_counter() - clock}
+        lookup, name = pattern_lookup(patterns, criterion, source.tree.box)
+        return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,
+                                       check_delaunay=check_delaunay, uniform=uniform, dual=dual, progress=progress,
+                                       timings=timings), device.origin)
     if isinstance(domain, Box):
         box = domain
     elif domain is not None:

@@ -36,9 +36,14 @@ DESCRIPTION = ("Mesh a 1-irregular octree: each leaf's true configuration, its e
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("--domain", nargs=3, metavar=("A", "B", "C"), required=True,
+    domain = parser.add_mutually_exclusive_group(required=True)
+    domain.add_argument("--domain", nargs=3, metavar=("A", "B", "C"),
                         help="the root cell's lengths, exact: 1, 1.4142, 3/2, sqrt(2)")
-    tree = parser.add_mutually_exclusive_group(required=True)
+    domain.add_argument("--device", type=path_argument, metavar="FILE",
+                        help="a device file (YAML: regions of boxes with their materials, contacts, refinement "
+                        "shapes and levels; see the devices page): the tree covers its bounding box, each element "
+                        "lies in one region; writes contacts.vtu too, and the dual's parts per region with --dual")
+    tree = parser.add_mutually_exclusive_group()
     tree.add_argument("--refine", action="append", metavar="SHAPE",
                       help="split cells whose closed box meets SHAPE, down to --levels: sphere:X,Y,Z,R (its surface), "
                       "plane:NX,NY,NZ,D, point:X,Y,Z or box:X0,Y0,Z0,X1,Y1,Z1, in domain units (repeatable)")
@@ -150,12 +155,22 @@ def _text(value) -> str:
 
 def run(args) -> int:
     pieces = _pieces(args)
+    if args.device is not None:
+        from ..formats.device_file import read_device
+
+        for option, value in (("--refine", args.refine), ("--leaves", args.leaves), ("--levels", args.levels),
+                              ("--partitions", args.partitions)):
+            if value is not None:
+                raise InputError(f"{option}: a device file gives its own tree (refine and levels): not with --device")
+        args.device = read_device(args.device)  # before the output folder: a bad file writes nothing
+    elif args.refine is None and args.leaves is None:
+        raise InputError("--domain needs the tree: --refine SHAPE (with --levels L) or --leaves FILE")
     if args.out is None:
         return _run(args, None)
     if pieces is not None:
         names = ("mesh.pvtu", "report.json", *(piece_name(k) for k in range(pieces)))
     else:
-        names = output_names(args.dual)
+        names = output_names(args.dual, args.device is not None)
     with OutputFolder(args.out, "mesh", names, writes=mesh_writes) as out:  # locked from the start; every file or none
         return _run(args, out)
 
@@ -180,17 +195,19 @@ def _pieces(args) -> int | None:
 
 
 def _run(args, out: OutputFolder | None) -> int:
-    box = Box.parse(args.domain)
     delaunay_mode(args.criterion, args.delaunay)  # a contradiction refused before the work
     at = _cut(args)
     max_leaves = _max_leaves(args.max_leaves)
-    if args.leaves is not None:
+    if args.device is not None:
+        given = {"device": args.device}
+    elif args.leaves is not None:
         if args.levels is not None:
             raise InputError("--levels goes with --refine, not with --leaves")
         given = {"leaves": args.leaves}
     else:
         shapes = [parse_shape(text) for text in args.refine]
         given = {"levels": _levels(args.levels), "refine": shapes, "balance": args.balance}
+    box = Box.parse(args.domain) if args.device is None else None
     if args.partitions is not None:
         return _in_pieces(args, tree_source(box, **given, max_leaves=max_leaves), out)
     with _bars() as progress:
@@ -208,6 +225,8 @@ def _run(args, out: OutputFolder | None) -> int:
         sys.stdout.write(f"dual_edges: {report['dual']['edges']:,}\n"
                          f"negative_coefficients: {negative['interior']:,} interior, {negative['boundary']:,} "
                          "boundary\n")
+    if report.get("device") is not None and args.format != "json":
+        _print_device(report["device"])
     if sys.stderr.isatty():
         print("cospherical mesh: seconds " + ", ".join(f"{k} {v:.2f}" for k, v in timings.items()), file=sys.stderr)
     return 0
@@ -242,6 +261,22 @@ def _print(args, report: dict) -> None:
         sys.stdout.write(report_json(report))
     else:
         sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in _SUMMARY_KEYS))
+
+
+def _print_device(device: dict) -> None:
+    """A device's regions and contacts, one line each (names are data: printed as their repr)."""
+    lines = [f"resolving_level: {device['resolving_level']}, depth: {device['depth']}\n"]
+    for region in device["regions"]:
+        negative = region.get("negative_coefficients")
+        lines.append(f"region {region['name']!r} ({region['material']!r}): {region['elements']:,} elements, "
+                     f"{region['nodes']:,} nodes, volume {region['volume']} ({_text(region['volume_ok'])})"
+                     + (f", negative coefficients {negative['interior']:,} interior" if negative else "") + "\n")
+    for contact in device["contacts"]:
+        lines.append(f"contact {contact['name']!r} on {contact['region']!r}: {contact['faces']:,} faces, "
+                     f"{contact['nodes']:,} nodes, area {contact['area']} ({_text(contact['area_ok'])})\n")
+    for interface in device["interfaces"]:
+        lines.append(f"interface {interface['name']!r}: {interface['faces']:,} faces, {interface['nodes']:,} nodes\n")
+    sys.stdout.write("".join(lines))
 
 
 def _write_listed_piece(listed: np.ndarray, mesh, path, leaves: np.ndarray) -> None:

@@ -472,6 +472,5 @@ def write_faces_vtu(mesh: Mesh, faces, path: str | Path, origin=None) -> None:
 
 def _padded(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two -1 padded arrays of rows brought to one width."""
-    width = max(a.shape[1] if a.ndim == 2 else 0, b.shape[1] if b.ndim == 2 else 0, 1)
-    return tuple(np.pad(x.reshape(len(x), -1), ((0, 0), (0, width - x.reshape(len(x), -1).shape[1])),
-                        constant_values=-1) for x in (a, b))
+    width = max(a.shape[1], b.shape[1], 1)
+    return tuple(np.pad(x, ((0, 0), (0, width - x.shape[1])), constant_values=-1) for x in (a, b))

@@ -138,7 +138,8 @@ class DeviceLayout:
     def cuts(self, level: int, cells: np.ndarray) -> np.ndarray:
         """Which cells (n x 3 at ``level``) a region boundary cuts, or whose face a boundary or a contact's edge crosses.
 
-        A cell is cut when blocks of different owners meet inside it: across some
+        A cell is cut when blocks of different owners (boxes of the device file: each
+        leaf lies in one box, hence one region) meet inside it: across some
         plane strictly inside the cell, in the cell's open span of the other two axes
         (counted with a prefix sum per plane).  It is also split when the blocks just
         beyond one of its faces, over the face's open rectangle, are not all of one
@@ -156,7 +157,8 @@ class DeviceLayout:
         cut = np.zeros(len(cells), dtype=bool)
         for axis in range(3):
             b, c = (axis + 1) % 3, (axis + 2) % 3
-            owner = np.moveaxis(self.owner, axis, 0)  # (blocks along axis, b, c)
+            # boxes, not only regions: each leaf must lie in one box (the global Delaunay mode works box by box)
+            owner = np.moveaxis(self.owner_box, axis, 0)  # (blocks along axis, b, c)
             if b > c:
                 owner = owner.transpose(0, 2, 1)
             # open spans of the cells along b and c, as block ranges

@@ -39,12 +39,14 @@ from ..core.configuration import Box
 from ..errors import InputError
 from .assembly import Lookup, Mesh, assemble
 from .delaunay import MODES, delaunay_mesh
+from .device import Device, DeviceLayout, device_layout, device_octree
 from .dual import Dual, dual_summary, mesh_dual
 from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape
+from .regions import RegionFaces, device_mesh, device_report, mesh_region_parts, region_faces
 from .report import MeshReport, mesh_report
 
-__all__ = ["PipelineResult", "Progress", "TreeSource", "delaunay_mode", "run_pipeline", "tree_from_leaves",
-           "tree_from_octree", "tree_from_refine"]
+__all__ = ["PipelineResult", "Progress", "TreeSource", "delaunay_mode", "run_pipeline", "tree_from_device",
+           "tree_from_leaves", "tree_from_octree", "tree_from_refine"]
 
 Progress = Callable[[str, "int | None", int], None]
 """``progress(stage, total, advance)``: ``advance`` more items of ``stage`` done, out of ``total``."""
@@ -58,13 +60,17 @@ class TreeSource:
     ``leaves``, with the levels, shapes and balance, or the leaf file's name, and
     the depth); ``leaf_order`` numbers the leaves as the user listed them (the
     ``leaf`` cell data of ``mesh.vtu``), ``None`` for the tree's own order;
-    ``shapes`` the refinement shapes (the picture cuts through the first one).
+    ``shapes`` the refinement shapes (the picture cuts through the first one);
+    ``device`` a device's layout and ``leaf_region`` each leaf's region (a device's
+    tree, :func:`tree_from_device`), else ``None``.
     """
 
     tree: Octree
     described: dict
     leaf_order: np.ndarray | None = None
     shapes: tuple[Shape, ...] = ()
+    device: DeviceLayout | None = None
+    leaf_region: np.ndarray | None = None
 
 
 def tree_from_refine(box: Box, levels: int, refine: Sequence[str | Shape], balance: str = "vertex",
@@ -85,6 +91,17 @@ def tree_from_leaves(box: Box, levels: Sequence[int] | np.ndarray, positions: Se
     tree = leaves_octree(box, levels, positions, where=where)
     described = {"source": "leaves", **({"file": file} if file is not None else {}), "depth": tree.depth}
     return TreeSource(tree, described, leaf_list_order(levels, positions))
+
+
+def tree_from_device(device: Device, max_leaves: int | None = None) -> TreeSource:
+    """The tree of a device (:mod:`cospherical.mesh.device`): checked, refined until its region boundaries and
+    contact edges lie on leaf faces, balanced, the leaves outside every region dropped."""
+    layout = device_layout(device)
+    tree, leaf_region = device_octree(layout, max_leaves)
+    described = {"source": "device", "device": device.name, "levels": device.levels,
+                 "refine": [s.text for s in device.refine], "balance": device.balance,
+                 "resolving_level": layout.resolving_level, "depth": tree.depth}
+    return TreeSource(tree, described, None, device.refine, layout, leaf_region)
 
 
 def tree_from_octree(tree: Octree) -> TreeSource:
@@ -108,7 +125,8 @@ class PipelineResult:
     """What :func:`run_pipeline` made: the mesh, its report, its dual (or ``None``) and the non-Delaunay elements.
 
     ``violating``: the elements whose circumsphere strictly holds a vertex (``None``
-    when the check was skipped); ``source``: the tree it meshed.
+    when the check was skipped); ``source``: the tree it meshed; ``faces``: a device's
+    contact and interface faces (:class:`~cospherical.mesh.regions.RegionFaces`).
     """
 
     source: TreeSource
@@ -116,6 +134,7 @@ class PipelineResult:
     report: MeshReport
     dual: Dual | None = field(default=None, repr=False)
     violating: np.ndarray | None = field(default=None, repr=False)
+    faces: RegionFaces | None = field(default=None, repr=False)
 
 
 class _Clock:
@@ -174,18 +193,28 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         return (lambda n: progress(stage, total, n)) if progress is not None else None
 
     clock.stage("assembly")
-    mesh = assemble(tree, lookup, progress=told("assembly", len(tree)), criterion=criterion)
-    clock.stage("global Delaunay" if mode == "global" else None)
-    mesh, leaf_mesh, checked = delaunay_mesh(mesh, mode, progress=told("regions", len(mesh)))
+    if source.device is not None:
+        mesh, leaf_mesh, checked = device_mesh(source.device, tree, source.leaf_region, lookup, criterion, mode,
+                                               progress=told("regions", len(tree)))
+    else:
+        mesh = assemble(tree, lookup, progress=told("assembly", len(tree)), criterion=criterion)
+        clock.stage("global Delaunay" if mode == "global" else None)
+        mesh, leaf_mesh, checked = delaunay_mesh(mesh, mode, progress=told("regions", len(mesh)))
     violating: list = []
     report = mesh_report(mesh, source.described, patterns, criterion, uniform=uniform, delaunay=check_delaunay,
                          stage=clock.stage, progress=told("delaunay", len(mesh)), violating=violating,
                          leaf_mesh=leaf_mesh, checked=checked)
-    found = None
+    found = faces = None
     if dual:
         clock.stage("dual")
         found = mesh_dual(mesh)
         report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"]))
+    if source.device is not None:
+        clock.stage("regions")
+        faces = region_faces(mesh)
+        if found is not None:
+            found.regions = mesh_region_parts(mesh, found, faces)
+        report["device"] = device_report(mesh, faces, found.regions if found is not None else None, found)
     clock.stage(None)
     return PipelineResult(source, mesh, MeshReport.from_dict(report, timings), found,
-                          violating[0] if violating else None)
+                          violating[0] if violating else None, faces)

@@ -168,7 +168,7 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     regions = mesh.regions
     layout = regions.layout
     element_region = mesh.element_region
-    rows, polygons, sizes = [], [], []
+    rows, polygons = [], []
     width = 0
     for element_rows, nodes, faces, _ in mesh.blocks():
         for cycle in faces:

@@ -212,10 +212,10 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
 
 # The report's keys that are left out, rather than written as null, when they were not computed:
 # the details of the global Delaunay check (only with the check), the uniform study (only when asked)
-# and the dual's figures (only with the dual).
+# the dual's figures (only with the dual) and a device's regions and contacts (only for a device).
 _ABSENT_WHEN_NONE = frozenset({"delaunay_violating_pairs", "delaunay_violating_leaves", "delaunay_ties",
                                "delaunay_exact_tests", "delaunay_violating_fvm_leaves", "uniform",
-                               "negative_coefficients", "dual"})
+                               "negative_coefficients", "dual", "device"})
 
 
 @dataclass(frozen=True)
@@ -279,6 +279,7 @@ class MeshReport:
     uniform: Mapping[str, Any] | None = None
     negative_coefficients: Mapping[str, int] | None = None
     dual: Mapping[str, Any] | None = None
+    device: Mapping[str, Any] | None = None
     timings: Mapping[str, float] = field(default_factory=dict, compare=False)
 
     def to_dict(self) -> dict:

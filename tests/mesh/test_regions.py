@@ -1,0 +1,211 @@
+"""Devices: regions, contacts, interfaces; the mesh checked by an oracle that reads the files back with meshio.
+
+The oracle knows only the device file (read here with PyYAML and Fractions, not with the
+tool's reader) and what meshio reads: the tetrahedra of every element (the solvers'
+conforming split, written as a tetrahedral VTU with the element's region) and, read
+by VTK, the contact polygons of ``contacts.vtu``.  It checks, exactly (integers on the grid):
+every tetrahedron's centroid lies in a box of its region; each region's tetrahedra
+fill its volume; every triangle is shared by two tetrahedra of one region or of two
+touching regions, or lies on the domain's boundary (the domain on one side only);
+each contact's polygons lie in its rectangle and cover its area.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from cospherical import build_mesh
+from cospherical.formats.vtu import write_grid
+from cospherical.mesh.tetrahedra import split_tetrahedra
+
+EXAMPLES = sorted((Path(__file__).parents[2] / "examples" / "devices").glob("*.yaml"))
+
+pytestmark = [pytest.mark.oracle_meshio, pytest.mark.oracle_vtk]
+
+
+def _device_boxes(data: dict) -> tuple[list, list, list[Fraction], list[Fraction]]:
+    """The regions' boxes and the contacts as Fractions, and the bounding box (low corner, lengths)."""
+    def exact(v):
+        return Fraction(str(v))
+
+    regions = [[tuple(exact(x) for x in box) for box in r["boxes"]] for r in data["regions"]]
+    contacts = [(next(i for i, r in enumerate(data["regions"]) if r["name"] == c["region"]),
+                 tuple(exact(x) for x in c["box"])) for c in data.get("contacts", [])]
+    boxes = [b for r in regions for b in r]
+    low = [min(b[a] for b in boxes) for a in range(3)]
+    length = [max(b[a + 3] for b in boxes) - low[a] for a in range(3)]
+    return regions, contacts, low, length
+
+
+def _oracle(data: dict, folder: Path) -> None:
+    regions, contacts, low, length = _device_boxes(data)
+    mesh = meshio.read(folder / "tets.vtu")
+    grid = int(np.asarray(mesh.field_data["grid_intervals"]).reshape(-1)[0])
+    points = np.asarray(mesh.point_data["grid_coordinates"], dtype=np.int64)
+    tets = mesh.cells_dict["tetra"].astype(np.int64)
+    region = np.asarray(mesh.cell_data_dict["region"]["tetra"], dtype=np.int64)
+
+    def on_grid(box):  # a box in grid units, exact (the device's coordinates are dyadic in its bounding box)
+        values = [(box[i] - low[i % 3]) / length[i % 3] * grid for i in range(6)]
+        assert all(v.denominator == 1 for v in values)
+        return [int(v) for v in values]
+
+    gridded = [[on_grid(b) for b in boxes] for boxes in regions]
+    # every centroid in a box of its region (4 x centroid against 4 x the box)
+    quad = points[tets].sum(axis=1)
+    inside = np.zeros(len(tets), dtype=bool)
+    for r, boxes in enumerate(gridded):
+        for b in boxes:
+            lo, hi = 4 * np.array(b[:3]), 4 * np.array(b[3:])
+            inside |= (region == r) & np.all((quad >= lo) & (quad <= hi), axis=1)
+    assert inside.all()
+    # region volumes: six times a tetrahedron's volume is an integer determinant on the grid
+    p = points[tets]
+    six = np.abs(np.linalg.det((p[:, 1:] - p[:, :1]).astype(np.float64)).round()).astype(np.int64)
+    assert (six > 0).all()
+    for r, boxes in enumerate(regions):
+        want = sum(((b[3] - b[0]) * (b[4] - b[1]) * (b[5] - b[2]) for b in boxes), Fraction(0))
+        got = Fraction(int(six[region == r].sum()), 6 * grid ** 3) * length[0] * length[1] * length[2]
+        assert got == want, (r, got, want)
+
+    def in_domain(point3, normal_axis, sign):
+        """Whether the domain holds the points just beyond ``point3 / 3`` along ``sign`` x the axis (exact)."""
+        held = np.zeros(len(point3), dtype=bool)
+        for boxes in gridded:
+            for b in boxes:
+                lo, hi = 3 * np.array(b[:3]), 3 * np.array(b[3:])
+                ok = np.all((point3 >= lo) & (point3 <= hi), axis=1)
+                ok &= np.where(sign > 0, point3[np.arange(len(point3)), normal_axis] < hi[normal_axis],
+                               point3[np.arange(len(point3)), normal_axis] > lo[normal_axis])
+                held |= ok
+        return held
+
+    touching = set()
+    for r, a_boxes in enumerate(gridded):
+        for s, b_boxes in enumerate(gridded):
+            for a in a_boxes:
+                for b in b_boxes:
+                    for k in range(3):
+                        others = [j for j in range(3) if j != k]
+                        if (a[k + 3] == b[k] or b[k + 3] == a[k]) and all(
+                                min(a[j + 3], b[j + 3]) > max(a[j], b[j]) for j in others):
+                            touching.add((r, s))
+    # faces: each triangle twice (same or touching regions), or once on the boundary
+    triangles = np.sort(np.concatenate([tets[:, [1, 2, 3]], tets[:, [0, 2, 3]], tets[:, [0, 1, 3]],
+                                        tets[:, [0, 1, 2]]]), axis=1)
+    owner = np.tile(region, 4)
+    order = np.lexsort(triangles.T[::-1])
+    triangles, owner = triangles[order], owner[order]
+    new = np.r_[True, np.any(triangles[1:] != triangles[:-1], axis=1)]
+    starts = np.flatnonzero(new)
+    counts = np.diff(np.r_[starts, len(triangles)])
+    assert counts.max() <= 2
+    pairs = starts[counts == 2]
+    for r, s in set(zip(owner[pairs].tolist(), owner[pairs + 1].tolist())):
+        assert r == s or (r, s) in touching
+    single = triangles[starts[counts == 1]]
+    tp = points[single]
+    flat = np.array([[np.all(tp[i, :, k] == tp[i, 0, k]) for k in range(3)] for i in range(len(tp))])
+    assert flat.any(axis=1).all()  # every boundary triangle is flat in an axis plane
+    axis = np.argmax(flat, axis=1)
+    centroid3 = tp.sum(axis=1)
+    assert (in_domain(centroid3, axis, 1) != in_domain(centroid3, axis, -1)).all()
+    # contacts: polygons in the rectangle, covering its area
+    ids, polygons, which = _faces_by_vtk(folder / "contacts.vtu")
+    for c, (r, box) in enumerate(contacts):
+        g = on_grid(box)
+        k = next(a for a in range(3) if g[a] == g[a + 3])
+        u, v = [a for a in range(3) if a != k]
+        twice = 0
+        for polygon, tag in zip(polygons, which.tolist()):
+            if tag != c:
+                continue
+            q = points[ids[np.asarray(polygon)]]
+            assert np.all(q[:, k] == g[k])
+            assert np.all((q[:, u] >= g[u]) & (q[:, u] <= g[u + 3]) & (q[:, v] >= g[v]) & (q[:, v] <= g[v + 3]))
+            twice += abs(int((q[:, u] * np.roll(q[:, v], -1) - np.roll(q[:, u], -1) * q[:, v]).sum()))
+        assert twice == 2 * (g[u + 3] - g[u]) * (g[v + 3] - g[v]), c
+
+
+def _faces_by_vtk(path: Path):
+    """contacts.vtu read by VTK: the points' global ids, each polygon's point indices, its contact."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    grid = reader.GetOutput()
+    ids = vtk_to_numpy(grid.GetPointData().GetArray("global_id")).astype(np.int64)
+    which = vtk_to_numpy(grid.GetCellData().GetArray("contact")).astype(np.int64)
+    polygons = []
+    for i in range(grid.GetNumberOfCells()):
+        cell = grid.GetCell(i)
+        polygons.append([cell.GetPointId(k) for k in range(cell.GetNumberOfPoints())])
+    return ids, polygons, which
+
+
+def _mesh_and_check(path: Path, folder: Path, dual: bool = False):
+    m = build_mesh(device=path, uniform=False, dual=dual)
+    m.write(folder)
+    tets = split_tetrahedra(m.assembled)
+    write_grid(folder / "tets.vtu", m.assembled.vertices.astype(np.float64), np.full(len(tets), 10, np.uint8),
+               tets.nodes.reshape(-1), 4 * np.arange(1, len(tets) + 1),
+               point_data={"grid_coordinates": m.assembled.vertices.astype(np.int64)},
+               cell_data={"region": tets.region.astype(np.int32)},
+               field_data={"grid_intervals": np.array([m.assembled.grid], dtype=np.int64)})
+    _oracle(yaml.safe_load(path.read_text()), folder)
+    return m
+
+
+@pytest.mark.parametrize("example", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+def test_example_devices_pass_the_oracle(example, tmp_path):
+    m = _mesh_and_check(example, tmp_path)
+    report = m.report
+    assert report.volume_ok and report.nonconforming_faces == 0
+    device = report.device
+    assert all(r["volume_ok"] for r in device["regions"]) and all(c["area_ok"] for c in device["contacts"])
+
+
+@st.composite
+def unions(draw):
+    """A connected union of unit cubes of a 4 x 4 x 2 grid, in one or two regions, with a contact on a side."""
+    cubes = {(0, 0, 0)}
+    for _ in range(draw(st.integers(1, 6))):
+        x, y, z = draw(st.sampled_from(sorted(cubes)))
+        axis, step = draw(st.integers(0, 2)), draw(st.sampled_from((-1, 1)))
+        cube = [x, y, z]
+        cube[axis] += step
+        if 0 <= cube[0] < 4 and 0 <= cube[1] < 4 and 0 <= cube[2] < 2:
+            cubes.add(tuple(cube))
+    for axis, size in enumerate((4, 4, 2)):  # a bounding box of 1, 2 or 4 cubes: dyadic, as a device needs
+        values = [c[axis] for c in cubes]
+        if max(values) - min(values) == 2:
+            far = max(cubes, key=lambda c: c[axis])
+            step = 1 if far[axis] + 1 < size else -1
+            near = far if step > 0 else min(cubes, key=lambda c: c[axis])
+            cubes.add(tuple(near[a] + (step if a == axis else 0) for a in range(3)))
+    cubes = sorted(cubes)
+    split = draw(st.integers(1, len(cubes)))
+    names = ["a", "b"]
+    regions = [{"name": names[k], "material": "Si", "boxes": [[x, y, z, x + 1, y + 1, z + 1] for x, y, z in part]}
+               for k, part in enumerate((cubes[:split], cubes[split:])) if part]
+    x, y, z = cubes[0]
+    return {"device": "union", "regions": regions,
+            "contacts": [{"name": "c", "region": "a", "box": [x, y, z, x + 1, y + 1, z]}], "levels": 1}
+
+
+@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=unions())
+def test_random_unions_of_boxes_pass_the_oracle(data, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("union")
+    path = folder / "device.yaml"
+    path.write_text(yaml.safe_dump(data))
+    _mesh_and_check(path, folder / "out")
