@@ -88,7 +88,12 @@ def test_a_leaf_list_in_memory_is_numbered_as_listed():
     (dict(domain=(1, 1, 1), levels=2, refine=["point:0,0,0"], leaves=[[0, 0, 0, 0]]), "not refine and leaves"),
     (dict(domain=(1, 0.5, 1), levels=2, refine=["point:0,0,0"]), "not a float"),
     (dict(domain=(1, 1), levels=2, refine=["point:0,0,0"]), "three lengths"),
-    (dict(domain=(1, 1, 1), leaves=[[0, 0, 0]]), "rows of (level, i, j, k)"),
+    (dict(domain=(1, 1, 1), leaves=[[0, 0, 0]]), "rows of four integers"),
+    (dict(domain=(1, 1, 1), leaves=[[0, 0.5, 0, 0]]), "rows of four integers"),  # never truncated to 0
+    (dict(domain=(1, 1, 1), leaves=[[0, 2**70, 0, 0]]), "rows of four integers"),
+    (dict(domain=(1, 1, 1), leaves=[["0", "0", "0", "0"]]), "rows of four integers"),
+    (dict(domain=(1, 1, 1), leaves=[[0, 0, 0, 0]] * 3, max_leaves=2), "above the bound of 2"),
+    (dict(domain=(1, 1, 1), leaves=[[1, 0, 0, 0]]), "no leaf covers"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], criterion="internal_faces", delaunay="global"),
      "use --delaunay leaf"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], device="d.yaml"), "not domain="),

@@ -108,13 +108,17 @@ def tree_source(box: Box, levels: int | None = None, refine: Sequence[str | Shap
 
         level_list, positions = read_leaves(leaves, max_leaves)
         return tree_from_leaves(box, level_list, positions, where=str(leaves), file=Path(leaves).name)
-    rows = np.asarray(leaves, dtype=np.int64)
-    if rows.ndim != 2 or rows.shape[1] != 4:
-        raise InputError(f"leaves=: rows of (level, i, j, k), not an array of shape {rows.shape}")
     from ..mesh.octree import check_leaf_count
 
-    check_leaf_count(len(rows), "leaves=:", max_leaves)
-    return tree_from_leaves(box, rows[:, 0], rows[:, 1:])
+    check_leaf_count(len(leaves), "leaves=:", max_leaves)  # before a row is converted
+    try:
+        rows = np.asarray(leaves)
+    except (ValueError, TypeError, OverflowError):
+        rows = np.asarray(None)
+    if rows.ndim != 2 or rows.shape[1] != 4 or rows.dtype.kind not in "iu" or rows.dtype.itemsize > 8:
+        raise InputError(f"leaves=: rows of four integers (level, i, j, k), not an array of shape {rows.shape} "
+                         f"and type {rows.dtype}")
+    return tree_from_leaves(box, rows[:, 0].astype(np.int64), rows[:, 1:].astype(np.int64))
 
 
 def pattern_lookup(patterns: Any, criterion: str, box: Box) -> tuple[Lookup | None, str | None]:
