@@ -32,6 +32,10 @@ def test_the_vertices_are_discretizes_nodes(cells, origin):
 
 
 def test_what_it_cannot_mesh_is_one_error():
+    faces_only = discretize.TreeMesh([[(1 / 16, 16)]] * 3, diagonal_balance=False)
+    faces_only.refine_points([[0.3, 0.6, 0.7]], level=4, padding_cells_by_level=[0, 0, 0, 0])
+    with pytest.raises(InputError, match="not 1-irregular .*: build the TreeMesh with diagonal_balance=True"):
+        cospherical.from_treemesh(faces_only)
     with pytest.raises(InputError, match="not finalized"):
         cospherical.from_treemesh(discretize.TreeMesh([[(1, 4)]] * 3, diagonal_balance=True))
     oblong = discretize.TreeMesh([[(1, 4)], [(1, 8)], [(1, 4)]], diagonal_balance=True)

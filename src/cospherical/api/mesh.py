@@ -497,5 +497,11 @@ def from_treemesh(tree_mesh: Any, **options: Any) -> OctreeMesh:
             raise InputError(f"from_treemesh: {taken}= is the TreeMesh's own")
     leaves = treemesh_leaves(tree_mesh)
     rows = np.column_stack([leaves.levels, leaves.positions])
-    mesh = build_mesh(domain=leaves.lengths, leaves=rows, **options)
+    try:
+        mesh = build_mesh(domain=leaves.lengths, leaves=rows, **options)
+    except InputError as error:
+        if "1-irregular" not in str(error):
+            raise
+        # discretize balances across faces only unless asked: the one fix a TreeMesh user needs
+        raise InputError(f"{error}: build the TreeMesh with diagonal_balance=True") from None
     return OctreeMesh(mesh._result, leaves.origin)
