@@ -13,7 +13,7 @@ Examples
 
 from __future__ import annotations
 
-__all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "one_line", "shown"]
+__all__ = ["CosphericalError", "CosphericalWarning", "FormatError", "InputError", "UsageError", "one_line", "shown"]
 
 
 class CosphericalError(Exception):
@@ -30,6 +30,11 @@ class FormatError(InputError):
 
 class UsageError(CosphericalError):
     """A command-line usage error: a missing, conflicting or malformed option."""
+
+
+class CosphericalWarning(UserWarning):
+    """An input that is used but most likely not what was meant (a refinement shape outside the
+    domain): the library warns with :func:`warnings.warn`, the CLI prints one line on stderr."""
 
 
 def shown(value, most: int = 40) -> str:

@@ -93,3 +93,13 @@ def test_leaf_cell_data_numbers_the_leaves_as_the_leaves_file_lists_them(tmp_pat
         ids = [grid.GetCell(c).GetPointId(k) for k in range(grid.GetCell(c).GetNumberOfPoints())]
         low = rows[leaf[c], 1:] * size[leaf[c]]
         assert np.all(points[ids] >= low - 1e-12) and np.all(points[ids] <= low + size[leaf[c]] + 1e-12)
+
+
+def test_a_refine_shape_outside_the_domain_is_one_warning_line(capsys):
+    argv = ["mesh", "--domain", "1", "2", "4", "--levels", "2", "--no-uniform", "--refine", "point:0.5,0.5,0.5",
+            "--refine", "point:0.5,0.5,4.5", "--refine", "sphere:0.5,1,2,0.1", "--refine", "plane:0,0,1,5\n"]
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert err.splitlines() == [  # one line each, the shape's text named as written
+        "cospherical: warning: refine shape 'point:0.5,0.5,4.5' does not meet the domain: it refines nothing",
+        "cospherical: warning: refine shape 'plane:0,0,1,5\\n' does not meet the domain: it refines nothing"], err

@@ -15,6 +15,7 @@ from cospherical.core.configuration import Box
 from cospherical.core.delaunay import delaunay_cells
 from cospherical.core.geometry import Frame
 from cospherical.core.incremental_delaunay import delaunay_tetrahedra
+from cospherical.errors import InputError
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.checks import grid_weights
 from cospherical.mesh.octree import build_octree, parse_shape
@@ -73,6 +74,31 @@ def test_bad_input():
         delaunay_tetrahedra(cube + [(1, 0, 1)], (1, 1, 1))
     with pytest.raises(ValueError, match="four"):
         delaunay_tetrahedra(cube[:3], (1, 1, 1))
+
+
+CUBE = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+
+
+@pytest.mark.parametrize("weights", [(0, 1, 1), (1, -1, 1), (-1, -1, -1), (0, 0, 0), (1, 1, 0), (1.0, 1, 1),
+                                     (1, 0.5, 1), (True, 1, 1), (np.float64(2), 1, 1), (1, 1), (1, 1, 1, 1), ("1", 1, 1)])
+def test_weights_that_are_no_metric_are_refused_by_name(weights):
+    # a zero or negative weight is no metric: (0, 0, 0) made every point 'coincide with a vertex',
+    # (0, 1, 1) and (-1, 1, 1) gave tetrahedra of a meaningless sphere test
+    with pytest.raises(InputError, match=r"^weights .*: three positive integers"):
+        delaunay_tetrahedra(CUBE, weights)
+
+
+@pytest.mark.parametrize("point", [(1, 1, 0.5), (0.9, 1, 1), (np.float64(1), 1, 1), (True, 1, 1), (1, 1), (1, 1, 1, 1),
+                                   ("1", 1, 1)])
+def test_coordinates_that_are_not_integers_are_refused_never_truncated(point):
+    # int() truncated 0.5 to 0: the point moved without a word
+    with pytest.raises(InputError, match=r"^point 8 .*: three integer grid coordinates"):
+        delaunay_tetrahedra(CUBE + [point], (1, 1, 1))
+
+
+def test_numpy_integers_and_positive_weights_are_accepted():
+    tets = delaunay_tetrahedra(np.array(CUBE + [(2, 1, 1)], dtype=np.int32), np.array([1, 4, 9], dtype=np.uint8))
+    assert sorted(set().union(*tets)) == list(range(9))
 
 
 @pytest.mark.oracle_qhull

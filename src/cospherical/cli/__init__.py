@@ -15,8 +15,9 @@ import os
 import signal
 import sys
 import threading
+import warnings
 
-from ..errors import CosphericalError, UsageError, one_line
+from ..errors import CosphericalError, CosphericalWarning, UsageError, one_line
 from ..version import __version__
 
 __all__ = ["build_parser", "main"]
@@ -132,6 +133,21 @@ def main(argv: list[str] | None = None) -> int:
     _interrupted.clear()
     _terminated.clear()
     _closed_standard_streams()
+    with warnings.catch_warnings():
+        python_shows = warnings.showwarning
+
+        def show(message, category, *where, **more) -> None:
+            # the library's warnings about the input are one line, as its errors are; others as Python shows them
+            if issubclass(category, CosphericalWarning):
+                _say(f"cospherical: warning: {message}")
+            else:
+                python_shows(message, category, *where, **more)
+
+        warnings.showwarning = show
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         words = sys.argv[1:] if argv is None else argv
         command = next((word for word in words if not word.startswith("-")), None)

@@ -39,6 +39,9 @@ from __future__ import annotations
 
 from typing import Sequence
 
+import numpy as np
+
+from ..errors import InputError, shown
 from .geometry import Frame, collinear
 from .morton import morton_codes
 
@@ -55,12 +58,15 @@ _PAIRS = tuple({k: tuple(j for j in range(4) if j not in (at, k)) for k in _OTHE
 def delaunay_tetrahedra(coords: Sequence[Sequence[int]], weights: Sequence[int]) -> list[tuple[int, int, int, int]]:
     """A Delaunay tetrahedralisation of integer points: tetrahedra as index quadruples, positively oriented.
 
-    ``weights``: positive integers proportional to the squared lengths of the
-    three axes' units (the metric is ``w0 dx^2 + w1 dy^2 + w2 dz^2``).  Every
-    tetrahedron has positive volume, no point strictly inside its circumsphere, and
-    they tile the convex hull; where more than four points share an empty sphere
-    the split among them is any one.  Raises ``ValueError`` when the points are
-    coplanar or two of them coincide.
+    ``weights``: three positive integers proportional to the squared lengths of the
+    three axes' units (the metric is ``w0 dx^2 + w1 dy^2 + w2 dz^2``; a weight of 0
+    or below is no metric, and every point would seem to coincide with another or
+    lie on every sphere).  Every tetrahedron has positive volume, no point strictly
+    inside its circumsphere, and they tile the convex hull; where more than four
+    points share an empty sphere the split among them is any one.  Raises
+    :class:`~cospherical.errors.InputError` (a ``ValueError``) when a coordinate or
+    weight is not an integer (a float is refused, never truncated), a weight is not
+    positive, the points are coplanar or two of them coincide.
 
     Examples
     --------
@@ -68,13 +74,31 @@ def delaunay_tetrahedra(coords: Sequence[Sequence[int]], weights: Sequence[int])
     >>> tets = delaunay_tetrahedra(cube, (1, 4, 9))  # one cell: any split of the cube
     >>> len(tets), sorted(set().union(*tets))
     (6, [0, 1, 2, 3, 4, 5, 6, 7])
+    >>> delaunay_tetrahedra(cube, (0, 1, 1))
+    Traceback (most recent call last):
+    ...
+    cospherical.errors.InputError: weights (0, 1, 1): three positive integers (squared lengths of the axes' units)
     """
-    points = [tuple(int(x) for x in p) for p in coords]
+    weights = tuple(weights) if isinstance(weights, (Sequence, np.ndarray)) else (weights,)
+    if len(weights) != 3 or not all(_is_integer(w) and w > 0 for w in weights):
+        raise InputError(f"weights {shown(weights)}: three positive integers (squared lengths of the axes' units)")
+    weights = [int(w) for w in weights]
+    points = []
+    for n, p in enumerate(coords):
+        p = tuple(p) if isinstance(p, (Sequence, np.ndarray)) else (p,)
+        if len(p) != 3 or not all(_is_integer(x) for x in p):
+            raise InputError(f"point {n} {shown(p)}: three integer grid coordinates")
+        points.append(tuple(int(x) for x in p))
     if len(points) < 4:
-        raise ValueError(f"{len(points)} points: a tetrahedralisation needs four that are not coplanar")
+        raise InputError(f"{len(points)} points: a tetrahedralisation needs four that are not coplanar")
     low = [min(p[axis] for p in points) for axis in range(3)]
-    frame = Frame.build({i: [x - m for x, m in zip(p, low)] for i, p in enumerate(points)}, list(weights))
+    frame = Frame.build({i: [x - m for x, m in zip(p, low)] for i, p in enumerate(points)}, weights)
     return _Triangulation(frame).run(_morton_order(frame.coords))
+
+
+def _is_integer(value) -> bool:
+    """An int or a numpy integer; not a bool, and never a float, however whole."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
 def _morton_order(coords: Sequence[Sequence[int]]) -> list[int]:
@@ -119,7 +143,7 @@ class _Triangulation:
             if len(chosen) == 1:
                 ok = frame.coords[i] != frame.coords[a]
                 if not ok:
-                    raise ValueError(f"points {a} and {i} coincide")
+                    raise InputError(f"points {a} and {i} coincide")
             elif len(chosen) == 2:
                 ok = not collinear(frame.coords[a], frame.coords[chosen[1]], frame.coords[i])
             else:
@@ -129,7 +153,7 @@ class _Triangulation:
                 if len(chosen) == 4:
                     break
         if len(chosen) < 4:
-            raise ValueError("the points are coplanar: no tetrahedralisation")
+            raise InputError("the points are coplanar: no tetrahedralisation")
         first = set(chosen)
         rest = [i for i in order if i not in first]
         return chosen, rest
@@ -237,7 +261,7 @@ class _Triangulation:
     def _insert(self, p: int) -> None:
         start = self._locate(p)
         if not self._conflict(start, p):
-            raise ValueError(f"point {p} coincides with a vertex")
+            raise InputError(f"point {p} coincides with a vertex")
         cavity = {start}
         stack = [start]
         boundary: list[tuple[int, int]] = []

@@ -17,6 +17,7 @@ from the finest level down, is the coarsest balanced tree containing the refinem
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from fractions import Fraction
 from itertools import product
@@ -26,7 +27,7 @@ import numpy as np
 
 from ..core.configuration import Box
 from ..core.exact import parse_rational
-from ..errors import InputError, shown
+from ..errors import CosphericalWarning, InputError, shown
 from ..files.yamlio import machine_memory
 
 __all__ = ["BALANCES", "BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count", "distinct",
@@ -367,7 +368,10 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
     (default :func:`leaf_bound`) is refused before any cell is visited.
     ``must_split(level, cells)`` (cells n x 3 at ``level``): which cells are split
     whatever the shapes say, at every level below ``max(levels, resolve)`` (a device's
-    region boundaries, :mod:`cospherical.mesh.device`).
+    region boundaries, :mod:`cospherical.mesh.device`).  A shape that does not meet the
+    closed domain refines nothing: it is run without it, with a
+    :class:`~cospherical.errors.CosphericalWarning` naming it (most likely a typo in a
+    coordinate, or a shape meant for a domain of other lengths).
 
     Examples
     --------
@@ -394,7 +398,11 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
         cells = _cells_of(level, existing)
         hit = np.zeros(len(cells), dtype=bool)
         for shape in shapes if level < levels else ():
-            hit |= _meets(shape, box, level, cells)
+            meets = _meets(shape, box, level, cells)
+            if level == 0 and not meets.any():  # the root cell is the whole closed domain
+                warnings.warn(f"refine shape {shown(shape.text)} does not meet the domain: it refines nothing",
+                              CosphericalWarning, stacklevel=2)
+            hit |= meets
         if must_split is not None:
             hit |= must_split(level, cells)
         split.append(existing[hit])
@@ -416,6 +424,47 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
 # A tree brought as a list of leaves
 
 
+def _leaf_integers(values, width: int, where: str, what: str) -> np.ndarray:
+    """Levels (``width`` 1) or positions (rows of 3) as a flat int64 array, each an integer.
+
+    numpy's own conversion to int64 truncates (a level 0.9 becomes 0, a position i + 0.5
+    becomes i), reads a bool array as 0 and 1 and raises OverflowError past 64 bits: what
+    numpy does not read as integers is looked at value by value, and the first that is not
+    a plain integer of at most 64 bits raises InputError naming its leaf.
+    """
+    int64 = np.iinfo(np.int64)
+    try:
+        array = values if isinstance(values, np.ndarray) else np.asarray(values)
+    except (ValueError, OverflowError, TypeError):  # rows of different lengths, ints past 64 bits
+        array = None
+    if array is not None and array.dtype.kind in "iu":
+        flat = array.reshape(-1)
+        if array.dtype.kind == "u" and array.dtype.itemsize == 8 and len(flat) and flat.max() > int64.max:
+            bad = int(np.flatnonzero(flat > int64.max)[0])
+            raise InputError(f"{where}: leaf {bad // width}: {what} {flat[bad]} is too large")
+        flat = flat.astype(np.int64)
+    else:
+        try:
+            flat = np.asarray(values, dtype=object).reshape(-1)
+        except ValueError:
+            raise InputError(f"{where}: the {what}s are not a list of integers") from None
+        if width > 1 and flat.ndim == 1 and any(isinstance(value, (list, tuple, np.ndarray)) for value in flat):
+            n = next(n for n, row in enumerate(flat) if not isinstance(row, (list, tuple, np.ndarray))
+                     or len(row) != width)  # rows of different lengths: the first that is not 3 long
+            raise InputError(f"{where}: leaf {n}: {what} {shown(flat[n])} is not {width} integers")
+        for n, value in enumerate(flat):
+            if not isinstance(value, (int, np.integer)) or isinstance(value, (bool, np.bool_)):
+                value = value.item() if isinstance(value, np.generic) else value
+                raise InputError(f"{where}: leaf {n // width}: {what} {shown(value)} is not an integer "
+                                 f"(a {type(value).__name__})")
+            if not int64.min <= value <= int64.max:
+                raise InputError(f"{where}: leaf {n // width}: {what} {shown(int(value))} is too large")
+        flat = flat.astype(np.int64)
+    if len(flat) % width:
+        raise InputError(f"{where}: {len(flat)} position numbers: not rows of 3")
+    return flat
+
+
 def leaves_octree(box: Box, levels: Sequence[int] | np.ndarray, positions: Sequence[Sequence[int]] | np.ndarray,
                   where: str = "leaves") -> Octree:
     """Check a list of leaves (level, i, j, k) and order it as an :class:`Octree`.
@@ -435,8 +484,8 @@ def leaves_octree(box: Box, levels: Sequence[int] | np.ndarray, positions: Seque
     ...
     cospherical.errors.InputError: leaves: no leaf covers the cell at level 1, position 1 1 1
     """
-    levels = np.asarray(levels, dtype=np.int64).reshape(-1)
-    positions = np.asarray(positions, dtype=np.int64).reshape(-1, 3)
+    levels = _leaf_integers(levels, 1, where, "level")
+    positions = _leaf_integers(positions, 3, where, "position").reshape(-1, 3)
     if len(levels) == 0:
         raise InputError(f"{where}: no leaves")
     if len(levels) != len(positions):
