@@ -209,3 +209,58 @@ def test_random_unions_of_boxes_pass_the_oracle(data, tmp_path_factory):
     path = folder / "device.yaml"
     path.write_text(yaml.safe_dump(data))
     _mesh_and_check(path, folder / "out")
+
+
+@pytest.fixture(scope="module")
+def mos_dual(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("mos")
+    m = build_mesh(device=EXAMPLES[[p.stem for p in EXAMPLES].index("mos-capacitor")], uniform=False, dual=True)
+    m.write(folder)
+    return m, folder / "dual.npz"
+
+
+def test_the_dual_splits_exactly_per_region(mos_dual):
+    m, _ = mos_dual
+    dual, parts = m.dual, m.dual.regions
+    # every vertex's and edge's parts sum to its total exactly
+    for index, values, den, total, total_den, count in (
+            (parts.volume_vertex, parts.volume_exact, parts.volume_denominator, dual.volume_exact,
+             dual.volume_denominator, len(dual.vertices)),
+            (parts.coupling_edge, parts.coupling_exact, parts.coupling_denominator, dual.coefficient_exact,
+             dual.coefficient_denominator, len(dual.edges))):
+        summed = np.zeros(count, dtype=object)
+        np.add.at(summed, index, values.astype(object))
+        assert all(Fraction(int(a), den) == Fraction(int(b), total_den) for a, b in zip(summed, total))
+    # a region's parts sum to its volume (the factor a*b*c is 1 here), a contact's to its rectangle's area
+    assert parts.region_volumes() == [Fraction(3, 4), Fraction(1, 4)]
+    assert parts.contact_areas() == [Fraction(1), Fraction(1, 4)]
+    # an interface vertex has a part in each region
+    both = np.bincount(parts.volume_vertex, minlength=len(dual.vertices)) == 2
+    assert both.sum() == m.report.device["interfaces"][0]["nodes"]
+
+
+def test_check_proves_the_region_parts_and_refuses_altered_ones(mos_dual, tmp_path, capsys):
+    import sys
+    sys.path.insert(0, str(Path(__file__).parents[1] / "formats"))
+    from test_dual import _resigned
+
+    from cospherical.cli import main
+
+    m, path = mos_dual
+    assert main(["check", str(path)]) == 0
+    capsys.readouterr()
+    parts = m.dual.regions
+    scale = {"volume_part": parts.volume_factor / parts.volume_denominator,
+             "coupling_part": parts.volume_factor / parts.coupling_denominator,
+             "contact_part": 1 / parts.contact_denominator}
+    with np.load(path) as archive:
+        members = {name: archive[name + "_exact"] for name in scale}
+    for name, values in members.items():
+        altered = values.copy()
+        altered[0] += 1  # a part moved between two rows keeps every sum; its floats follow (only recomputing finds it)
+        altered[1] -= 1
+        target = tmp_path / f"{name}.npz"
+        _resigned(path, target, members={name + "_exact": altered, name: altered.astype(np.float64) * scale[name]})
+        assert main(["check", str(target)]) == 2
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1 and name.rsplit("_", 1)[0] in err, err

@@ -6,7 +6,7 @@ same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` element
 
 ===========================  ==========  ==================================================
 ``manifest``                 uint8       JSON text: ``format`` (``cospherical-dual``),
-                                         ``version`` (3), ``domain`` (the box, exact
+                                         ``version`` (3; 4 for a device, below), ``domain`` (the box, exact
                                          texts), ``grid``, the exact denominators and
                                          factors (decimal texts), ``sha256`` of every
                                          other member
@@ -38,6 +38,33 @@ same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` element
                                          padded with -1; ``4 <= w <= 64``
 ``element_sizes``            int e       each element's number of vertices
 ===========================  ==========  ==================================================
+
+A device's dual (``mesh --device ... --dual``) is version 4: the members above plus its
+parts per region and its contacts (manifest: ``region_names``, ``region_materials``,
+``contact_names``, ``contact_regions`` (region indices), ``contact_boxes`` (exact
+texts, device units), ``origin`` (the bounding box's low corner, where the grid
+starts) and the three part denominators)::
+
+    element_region                   int e     each element's region
+    volume_part_vertex, _region      int p     one row per (vertex, region), sorted
+    volume_part_exact, volume_part   iU/f8 p   over volume_part_denominator, times
+                                               sqrt(volume_factor_squared): its part
+                                               of the vertex's control volume
+    coupling_part_edge, _region      int q     one row per (edge, region), sorted
+    coupling_part_exact, coupling_part         over coupling_part_denominator, times
+                                               sqrt(volume_factor_squared): its part
+                                               of the edge's coefficient
+    contact_face_nodes               int f x w each contact face (polygon, -1 padded)
+    contact_face_contact             int f     its contact
+    contact_part_vertex, _contact    int r     one row per (vertex, contact), sorted
+    contact_part_exact, contact_part iU/f8 r   over contact_part_denominator (device
+                                               units): its part of the contact's area
+
+The parts of a vertex or an edge sum to its total exactly, a region's volume parts
+to its volume, a contact's area parts to its rectangle's area.  A one-box mesh (one
+region) writes version 3, byte for byte as before; both versions are read, and
+:func:`verify_dual` computes a version 4 file's parts again from its elements, their
+regions and its contact faces.
 
 The reader refuses, with one line, a file that is not such a zip, lacks or adds a
 member, has an array of the wrong kind or shape, fails a checksum (a truncated or
@@ -77,13 +104,16 @@ from pathlib import Path
 import numpy as np
 
 from ..core.configuration import Box
-from ..errors import FormatError, InputError
+from ..errors import FormatError, InputError, shown
 from ..files.yamlio import atomic_write, machine_memory, parse_json
-from ..mesh.dual import Dual
+from ..mesh.dual import Dual, RegionParts
 
 __all__ = ["DUAL_FORMAT_VERSION", "read_dual", "verify_dual", "write_dual"]
 
-DUAL_FORMAT_VERSION = 3
+DUAL_FORMAT_VERSION = 4
+# Version 3 is version 4 without the region members: a one-box mesh (one region) still writes it,
+# byte for byte as before, and both are read.
+_VERSIONS = (3, 4)
 _MAX_DUAL_FILE = 16 * 1024**3
 # member -> (dtype kind, columns or None, which count: n vertices, m edges, e elements)
 _MEMBERS = {
@@ -93,6 +123,18 @@ _MEMBERS = {
     "boundary_area": ("f", None, "n"), "boundary_area_exact": ("iU", 3, "n"), "element_circumcenter": ("f", 3, "e"),
     "element_nodes": ("i", "w", "e"), "element_sizes": ("i", None, "e"),
 }
+# a device's members (version 4): p control-volume parts, q coupling parts, f contact faces, r contact area parts
+_REGION_MEMBERS = {
+    "element_region": ("i", None, "e"),
+    "volume_part_vertex": ("i", None, "p"), "volume_part_region": ("i", None, "p"),
+    "volume_part_exact": ("iU", None, "p"), "volume_part": ("f", None, "p"),
+    "coupling_part_edge": ("i", None, "q"), "coupling_part_region": ("i", None, "q"),
+    "coupling_part_exact": ("iU", None, "q"), "coupling_part": ("f", None, "q"),
+    "contact_face_nodes": ("i", "w", "f"), "contact_face_contact": ("i", None, "f"),
+    "contact_part_vertex": ("i", None, "r"), "contact_part_contact": ("i", None, "r"),
+    "contact_part_exact": ("iU", None, "r"), "contact_part": ("f", None, "r"),
+}
+_MAX_NAMES = 64
 # the most vertices an element may list: a leaf's 26 points, or a cell of the global mode (co-spherical
 # grid points); bounds the exact hull computed per distinct element shape when the dual is verified
 _MAX_ELEMENT_NODES = 64
@@ -112,6 +154,7 @@ _MAX_TEXT_DIGITS = 1000  # the manifest's exact numbers, written as text
 _POSITIVE = re.compile(r"[1-9][0-9]{0,%d}" % (_MAX_TEXT_DIGITS - 1))
 _POSITIVE_FRACTION = re.compile(r"[1-9][0-9]{0,%d}(/[1-9][0-9]{0,%d})?" % (_MAX_TEXT_DIGITS - 1, _MAX_TEXT_DIGITS - 1))
 _MAX_GRID = 1 << 40
+_FRACTION = re.compile(r"-?[0-9]{1,%d}(/[1-9][0-9]{0,%d})?" % (_MAX_TEXT_DIGITS - 1, _MAX_TEXT_DIGITS - 1))
 
 
 def _npy(array: np.ndarray) -> bytes:
@@ -132,9 +175,30 @@ def write_dual(dual: Dual, path: str | Path) -> None:
     arrays["coefficient_exact"] = _exact(arrays["coefficient_exact"])
     arrays["volume_exact"] = _exact(arrays["volume_exact"])
     arrays["boundary_area_exact"] = _exact(arrays["boundary_area_exact"])
+    parts = dual.regions
+    extra = {}
+    if parts is not None:
+        arrays.update({
+            "element_region": parts.element_region.astype(np.int32),
+            "volume_part_vertex": parts.volume_vertex, "volume_part_region": parts.volume_region.astype(np.int32),
+            "volume_part_exact": _exact(parts.volume_exact), "volume_part": parts.volume_part,
+            "coupling_part_edge": parts.coupling_edge, "coupling_part_region": parts.coupling_region.astype(np.int32),
+            "coupling_part_exact": _exact(parts.coupling_exact), "coupling_part": parts.coupling_part,
+            "contact_face_nodes": _face_rows(parts.contact_face_nodes),
+            "contact_face_contact": parts.contact_face_contact.astype(np.int32),
+            "contact_part_vertex": parts.contact_vertex, "contact_part_contact": parts.contact_contact.astype(np.int32),
+            "contact_part_exact": _exact(parts.contact_exact), "contact_part": parts.contact_part})
+        extra = {"region_names": list(parts.names), "region_materials": list(parts.materials),
+                 "contact_names": list(parts.contact_names), "contact_regions": [int(r) for r in parts.contact_regions],
+                 "contact_boxes": [list(b) for b in parts.contact_boxes],
+                 "volume_part_denominator": str(parts.volume_denominator),
+                 "coupling_part_denominator": str(parts.coupling_denominator),
+                 "contact_part_denominator": str(parts.contact_denominator),
+                 "origin": [str(x) for x in parts.origin]}
     blobs = {name: _npy(array) for name, array in arrays.items()}
     manifest = {
-        "format": "cospherical-dual", "version": DUAL_FORMAT_VERSION, "domain": list(dual.box.texts),
+        "format": "cospherical-dual", "version": DUAL_FORMAT_VERSION if parts is not None else 3, **extra,
+        "domain": list(dual.box.texts),
         "grid": int(dual.grid), "coefficient_denominator": str(dual.coefficient_denominator),
         "volume_denominator": str(dual.volume_denominator), "volume_factor_squared": str(dual.volume_factor_squared),
         "boundary_area_denominator": str(dual.boundary_area_denominator),
@@ -150,6 +214,14 @@ def write_dual(dual: Dual, path: str | Path) -> None:
             info.external_attr = 0o644 << 16
             archive.writestr(info, blob, compresslevel=6)
     atomic_write(path, buffer.getvalue())
+
+
+def _face_rows(faces: np.ndarray) -> np.ndarray:
+    """Contact polygons as rows of at least 4 columns (-1 padded): the element rule of the reader."""
+    faces = faces.reshape(len(faces), -1) if len(faces) else np.zeros((0, 4), dtype=np.int32)
+    if faces.shape[1] < 4:
+        faces = np.pad(faces, ((0, 0), (0, 4 - faces.shape[1])), constant_values=-1)
+    return faces.astype(np.int32)
 
 
 def _regular(path: Path) -> None:
@@ -175,7 +247,7 @@ def _member(archive: zipfile.ZipFile, name: str, path: Path, limit: int) -> tupl
     return blob, array
 
 
-def _check_headers(archive: zipfile.ZipFile, path: Path) -> None:
+def _check_headers(archive: zipfile.ZipFile, path: Path, members: dict) -> None:
     """Every member's type and shape from its .npy header, checked against the others and against
     this machine's memory before any member's data is read.
 
@@ -185,7 +257,7 @@ def _check_headers(archive: zipfile.ZipFile, path: Path) -> None:
     says is damaged.
     """
     headers = {}
-    for name in _MEMBERS:
+    for name in members:
         info = archive.getinfo(f"{name}.npy")
         with archive.open(info) as stream:
             try:
@@ -203,14 +275,18 @@ def _check_headers(archive: zipfile.ZipFile, path: Path) -> None:
         headers[name] = dtype, shape
     counts = {"n": headers["grid_vertices"][1][:1], "m": headers["edges"][1][:1],
               "e": headers["element_circumcenter"][1][:1]}
-    for name, (kinds, columns, count) in _MEMBERS.items():
+    for name, count in (("volume_part_vertex", "p"), ("coupling_part_edge", "q"), ("contact_face_contact", "f"),
+                        ("contact_part_vertex", "r")):
+        if name in headers:
+            counts[count] = headers[name][1][:1]
+    for name, (kinds, columns, count) in members.items():
         dtype, shape = headers[name]
         if columns == "w":  # any width from 4 to _MAX_ELEMENT_NODES
             columns = shape[1] if len(shape) == 2 and 4 <= shape[1] <= _MAX_ELEMENT_NODES else "4..64"
         expected = counts[count] + (() if columns is None else (columns,))
         if dtype.kind not in kinds or shape != expected:
             raise FormatError(f"{path}: member {name}: {dtype} {shape}, expected {'/'.join(kinds)} {expected}")
-    needed = 2 * sum(archive.getinfo(f"{name}.npy").file_size for name in _MEMBERS)  # the data and its array
+    needed = 2 * sum(archive.getinfo(f"{name}.npy").file_size for name in members)  # the data and its array
     if needed > machine_memory() // 2:
         raise FormatError(f"{path}: cannot read: its members need {needed:,} bytes, more than half this "
                           f"machine's memory ({machine_memory() // 2:,})")
@@ -224,7 +300,8 @@ def read_dual(path: str | Path) -> Dual:
     try:
         with zipfile.ZipFile(path) as archive:
             names = sorted(archive.namelist())
-            expected = sorted(f"{name}.npy" for name in ("manifest", *_MEMBERS))
+            members = {**_MEMBERS, **_REGION_MEMBERS} if "element_region.npy" in names else _MEMBERS
+            expected = sorted(f"{name}.npy" for name in ("manifest", *members))
             if names != expected:
                 extra = sorted(set(names) ^ set(expected))
                 raise FormatError(f"{path}: not a cospherical dual: member {extra[0] if extra else '?'} "
@@ -232,9 +309,12 @@ def read_dual(path: str | Path) -> Dual:
             limit = max(size * 1100, 1 << 20)  # deflate's best ratio is about 1000
             _, raw = _member(archive, "manifest", path, 1 << 20)
             manifest = _manifest(raw, path)
-            _check_headers(archive, path)
+            if (manifest["version"] == 4) != (members is not _MEMBERS):
+                raise FormatError(f"{path}: dual format version {manifest['version']} "
+                                  f"{'without' if manifest['version'] == 4 else 'with'} the region members")
+            _check_headers(archive, path, members)
             arrays = {}
-            for name in _MEMBERS:
+            for name in members:
                 blob, arrays[name] = _member(archive, name, path, limit)
                 if hashlib.sha256(blob).hexdigest() != manifest["sha256"].get(name):
                     raise FormatError(f"{path}: member {name}: checksum mismatch (the file was changed or damaged)")
@@ -257,9 +337,9 @@ def _manifest(raw: np.ndarray, path: Path) -> dict:
     manifest = parse_json(text, f"{path}: member manifest", max_digits=_MAX_TEXT_DIGITS)
     if not isinstance(manifest, dict) or manifest.get("format") != "cospherical-dual":
         raise FormatError(f"{path}: not a cospherical dual (its manifest names no format cospherical-dual)")
-    if manifest.get("version") != DUAL_FORMAT_VERSION:
-        raise FormatError(f"{path}: dual format version {manifest.get('version')!r}; this reads {DUAL_FORMAT_VERSION} "
-                          "(write it again with cospherical mesh --dual)")
+    if manifest.get("version") not in _VERSIONS:
+        raise FormatError(f"{path}: dual format version {manifest.get('version')!r}; this reads "
+                          f"{' and '.join(map(str, _VERSIONS))} (write it again with cospherical mesh --dual)")
     for key, kind in (("domain", list), ("grid", int), ("coefficient_denominator", str), ("volume_denominator", str),
                       ("volume_factor_squared", str), ("boundary_area_denominator", str),
                       ("boundary_factors_squared", list), ("sha256", dict)):
@@ -308,6 +388,8 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
     squared = tuple(Fraction(x) for x in box.squared)
     if plane_squared != tuple(squared[(k + 1) % 3] * squared[(k + 2) % 3] for k in range(3)):
         raise FormatError(f"{path}: manifest: boundary_factors_squared are not the domain's (b^2 c^2, a^2 c^2, a^2 b^2)")
+    regions = _region_parts(arrays, manifest, len(vertices), len(edges), len(nodes), path, factor) \
+        if "element_region" in arrays else None
     return Dual(box=box, grid=grid, grid_vertices=arrays["grid_vertices"].astype(np.int64),
                 vertices=arrays["vertices"], edges=edges.astype(np.int64), length=arrays["length"],
                 area=arrays["area"], coefficient=arrays["coefficient"], control_volume=arrays["control_volume"],
@@ -317,7 +399,67 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
                 volume_denominator=vden, volume_factor=factor, volume_factor_squared=factor_squared,
                 boundary_area_exact=_integers(arrays["boundary_area_exact"], "boundary_area_exact", path),
                 boundary_area_denominator=bden, boundary_factors_squared=plane_squared,
-                element_circumcenter=arrays["element_circumcenter"], element_nodes=nodes, element_sizes=sizes)
+                element_circumcenter=arrays["element_circumcenter"], element_nodes=nodes, element_sizes=sizes,
+                regions=regions)
+
+
+def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n_elements: int, path: Path,
+                  factor: float) -> RegionParts:
+    """A version 4 file's region members, checked: names, indices in range, denominators (before any geometry)."""
+    names, materials = manifest.get("region_names"), manifest.get("region_materials")
+    contacts, regions_of = manifest.get("contact_names"), manifest.get("contact_regions")
+    boxes = manifest.get("contact_boxes")
+
+    def texts(value, count=None) -> bool:
+        return isinstance(value, list) and len(value) <= _MAX_NAMES and (count is None or len(value) == count) and \
+            all(isinstance(x, str) and 0 < len(x) <= 64 for x in value)
+
+    if not texts(names) or not names or not isinstance(materials, list) or len(materials) != len(names) or \
+            not all(isinstance(x, str) and len(x) <= 64 for x in materials):
+        raise FormatError(f"{path}: manifest: region_names and region_materials are not lists of up to "
+                          f"{_MAX_NAMES} names")
+    if not texts(contacts) or not isinstance(regions_of, list) or len(regions_of) != len(contacts) or \
+            not all(isinstance(r, int) and 0 <= r < len(names) for r in regions_of) or \
+            not isinstance(boxes, list) or len(boxes) != len(contacts) or \
+            not all(isinstance(b, list) and len(b) == 6 and all(isinstance(x, str) and _FRACTION.fullmatch(x)
+                                                               for x in b) for b in boxes):
+        raise FormatError(f"{path}: manifest: contact_names, contact_regions and contact_boxes do not agree")
+    denominators = []
+    for key in ("volume_part_denominator", "coupling_part_denominator", "contact_part_denominator"):
+        if not isinstance(manifest.get(key), str) or not _POSITIVE.fullmatch(manifest[key]):
+            raise FormatError(f"{path}: manifest: {key} is not a positive integer of at most 1000 digits")
+        denominators.append(int(manifest[key]))
+    for name, bound in (("element_region", len(names)), ("volume_part_vertex", n_vertices),
+                        ("volume_part_region", len(names)), ("coupling_part_edge", n_edges),
+                        ("coupling_part_region", len(names)), ("contact_face_contact", len(contacts)),
+                        ("contact_part_vertex", n_vertices), ("contact_part_contact", len(contacts))):
+        values = arrays[name]
+        if len(values) and (values.min() < 0 or values.max() >= bound):
+            raise FormatError(f"{path}: member {name}: an index outside 0..{bound - 1}")
+    faces = arrays["contact_face_nodes"]
+    if np.any((faces < -1) | (faces >= n_vertices)) or np.any((faces[:, :3] < 0)):
+        raise FormatError(f"{path}: member contact_face_nodes: a face that names no vertex")
+    if len(arrays["element_region"]) != n_elements:
+        raise FormatError(f"{path}: member element_region: not one region per element")
+    origin = manifest.get("origin")
+    if not isinstance(origin, list) or len(origin) != 3 or not all(isinstance(x, str) and _FRACTION.fullmatch(x)
+                                                                    for x in origin):
+        raise FormatError(f"{path}: manifest: origin is not three exact numbers")
+    parts = RegionParts(
+        tuple(names), tuple(materials), arrays["element_region"].astype(np.int32),
+        arrays["volume_part_vertex"].astype(np.int64), arrays["volume_part_region"].astype(np.int32),
+        _integers(arrays["volume_part_exact"], "volume_part_exact", path), denominators[0],
+        arrays["coupling_part_edge"].astype(np.int64), arrays["coupling_part_region"].astype(np.int32),
+        _integers(arrays["coupling_part_exact"], "coupling_part_exact", path), denominators[1],
+        tuple(contacts), tuple(regions_of), tuple(tuple(b) for b in boxes), faces.astype(np.int32),
+        arrays["contact_face_contact"].astype(np.int32), arrays["contact_part_vertex"].astype(np.int64),
+        arrays["contact_part_contact"].astype(np.int32),
+        _integers(arrays["contact_part_exact"], "contact_part_exact", path), denominators[2], factor,
+        tuple(origin))
+    for name in ("volume_part", "coupling_part", "contact_part"):  # the floats: what the exact values give
+        if not np.array_equal(arrays[name], getattr(parts, name)):
+            raise FormatError(f"{path}: member {name}: not what the exact values give")
+    return parts
 
 
 def _elements(nodes: np.ndarray, sizes: np.ndarray, n_vertices: int, path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -457,3 +599,71 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
             what = f"edge {dual.edges[k, 0]}-{dual.edges[k, 1]}" if len(value) == len(dual.edges) and name in (
                 "length", "coefficient", "area") else f"vertex {k}"
             raise FormatError(f"{path}: member {name}: {what} is not what the exact values give")
+    if dual.regions is not None:
+        _verify_regions(dual, path)
+
+
+def _verify_regions(dual: Dual, path: str | Path) -> None:
+    """A version 4 file's region parts computed again from its elements, their regions and its contact faces,
+    and compared exactly; each contact's faces lie in its rectangle and cover its area exactly."""
+    from ..mesh.regions import region_parts
+
+    parts = dual.regions
+    boxes = [tuple(Fraction(x) for x in box) for box in parts.contact_boxes]
+    try:
+        lengths = tuple(Fraction(text) for text in dual.box.texts)
+    except ValueError:
+        raise FormatError(f"{path}: manifest: a device's domain lengths must be rational") from None
+    axes = []
+    for c, box in enumerate(boxes):
+        flat = [a for a in range(3) if box[a] == box[a + 3]]
+        if len(flat) != 1:
+            raise FormatError(f"{path}: manifest: contact {c}'s box is not a rectangle")
+        axes.append(flat[0])
+    contacts = tuple((name, region, tuple(box), axis) for name, region, box, axis in
+                     zip(parts.contact_names, parts.contact_regions, parts.contact_boxes, axes))
+    again = region_parts(dual.box, dual.grid, dual.grid_vertices, dual, parts.element_region, parts.names,
+                         parts.materials, contacts, parts.contact_face_nodes, parts.contact_face_contact, lengths,
+                         parts.origin)
+
+    def rows_differ(name: str, ours: tuple, theirs: tuple) -> None:
+        (a_index, a_values, a_den), (b_index, b_values, b_den) = ours, theirs
+        if len(a_index[0]) != len(b_index[0]) or any(not np.array_equal(x, y) for x, y in zip(a_index, b_index)):
+            raise FormatError(f"{path}: member {name}: not the rows its elements give ({len(b_index[0])} rows, "
+                              f"its elements give {len(a_index[0])})")
+        left = a_values.astype(object) * b_den
+        right = b_values.astype(object) * a_den
+        wrong = np.flatnonzero(np.asarray(left != right).reshape(-1))
+        if len(wrong):
+            k = int(wrong[0])
+            raise FormatError(f"{path}: member {name}_exact: row {k} ({' '.join(str(int(i[k])) for i in a_index)}) "
+                              "is not the part its elements give")
+
+    rows_differ("volume_part", ((again.volume_vertex, again.volume_region), again.volume_exact,
+                                again.volume_denominator),
+                ((parts.volume_vertex, parts.volume_region), parts.volume_exact, parts.volume_denominator))
+    rows_differ("coupling_part", ((again.coupling_edge, again.coupling_region), again.coupling_exact,
+                                  again.coupling_denominator),
+                ((parts.coupling_edge, parts.coupling_region), parts.coupling_exact, parts.coupling_denominator))
+    rows_differ("contact_part", ((again.contact_vertex, again.contact_contact), again.contact_exact,
+                                 again.contact_denominator),
+                ((parts.contact_vertex, parts.contact_contact), parts.contact_exact, parts.contact_denominator))
+    # each contact: its faces in its rectangle, their areas the rectangle's (exact, on the grid)
+    g = dual.grid_vertices
+    origin = [Fraction(x) for x in parts.origin]
+    for c, (box, axis) in enumerate(zip(boxes, axes)):
+        b, d = (axis + 1) % 3, (axis + 2) % 3
+        rectangle = [(box[i] - origin[i % 3]) / lengths[i % 3] * dual.grid for i in range(6)]
+        twice = 0
+        for face in parts.contact_face_nodes[parts.contact_face_contact == c]:
+            p = g[face[face >= 0]].astype(np.int64)
+            if not all(rectangle[a] <= int(v) <= rectangle[a + 3] for a in range(3) for v in p[:, a]):
+                raise FormatError(f"{path}: member contact_face_nodes: a face of contact "
+                                  f"{shown(parts.contact_names[c])} leaves its rectangle")
+            x, y = p[:, b], p[:, d]
+            twice += abs(int((x * np.roll(y, -1) - np.roll(x, -1) * y).sum()))
+        area = Fraction(twice, 2 * dual.grid ** 2) * lengths[b] * lengths[d]
+        if area != (box[b + 3] - box[b]) * (box[d + 3] - box[d]):
+            raise FormatError(f"{path}: contact {shown(parts.contact_names[c])}: its faces' area {area} is not its "
+                              "rectangle's")
+

@@ -255,7 +255,7 @@ class _Vertices:
 def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_region: np.ndarray,
                  names: tuple[str, ...], materials: tuple[str, ...], contacts: tuple = (),
                  contact_face_nodes: np.ndarray | None = None, contact_face_contact: np.ndarray | None = None,
-                 lengths: tuple[Fraction, Fraction, Fraction] | None = None) -> RegionParts:
+                 lengths: tuple[Fraction, Fraction, Fraction] | None = None, origin=("0", "0", "0")) -> RegionParts:
     """The dual of each region's elements alone (exact), as parts of ``dual`` (see :class:`RegionParts`).
 
     A region's part of a control volume or of a coupling is the dual of its own
@@ -303,7 +303,8 @@ def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_regio
         tuple(tuple(c[2]) for c in contacts), contact_face_nodes.astype(np.int32),
         contact_face_contact.astype(np.int32), np.array([v for v, _ in pairs], dtype=np.int64).reshape(-1),
         np.array([c for _, c in pairs], dtype=np.int32).reshape(-1),
-        _narrow([int(shares[p] * contact_denominator) for p in pairs]), contact_denominator, dual.volume_factor)
+        _narrow([int(shares[p] * contact_denominator) for p in pairs]), contact_denominator, dual.volume_factor,
+        tuple(str(x) for x in origin))
 
 
 def _used(nodes: np.ndarray, count: int) -> np.ndarray:
@@ -377,7 +378,8 @@ def mesh_region_parts(mesh: Mesh, dual: Dual, faces: RegionFaces) -> RegionParts
     contacts = tuple((c.name, names.index(c.region), tuple(str(x) for x in c.box), c.axis) for c in device.contacts)
     lengths = tuple(high - low for low, high in device.bounds)
     return region_parts(mesh.box, mesh.grid, mesh.vertices, dual, mesh.element_region, mesh.regions.names,
-                        mesh.regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths)
+                        mesh.regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths,
+                        device.origin)
 
 
 def region_volumes(mesh: Mesh) -> list[Fraction]:
