@@ -303,3 +303,61 @@ def test_elements_whose_exact_hulls_are_too_much_work_are_refused_before_any_geo
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "member element_nodes: " in err and "Traceback" not in err, err
     assert measured == []
+
+
+# the cube's six Kuhn tetrahedra around its diagonal 0-6 (corners in VTK hexahedron order) and tetrahedra of the
+# same volume (1/6 of the cube) around the other diagonals
+KUHN = [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]]
+OTHER_DIAGONAL = [[1, 2, 3, 7], [4, 5, 7, 2], [3, 0, 1, 5]]
+
+
+def _forged_dual(path: Path, replaced: dict[int, list[list[int]]], tetrahedra: bool = False) -> Path:
+    """The dual.npz of the uniform 4 x 4 x 4 cube tree (64 hexahedra, or with ``tetrahedra`` their
+    conforming split: each cube's six Kuhn tetrahedra) whose ``replaced`` interior cubes (k: the k-th
+    interior one) are given instead as these tetrahedra (corners of the cube, VTK order), its dual
+    computed from those elements and written as the mesher writes it: every value is its elements'."""
+    from cospherical.core.configuration import Box
+    from cospherical.formats.dual import write_dual
+    from cospherical.mesh.assembly import assemble
+    from cospherical.mesh.dual import mesh_dual
+    from cospherical.mesh.octree import build_octree, parse_shape
+    from cospherical.mesh.tetrahedra import split_tetrahedra
+
+    mesh = assemble(build_octree(Box.parse(["1", "1", "1"]), 2, [parse_shape("point:0.5,0.5,0.5")]))
+    conn, sizes = mesh.connectivity()
+    inside = [e for e in range(len(mesh)) if ((mesh.tree.positions[mesh.element_leaf[e]] % 3) > 0).all()]
+    assert len(mesh) == 64 and len(inside) == 8 and (sizes == 8).all()
+    split = split_tetrahedra(mesh)
+    rows = []
+    for e in range(len(mesh)):
+        own = [np.r_[t, [-1] * 4] for t in split.nodes[split.parent == e]] if tetrahedra else [conn[e]]
+        if e in inside and inside.index(e) in replaced:
+            if tetrahedra:  # the split is the Kuhn one: the forgery differs from it only where it says
+                assert {frozenset(t[:4]) for t in own} == {frozenset(conn[e][k]) for k in KUHN}
+            own = [np.r_[conn[e][t], [-1] * 4] for t in replaced[inside.index(e)]]
+        rows += own
+    nodes = np.array(rows, dtype=np.int32)
+    write_dual(mesh_dual(mesh, (nodes, (nodes >= 0).sum(axis=1).astype(np.int8))), path)
+    return path
+
+
+@pytest.mark.parametrize("replaced, tetrahedra", [
+    # the attack: an interior cube of the hexahedra given as five of its Kuhn tetrahedra and one of
+    # the other diagonal, which overlaps two of them and leaves a hole of its own volume
+    ({3: KUHN[:5] + OTHER_DIAGONAL[:1]}, False),
+    # the same in the conforming split into tetrahedra: nothing else is out of place
+    ({5: KUHN[1:] + OTHER_DIAGONAL[1:2]}, True),
+    # the overlap in one cube (a seventh tetrahedron), the hole in another (one of six missing)
+    ({0: KUHN + OTHER_DIAGONAL[2:], 7: KUHN[:3] + KUHN[4:]}, True),
+])
+def test_a_resigned_dual_whose_elements_overlap_and_leave_a_hole_is_refused(tmp_path, capsys, replaced, tetrahedra):
+    from cospherical.cli import main
+    from cospherical.formats.dual import read_dual
+
+    path = _forged_dual(tmp_path / "forged.npz", replaced, tetrahedra)
+    dual = read_dual(path)
+    assert dual.volume_sum() == 1 and dual.boundary_area_sums() == (2, 2, 2)  # every sum holds
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "forged.npz: member element_nodes: the elements are not a mesh" in err, err
+    assert main(["check", str(_forged_dual(tmp_path / "good.npz", {}, tetrahedra))]) == 0  # unforged, it passes

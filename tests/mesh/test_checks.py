@@ -30,3 +30,36 @@ def test_global_delaunay_equals_brute_force_on_a_brick():
     assert (found["delaunay_violating_pairs"], found["delaunay_violations"]) == (pairs, elements)
     assert found["delaunay_violations"] > 0
     assert check_circumcenters(mesh)["leaves_not_fvm_adequate"] > 0
+
+
+def _shapes(vertices: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """Each element's class of translates, node for node (what check computes from a dual's elements)."""
+    coords = np.where((conn >= 0)[..., None], vertices[np.maximum(conn, 0)], 0)
+    relative = np.where((conn >= 0)[..., None], coords - coords[:, :1], -1).reshape(len(conn), -1)
+    return np.unique(relative, axis=0, return_inverse=True)[1].reshape(-1)
+
+
+def test_faces_of_elements_given_by_their_vertices_pair_as_the_meshs_own():
+    """The faces check computes from bare element lists (a dual's) pair exactly as the mesh's own faces do:
+    same interior pairs and boundary faces; and faces that would take more memory than allowed are
+    refused before any is made."""
+    import pytest
+
+    from cospherical.errors import InputError
+    from cospherical.mesh.checks import check_conformity, element_faces, pair_faces
+
+    mesh = assemble(build_octree(BRICK, 3, [parse_shape("sphere:0.5,1,2,0.6")]))
+    conn, sizes = mesh.connectivity()
+    shape = _shapes(mesh.vertices, conn)
+    faces = element_faces(mesh.vertices, conn, sizes, shape, BRICK.squared)
+    needed = sum(rows.nbytes for parts in faces.values() for rows in parts)
+    found = pair_faces(faces, mesh.vertices, mesh.grid)
+    own = check_conformity(mesh)
+    assert found == own and own["nonconforming_faces"] == 0 and own["interior_faces"] > 0
+    # one element's nodes moved to another's: the faces no longer pair
+    conn[3] = conn[200]
+    broken = pair_faces(element_faces(mesh.vertices, conn, sizes, _shapes(mesh.vertices, conn), BRICK.squared),
+                        mesh.vertices, mesh.grid)
+    assert broken["nonconforming_faces"] > 0
+    with pytest.raises(InputError, match="faces need"):
+        element_faces(mesh.vertices, conn, sizes, shape, BRICK.squared, most_bytes=needed)

@@ -15,7 +15,9 @@ HELP = "validate catalogues, pattern tables (YAML or SQLite store) and dual.npz 
 DESCRIPTION = ("Validate catalogues (schema, unique ids, consistent faces, known split types) and pattern "
                "tables (schema, known types, node counts, and that every configuration's elements tile the box), and "
                "dual.npz files of `cospherical mesh --dual` (members, checksums, control volumes summing to the domain, boundary areas to its surface, "
-               "and every coefficient, control volume and boundary area computed again from the file's elements and compared exactly). "
+               "and every coefficient, control volume and boundary area computed again from the file's elements and compared exactly, "
+               "and the elements proved a mesh of the domain: every face shared by two elements in opposite orientations or in the "
+               "domain's boundary). "
                "Exit status 0 when every file is valid, 2 at the first problem.")
 
 
@@ -65,6 +67,7 @@ def _check_dual(path: Path) -> None:
     verify_dual(dual, path)  # a re-signed change that keeps the sums: every value computed again
     negative = dual.negative_coefficients()
     print(f"{path}: ok, dual of {len(dual.vertices)} vertices and {len(dual.edges)} edges, every value equal to "
-          f"its elements' exactly, control volumes sum to the domain and boundary areas to its surface, "
+          f"its elements' exactly, its elements a mesh of the domain (every face shared by two in opposite "
+          f"orientations or in the boundary), control volumes sum to the domain and boundary areas to its surface, "
           f"{negative['interior']} interior and "
           f"{negative['boundary']} boundary negative coefficients")

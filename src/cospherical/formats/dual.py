@@ -79,7 +79,11 @@ volume and boundary area with the file's, exactly, and every float with the one 
 exact value gives.  A change that keeps the sums (one coefficient ``+k``, another
 ``-k``) is refused with the first edge it changed.  The cost is that of computing
 the dual from its elements: 0.9 CPU-s for the 50,912 elements of the 21,512-leaf
-example of the results page, linear in the elements.  Elements whose distinct shapes
+example of the results page, linear in the elements.  Sums cannot see elements that
+overlap and leave a hole of the same volume, so the elements are also proved a mesh
+of the domain: every face shared by exactly two elements in opposite orientations, or
+by one in the domain's boundary (the mesher's own conformity rule; 0.2 CPU-s more on
+that example, its memory bounded before the faces are made).  Elements whose distinct shapes
 would need more exact hull work than their number justifies (a small file of many
 different 64-vertex shapes would take hours) are refused before any hull is computed.
 The circumcentres
@@ -508,16 +512,18 @@ def _distinct_vertices(vertices: np.ndarray, path: str | Path) -> None:
                           f"{vertices[i].tolist()}")
 
 
-def _bound_hull_work(dual: Dual, path: str | Path) -> None:
-    """Refuse elements whose distinct shapes need more exact hull work than :data:`_TRIPLES_ALLOWED`
-    and :data:`_TRIPLES_PER_ELEMENT` allow (see there), from the vertex ids alone.
+def _element_shapes(dual: Dual, path: str | Path) -> np.ndarray:
+    """Each element's shape: a number equal for elements whose vertices, node for node, are translates of
+    each other; from the vertex ids alone.  Elements whose distinct shapes need more exact hull work than
+    :data:`_TRIPLES_ALLOWED` and :data:`_TRIPLES_PER_ELEMENT` allow (see there) are refused first.
 
     Shapes are told apart up to translation, finer than the dual's grouping (which also divides out
     a power of two), so the work counted is never less than the work done.
     """
     nodes, vertices = dual.element_nodes, dual.grid_vertices
     allowed = _TRIPLES_ALLOWED + _TRIPLES_PER_ELEMENT * len(nodes)
-    seen: set[bytes] = set()
+    seen: dict[bytes, int] = {}
+    shape = np.empty(len(nodes), dtype=np.int64)
     triples = 0
     step = max(1, (1 << 17) // nodes.shape[1])  # elements per block: 3 MB of coordinates (24 bytes a vertex)
     for start in range(0, len(nodes), step):
@@ -527,15 +533,48 @@ def _bound_hull_work(dual: Dual, path: str | Path) -> None:
         low = np.where(used[..., None], coords, np.iinfo(np.int64).max).min(axis=1)
         relative = np.where(used[..., None], coords - low[:, None, :], -1).reshape(len(block), -1)
         rows = np.ascontiguousarray(relative).view(np.dtype((np.void, relative.shape[1] * 8))).ravel()
-        for row in np.unique(rows):  # as raw bytes: ten times faster than np.unique(axis=0)
+        distinct, inverse = np.unique(rows, return_inverse=True)  # as raw bytes: ten times faster than axis=0
+        numbers = np.empty(len(distinct), dtype=np.int64)
+        for k, row in enumerate(distinct):
             key = row.tobytes()
             if key not in seen:
-                seen.add(key)
+                seen[key] = len(seen)
                 triples += math.comb(int((np.frombuffer(key, dtype=np.int64)[::3] >= 0).sum()), 3)
                 if triples > allowed:
                     raise FormatError(f"{path}: member element_nodes: {len(seen):,} distinct element shapes whose "
                                       f"exact hulls are more work than {len(nodes):,} elements may need "
                                       f"({triples:,} vertex triples, at most {allowed:,})")
+            numbers[k] = seen[key]
+        shape[start:start + len(block)] = numbers[inverse.reshape(-1)]
+    return shape
+
+
+def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path) -> None:
+    """The elements are a mesh of the domain: every face met by exactly two elements, in opposite
+    orientations, or by one in the domain's boundary
+    (:func:`~cospherical.mesh.checks.pair_faces`, the mesher's own conformity rule).
+
+    With positive volumes (every element is the hull of its vertices: not flat) and volumes
+    adding up to the domain's (the control volumes, recomputed from the elements, sum to it),
+    this proves that the elements tile the domain: crossing a face met from both sides keeps
+    the number of elements over a point, so that number is the same all over the domain, and
+    the volumes make it one.  Volume sums alone cannot see elements that overlap and leave a
+    hole of the same volume.
+    """
+    from ..mesh.checks import element_faces, pair_faces
+
+    try:
+        faces = element_faces(dual.grid_vertices, dual.element_nodes, dual.element_sizes, shape, dual.box.squared,
+                              machine_memory() // 2)
+    except InputError as error:
+        raise FormatError(f"{path}: member element_nodes: {error}") from None
+    found = pair_faces(faces, dual.grid_vertices, dual.grid, examples=1)
+    if found["nonconforming_faces"]:
+        corners = [[round(x * dual.grid) for x in corner] for corner in found["nonconforming_examples"][0]]
+        raise FormatError(f"{path}: member element_nodes: the elements are not a mesh: {found['nonconforming_faces']:,} "
+                          "faces are neither shared by two elements in opposite orientations nor in the domain's "
+                          f"boundary, e.g. the face of grid points {', '.join(map(str, corners[:6]))}"
+                          f"{', ...' if len(corners) > 6 else ''}")
 
 
 def verify_dual(dual: Dual, path: str | Path) -> None:
@@ -547,11 +586,12 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
     from ..mesh.dual import _scaled, boundary_areas, mesh_dual
 
     _distinct_vertices(dual.grid_vertices, path)
-    _bound_hull_work(dual, path)
+    shape = _element_shapes(dual, path)
     try:
         again = mesh_dual(_Vertices(dual.box, dual.grid, dual.grid_vertices), (dual.element_nodes, dual.element_sizes))
     except InputError as error:  # an element that is flat or not co-spherical has no dual
         raise FormatError(f"{path}: member element_nodes: {error}") from None
+    _check_mesh(dual, shape, path)
     if not np.array_equal(again.edges, dual.edges):
         raise FormatError(f"{path}: member edges: not the edges of its elements ({len(dual.edges)} edges, "
                           f"its elements have {len(again.edges)})")

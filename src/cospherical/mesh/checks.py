@@ -21,11 +21,12 @@ from fractions import Fraction
 
 import numpy as np
 
-from ..core.geometry import in_closed_box
+from ..core.geometry import Frame, in_closed_box
 from ..core.morton import morton_codes
+from ..core.polyhedron import measure
 from ..errors import InputError
 from .assembly import Mesh
-from .device import domain_boundary
+from .device import DeviceLayout, domain_boundary
 from .octree import distinct
 
 # Vertices found near spheres and tested exactly, at most: each test is a few microseconds of
@@ -35,7 +36,8 @@ from .octree import distinct
 _MAX_EXACT_TESTS = 1 << 24
 _PAIR_CHUNK = 1 << 22
 
-__all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "grid_weights", "match_seams"]
+__all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "element_faces", "grid_weights",
+           "match_seams", "on_domain_boundary", "pair_faces"]
 
 
 def check_volume(mesh: Mesh) -> dict:
@@ -78,6 +80,44 @@ def _faces(mesh: Mesh) -> dict[int, list[np.ndarray]]:
     return by_size
 
 
+def element_faces(vertices: np.ndarray, nodes: np.ndarray, sizes: np.ndarray, shape: np.ndarray, squared,
+                  most_bytes: int | None = None) -> dict[int, list[np.ndarray]]:
+    """Every face of elements given by their vertices, as :func:`pair_faces` reads them: by size, rows of
+    vertex ids counter-clockwise seen from outside.
+
+    ``nodes`` (elements x width, -1 padded) and ``sizes`` list each element's vertex ids
+    into ``vertices`` (grid points); ``shape`` numbers the elements so that two with the
+    same number are translates of each other, node for node.  A shape's faces are the hull
+    of one of its elements (:func:`~cospherical.core.polyhedron.measure`, exact, in the frame
+    of the box's squared lengths ``squared``), taken for all its elements at once.  A flat
+    element raises :class:`~cospherical.errors.InputError`, and so do faces whose arrays (with
+    what :func:`pair_faces` makes of them) would take more than ``most_bytes``, before they
+    are made.
+    """
+    order = np.argsort(shape, kind="stable")
+    _, starts = np.unique(shape[order], return_index=True)
+    groups = []
+    for start, end in zip(starts.tolist(), np.r_[starts[1:], len(order)].tolist()):
+        members = order[start:end]
+        first = int(members[0])
+        ids = nodes[first, :int(sizes[first])].astype(np.int64)
+        corners = vertices[ids] - vertices[ids].min(axis=0)
+        frame = Frame.build({i: tuple(Fraction(int(x)) for x in point) for i, point in enumerate(corners)}, squared)
+        cycles = measure(frame, range(len(ids))).cycles
+        if not cycles:
+            raise InputError(f"element {first} is flat: it has no volume")
+        groups.append((members, cycles))
+    # each face's ids, their concatenation and the turned copy, and the sort's keys and order (int64)
+    needed = sum(len(members) * sum(len(c) * 3 * nodes.itemsize + 16 for c in cycles) for members, cycles in groups)
+    if most_bytes is not None and needed > most_bytes:
+        raise InputError(f"the elements' faces need {needed:,} bytes to be paired, more than {most_bytes:,}")
+    faces: dict[int, list[np.ndarray]] = {}
+    for members, cycles in groups:
+        for cycle in cycles:
+            faces.setdefault(len(cycle), []).append(nodes[np.ix_(members, cycle)])
+    return faces
+
+
 def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -> dict:
     """Every interior face shared by exactly two elements, same vertices, opposite orientation; the rest on the boundary.
 
@@ -104,29 +144,33 @@ def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -
     >>> found["nonconforming_faces"], found["interior_faces"], found["boundary_faces"]
     (0, 12, 24)
     """
-    grid = mesh.grid
+    layout = mesh.regions.layout if mesh.regions is not None else None
+    return pair_faces(_faces(mesh), mesh.vertices, mesh.grid, examples, seams, layout)
+
+
+def pair_faces(faces: dict[int, list[np.ndarray]], vertices: np.ndarray, grid: int, examples: int = 5,
+               seams: list | None = None, layout: DeviceLayout | None = None) -> dict:
+    """:func:`check_conformity` on any elements' faces: ``faces``, by size, lists of arrays whose rows are
+    faces as cycles of vertex ids counter-clockwise seen from outside their element; ``vertices``
+    the grid points, ``grid`` intervals per side of the box, the domain (or its union of boxes,
+    ``layout``: see :func:`on_domain_boundary`).  The lists are emptied as they are read.
+    """
     bad_total, interior, boundary = 0, 0, 0
     shown: list[list[list[float]]] = []
-    for size, parts in sorted(_faces(mesh).items()):
-        faces = np.concatenate(parts)
-        del parts
-        start = np.argmin(faces, axis=1)
+    for size, parts in sorted(faces.items()):
+        rows = np.concatenate(parts)
+        parts.clear()
+        start = np.argmin(rows, axis=1)
         # column by column (np.choose), not through a (faces x size) int64 index: a fraction of the memory
-        turned = np.empty_like(faces)
+        turned = np.empty_like(rows)
         for column in range(size):
-            turned[:, column] = np.choose((start + column) % size, faces.T)
+            turned[:, column] = np.choose((start + column) % size, rows.T)
+        del rows
         flipped = turned[:, 1] > turned[:, -1]
         turned[flipped, 1:] = turned[flipped, :0:-1]
         turned, flipped, ok, pairs, single = _paired(turned, flipped)
         interior += pairs
-        points = mesh.vertices[turned[single]]  # (n, size, 3)
-        on_boundary = np.zeros(len(single), dtype=bool)
-        if mesh.regions is not None and mesh.regions.layout is not None:
-            on_boundary = domain_boundary(mesh.regions.layout, points, grid)
-        else:
-            for axis in range(3):
-                for side in (0, grid):
-                    on_boundary |= np.all(points[:, :, axis] == side, axis=1)
+        on_boundary = on_domain_boundary(vertices[turned[single]], grid, layout)
         ok[single[on_boundary]] = True
         boundary += int(on_boundary.sum())
         if seams is not None:
@@ -136,9 +180,27 @@ def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -
         bad = np.flatnonzero(~ok)
         bad_total += len(bad)
         for row in bad[:max(0, examples - len(shown))]:
-            shown.append((mesh.vertices[turned[row]] / grid).tolist())
+            shown.append((vertices[turned[row]] / grid).tolist())
     return {"nonconforming_faces": int(bad_total), "interior_faces": int(interior), "boundary_faces": int(boundary),
             "nonconforming_examples": shown}
+
+
+def on_domain_boundary(points: np.ndarray, grid: int, layout: DeviceLayout | None = None) -> np.ndarray:
+    """Per face (``points``: faces x corners x 3 grid points), whether it lies in the domain's boundary.
+
+    The one place that says where the domain's boundary is, for the mesh's conformity check and
+    for check's proof that a dual's elements are a mesh.  The domain is the box of ``grid``
+    intervals per side, where a face lies in the boundary when all its corners share a
+    coordinate 0 or ``grid``; or a device's union of boxes (``layout``, non-convex, with holes:
+    :func:`~cospherical.mesh.device.domain_boundary`).
+    """
+    if layout is not None:
+        return domain_boundary(layout, points, grid)
+    on_boundary = np.zeros(len(points), dtype=bool)
+    for axis in range(3):
+        for side in (0, grid):
+            on_boundary |= np.all(points[:, :, axis] == side, axis=1)
+    return on_boundary
 
 
 def _paired(turned: np.ndarray, flipped: np.ndarray):
