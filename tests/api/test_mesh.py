@@ -93,6 +93,7 @@ def test_a_leaf_list_in_memory_is_numbered_as_listed():
     (dict(domain=(1, 1, 1), leaves=[[0, 2**70, 0, 0]]), "rows of four integers"),
     (dict(domain=(1, 1, 1), leaves=[["0", "0", "0", "0"]]), "rows of four integers"),
     (dict(domain=(1, 1, 1), leaves=[[0, 0, 0, 0]] * 3, max_leaves=2), "above the bound of 2"),
+    (dict(domain=(1, 1, 1), leaves=iter([[0, 0, 0, 0]])), "not list_iterator"),
     (dict(domain=(1, 1, 1), leaves=[[1, 0, 0, 0]]), "no leaf covers"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], criterion="internal_faces", delaunay="global"),
      "use --delaunay leaf"),

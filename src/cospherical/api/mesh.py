@@ -110,6 +110,8 @@ def tree_source(box: Box, levels: int | None = None, refine: Sequence[str | Shap
         return tree_from_leaves(box, level_list, positions, where=str(leaves), file=Path(leaves).name)
     from ..mesh.octree import check_leaf_count
 
+    if not isinstance(leaves, (Sequence, np.ndarray)):
+        raise InputError(f"leaves=: a leaf list file or rows of (level, i, j, k), not {type(leaves).__name__}")
     check_leaf_count(len(leaves), "leaves=:", max_leaves)  # before a row is converted
     try:
         rows = np.asarray(leaves)
