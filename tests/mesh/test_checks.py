@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+from hypothesis import HealthCheck, given, settings
 
 from cospherical.core.configuration import Box
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.checks import check_circumcenters, check_delaunay
 from cospherical.mesh.octree import build_octree, parse_shape
+
+from .test_dual import octrees
 
 BRICK = Box.parse(["1", "2", "4"])
 
@@ -63,3 +66,13 @@ def test_faces_of_elements_given_by_their_vertices_pair_as_the_meshs_own():
     assert broken["nonconforming_faces"] > 0
     with pytest.raises(InputError, match="faces need"):
         element_faces(mesh.vertices, conn, sizes, shape, BRICK.squared, most_bytes=needed)
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(octrees())
+def test_bare_element_lists_pair_as_the_mesh_on_any_octree(mesh):
+    from cospherical.mesh.checks import check_conformity, element_faces, pair_faces
+
+    conn, sizes = mesh.connectivity()
+    faces = element_faces(mesh.vertices, conn, sizes, _shapes(mesh.vertices, conn), mesh.box.squared)
+    assert pair_faces(faces, mesh.vertices, mesh.grid) == check_conformity(mesh)

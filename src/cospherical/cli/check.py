@@ -13,7 +13,9 @@ __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ b
 
 HELP = "validate catalogues, pattern tables (YAML or SQLite store) and dual.npz files"
 DESCRIPTION = ("Validate catalogues (schema, unique ids, consistent faces, known split types) and pattern "
-               "tables (schema, known types, node counts, and that every configuration's elements tile the box), and "
+               "tables (schema, known types, node counts; each element's type, mirror flag and circumcenter recomputed, its node "
+               "order giving its type's faces outward, VTK's positive orientation; every configuration's elements tiling the "
+               "box, each face met once from each side or once on its boundary), and "
                "dual.npz files of `cospherical mesh --dual` (members, checksums, control volumes summing to the domain, boundary areas to its surface, "
                "and every coefficient, control volume and boundary area computed again from the file's elements and compared exactly, "
                "and the elements proved a mesh of the domain: every face shared by two elements in opposite orientations or in the "
