@@ -103,3 +103,15 @@ def test_bad_calls_raise_one_input_error(kwargs, needle):
     with pytest.raises(InputError, match=None) as raised:
         cospherical.build_mesh(**kwargs)
     assert needle in str(raised.value) and "\n" not in str(raised.value)
+
+
+def test_a_devices_dual_asked_later_has_its_region_parts():
+    """``m.dual`` on first use is the dual ``dual=True`` makes: for a device, split per region and contact too."""
+    import dataclasses
+
+    later = cospherical.build_mesh(device="examples/devices/mos-capacitor.yaml", uniform=False)
+    now = cospherical.build_mesh(device="examples/devices/mos-capacitor.yaml", uniform=False, dual=True)
+    assert later.report.dual is None and later.dual.regions is not None
+    for item in dataclasses.fields(now.dual.regions):
+        ours, theirs = getattr(later.dual.regions, item.name), getattr(now.dual.regions, item.name)
+        assert np.array_equal(ours, theirs) if isinstance(ours, np.ndarray) else ours == theirs, item.name

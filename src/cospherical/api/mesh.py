@@ -33,10 +33,10 @@ from ..core.configuration import Box
 from ..errors import InputError
 from ..files.outputs import OutputFolder
 from ..mesh.assembly import Lookup, Mesh
-from ..mesh.dual import Dual, mesh_dual
+from ..mesh.dual import Dual
 from ..mesh.octree import Octree, Shape
-from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode, run_pipeline, tree_from_leaves,
-                             tree_from_octree, tree_from_refine)
+from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode, full_dual, run_pipeline,
+                             tree_from_leaves, tree_from_octree, tree_from_refine)
 from ..mesh.report import MeshReport
 
 __all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "device_cut_axis", "from_treemesh",
@@ -256,7 +256,7 @@ class OctreeMesh:
     def dual(self) -> Dual:
         """The exact finite-volume dual (control volumes, edges, areas, coefficients, ``laplacian()``)."""
         if self._dual is None:
-            self._dual = mesh_dual(self.assembled)
+            self._dual = full_dual(self.assembled, self._result.faces)
         return self._dual
 
     @property

@@ -45,7 +45,7 @@ from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree,
 from .regions import RegionFaces, device_mesh, device_report, mesh_region_parts, region_faces
 from .report import MeshReport, mesh_report
 
-__all__ = ["PipelineResult", "Progress", "TreeSource", "delaunay_mode", "run_pipeline", "tree_from_device",
+__all__ = ["PipelineResult", "Progress", "TreeSource", "delaunay_mode", "full_dual", "run_pipeline", "tree_from_device",
            "tree_from_leaves", "tree_from_octree", "tree_from_refine"]
 
 Progress = Callable[[str, "int | None", int], None]
@@ -213,8 +213,21 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         clock.stage("regions")
         faces = region_faces(mesh)
         if found is not None:
-            found.regions = mesh_region_parts(mesh, found, faces)
+            found = full_dual(mesh, faces, found)
         report["device"] = device_report(mesh, faces, found.regions if found is not None else None, found)
     clock.stage(None)
     return PipelineResult(source, mesh, MeshReport.from_dict(report, timings), found,
                           violating[0] if violating else None, faces)
+
+
+def full_dual(mesh: Mesh, faces: RegionFaces | None, dual: Dual | None = None) -> Dual:
+    """The mesh's exact dual (``dual`` when already computed) with, for a device, its parts per region and contact.
+
+    ``faces``: the device's region faces (:attr:`PipelineResult.faces`), ``None`` for a one-box mesh.
+    The one place both the pipeline (``dual=True``) and a dual asked for later make it.
+    """
+    if dual is None:
+        dual = mesh_dual(mesh)
+    if faces is not None and dual.regions is None:
+        dual.regions = mesh_region_parts(mesh, dual, faces)
+    return dual
