@@ -113,8 +113,9 @@ def element_faces(vertices: np.ndarray, nodes: np.ndarray, sizes: np.ndarray, sh
         raise InputError(f"the elements' faces need {needed:,} bytes to be paired, more than {most_bytes:,}")
     faces: dict[int, list[np.ndarray]] = {}
     for members, cycles in groups:
+        rows = nodes[members]
         for cycle in cycles:
-            faces.setdefault(len(cycle), []).append(nodes[np.ix_(members, cycle)])
+            faces.setdefault(len(cycle), []).append(rows[:, cycle])
     return faces
 
 
