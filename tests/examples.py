@@ -4,7 +4,11 @@ Shell examples are the lines of its ```sh blocks (comments stripped); heavy ones
 small size, only their size arguments rewritten (``SMALLER``). They run in a scratch clone
 of the repository, so outputs such as ``results/sweep`` never touch the checkout, with the
 few stand-in files the examples name as the reader's own (``OLD.yaml``, ``NEW.yaml``,
-``SRC``). Python examples are its ```python blocks.
+``SRC``). Python examples are its ```python blocks. An example must leave no stray file
+in the checkout (nothing new in ``git status --porcelain``): what it writes goes to ``out/``
+(ignored) or a temporary folder, so a reader who runs it in a clone finds nothing to clean
+up. Rewriting a committed file is what some examples are for (a benchmark records its run
+in ``results/benchmarks/``, ``sweep --out results/sweep`` regenerates the sweep).
 """
 
 from __future__ import annotations
@@ -55,7 +59,19 @@ def shell_examples(text: str) -> list[str]:
 
 
 def python_examples(text: str) -> list[str]:
-    return re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    """The programs of a document's ```python blocks.
+
+    A block whose first line is a comment starting ``# continued`` is the next cell of the
+    block before it, as in a notebook (a tutorial's steps with prose between them): the two
+    run as one program.
+    """
+    programs: list[str] = []
+    for block in re.findall(r"```python\n(.*?)```", text, flags=re.S):
+        if block.startswith("# continued") and programs:
+            programs[-1] += block
+        else:
+            programs.append(block)
+    return programs
 
 
 def heavy_lines_without_figures(text: str) -> list[str]:
@@ -92,8 +108,9 @@ def run_shell_example(line: str, cwd: Path) -> None:
         command = pattern.sub(replacement, command)
     bin_dir = str(Path(sys.executable).parent)
     env = {**os.environ, "PATH": bin_dir + os.pathsep + os.environ["PATH"]}
-    result = subprocess.run(["bash", "-c", command], cwd=cwd, env=env, capture_output=True, text=True,
-                            timeout=1800)  # a guard against hangs only: a loaded machine is slow
+    with no_stray_files(cwd, line):
+        result = subprocess.run(["bash", "-c", command], cwd=cwd, env=env, capture_output=True, text=True,
+                                timeout=1800)  # a guard against hangs only: a loaded machine is slow
     if "SCHEDULER" in command:  # a placeholder host: one line, exit 2
         assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1, result.stderr
         return
@@ -105,9 +122,24 @@ def run_shell_example(line: str, cwd: Path) -> None:
 def run_python_example(snippet: str, cwd: Path, name: str) -> str:
     """Run one Python example in ``cwd``; what it printed (an example shows its result)."""
     printed = io.StringIO()
-    with _chdir(cwd), contextlib.redirect_stdout(printed):
+    with no_stray_files(cwd, f"the Python example of {name}"), _chdir(cwd), contextlib.redirect_stdout(printed):
         exec(compile(snippet, name, "exec"), {"__name__": "__example__"})
     return printed.getvalue()
+
+
+def _untracked(checkout: Path) -> set[str]:
+    status = subprocess.run(["git", "status", "--porcelain", "--untracked-files=all"], cwd=checkout, check=True,
+                            capture_output=True, text=True, timeout=120).stdout.splitlines()
+    return {line[3:] for line in status if line.startswith("?? ")}
+
+
+@contextlib.contextmanager
+def no_stray_files(checkout: Path, example: str):
+    """Fail if ``example`` left a file in ``checkout`` that git would show as untracked (out/ is ignored)."""
+    before = _untracked(checkout)
+    yield
+    stray = sorted(_untracked(checkout) - before)
+    assert not stray, f"{example} left files in the checkout: {stray}"
 
 
 @contextlib.contextmanager

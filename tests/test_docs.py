@@ -32,7 +32,7 @@ README_LINES = set(shell_examples((ROOT / "README.md").read_text()))
 # store reader are run by the tests below (test_site_builds_strict, test_c_reader_...); the leaf
 # study of the 1 x 2 x 4 box, the same command, by cli/test_study.py (test_study_leaves_json_and_tables),
 # which checks its output.
-NOT_RUN = ("scripts/setup.sh", "mkdocs ", "./lookup", "cospherical study leaves --box 1 2 4 --format json --out ")
+NOT_RUN = ("scripts/setup.sh", "mkdocs ", "out/lookup out/", "cospherical study leaves --box 1 2 4 --format json --out ")
 MKDOCS = Path(sys.executable).parent / "mkdocs"
 
 
@@ -160,6 +160,22 @@ SNIPPETS = [(page, snippet) for page, text in PAGES.items() for snippet in pytho
 @pytest.mark.parametrize("page, snippet", SNIPPETS, ids=[f"{page}-{i}" for i, (page, _) in enumerate(SNIPPETS)])
 def test_docs_python_example_runs(scratch, page, snippet):
     assert run_python_example(snippet, scratch, page).strip(), "an example shows its result"
+
+
+def test_an_example_that_leaves_a_file_in_the_checkout_fails(tmp_path):
+    checkout = tmp_path / "clone"
+    subprocess.run(["git", "init", "-q", str(checkout)], check=True)
+    (checkout / ".gitignore").write_text("out/\n")
+    subprocess.run(["git", "add", ".gitignore"], cwd=checkout, check=True)
+    subprocess.run(["git", "-c", "user.name=t", "-c", "user.email=t@t", "commit", "-q", "-m", "ignore out/"],
+                   cwd=checkout, check=True)
+    run_shell_example("mkdir -p out && echo kept > out/result.txt", checkout)  # out/ is where examples write
+    run_shell_example("echo 'out/' > .gitignore", checkout)  # a committed file rewritten: what regenerating is
+    with pytest.raises(AssertionError, match=r"left files in the checkout: \['stray\.txt'\]"):
+        run_shell_example("echo stray > stray.txt", checkout)
+    with pytest.raises(AssertionError, match=r"left files in the checkout: \['new/deep\.py'\]"):
+        run_python_example("from pathlib import Path\nPath('new').mkdir()\nPath('new/deep.py').write_text('')",
+                           checkout, "a page")
 
 
 def test_cuboid_diagram_numbers_the_nodes_as_the_code_does():

@@ -424,6 +424,14 @@ def test_bad_and_unreachable_schedulers_are_one_line():
     assert time.monotonic() - start < 30
 
 
+def test_a_scheduler_port_where_nothing_listens_is_one_line_at_once(capsys):
+    # dask's connect retried the refused connection for the whole default timeout (30 s)
+    start = time.monotonic()
+    refused(capsys, "study", "intersection", "--resolution", "2", "--scheduler", f"tcp://127.0.0.1:{_closed_port()}",
+            needle="cannot connect: nothing listens on port")
+    assert time.monotonic() - start < 5
+
+
 def test_a_scheduler_port_that_never_answers_is_one_line_within_the_timeout(capsys):
     # the kernel accepts the connection (the backlog), nothing answers: dask's Client waited for good
     with socket.socket() as silent:

@@ -89,7 +89,8 @@ def add_arguments(parser) -> None:
                         "a folder the workers share). It must be a scheduler you run: Dask unpickles what it "
                         "sends, so it can run any code as you")
     parser.add_argument("--scheduler-timeout", type=float, default=30.0, metavar="SECONDS",
-                        help="give up connecting to --scheduler after this long (default 30)")
+                        help="give up on a --scheduler host that does not answer after this long (default 30; a port where "
+                        "nothing listens, or a host name that does not resolve, is refused at once)")
     parser.add_argument("--dask-workers", type=int, metavar="N",
                         help="run the pieces on a local Dask cluster of N processes (with --partitions)")
     parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check of the result")

@@ -80,7 +80,8 @@ def _add_family(parser, family: str) -> None:
            help="run the work units on this Dask scheduler's workers. It must be a scheduler you run: Dask "
            "unpickles what it sends, so it can run any code as you")
     option("--scheduler-timeout", type=float, metavar="SECONDS", only=intersection,
-           help="give up connecting to --scheduler after this long (default 30)")
+           help="give up on a --scheduler host that does not answer after this long (default 30; a port where "
+                "nothing listens, or a host name that does not resolve, is refused at once)")
     option("--dask-workers", type=int, metavar="N", only=intersection,
            help="run the work units on a local Dask cluster of N processes")
     option("--no-orbits", action="store_true", only=intersection,

@@ -173,6 +173,7 @@ def _handshake(scheduler: str) -> None:
     from distributed.comm import connect
 
     timeout = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), "s")
+    _listening(scheduler, timeout)
 
     async def handshake() -> None:
         comm = await asyncio.wait_for(connect(scheduler, timeout=timeout), timeout)
@@ -185,6 +186,42 @@ def _handshake(scheduler: str) -> None:
     except Exception as error:  # refused, unreachable, or not a Dask scheduler's answer (MemoryError included)
         text = str(error).splitlines()[0] if str(error) else type(error).__name__
         raise InputError(f"Dask scheduler {scheduler}: cannot connect: {text}") from None
+
+
+def _listening(scheduler: str, timeout: float) -> None:
+    """Refuse at once, with one line, a TCP or TLS scheduler address where nothing can be reached.
+
+    dask's ``connect`` retries a refused connection or an unknown host name until its
+    timeout: a port where nothing listens, or a mistyped host, cost the whole 30 s of the
+    default ``--scheduler-timeout`` before the command said so. One plain TCP connect tells
+    at once (the kernel refuses a closed port; a name that does not resolve fails in the
+    lookup), and still waits up to the timeout for a host that does not answer at all.
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    address = urlsplit(scheduler)
+    if address.scheme not in ("tcp", "tls"):  # ucx:// is not TCP: dask alone decides
+        return
+    try:
+        host, port = address.hostname, address.port
+    except ValueError:  # a port that is not a number, or out of range
+        raise InputError(f"Dask scheduler {scheduler}: cannot connect: the port is not a number from 0 to "
+                         "65535") from None
+    if not host or port is None:
+        raise InputError(f"Dask scheduler {scheduler}: cannot connect: give tcp://HOST:PORT")
+    named = address.netloc.rpartition(":")[0].strip("[]")  # the host as given (hostname is lower-cased)
+    try:
+        socket.create_connection((host, port), timeout=timeout).close()
+    except socket.gaierror:
+        raise InputError(f"Dask scheduler {scheduler}: cannot connect: host {named!r} not found") from None
+    except ConnectionRefusedError:
+        raise InputError(f"Dask scheduler {scheduler}: cannot connect: nothing listens on port {port} "
+                         f"of {named}") from None
+    except TimeoutError:
+        raise InputError(f"Dask scheduler {scheduler}: cannot connect: no answer within {timeout:g} s") from None
+    except OSError as error:  # no route to the host, network unreachable
+        raise InputError(f"Dask scheduler {scheduler}: cannot connect: {error.strerror or error}") from None
 
 
 @contextmanager
