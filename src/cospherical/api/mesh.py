@@ -213,18 +213,22 @@ class OctreeMesh:
 
     @property
     def assembled(self) -> Mesh:
+        """The mesher's own mesh, leaf by leaf (:class:`~cospherical.mesh.assembly.Mesh`), for the lower-level functions."""
         return self._result.mesh
 
     @property
     def tree(self) -> Octree:
+        """The octree meshed (levels and integer positions of its leaves, in the tree's order)."""
         return self._result.source.tree
 
     @property
     def box(self) -> Box:
+        """The domain, with its exact lengths."""
         return self.tree.box
 
     @property
     def report(self) -> MeshReport:
+        """What the exact checks found, the counts and frequencies, and the seconds per stage (frozen)."""
         return self._result.report
 
     @cached_property
@@ -236,11 +240,13 @@ class OctreeMesh:
 
     @property
     def exact_vertices(self) -> ExactVertices:
+        """The vertices exactly: integer grid coordinates, the grid's steps per side and the domain."""
         mesh = self.assembled
         return ExactVertices(np.asarray(mesh.vertices, dtype=np.int64), int(mesh.grid), mesh.box)
 
     @cached_property
     def elements(self) -> Elements:
+        """The elements: types, vertex ids (flat, with offsets) and leaves, in the mesh's element order."""
         mesh = self.assembled
         conn, sizes = mesh.connectivity()
         ids, element_type = mesh.element_types()
