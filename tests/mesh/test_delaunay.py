@@ -2,7 +2,7 @@
 
 The oracle triangulates all mesh vertices at once with scipy's Qhull and merges
 its tetrahedra with an exact integer in-sphere test across shared faces (no
-regions, no leaf tables, no circumcenters): the cells of the global mode must be
+clusters, no leaf tables, no circumcenters): the cells of the global mode must be
 its cells, as sets of vertex sets.
 """
 
@@ -63,7 +63,7 @@ def test_global_mode_equals_qhull_merged_exactly(domain, levels, shapes, balance
     if domain == ["1", "1", "1"]:
         assert mesh is leaf and mesh.cells is None  # cube octrees: already Delaunay, untouched
     elif check_delaunay(leaf)["delaunay_violations"]:
-        assert mesh_cells(leaf) != expected and mesh.cells is not None and mesh.cells.regions >= 1
+        assert mesh_cells(leaf) != expected and mesh.cells is not None and mesh.cells.clusters >= 1
     # every leaf element kept is a cell; the replaced leaves hold none of the mesh's leaf elements
     assert mesh_cells(leaf) & expected <= mesh_cells(mesh)
     circumcenters = check_circumcenters(mesh)
@@ -155,7 +155,7 @@ def test_the_final_check_skips_only_what_the_leaf_check_proved():
 
 
 def _count_exact(monkeypatch) -> list:
-    """Record the regions the exact engine tetrahedralises (their vertex counts)."""
+    """Record the clusters the exact engine tetrahedralises (their vertex counts)."""
     import cospherical.mesh.delaunay as delaunay
 
     calls: list = []
@@ -181,7 +181,7 @@ def test_exact_engine_gives_the_qhull_paths_cells(domain, levels, shapes, balanc
 @pytest.mark.parametrize("domain, shape", [(["1e-12", "1", "3e9"], "point:0,0.3,1e9"),
                                            (["sqrt(2)", "1e-12", "1"], "point:0.5,0,0.7")])
 def test_extreme_boxes_mesh_exactly(domain, shape, monkeypatch, capsys, tmp_path):
-    # Qhull's float triangulation fails on these regions; the exact engine takes them; the dual's
+    # Qhull's float triangulation fails on these clusters; the exact engine takes them; the dual's
     # numbers pass float's range and the picture's section is one pixel wide: every output is written
     calls = _count_exact(monkeypatch)
     argv = ["mesh", "--domain", *domain, "--levels", "4", "--refine", shape, "--format", "json", "--no-uniform",
@@ -281,7 +281,7 @@ def test_a_wrong_proposal_the_local_check_passes_is_redone_exactly(change, monke
     leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))
     calls = _count_exact(monkeypatch)
     mesh = global_delaunay(leaf, proposal=_tampered(change))
-    assert calls  # the proof failed on the proposal's cells: the exact engine redid those regions
+    assert calls  # the proof failed on the proposal's cells: the exact engine redid those clusters
     assert mesh_cells(mesh) == oracle_cells(leaf)
     assert whole(mesh) == WHOLE
 
@@ -314,8 +314,8 @@ def test_a_table_element_that_is_not_cospherical_is_replaced_by_delaunay_cells()
 
 
 @pytest.mark.oracle_qhull
-def test_only_a_wrong_proposals_own_failure_sends_every_region_to_the_exact_engine(monkeypatch):
-    # Tetrahedra of one centre that are not one cell (NotOneCell) are a proposal's fault: every region is
+def test_only_a_wrong_proposals_own_failure_sends_every_cluster_to_the_exact_engine(monkeypatch):
+    # Tetrahedra of one centre that are not one cell (NotOneCell) are a proposal's fault: every cluster is
     # redone exactly.  Any other error on the way is a bug and must surface, not be taken for that one.
     import cospherical.mesh.delaunay as delaunay
 
@@ -340,9 +340,9 @@ def test_only_a_wrong_proposals_own_failure_sends_every_region_to_the_exact_engi
         monkeypatch.undo()
 
 
-def test_a_kept_element_found_again_is_a_bug_not_a_region(monkeypatch):
+def test_a_kept_element_found_again_is_a_bug_not_a_cluster(monkeypatch):
     # the final check tests only the fresh cells: a kept leaf element among its findings cannot be
-    # attributed to a region (it was once read through a negative index), so it stops the run
+    # attributed to a cluster (it was once read through a negative index), so it stops the run
     import cospherical.mesh.delaunay as delaunay
 
     leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))

@@ -21,14 +21,14 @@ from cospherical.core.configuration import Box
 from cospherical.formats.mesh import table_lookup
 from cospherical.formats.patterns import load
 from cospherical.mesh.assembly import assemble
-from cospherical.mesh.delaunay import _regions, delaunay_mesh
+from cospherical.mesh.delaunay import _clusters, delaunay_mesh
 from cospherical.mesh.octree import build_octree, parse_shape
 from cospherical.mesh.partition import morton_pieces
 from tests.test_outputs import _descendants
 
 ROOT = Path(__file__).resolve().parents[2]
-# A cube sphere tree (every element from the leaf table, no region to re-tessellate) and a 1 x 2 x 4 tree
-# whose leaf mesh is not Delaunay: its one re-tessellated region lies across the pieces' seams.
+# A cube sphere tree (every element from the leaf table, no cluster to re-tessellate) and a 1 x 2 x 4 tree
+# whose leaf mesh is not Delaunay: its one re-tessellated cluster lies across the pieces' seams.
 SPHERE = ("--domain", "1", "1", "1", "--levels", "4", "--refine", "sphere:0.5,0.5,0.5,0.3",
           "--patterns", str(ROOT / "patterns" / "leaves-1x1x1.yaml"))
 BRICK = ("--domain", "1", "2", "4", "--levels", "4", "--refine", "point:0.1,0.1,2")
@@ -102,19 +102,19 @@ def test_the_pieces_are_the_mesh_of_one_process(argv, pieces, tmp_path, capsys):
     assert report["nonconforming_faces"] == 0 and report["delaunay_violations"] == 0 and report["volume_ok"]
 
 
-def test_the_brick_region_crosses_the_seams(brick):
-    """The test above is meant to see re-tessellated cells whose region lies in several pieces."""
+def test_the_brick_cluster_crosses_the_seams(brick):
+    """The test above is meant to see re-tessellated cells whose cluster lies in several pieces."""
     mesh, _ = brick
     assert mesh.cells is not None and len(mesh.cells)
     fresh = ~mesh.cells.proven  # the re-tessellated cells, in parts through shared vertices
-    region, count = _regions(mesh.cells.nodes[fresh], len(mesh.vertices))
+    cluster, count = _clusters(mesh.cells.nodes[fresh], len(mesh.vertices))
     first = mesh.cells.leaf[fresh]
     assert count >= 1
     for pieces in (2, 4):
         piece_of = np.empty(len(mesh.tree), dtype=np.int64)
         for k, leaves in enumerate(morton_pieces(mesh.tree, pieces)):
             piece_of[leaves] = k
-        assert any(len(np.unique(piece_of[first[region == r]])) > 1 for r in range(count)), pieces
+        assert any(len(np.unique(piece_of[first[cluster == r]])) > 1 for r in range(count)), pieces
 
 
 def test_same_input_same_bytes(tmp_path, capsys):

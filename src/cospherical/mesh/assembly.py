@@ -162,8 +162,9 @@ class Cells:
     an interior point of it (the centroid of its vertices); ``spanning[i]``
     whether the cell reaches beyond that leaf; ``proven[i]`` whether it is a leaf
     element that passed the exact global check, kept as it is (the others were
-    re-tessellated).  ``regions`` and ``largest_region`` (in vertices) describe what
-    was re-tessellated.
+    re-tessellated).  ``clusters`` (connected groups of leaf elements re-tessellated
+    together; not a device's regions) and ``largest_cluster`` (in vertices) describe
+    what was re-tessellated.
     """
 
     shapes: list[CellShape]
@@ -173,8 +174,8 @@ class Cells:
     leaf: np.ndarray
     spanning: np.ndarray
     proven: np.ndarray
-    regions: int = 0
-    largest_region: int = 0
+    clusters: int = 0
+    largest_cluster: int = 0
 
     def __len__(self) -> int:
         return len(self.shape)

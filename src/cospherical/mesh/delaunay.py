@@ -1,4 +1,4 @@
-"""The exact Delaunay subdivision of a mesh's vertex set, from the leaf mesh and a few re-tessellated regions.
+"""The exact Delaunay subdivision of a mesh's vertex set, from the leaf mesh and a few re-tessellated clusters.
 
 Let V be the vertices and D their Delaunay subdivision: each cell the convex hull
 of all points of V on one empty sphere, the cells tiling the domain (the convex
@@ -6,7 +6,7 @@ hull of V).  The leaf mesh already tiles the domain with elements that are
 co-spherical polytopes.
 
 Why the leaf elements that pass the exact global check are kept, and the rest
-re-tessellated region by region.  What the leaf mesh brings: the tree is
+re-tessellated cluster by cluster.  What the leaf mesh brings: the tree is
 1-irregular (edge or vertex balance; face balance alone is refused and a leaf
 list is checked for it), so two leaves whose closed boxes share a piece of a face
 or of an edge differ by at most one level, and a leaf whose box meets another's
@@ -46,7 +46,7 @@ the domain face to face (two closed elements that meet, meet in a common face).
    closed box holds x decides it: x lies in a closed element F of that leaf, and x
    is in U_r exactly when such an F is an element of U_r (a kept element, or one
    of another part, would overlap the interior of the cell of D that x is inside).
-So D = the kept leaf elements plus, per region, the cells of Del(V_r) inside U_r:
+So D = the kept leaf elements plus, per cluster, the cells of Del(V_r) inside U_r:
 every cell of D is a kept element (1) or lies in U (2), then in exactly one U_r
 (3), where it is one of the cells chosen (4).  These cells tile each U_r, and
 they meet the kept elements and one another face to face because all of them are
@@ -63,7 +63,7 @@ leaf that holds it (integer point location, then integer plane sides); tetrahedr
 with the same exact circumcenter are one cell (concentric empty spheres through
 points cannot differ, so the centre names the sphere).  Qhull is given only the
 vertices of U_r's elements, not those of whole leaves: measured on the 1 x 2 x 4
-sphere tree of 345,640 leaves, 110,695 points in 1,305 regions (largest 10,070)
+sphere tree of 345,640 leaves, 110,695 points in 1,305 clusters (largest 10,070)
 instead of 209,793 in 239 (largest 80,067), and Qhull's time 4.2 s instead of 15.7 s.  Measured against CGAL's exact-predicate triangulation (pip ``cgal``) on
 50,000 points at load 11: Qhull 13.1 s in all, CGAL 2.9 s to insert but 13.4 s to
 read its cells back through the Python bindings, one object per cell; Qhull hands
@@ -71,24 +71,24 @@ back arrays.  A cell's vertices are its tetrahedra's.  Where Qhull fails (boxes 
 ratio, 1e-12 x 1 x 3e9, whose first simplex is flat in floats) or drops a point, the
 exact engine (:mod:`cospherical.core.incremental_delaunay`, Bowyer-Watson in Python
 integers, about 3.6 times Qhull's path's CPU) tetrahedralises V_r instead.  Qhull's
-tetrahedra are first checked per region in integers: across every face between two
+tetrahedra are first checked per cluster in integers: across every face between two
 solid tetrahedra the far vertex is not strictly inside the near one's sphere (float
 rounding on thin boxes makes exactly such flips).  That check is cheap and saves a
 second pass, but it proves nothing alone: it does not see the faces next to flat or
 missing tetrahedra, nor overlaps.  What proves the cells, whatever proposed them:
 
-5. The cells made for a region r are accepted when (i) none of them holds a vertex
+5. The cells made for a cluster r are accepted when (i) none of them holds a vertex
    of V strictly inside its sphere or a vertex of V on it that is not its own
    (:func:`~cospherical.mesh.checks.check_delaunay` on the mesh with the cells,
-   exact), and (ii) the exact volumes of the cells named by r (by the region of
+   exact), and (ii) the exact volumes of the cells named by r (by the cluster of
    their first vertex: the V_r are disjoint) sum to the exact volume of U_r's
    elements.  Then they are the cells of D inside U_r.  By (i) each is a cell of D.
-   Each has an interior point in U_r of its own region: the centroid of one of its
+   Each has an interior point in U_r of its own cluster: the centroid of one of its
    solid tetrahedra (a tetrahedron on the cell's vertices lies in the cell, its
    interior in the cell's interior), kept only when it lies in a closed element of
-   its tetrahedron's region; a point interior to a cell of D lies in no other
+   its tetrahedron's cluster; a point interior to a cell of D lies in no other
    closed cell, so by 2 and 4 the cell is one of those tiling U_r (a cell made of
-   tetrahedra of two regions would be one of both tilings: it fails (i)).  Two
+   tetrahedra of two clusters would be one of both tilings: it fails (i)).  Two
    cells made are never the same cell of D: tetrahedra are grouped by exact
    centre, and one centre names one empty sphere.  So the cells named by r are
    distinct cells of the tiling of U_r, and their volumes sum to U_r's only if
@@ -99,15 +99,15 @@ missing tetrahedra, nor overlaps.  What proves the cells, whatever proposed them
    if its solid tetrahedra missed one of its vertices that vertex would tie with
    the cell (i); if they missed a whole cell the volume would fall short (ii).
    Tetrahedra of one centre that are not one co-spherical cell (different radii)
-   cannot be classified: then every region is taken as failing.
-7. A failing region is tetrahedralised again by the exact engine and the whole is
+   cannot be classified: then every cluster is taken as failing.
+7. A failing cluster is tetrahedralised again by the exact engine and the whole is
    checked again.  The exact engine's tetrahedra tile conv(V_r) and are Delaunay,
    so its cells pass; should they not, that is a bug, and it raises rather than
    return a mesh that is not D.  The check of 5 is the one the report runs on the
    mesh anyway, handed on to it (the report tests only the cells not proven):
    proving costs the volume sums, no second empty-sphere pass.
 Cube octrees, whose leaf mesh is already
-globally Delaunay, have no region: the mesh is returned as it is.
+globally Delaunay, have no cluster: the mesh is returned as it is.
 """
 
 from __future__ import annotations
@@ -126,13 +126,13 @@ from .checks import check_delaunay, grid_weights
 __all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
 ENGINES = ("qhull", "exact")
-_NO_REGION = -1  # the region of a leaf element that is kept, and of a vertex of no region
+_NO_CLUSTER = -1  # the cluster of a leaf element that is kept, and of a vertex of no cluster
 
 
 class NotOneCell(Exception):
     """Tetrahedra of one exact centre whose vertices are not one co-spherical cell (different radii).
 
-    Only a wrong proposal makes them; :func:`retessellate` then redoes every region with
+    Only a wrong proposal makes them; :func:`retessellate` then redoes every cluster with
     the exact engine.  Its own class, so that no other error is taken for this one.
     """
 
@@ -141,9 +141,9 @@ def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull"
     """The exact Delaunay subdivision of ``mesh``'s vertices, as a :class:`Mesh` (see the module's proof).
 
     ``found``: the result of :func:`check_delaunay` on ``mesh`` when the caller has it.
-    ``engine``: how regions are tetrahedralised, ``qhull`` (floats propose, integers
+    ``engine``: how clusters are tetrahedralised, ``qhull`` (floats propose, integers
     check, the exact engine where either fails) or ``exact`` (the exact engine alone).
-    ``proposal``: what proposes a region's tetrahedra in place of Qhull (see :func:`retessellate`).
+    ``proposal``: what proposes a cluster's tetrahedra in place of Qhull (see :func:`retessellate`).
 
     Examples
     --------
@@ -152,7 +152,7 @@ def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull"
     >>> from cospherical.mesh.octree import build_octree, parse_shape
     >>> leaf = assemble(build_octree(Box.parse([1, 2, 4]), 3, [parse_shape("point:0.1,0.1,0.1")]))
     >>> whole = global_delaunay(leaf)
-    >>> [check_delaunay(m)["delaunay_violations"] for m in (leaf, whole)], whole.cells.regions
+    >>> [check_delaunay(m)["delaunay_violations"] for m in (leaf, whole)], whole.cells.clusters
     ([5, 0], 1)
     """
     return _global_delaunay(mesh, found, engine, proposal)[0]
@@ -160,7 +160,7 @@ def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull"
 
 def _global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull",
                      proposal=None) -> tuple[Mesh, dict | None]:
-    """:func:`global_delaunay`, and :func:`check_delaunay` on the result when it ran (a region was re-tessellated)."""
+    """:func:`global_delaunay`, and :func:`check_delaunay` on the result when it ran (a cluster was re-tessellated)."""
     if engine not in ENGINES:
         raise ValueError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
     if found is None:
@@ -190,71 +190,71 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     ``elements``: the leaf elements that are not cells of it (see the module's proof).
     The other elements of their leaves come back as cells, as they are, marked proven.
     ``mesh`` may hold only some of a tree's leaves (with the whole tree's vertices):
-    a point outside its leaves is outside every region, as it is outside the failing
+    a point outside its leaves is outside every cluster, as it is outside the failing
     elements of the whole tree.  ``types`` receives the cells' types it lacks (id -> name, class, VTK cell).
     ``engine``: as for :func:`global_delaunay`.  ``proposal(real_points)``: what
-    proposes a region's tetrahedra in place of Qhull (rows of point indices; a seam
+    proposes a cluster's tetrahedra in place of Qhull (rows of point indices; a seam
     for tests).  The cells are proven before they are returned (the module's last
-    part): a region whose cells fail is tetrahedralised again by the exact engine.
+    part): a cluster whose cells fail is tetrahedralised again by the exact engine.
     ``checked`` (a list) receives :func:`check_delaunay` on the mesh with the cells.
     """
     nodes = mesh.element_nodes(elements)
-    part, regions = _regions(nodes, len(mesh.vertices))
-    region = np.full(len(mesh), _NO_REGION, dtype=np.int64)
-    region[elements] = part
-    # each region's vertices: unique (region, vertex) pairs, in region order
+    part, clusters = _clusters(nodes, len(mesh.vertices))
+    cluster = np.full(len(mesh), _NO_CLUSTER, dtype=np.int64)
+    cluster[elements] = part
+    # each cluster's vertices: unique (cluster, vertex) pairs, in cluster order
     valid = nodes >= 0
     pairs = distinct(np.repeat(part, nodes.shape[1])[valid.reshape(-1)] * np.int64(len(mesh.vertices))
                       + nodes[valid])
-    bounds = np.searchsorted(pairs // len(mesh.vertices), np.arange(regions + 1))
+    bounds = np.searchsorted(pairs // len(mesh.vertices), np.arange(clusters + 1))
     vertices = pairs % len(mesh.vertices)
-    # the regions' vertex sets are disjoint (a shared vertex would join them): a vertex names its region
-    vertex_region = np.full(len(mesh.vertices), _NO_REGION, dtype=np.int64)
-    vertex_region[vertices] = pairs // len(mesh.vertices)
+    # the clusters' vertex sets are disjoint (a shared vertex would join them): a vertex names its cluster
+    vertex_cluster = np.full(len(mesh.vertices), _NO_CLUSTER, dtype=np.int64)
+    vertex_cluster[vertices] = pairs // len(mesh.vertices)
     located = _Locator(mesh)
     # the other elements of the leaves that give up theirs: cells as they are, proven by the check
     leaves = distinct(mesh.element_leaf[elements])
     counts = mesh.element_offsets[leaves + 1] - mesh.element_offsets[leaves]
     given_up = np.repeat(mesh.element_offsets[leaves] - np.r_[0, np.cumsum(counts)[:-1]], counts) \
         + np.arange(int(counts.sum()))
-    proven = mesh.element_nodes(given_up[region[given_up] == _NO_REGION])
+    proven = mesh.element_nodes(given_up[cluster[given_up] == _NO_CLUSTER])
     bad = _leaves_of(mesh, elements)
-    wanted = _region_volumes(mesh, elements, part, regions)
-    tets = [_region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine, proposal) for r in range(regions)]
-    exact = set(range(regions)) if engine == "exact" else set()
+    wanted = _cluster_volumes(mesh, elements, part, clusters)
+    tets = [_cluster_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine, proposal) for r in range(clusters)]
+    exact = set(range(clusters)) if engine == "exact" else set()
     while True:
-        tet_region = np.concatenate([np.full(len(t), r, dtype=np.int64) for r, t in enumerate(tets)])
+        tet_cluster = np.concatenate([np.full(len(t), r, dtype=np.int64) for r, t in enumerate(tets)])
         every = np.concatenate(tets)
-        every = every[_inside(mesh, every, tet_region, region, located)]
+        every = every[_inside(mesh, every, tet_cluster, cluster, located)]
         try:
             cells = _cells(mesh, _members(_same_sphere(mesh, every, grid_weights(mesh)), every, len(mesh.vertices)),
                            proven, located, types)
-        except NotOneCell:  # no cell to name a region by: no proof per region
-            failing = set(range(regions))
+        except NotOneCell:  # no cell to name a cluster by: no proof per cluster
+            failing = set(range(clusters))
         else:
             cells = Cells(cells.shapes, cells.shape, cells.anchor, cells.nodes, cells.leaf, cells.spanning,
-                          cells.proven, regions=int(regions), largest_region=int(np.diff(bounds).max()))
+                          cells.proven, clusters=int(clusters), largest_cluster=int(np.diff(bounds).max()))
             trial = with_cells(mesh, bad, cells, types)
             found = check_delaunay(trial)
-            failing = _failing_regions(trial, found, vertex_region, wanted)
+            failing = _failing_clusters(trial, found, vertex_cluster, wanted)
             if not failing:
                 if checked is not None:
                     checked.append(found)
                 return cells
         if failing <= exact:  # the exact engine's cells are Delaunay by construction: a bug, not rounding
-            raise RuntimeError(f"the exact engine's cells of regions {sorted(failing)[:5]} fail the exact checks")
+            raise RuntimeError(f"the exact engine's cells of clusters {sorted(failing)[:5]} fail the exact checks")
         for r in failing - exact:
-            tets[r] = _region_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], "exact")
+            tets[r] = _cluster_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], "exact")
         exact |= failing
 
 
-def _region_volumes(mesh: Mesh, elements: np.ndarray, part: np.ndarray, regions: int) -> list[Fraction]:
-    """Per region, the exact volume of its elements in grid cells."""
+def _cluster_volumes(mesh: Mesh, elements: np.ndarray, part: np.ndarray, clusters: int) -> list[Fraction]:
+    """Per cluster, the exact volume of its elements in grid cells."""
     leaf = mesh.element_leaf[elements]
     kind = mesh.leaf_tessellation[leaf].astype(np.int64) * 65536 + mesh.element_local[elements]
     size = (mesh.grid >> mesh.tree.levels[leaf].astype(np.int64)).astype(object) ** 3
-    volumes = [Fraction(0)] * regions
-    # elements of one local element (tessellation, element in it) and one region: one Fraction product per pair
+    volumes = [Fraction(0)] * clusters
+    # elements of one local element (tessellation, element in it) and one cluster: one Fraction product per pair
     for (r, k), total in _sums(part * (int(kind.max()) + 1) + kind, size, int(kind.max()) + 1):
         element = mesh.tessellations[k // 65536].elements[k % 65536]
         volumes[r] += element.unit_volume * total
@@ -270,27 +270,27 @@ def _sums(key: np.ndarray, values: np.ndarray, base: int):
         yield divmod(int(key[start]), base), total
 
 
-def _failing_regions(mesh: Mesh, found: dict, vertex_region: np.ndarray, wanted: list) -> set[int]:
-    """The regions whose re-tessellated cells are not proven cells of the Delaunay subdivision (the module's proof).
+def _failing_clusters(mesh: Mesh, found: dict, vertex_cluster: np.ndarray, wanted: list) -> set[int]:
+    """The clusters whose re-tessellated cells are not proven cells of the Delaunay subdivision (the module's proof).
 
-    A region fails when one of its cells is not empty or ties with a vertex, or when
+    A cluster fails when one of its cells is not empty or ties with a vertex, or when
     its cells' exact volumes do not sum to its elements'.
     """
     cells = mesh.cells
     fresh = np.flatnonzero(~cells.proven)
-    # A fresh cell's vertices are its tetrahedra's, all of one region (the regions' vertex sets are
-    # disjoint): its first vertex names the region.  The proven cells belong to no region.
-    cell_region = np.full(len(cells), _NO_REGION, dtype=np.int64)
-    cell_region[fresh] = vertex_region[cells.nodes[fresh, 0]]
+    # A fresh cell's vertices are its tetrahedra's, all of one cluster (the clusters' vertex sets are
+    # disjoint): its first vertex names the cluster.  The proven cells belong to no cluster.
+    cell_cluster = np.full(len(cells), _NO_CLUSTER, dtype=np.int64)
+    cell_cluster[fresh] = vertex_cluster[cells.nodes[fresh, 0]]
     # check_delaunay tests only the fresh cells (the kept leaf elements and the proven cells passed it on
-    # the same vertex set), so every element it finds is a fresh cell: anything else is a bug, not a region.
+    # the same vertex set), so every element it finds is a fresh cell: anything else is a bug, not a cluster.
     not_cells = found["_not_cells"] - mesh.leaf_elements  # indices among the cells
-    if np.any(cell_region[fresh] == _NO_REGION) or np.any(not_cells < 0) \
-            or np.any(cell_region[not_cells] == _NO_REGION):
-        raise RuntimeError("an element that is not a fresh cell of a region was found not to be a cell")
-    failing = set(cell_region[not_cells].tolist())
+    if np.any(cell_cluster[fresh] == _NO_CLUSTER) or np.any(not_cells < 0) \
+            or np.any(cell_cluster[not_cells] == _NO_CLUSTER):
+        raise RuntimeError("an element that is not a fresh cell of a cluster was found not to be a cell")
+    failing = set(cell_cluster[not_cells].tolist())
     volumes = [Fraction(0)] * len(wanted)
-    key = cell_region[fresh] * len(cells.shapes) + cells.shape[fresh]
+    key = cell_cluster[fresh] * len(cells.shapes) + cells.shape[fresh]
     for (r, s), n in _sums(key, np.ones(len(fresh), dtype=object), len(cells.shapes)):
         volumes[r] += cells.shapes[s].grid_volume * n
     return failing | {r for r, (v, w) in enumerate(zip(volumes, wanted)) if v != w}
@@ -311,7 +311,7 @@ def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict) -> Mesh:
                 types, replaced=bad, cells=cells, catalogue=mesh.catalogue, regions=mesh.regions)
 
 
-def _regions(nodes: np.ndarray, vertices: int) -> tuple[np.ndarray, int]:
+def _clusters(nodes: np.ndarray, vertices: int) -> tuple[np.ndarray, int]:
     """Connected parts of elements (rows of vertex ids, -1 padded) through shared vertices: per row its part, and how many."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -360,8 +360,8 @@ class _Locator:
         return found
 
 
-def _region_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull", proposal=None) -> np.ndarray:
-    """The Delaunay tetrahedra of a region's vertices (global ids, in and out), without flat ones.
+def _cluster_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull", proposal=None) -> np.ndarray:
+    """The Delaunay tetrahedra of a cluster's vertices (global ids, in and out), without flat ones.
 
     ``qhull``: Qhull proposes them in floats and integers check the proposal; where
     Qhull fails (boxes of extreme aspect ratio, 1e-12 x 1 x 3e9: its first simplex
@@ -392,7 +392,7 @@ def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray
     real = (coords - coords.min(axis=0)) * (np.array(mesh.box.to_float()) / mesh.grid)
     try:
         triangulation = (proposal or (lambda points: Delaunay(points, qhull_options="Qbb Qc Qz Q12 Qt")))(real)
-    except Exception:  # Qhull's float precision errors: the exact engine takes the region
+    except Exception:  # Qhull's float precision errors: the exact engine takes the cluster
         return None
     if len(triangulation.coplanar):
         return None
@@ -410,10 +410,10 @@ def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray
     return simplices[solid]
 
 
-def _inside(mesh: Mesh, tets: np.ndarray, tet_region: np.ndarray, region: np.ndarray, located: _Locator) -> np.ndarray:
-    """Per tetrahedron: its centroid lies in a closed element of its region, of the leaf whose box holds it (exactly).
+def _inside(mesh: Mesh, tets: np.ndarray, tet_cluster: np.ndarray, cluster: np.ndarray, located: _Locator) -> np.ndarray:
+    """Per tetrahedron: its centroid lies in a closed element of its cluster, of the leaf whose box holds it (exactly).
 
-    ``region``: per leaf element its region, ``_NO_REGION`` for the kept ones.  In the leaf's own
+    ``cluster``: per leaf element its cluster, ``_NO_CLUSTER`` for the kept ones.  In the leaf's own
     frame (4 x grid units from its lowest corner) node ``s`` sits at ``2 size
     NODE_OFFSETS[s]``; an element holds the point when no face plane has it on the
     side away from the element's vertex centroid.  The numbers are below 100 times
@@ -421,9 +421,9 @@ def _inside(mesh: Mesh, tets: np.ndarray, tet_region: np.ndarray, region: np.nda
     """
     coords = mesh.vertices.astype(np.int64)
     quad = coords[tets].sum(axis=1)
-    # a centroid outside the mesh's leaves (it may hold only some of a tree's) is outside every region
+    # a centroid outside the mesh's leaves (it may hold only some of a tree's) is outside every cluster
     found = located.leaf(quad)
-    tets, tet_region, quad, leaf = tets[found >= 0], tet_region[found >= 0], quad[found >= 0], found[found >= 0]
+    tets, tet_cluster, quad, leaf = tets[found >= 0], tet_cluster[found >= 0], quad[found >= 0], found[found >= 0]
     size = mesh.leaf_size()[leaf]
     local = quad - 4 * mesh.tree.positions[leaf].astype(np.int64) * size[:, None]
     first = mesh.element_offsets[leaf]
@@ -434,7 +434,7 @@ def _inside(mesh: Mesh, tets: np.ndarray, tet_region: np.ndarray, region: np.nda
     for p, element_planes in enumerate(_planes(mesh)):
         rows = order[starts[p]:starts[p + 1]]
         for j, planes in enumerate(element_planes):
-            rows_j = rows[region[first[rows] + j] == tet_region[rows]]
+            rows_j = rows[cluster[first[rows] + j] == tet_cluster[rows]]
             holds = np.ones(len(rows_j), dtype=bool)
             for normal, corner, side in planes:
                 holds &= side * ((local[rows_j] - 2 * size[rows_j, None] * corner) @ normal) >= 0

@@ -219,7 +219,7 @@ def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, f
         used, shape = np.unique(cells.shape[rows], return_inverse=True)
         mine = Cells([cells.shapes[s] for s in used.tolist()], shape.astype(np.int32).reshape(-1),
                      cells.anchor[rows], cells.nodes[rows], np.searchsorted(parts[k], first[rows]),
-                     cells.spanning[rows], cells.proven[rows], cells.regions, cells.largest_region)
+                     cells.spanning[rows], cells.proven[rows], cells.clusters, cells.largest_cluster)
         replaced = np.isin(parts[k], marked)
         again[k] = {"cells": mine, "replaced": replaced, "types": types}
-    return again, (cells.regions, cells.largest_region)
+    return again, (cells.clusters, cells.largest_cluster)

@@ -86,7 +86,7 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
         cells = result.cells
         nodes = np.where(cells.nodes >= 0, ids[np.maximum(cells.nodes, 0)], -1).astype(np.int32)
         parts.append(Cells(cells.shapes, cells.shape, cells.anchor, nodes, leaves[cells.leaf], cells.spanning,
-                           cells.proven, cells.regions, cells.largest_region))
+                           cells.proven, cells.clusters, cells.largest_cluster))
     leaf = {key: sum(f[key] for f in found) for key in found[0]}
     checked = {key: (sum(c[key] for c in checks) if not key.startswith("_") else np.zeros(0, dtype=np.int64))
                for key in checks[0]}
@@ -125,8 +125,8 @@ def _merged(parts: list[Cells]) -> Cells:
                             for c in parts])
     return Cells(shapes, np.concatenate(shape).astype(np.int32), np.concatenate([c.anchor for c in parts]), nodes,
                  np.concatenate([c.leaf for c in parts]), np.concatenate([c.spanning for c in parts]),
-                 np.concatenate([c.proven for c in parts]), sum(c.regions for c in parts),
-                 max(c.largest_region for c in parts))
+                 np.concatenate([c.proven for c in parts]), sum(c.clusters for c in parts),
+                 max(c.largest_cluster for c in parts))
 
 
 @dataclass(frozen=True)

@@ -102,7 +102,7 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
 
     ``catalogue``: the element catalogue the pieces were assembled with (it names the types).
 
-    ``cells``: the regions re-tessellated and the largest one's vertices; ``seams``:
+    ``cells``: the clusters re-tessellated (the report keeps its keys ``regions_retessellated`` and ``largest_region_vertices``) and the largest one's vertices; ``seams``:
     the faces the pieces left open, paired here (``vertex_points(ids)`` gives their
     grid points, for the examples).  ``domain_share``: the domain's volume as a fraction of the
     root box's (a device's boxes can leave part of their bounding box out).
@@ -205,7 +205,7 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     figures = mesh_figures(mesh, delaunay, stage, progress, checked)
     if violating is not None and delaunay:
         violating.append(figures["_violating"])
-    cells = (mesh.cells.regions, mesh.cells.largest_region) if mesh.cells is not None else (0, 0)
+    cells = (mesh.cells.clusters, mesh.cells.largest_cluster) if mesh.cells is not None else (0, 0)
     return merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
                          leaf_mesh, cells, catalogue=mesh.catalogue, domain_share=mesh.domain_share)
 
