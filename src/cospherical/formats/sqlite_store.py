@@ -14,7 +14,8 @@ what lets each compress ten-fold and still be read alone::
 :func:`cospherical.formats.patterns.load` opens either form; ``check`` and ``diff``
 read both.  A store is written atomically (a temporary file renamed into place) and
 checked when opened: a file that is not a complete SQLite database of this layout
-(truncated, or another file) raises :class:`FormatError`.
+(truncated, or another file), or whose count is not its entries', raises
+:class:`FormatError`.
 """
 
 from __future__ import annotations
