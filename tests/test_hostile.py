@@ -668,7 +668,7 @@ def test_sigterm_while_a_local_dask_cluster_starts_waits_for_it_to_be_made():
     """A cluster half made when SIGTERM arrived could not be closed, and its workers made their
     scratch space again after the command had removed it (a /tmp/cospherical-dask-* folder left
     behind). The start is a block that holds SIGTERM and Ctrl-C back, then acts on them."""
-    from cospherical.studies.intersection.backends import _interrupt_deferred
+    from cospherical.execution.backends import _interrupt_deferred
 
     seen = []
     previous = signal.signal(signal.SIGTERM, lambda signum, frame: (seen.append("handler"), sys.exit(128 + signum)))

@@ -220,7 +220,7 @@ def _say(message: str) -> None:
 def _stop_workers() -> None:
     # Worker processes still running (a pool, a local Dask cluster) are stopped now, not
     # joined at exit, which would wait for the chunks they are running.
-    pool = sys.modules.get("cospherical.studies.pool")  # loaded only if workers were started
+    pool = sys.modules.get("cospherical.execution.pool")  # loaded only if workers were started
     if pool is not None:
         pool.stop_all()
 

@@ -179,7 +179,7 @@ def run(args) -> int:
 def _pieces(args) -> int | None:
     """``--partitions`` and its backend, checked before any work; ``None`` without it."""
     from ..mesh.partition import MAX_PARTITIONS
-    from ..studies.intersection.backends import MAX_WORKERS, check_backend
+    from ..execution.backends import MAX_WORKERS, check_backend
 
     pieces = _count(args.partitions, "--partitions", MAX_PARTITIONS)
     backend = [option for option, value in (("--jobs", args.jobs), ("--scheduler", args.scheduler),

@@ -163,7 +163,7 @@ def _report(summary: dict, args, study=None) -> int:
 
 def _intersection(args) -> int:
     from ..studies.intersection import run_intersection, set_patterns  # numpy: not for the other studies
-    from ..studies.intersection.backends import check_backend
+    from ..execution.backends import check_backend
 
     if Box.parse(args.box).squared != (1, 1, 1) or args.face_points != "octree":
         raise UsageError("cospherical study: error: the intersection study is the paper's: the cube, octree points")

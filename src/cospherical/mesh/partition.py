@@ -47,7 +47,7 @@ from ..catalogue import shipped_catalogue
 from ..core.configuration import Box
 from ..core.morton import morton_codes
 from ..errors import InputError
-from ..studies.intersection.backends import completed
+from ..execution.backends import completed
 from .assembly import Cells, assemble, vertex_keys
 from .checks import check_delaunay
 from .delaunay import retessellate, with_cells
@@ -156,7 +156,7 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
 
     ``lookup``: ``(factory, arguments)`` of the pattern lookup (``None``: every
     configuration tessellated); ``jobs``, ``scheduler``, ``dask_workers``: where the
-    tasks run (:func:`~cospherical.studies.intersection.backends.completed`); ``catalogue``: the
+    tasks run (:func:`~cospherical.execution.backends.completed`); ``catalogue``: the
     element catalogue (default: the shipped one), as in :func:`~cospherical.mesh.assembly.assemble`.
     """
     catalogue = shipped_catalogue() if catalogue is None else catalogue

@@ -9,7 +9,7 @@ from ..core.configuration import Box
 from ..core.exact import parse_rational, rational_text
 from ..errors import InputError
 from .engine import bisection_codes, run_study
-from .pool import process_pool
+from ..execution.pool import process_pool
 
 __all__ = ["box_statistics", "grid_values", "sweep"]
 

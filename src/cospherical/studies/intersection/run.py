@@ -20,7 +20,7 @@ import json
 import os
 import re
 import stat
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 from typing import Callable
 
@@ -35,13 +35,13 @@ from ...core.geometry import Frame
 from ...core.polyhedron import polyhedron
 from ...core.split import SPLIT_CRITERIA
 from ...core.symmetry import key_code
+from ...execution.backends import completed
 from ...files.yamlio import atomic_write, parse_json
 from ..summary import TypeInfo
-from .backends import completed
 from .family import all_configurations, orbits
-from .statistics import statistics
+from .statistics import ElementEntry, statistics
 
-__all__ = ["CHUNK", "ELEMENT_CHUNK", "ElementEntry", "cell_polyhedron", "element_entries", "example_elements", "run_intersection",
+__all__ = ["CHUNK", "ELEMENT_CHUNK", "cell_polyhedron", "element_entries", "example_elements", "run_intersection",
            "tessellate_chunk"]
 
 CHUNK = 5000
@@ -49,19 +49,6 @@ ELEMENT_CHUNK = 500
 # Bumped when a checkpoint's content changes, so --resume never reads an older layout.
 _CHECKPOINT_FORMAT = 3
 _CELLS_PER_CONFIGURATION = 96  # the compiled walk's room per configuration, tetrahedra included
-
-
-@dataclass(frozen=True)
-class ElementEntry:
-    """A distinct element of the study: its type id and, per split criterion, its options
-    (sorted piece-type tuples, the element itself first, in the order the criteria prefer them)."""
-
-    type: str
-    options: dict[str, tuple[tuple[str, ...], ...]]
-
-    @classmethod
-    def from_json(cls, data: dict) -> ElementEntry:
-        return cls(data["type"], {c: tuple(map(tuple, o)) for c, o in data["options"].items()})
 
 
 @cached(maxsize=1)

@@ -1,4 +1,5 @@
-"""The intersection study's statistics from its two stages, in the summary shape every study shares.
+"""The intersection study's statistics from its two stages, in the summary shape every study shares,
+and the entries (:class:`ElementEntry`) that describe its distinct elements to them.
 
 The counting is vectorised (millions of configurations); the kept sets and the
 frequency tables come from the same functions as the bisection study's
@@ -7,7 +8,7 @@ frequency tables come from the same functions as the bisection study's
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -15,10 +16,20 @@ from ...catalogue import choose_kept
 from ...core.split import SPLIT_CRITERIA
 from ..summary import TypeInfo, frequency_table
 
-if TYPE_CHECKING:
-    from .run import ElementEntry
+__all__ = ["ElementEntry", "statistics"]
 
-__all__ = ["statistics"]
+
+@dataclass(frozen=True)
+class ElementEntry:
+    """A distinct element of the study: its type id and, per split criterion, its options
+    (sorted piece-type tuples, the element itself first, in the order the criteria prefer them)."""
+
+    type: str
+    options: dict[str, tuple[tuple[str, ...], ...]]
+
+    @classmethod
+    def from_json(cls, data: dict) -> ElementEntry:
+        return cls(data["type"], {c: tuple(map(tuple, o)) for c, o in data["options"].items()})
 
 
 def statistics(sizes: np.ndarray, cells: dict, element_of: np.ndarray, entries: list[ElementEntry],

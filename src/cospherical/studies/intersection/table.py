@@ -34,8 +34,8 @@ from ...catalogue import kept_split, split_options
 from ...core.symmetry import key_code
 from ...core.tessellation import Element, element_entry
 from ...errors import InputError
+from ...execution.backends import completed
 from ...files.flowyaml import flow
-from .backends import completed
 from .family import orbits
 from .run import cell_polyhedron, tessellate_chunk
 
@@ -134,7 +134,7 @@ class TableRun:
 
     ``progress(stage, n)`` as work finishes: ``cells`` and ``entries`` in
     representatives, ``elements`` in distinct cells.  The work runs on the
-    backend of :func:`~cospherical.studies.intersection.completed` (``jobs``,
+    backend of :func:`~cospherical.execution.backends.completed` (``jobs``,
     ``scheduler``, ``dask_workers``).
     """
 

@@ -1,11 +1,11 @@
-"""Where the work units of the intersection study run: in this process, a local process pool, or Dask."""
+"""Where work units run (a study's chunks, a mesh's parts): in this process, a local process pool, or Dask."""
 
 from __future__ import annotations
 
 from contextlib import contextmanager
 from typing import Any, Callable, Hashable, Iterator
 
-from ...errors import InputError, UsageError
+from ..errors import InputError, UsageError
 
 __all__ = ["check_backend", "completed"]
 
@@ -19,7 +19,7 @@ MAX_WORKERS = 256
 _MAX_TIMEOUT = 86400.0
 
 
-def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, timeout: float | None,
+def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, timeout: float,
                   jobs: int | None = None) -> None:
     """Refuse a bad choice of backend with one line (``prog``: the command, for the message); set the timeout.
 
@@ -83,7 +83,7 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
     else:
         from concurrent.futures import FIRST_COMPLETED, wait
 
-        from ..pool import process_pool
+        from .pool import process_pool
 
         with process_pool(jobs) as pool:  # left by an error, Ctrl-C or SIGTERM: the workers are stopped at once
             pending = {pool.submit(function, *args, *common): key for key, args in tasks.items()}
@@ -108,7 +108,7 @@ def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler:
     import dask
     from dask.distributed import Client, LocalCluster, as_completed
 
-    from ..pool import register_stop, unregister_stop
+    from .pool import register_stop, unregister_stop
 
     scratch = None if scheduler else tempfile.mkdtemp(prefix="cospherical-dask-")
     cluster = client = None
@@ -142,7 +142,7 @@ def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler:
         except (OSError, TimeoutError, ValueError, TypeError) as error:
             raise InputError(f"Dask scheduler {scheduler}: cannot connect: "
                              f"{str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
-        register_stop(id(client), lambda: (_kill_workers(cluster), _close_dask(client, cluster)))
+        register_stop(id(client), lambda: _stop_dask(client, cluster))
         shared = client.scatter(list(common), broadcast=True) if common else []
         futures = {client.submit(function, *args, *shared, pure=False): key for key, args in tasks.items()}
         for future in as_completed(futures):
@@ -257,7 +257,13 @@ def _interrupt_deferred():
             signal.raise_signal(held[0])  # the default action, as if it had not been held
 
 
-def _kill_workers(cluster) -> None:
+def _stop_dask(client: Any, cluster: Any) -> None:
+    """Stop a run on Dask now (Ctrl-C, SIGTERM): its local workers killed, then client and cluster closed."""
+    _kill_workers(cluster)
+    _close_dask(client, cluster)
+
+
+def _kill_workers(cluster: Any) -> None:
     """Kill the worker processes of a local cluster, whose nannies would wait seconds for running tasks."""
     import os
     import signal
@@ -274,7 +280,7 @@ def _kill_workers(cluster) -> None:
                 pass
 
 
-def _close_dask(client, cluster) -> None:
+def _close_dask(client: Any, cluster: Any) -> None:
     """Close the client and the local cluster without a word, even when a second Ctrl-C arrives meanwhile.
 
     Once closed they are also no longer in dask's own exit handlers, which would
