@@ -38,9 +38,13 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     # A writer reaching into the studies: formats only reads and writes what is computed below it.
     diff = tmp_path / "cospherical" / "formats" / "diff.py"
     diff.write_text(diff.read_text() + "\nfrom ..studies.engine import run_study  # wrong on purpose\n")
+    # The intersection study's statistics importing its run: the circle its layers broke.
+    statistics = tmp_path / "cospherical" / "studies" / "intersection" / "statistics.py"
+    statistics.write_text(statistics.read_text() + "\nfrom .run import run_intersection  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
-    assert "Contracts: 0 kept, 4 broken." in result.stdout
+    assert "Contracts: 0 kept, 5 broken." in result.stdout
+    assert "cospherical.studies.intersection.statistics is not allowed to import" in result.stdout
     assert "cospherical.formats.diff -> cospherical.studies.engine" in result.stdout
     assert "cospherical.core.configuration -> cospherical.core.delaunay" in result.stdout
     assert "cospherical.core.geometry -> cospherical.catalogue" in result.stdout
