@@ -96,7 +96,7 @@ def delaunay_tetrahedra(coords: Sequence[Sequence[int]], weights: Sequence[int])
     return _Triangulation(frame).run(_morton_order(frame.coords))
 
 
-def _is_integer(value) -> bool:
+def _is_integer(value: object) -> bool:
     """An int or a numpy integer; not a bool, and never a float, however whole."""
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
