@@ -9,6 +9,8 @@ import pytest
 import cospherical
 from cospherical.errors import InputError
 
+pytestmark = pytest.mark.oracle_discretize
+
 
 def _rows(points: np.ndarray) -> np.ndarray:
     return np.unique(np.round(points, 12), axis=0)

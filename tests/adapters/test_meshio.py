@@ -11,6 +11,8 @@ import pytest
 import cospherical
 from cospherical.errors import InputError
 
+pytestmark = pytest.mark.oracle_meshio
+
 
 def _volumes(points: np.ndarray, tets: np.ndarray) -> np.ndarray:
     p = points[tets]

@@ -12,6 +12,8 @@ import cospherical
 from cospherical.adapters.pyvista import legacy_cells
 from cospherical.errors import InputError
 
+pytestmark = pytest.mark.oracle_vtk
+
 
 @pytest.fixture(scope="module")
 def graded():
