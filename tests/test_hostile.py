@@ -14,7 +14,6 @@ import json
 import os
 import resource
 import signal
-import socket
 import stat
 import subprocess
 import sys
@@ -408,47 +407,6 @@ def test_stdout_on_a_full_device_is_one_line(args):
         result = subprocess.run([sys.executable, "-m", "cospherical", *args],
                                 stdout=full, stderr=subprocess.PIPE, text=True, timeout=60)
     one_line(result.returncode, result.stderr)
-
-
-def _closed_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def test_bad_and_unreachable_schedulers_are_one_line():
-    refused_subprocess("study", "intersection", "--resolution", "2", "--scheduler", "garbage://x")
-    start = time.monotonic()
-    refused_subprocess("study", "intersection", "--resolution", "2", "--scheduler",
-                       f"tcp://127.0.0.1:{_closed_port()}", "--scheduler-timeout", "2", needle="scheduler")
-    assert time.monotonic() - start < 30
-
-
-def test_a_scheduler_port_where_nothing_listens_is_one_line_at_once(capsys):
-    # dask's connect retried the refused connection for the whole default timeout (30 s)
-    start = time.monotonic()
-    refused(capsys, "study", "intersection", "--resolution", "2", "--scheduler", f"tcp://127.0.0.1:{_closed_port()}",
-            needle="cannot connect: nothing listens on port")
-    assert time.monotonic() - start < 5
-
-
-def test_a_scheduler_port_that_never_answers_is_one_line_within_the_timeout(capsys):
-    # the kernel accepts the connection (the backlog), nothing answers: dask's Client waited for good
-    with socket.socket() as silent:
-        silent.bind(("127.0.0.1", 0))
-        silent.listen(8)
-        start = time.monotonic()
-        refused(capsys, "study", "intersection", "--resolution", "2", "--scheduler",
-                f"tcp://127.0.0.1:{silent.getsockname()[1]}", "--scheduler-timeout", "1",
-                needle="cannot connect: no answer within 1 s")
-        assert time.monotonic() - start < 20
-
-
-@pytest.mark.parametrize("option", [["--jobs", "100000"], ["--jobs", "-1"], ["--dask-workers", "100000"]])
-def test_worker_counts_are_bounded_before_any_process_starts(capsys, option):
-    # 100,000 local workers: each a Python with numpy; the run went on for minutes before failing
-    refused(capsys, "study", "intersection", "--resolution", "2", *option,
-            needle=f"{option[0]} {option[1]}: must be an integer from 1 to 256")
 
 
 def test_damaged_checkpoints_are_one_line(tmp_path, capsys):
