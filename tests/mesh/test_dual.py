@@ -251,13 +251,13 @@ def test_a_full_disk_under_tetgens_scratch_file_names_that_file(monkeypatch):
     # a failed write names no file (EFBIG from a file-size limit was 'cospherical: error: File too large')
     import errno
 
-    from cospherical.mesh.dual import delaunay_tetrahedra
+    from cospherical.mesh.dual import external_tetrahedra
 
     def full(*args, **kwargs):
         raise OSError(errno.EFBIG, "File too large")
     monkeypatch.setattr(np, "savetxt", full)
     with pytest.raises(OSError) as raised:
-        delaunay_tetrahedra(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]))
+        external_tetrahedra(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]))
     assert raised.value.filename.endswith("points.node") and raised.value.errno == errno.EFBIG
 
 
@@ -274,13 +274,13 @@ def test_tetgen_tetrahedra_of_the_same_vertices_give_the_same_dual_exactly(name)
     """
     import shutil
 
-    from cospherical.mesh.dual import delaunay_tetrahedra
+    from cospherical.mesh.dual import external_tetrahedra
 
     assert shutil.which("tetgen"), "tetgen (Debian) is a test dependency: scripts/setup.sh installs it"
     tree = OCTREES[name]()
     mesh = assemble(tree, cache=CACHES.setdefault(tree.box.texts, {}))
     mixed = mesh_dual(mesh)
-    tets, tool, flat = delaunay_tetrahedra(mesh.vertices)
+    tets, tool, flat = external_tetrahedra(mesh.vertices)
     assert tool == "tetgen" and flat == 0
     tetra = mesh_dual(mesh, (tets.astype(np.int32), np.full(len(tets), 4, dtype=np.int8)))
 

@@ -59,8 +59,8 @@ from ..core.polyhedron import measure
 from ..errors import InputError
 from .octree import distinct
 
-__all__ = ["Dual", "ElementPieces", "RegionParts", "TETRAHEDRAL_LIMIT", "boundary_areas", "delaunay_tetrahedra", "dual_summary",
-           "element_pieces", "mesh_dual", "tetrahedral_counts"]
+__all__ = ["Dual", "ElementPieces", "RegionParts", "TETRAHEDRAL_LIMIT", "boundary_areas", "dual_summary",
+           "element_pieces", "external_tetrahedra", "mesh_dual", "tetrahedral_counts"]
 
 Point = tuple[Fraction, Fraction, Fraction]
 
@@ -604,8 +604,8 @@ def _element_groups(mesh, squared, conn: np.ndarray, element_sizes: np.ndarray):
 TETRAHEDRAL_LIMIT = 1_000_000  # vertices: above it the tetrahedral comparison is skipped (minutes and gigabytes)
 
 
-def delaunay_tetrahedra(grid_vertices: np.ndarray) -> tuple[np.ndarray, str, int]:
-    """A tetrahedral Delaunay mesh of integer points: (tetrahedra, the tool, flat ones left out).
+def external_tetrahedra(grid_vertices: np.ndarray) -> tuple[np.ndarray, str, int]:
+    """A tetrahedral Delaunay mesh of integer points by an outside mesher: (tetrahedra, the tool, flat ones left out).
 
     TetGen (``tetgen``, Debian; exact predicates) when it is installed; else scipy's
     Qhull, whose flat tetrahedra (co-spherical points it triangulates through a
@@ -641,10 +641,10 @@ def tetrahedral_counts(grid_vertices: np.ndarray) -> dict:
     """Elements, edges, faces and matrix nonzeros of a tetrahedral Delaunay mesh of the same vertices.
 
     The paper's claim is that mixed elements need fewer of each; this is the
-    tetrahedral side of that comparison (:func:`delaunay_tetrahedra`).
+    tetrahedral side of that comparison (:func:`external_tetrahedra`).
     """
     points = np.asarray(grid_vertices, dtype=np.int64)
-    tets, tool, flat = delaunay_tetrahedra(points)
+    tets, tool, flat = external_tetrahedra(points)
     tets = np.sort(tets, axis=1)
     n = np.int64(len(points))
     pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
