@@ -123,7 +123,7 @@ def test_results_pages_show_what_results_holds(site):
 
 
 def test_every_example_file_a_page_names_ships():
-    named = {name for text in PAGES.values() for name in re.findall(r"examples/[\w.-]+\w", text)}
+    named = {name for text in PAGES.values() for name in re.findall(r"examples/[\w./-]+\w", text)}
     assert named, "the pages name the shipped examples"
     for name in named:
         assert (ROOT / name).is_file(), name

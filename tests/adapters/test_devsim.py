@@ -63,6 +63,27 @@ def test_devsim_assembles_with_the_exact_dual(devsim, graded):
         drop(devsim, handed.name)
 
 
+def test_a_device_gives_regions_interfaces_and_each_region_its_part_of_the_dual(devsim):
+    """The MOS capacitor (level 3): substrate and oxide with their materials, the bulk and gate contacts, the
+    interface; each region assembles with its own part of the dual, summing to the region's volume."""
+    from dataclasses import replace
+
+    from cospherical.api.mesh import build_mesh
+    from cospherical.formats.device_file import read_device
+
+    device = read_device(ROOT / "examples" / "devices" / "mos-capacitor.yaml")
+    handed = create_device(build_mesh(device=replace(device, levels=3)), device="mos")
+    try:
+        assert handed.regions == ("substrate", "oxide") and handed.contacts == ("bulk", "gate")
+        assert tuple(devsim.get_interface_list(device="mos")) == ("substrate|oxide",)
+        assert [devsim.get_material(device="mos", region=r) for r in handed.regions] == ["Si", "SiO2"]
+        for region, volume in (("substrate", 0.75), ("oxide", 0.25)):
+            volumes, couple, length = assembled_with(devsim, "mos", region)
+            assert abs(volumes.sum() - volume) < 1e-12 and abs((couple * length).sum() - 3 * volume) < 1e-12
+    finally:
+        drop(devsim, "mos")
+
+
 def test_a_mesh_folder_gives_the_same_device(devsim, graded, tmp_path):
     dual = mesh_dual(graded)
     write_dual(dual, tmp_path / "dual.npz")
@@ -76,14 +97,38 @@ def test_a_mesh_folder_gives_the_same_device(devsim, graded, tmp_path):
         drop(devsim, handed.name)
 
 
-def test_the_laplace_example_is_exact_with_the_dual_and_not_without(capsys):
-    spec = importlib.util.spec_from_file_location("laplace_example", ROOT / "examples" / "devsim" / "laplace.py")
-    example = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(example)
-    rows = [example.run_case(["1", "1", "1"], 3, "test-cube"), example.run_case(["1", "2", "4"], 3, "test-124")]
+def example(name: str):
+    """A script of examples/devsim as a module (its functions run here at a small size)."""
+    spec = importlib.util.spec_from_file_location(f"devsim_{name}_example", ROOT / "examples" / "devsim" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_laplace_example_is_exact_with_the_dual_and_not_without():
+    example_ = example("laplace")
+    rows = [example_.run_case(["1", "1", "1"], 3, "test-cube"), example_.run_case(["1", "2", "4"], 3, "test-124")]
     for row in rows:
         assert row["laplace_exact"] < 1e-12 and abs(row["poisson_exact"] - 1) < 1e-12
         assert row["laplace_devsim"] > 1e-3 and row["poisson_devsim"] > 1.05  # graded: DEVSIM's geometry is off
+
+
+def test_the_diode_example_on_a_small_mesh(devsim):
+    """455 nodes (level 3 on the junction plane), 0.7 V in steps of 0.1 V: the exact dual's current is
+    near the converged 1D one, DEVSIM's geometry on the same tetrahedra is far off (12 CPU-s)."""
+    diode = example("diode")
+    diode.extended_precision(devsim)
+    try:
+        area = diode.UM ** 2
+        reference = diode.reference(devsim, [0.7], spacing=0.01 * diode.UM, step=0.1)[0] * area
+        row = diode.octree_currents(devsim, 3, [0.7], step=0.1)
+    finally:
+        for name in ("extended_solver", "extended_model", "extended_equation"):
+            devsim.set_parameter(name=name, value=False)
+    assert row["nodes"] == 455
+    exact, own = (row[g][0] / reference - 1 for g in ("exact", "devsim"))
+    assert 0 < exact < 0.02  # the junction's 125 nm spacing, as a 1D mesh of that spacing gives
+    assert own > 0.08
 
 
 @pytest.mark.parametrize("make", ["missing", "empty", "file"])

@@ -115,3 +115,44 @@ def test_a_devices_dual_asked_later_has_its_region_parts():
     for item in dataclasses.fields(now.dual.regions):
         ours, theirs = getattr(later.dual.regions, item.name), getattr(now.dual.regions, item.name)
         assert np.array_equal(ours, theirs) if isinstance(ours, np.ndarray) else ours == theirs, item.name
+
+
+def test_the_cli_writes_the_tetrahedra_and_gmsh_file_that_write_writes(tmp_path, capsys):
+    """mesh --gmsh 4.1 --gmsh-binary --tets: mesh.msh and tets.vtu in the folder and its manifest, as write() makes
+    them; Gmsh reads the device's regions, contacts and interface back by name."""
+    import gmsh
+
+    device = "examples/devices/mos-capacitor.yaml"
+    assert main(["mesh", "--device", device, "--gmsh", "4.1", "--gmsh-binary", "--tets", "--no-uniform",
+                 "--out", str(tmp_path / "cli")]) == 0
+    capsys.readouterr()
+    cospherical.build_mesh(device=device, uniform=False).write(tmp_path / "api", gmsh="4.1", binary=True, tets=True)
+    cli, api = _digests(tmp_path / "cli"), _digests(tmp_path / "api")
+    assert {"mesh.msh", "tets.vtu", ".cospherical-manifest.json"} <= set(cli) and cli == api
+    manifest = json.loads((tmp_path / "cli" / ".cospherical-manifest.json").read_text())
+    assert {"mesh.msh", "tets.vtu"} <= set(manifest["mesh"])
+    gmsh.initialize(readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(str(tmp_path / "cli" / "mesh.msh"))
+        names = {(dim, gmsh.model.getPhysicalName(dim, tag)) for dim, tag in gmsh.model.getPhysicalGroups()}
+    finally:
+        gmsh.finalize()
+    assert names == {(3, "substrate"), (3, "oxide"), (2, "bulk"), (2, "gate"), (2, "substrate|oxide")}
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--gmsh-binary", "--gmsh", "2.2"], None),
+    (["--gmsh-binary"], "give --gmsh VERSION too"),
+    (["--gmsh", "3.0"], "invalid choice"),
+    (["--tets", "--partitions", "2"], "not with --partitions"),
+])
+def test_gmsh_and_tets_options_refused_with_one_line(tmp_path, capsys, argv, needle):
+    base = ["mesh", "--domain", "1", "1", "1", "--refine", "point:0.5,0.5,0.5", "--levels", "1", "--no-uniform"]
+    if needle is None:  # without --out there is nowhere to write mesh.msh
+        argv, needle = argv, "with --out"
+    else:
+        base += ["--out", str(tmp_path / "out")]
+    assert main([*base, *argv]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0] and not (tmp_path / "out").exists()

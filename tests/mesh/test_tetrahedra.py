@@ -71,3 +71,39 @@ def test_the_split_is_deterministic_and_regions_follow_the_parent():
     first, second = split_tetrahedra(mesh), split_tetrahedra(mesh)
     assert np.array_equal(first.nodes, second.nodes) and np.array_equal(first.parent, second.parent)
     assert (first.region == 0).all()
+
+
+def test_a_device_gives_a_volume_per_region_and_a_surface_per_contact_and_interface():
+    """The MOS capacitor (substrate and oxide, bulk and gate contacts) at level 3: every contact and interface
+    triangle is a face of the tetrahedra, met on the right side, and the regions keep their elements' volume."""
+    from dataclasses import replace
+    from pathlib import Path
+
+    from cospherical.api.mesh import build_mesh
+    from cospherical.formats.device_file import read_device
+    from cospherical.mesh.tetrahedra import simplex_mesh
+
+    device = read_device(Path(__file__).resolve().parents[2] / "examples" / "devices" / "mos-capacitor.yaml")
+    mesh = build_mesh(device=replace(device, levels=3)).assembled
+    simplices = simplex_mesh(mesh)
+    assert simplices.volumes == ("substrate", "oxide")
+    assert simplices.surfaces == ("bulk", "gate", "substrate|oxide")
+    tets = split_tetrahedra(mesh)
+    assert np.array_equal(simplices.volume, mesh.element_region[tets.parent])
+    vertices = np.asarray(mesh.vertices, dtype=np.int64)
+    volumes = six_volumes(vertices[simplices.tetrahedra])
+    grid = int(mesh.grid)
+    assert [int(volumes[simplices.volume == r].sum()) for r in range(2)] == [6 * grid ** 3 * 3 // 4,
+                                                                            6 * grid ** 3 // 4]
+    # oriented faces of the tetrahedra, outward, with the region of the tetrahedron they bound
+    outward = simplices.tetrahedra[:, [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]]]
+    faces = {}
+    for tet, region in zip(outward.tolist(), simplices.volume.tolist()):
+        for face in tet:
+            faces.setdefault(tuple(sorted(face)), []).append(region)
+    region_of = {"bulk": [0], "gate": [1], "substrate|oxide": [0, 1]}  # bulk on the substrate, gate on the oxide
+    for k, name in enumerate(simplices.surfaces):
+        triangles = simplices.triangles[simplices.surface == k]
+        assert len(triangles)
+        sides = [faces[tuple(sorted(t))] for t in triangles.tolist()]
+        assert all(sorted(s) == region_of[name] for s in sides)

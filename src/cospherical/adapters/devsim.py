@@ -49,6 +49,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, shown
+from ..mesh.dual import Dual
+from ..mesh.tetrahedra import SimplexMesh
 
 __all__ = ["EXACT_EDGE_COUPLE", "EXACT_NODE_VOLUME", "DevsimDevice", "create_device", "import_devsim"]
 
@@ -85,15 +87,27 @@ class DevsimDevice:
     name: str
     regions: tuple[str, ...]
     contacts: tuple[str, ...]
-    simplices: object
-    dual: object
+    simplices: SimplexMesh
+    dual: Dual
     node_ids: dict
     edge_ids: dict
+    interfaces: tuple[str, ...] = ()
     log: str = ""
 
 
-def _source(mesh):
-    """(simplices, dual) of an API mesh, an assembled mesh, or a mesh folder holding dual.npz."""
+@dataclass(frozen=True)
+class _Source:
+    """What a device is built from: the simplices, the dual, per region its node volumes and edge areas
+    (region name -> (volume per vertex, area per dual edge)), each contact's region."""
+
+    simplices: SimplexMesh
+    dual: Dual
+    geometry: dict
+    contact_region: dict
+
+
+def _source(mesh) -> _Source:
+    """The simplices and exact geometry of an API mesh, an assembled mesh, or a mesh folder holding dual.npz."""
     from ..mesh.dual import mesh_dual
     from ..mesh.tetrahedra import dual_simplex_mesh, simplex_mesh
 
@@ -109,69 +123,130 @@ def _source(mesh):
             raise InputError(f"{shown(str(folder))}: not a mesh folder with dual.npz (write one with cospherical "
                              "mesh --dual --out DIR)")
         dual = read_dual(path)
-        return dual_simplex_mesh(dual), dual
+        simplices = dual_simplex_mesh(dual)
+        return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area)}, {})
     assembled = getattr(mesh, "assembled", mesh)  # the API's mesh holds the assembled one
     if not hasattr(assembled, "blocks"):
         raise InputError(f"create_device: {type(mesh).__name__} is not a mesh (give the API's mesh, "
                          "an assembled mesh or a mesh folder)")
-    dual = getattr(mesh, "dual", None)
-    if dual is None or callable(dual):
-        dual = mesh_dual(assembled)
-    return simplex_mesh(assembled), dual
+    given = getattr(mesh, "dual", None)  # the API's mesh computes its dual once (with its parts per region)
+    dual = given if isinstance(given, Dual) else mesh_dual(assembled)
+    regions = getattr(assembled, "regions", None)
+    if regions is None or regions.layout is None:
+        simplices = simplex_mesh(assembled)
+        return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area)}, {})
+    from ..mesh.regions import mesh_region_parts, region_faces
+
+    faces = region_faces(assembled)
+    simplices = simplex_mesh(assembled, faces=faces)
+    parts = dual.regions if dual.regions is not None else mesh_region_parts(assembled, dual, faces)
+    geometry = {}
+    for r, name in enumerate(parts.names):
+        volume = np.zeros(len(dual.vertices))
+        rows = parts.volume_region == r
+        volume[parts.volume_vertex[rows]] = parts.volume_part[rows]
+        area = np.zeros(len(dual.edges))
+        rows = parts.coupling_region == r
+        edges = parts.coupling_edge[rows]
+        area[edges] = parts.coupling_part[rows] * dual.length[edges]
+        geometry[name] = (volume, area)
+    device = regions.layout.device
+    return _Source(simplices, dual, geometry, {c.name: c.region for c in device.contacts})
 
 
-def create_device(mesh, device: str = "device", contacts=None, material: str = "Silicon") -> DevsimDevice:
+def create_device(mesh, device: str = "device", contacts=None, material: str = "Silicon",
+                  scale: float = 1.0) -> DevsimDevice:
     """Build DEVSIM's mesh and device from ``mesh``, the exact dual installed as its geometry.
 
     ``mesh``: the API's mesh, an assembled :class:`~cospherical.mesh.assembly.Mesh`, or a
-    mesh folder with ``dual.npz`` (``cospherical mesh --dual --out DIR``).  The device
-    gets one region per region of the mesh (``domain`` with ``material`` in a mesh of
-    one region); ``contacts``: the names of the mesh's surfaces that become DEVSIM
-    contacts (in a mesh of one region the box's sides, ``xmin`` ... ``zmax``; default
-    none).  DEVSIM's mesh is named like the device.  DEVSIM's messages while it builds
-    them are kept in :attr:`DevsimDevice.log`, not printed.
+    mesh folder with ``dual.npz`` (``cospherical mesh --dual --out DIR``).
+
+    A device's mesh (``build_mesh(device=...)``) gives one DEVSIM region per region,
+    with its name and material, one contact per contact of the device (``contacts``:
+    a subset of their names, default all) and one interface per pair of touching
+    regions, named ``"a|b"``; each region's node volumes and edge couplings are its
+    parts of the exact dual (an interface vertex's control volume and an interface
+    edge's dual face split between the regions).  Any other mesh gives the region
+    ``domain`` of ``material``, and ``contacts`` names which of the box's sides
+    (``xmin`` ... ``zmax``) become contacts (default none).
+
+    DEVSIM's mesh is named like the device.  DEVSIM's messages while it builds them
+    are kept in :attr:`DevsimDevice.log`, not printed.  ``scale``: DEVSIM's length per
+    unit of the mesh (``1e-4`` for a mesh in micrometres, DEVSIM's physics being in
+    centimetres): coordinates times ``scale``, couplings (areas) times ``scale**2`` and
+    node volumes times ``scale**3``.
     """
+    if not (isinstance(scale, (int, float)) and np.isfinite(scale) and scale > 0):
+        raise InputError(f"scale {shown(scale)}: must be a positive number")
     if not isinstance(device, str) or not device.strip() or len(device) > 200 or not device.isprintable():
         raise InputError(f"device name {shown(device)}: must be a non-empty printable name")
     devsim = import_devsim()
     if device in devsim.get_device_list() or device in devsim.get_mesh_list():
         raise InputError(f"device {shown(device)}: DEVSIM already has a device or mesh of that name")
-    simplices, dual = _source(mesh)
-    contacts = tuple(contacts or ())
-    unknown = [c for c in contacts if c not in simplices.surfaces]
+    source = _source(mesh)
+    simplices = source.simplices
+    points = simplices.points * float(scale)
+    named = tuple(source.contact_region) if source.contact_region else simplices.surfaces
+    contacts = tuple(source.contact_region) if contacts is None and source.contact_region else tuple(contacts or ())
+    unknown = [c for c in contacts if c not in named]
     if unknown:
-        raise InputError(f"contact {shown(unknown[0])}: the mesh's surfaces are {', '.join(simplices.surfaces)}")
+        raise InputError(f"contact {shown(unknown[0])}: the mesh's contacts are {', '.join(named) or 'none'}")
+    interfaces = [name for name in simplices.surfaces if name not in named]
     names = list(simplices.volumes) + list(simplices.surfaces)
     offset = len(simplices.volumes)
     elements = np.concatenate([
         np.column_stack([np.full(len(simplices.triangles), 2), simplices.surface + offset, simplices.triangles]
                         ).reshape(-1),
         np.column_stack([np.full(len(simplices.tetrahedra), 3), simplices.volume, simplices.tetrahedra]).reshape(-1)])
+    materials = _materials(mesh, simplices.volumes, material)
     log = io.StringIO()
     try:
         with contextlib.redirect_stdout(log):  # DEVSIM prints through Python's sys.stdout
-            devsim.create_gmsh_mesh(mesh=device, coordinates=simplices.points.reshape(-1).tolist(),
+            devsim.create_gmsh_mesh(mesh=device, coordinates=points.reshape(-1).tolist(),
                                     physical_names=names, elements=elements.astype(np.int64).tolist())
             for name in simplices.volumes:
-                devsim.add_gmsh_region(gmsh_name=name, mesh=device, region=name, material=material)
-            region = simplices.volumes[0]
+                devsim.add_gmsh_region(gmsh_name=name, mesh=device, region=name, material=materials[name])
             for name in contacts:
-                devsim.add_gmsh_contact(gmsh_name=name, mesh=device, name=name, region=region,
+                devsim.add_gmsh_contact(gmsh_name=name, mesh=device, name=name,
+                                        region=source.contact_region.get(name, simplices.volumes[0]),
                                         material=CONTACT_MATERIAL)
+            for name in interfaces:
+                first, second = _pair(name, simplices.volumes)
+                devsim.add_gmsh_interface(gmsh_name=name, mesh=device, name=name, region0=first, region1=second)
             devsim.finalize_mesh(mesh=device)
             devsim.create_device(mesh=device, device=device)
             node_ids, edge_ids = {}, {}
             for name in simplices.volumes:
-                node_ids[name], edge_ids[name] = _install_dual(devsim, device, name, simplices.points, dual)
+                node_ids[name], edge_ids[name] = _install_dual(devsim, device, name, points, source.dual,
+                                                               source.geometry[name], float(scale))
     except devsim.error as error:
         text = " ".join(str(error).split())
         raise InputError(f"DEVSIM refused the mesh of device {shown(device)}: {text[:200]}") from None
-    return DevsimDevice(device, tuple(simplices.volumes), contacts, simplices, dual, node_ids, edge_ids,
-                        log.getvalue())
+    return DevsimDevice(device, tuple(simplices.volumes), contacts, simplices, source.dual, node_ids, edge_ids,
+                        tuple(interfaces), log.getvalue())
 
 
-def _install_dual(devsim, device: str, region: str, points: np.ndarray, dual) -> tuple[np.ndarray, np.ndarray]:
+def _materials(mesh, regions, default: str) -> dict:
+    """Each region's material: the device's (when it names one), else ``default``."""
+    assembled = getattr(mesh, "assembled", mesh)
+    found = getattr(getattr(assembled, "regions", None), "materials", None) or ()
+    given = dict(zip(regions, found)) if len(found) == len(regions) else {}
+    return {name: given.get(name) or default for name in regions}
+
+
+def _pair(interface: str, regions) -> tuple[str, str]:
+    """The two regions of an interface named ``"a|b"`` (region names may hold ``|`` themselves)."""
+    for first in regions:
+        for second in regions:
+            if first != second and interface == f"{first}|{second}":
+                return first, second
+    raise InputError(f"interface {shown(interface)}: names no two regions")
+
+
+def _install_dual(devsim, device: str, region: str, points: np.ndarray, dual, geometry, scale: float
+                  ) -> tuple[np.ndarray, np.ndarray]:
     """Set the region's exact node volumes and edge couplings and select them; DEVSIM's node and edge maps."""
+    volumes, areas = geometry
     xyz = np.column_stack([devsim.get_node_model_values(device=device, region=region, name=axis)
                            for axis in ("x", "y", "z")])
     # DEVSIM keeps the coordinates it was given (doubles): exact equality finds each node's vertex id
@@ -191,10 +266,10 @@ def _install_dual(devsim, device: str, region: str, points: np.ndarray, dual) ->
     wanted = pairs[:, 0] * n + pairs[:, 1]
     where = np.minimum(np.searchsorted(known, wanted), len(known) - 1)
     edges = np.where(known[where] == wanted, where, -1)
-    area = np.where(edges >= 0, dual.area[np.maximum(edges, 0)], 0.0)
+    area = np.where(edges >= 0, areas[np.maximum(edges, 0)], 0.0) * scale ** 2
     devsim.node_solution(device=device, region=region, name=EXACT_NODE_VOLUME)
     devsim.set_node_values(device=device, region=region, name=EXACT_NODE_VOLUME,
-                           values=dual.control_volume[nodes].tolist())
+                           values=(volumes[nodes] * scale ** 3).tolist())
     devsim.edge_solution(device=device, region=region, name=EXACT_EDGE_COUPLE)
     devsim.set_edge_values(device=device, region=region, name=EXACT_EDGE_COUPLE, values=area.tolist())
     devsim.set_parameter(device=device, region=region, name="node_volume_model", value=EXACT_NODE_VOLUME)

@@ -32,6 +32,7 @@ import numpy as np
 from ..core.configuration import Box
 from ..errors import InputError
 from ..files.outputs import OutputFolder
+from ..formats.gmsh import GMSH_VERSIONS
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.dual import Dual
 from ..mesh.octree import Octree, Shape
@@ -44,7 +45,7 @@ __all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut
            "pattern_lookup", "piece_name", "tree_source"]
 
 
-def output_names(dual: bool, device: bool = False) -> tuple[str, ...]:
+def output_names(dual: bool, device: bool = False, gmsh: bool = False, tets: bool = False) -> tuple[str, ...]:
     """The files a mesh writes into its folder (``mesh --out``, :meth:`OctreeMesh.write`), known before the work.
 
     The output folder is locked and these names checked before the mesh is made,
@@ -52,7 +53,7 @@ def output_names(dual: bool, device: bool = False) -> tuple[str, ...]:
     that it did not write again).
     """
     return ("mesh.vtu", "report.json", "mesh.png") + (("dual.npz",) if dual else ()) + \
-        (("contacts.vtu",) if device else ())
+        (("contacts.vtu",) if device else ()) + (("mesh.msh",) if gmsh else ()) + (("tets.vtu",) if tets else ())
 
 
 def piece_name(k: int) -> str:
@@ -65,7 +66,7 @@ def mesh_writes(name: str) -> bool:
     from ..mesh.partition import MAX_PARTITIONS
 
     piece = re.fullmatch(r"mesh-(0|[1-9][0-9]{0,9})\.vtu", name)
-    return name in (*output_names(True, True), "mesh.pvtu") or piece is not None and int(piece[1]) < MAX_PARTITIONS
+    return name in (*output_names(True, True, True, True), "mesh.pvtu") or piece is not None and int(piece[1]) < MAX_PARTITIONS
 
 
 def default_cut(shapes: Sequence[Shape], box: Box) -> float:
@@ -270,24 +271,35 @@ class OctreeMesh:
         """The elements whose circumsphere strictly holds a vertex (``None``: the check was skipped)."""
         return self._result.violating
 
-    def write(self, folder: str | Path, cut: float | None = None) -> None:
+    def write(self, folder: str | Path, cut: float | None = None, gmsh: str | None = None, binary: bool = False,
+              tets: bool = False) -> None:
         """Write ``mesh.vtu``, ``report.json``, ``mesh.png`` (and ``dual.npz`` when built with ``dual=True``) into ``folder``.
 
         The files of ``cospherical mesh --out folder``, byte for byte: all of them
         or, on an error, none (the folder is locked and its files renamed into place
         together).  ``cut``: the height of ``mesh.png``'s cut as a fraction of the
-        domain's (default :func:`default_cut`).
+        domain's (default :func:`default_cut`).  ``gmsh``: also ``mesh.msh``, the
+        mesh split into tetrahedra as a Gmsh file of that version (``"2.2"`` or
+        ``"4.1"``; ``binary`` for Gmsh's binary form), with named physical groups
+        (:mod:`cospherical.formats.gmsh`); ``tets``: also ``tets.vtu``, the same
+        tetrahedra with cell data ``element`` (the parent) and ``region``.
         """
-        names = output_names(self.report.dual is not None, self._result.source.device is not None)
+        names = output_names(self.report.dual is not None, self._result.source.device is not None, gmsh is not None,
+                             tets)
         with OutputFolder(folder, "mesh", names, writes=mesh_writes) as out:
-            self.write_files(out.path, cut)
+            self.write_files(out.path, cut, gmsh, binary, tets)
 
-    def write_files(self, path: Callable[[str], Path], cut: float | None = None) -> None:
+    def write_files(self, path: Callable[[str], Path], cut: float | None = None, gmsh: str | None = None,
+                    binary: bool = False, tets: bool = False) -> None:
         """Write the outputs, each to ``path(name)`` (an :class:`~cospherical.files.outputs.OutputFolder`'s ``path``)."""
         from ..formats.mesh import write_report, write_vtu
         from ..outputs.mesh_picture import cut_png
 
         mesh, report, source = self.assembled, self.report, self._result.source
+        if gmsh is not None and gmsh not in GMSH_VERSIONS:
+            raise InputError(f"Gmsh version {gmsh!r}: write one of {', '.join(GMSH_VERSIONS)}")
+        if gmsh is not None or tets:
+            self._write_tetrahedra(path, gmsh, binary, tets)
         with_dual = report.dual is not None
         if with_dual:
             from ..formats.dual import write_dual
@@ -304,6 +316,23 @@ class OctreeMesh:
                 title=f"{' x '.join(self.box.texts)}: {shapes}; {report.leaves:,} leaves, {report.elements:,} "
                       f"elements, {report.types} types (cut at z = {at * float(self.box.c):.4g})")
         write_report(report.to_dict(), path("report.json"))
+
+    def _write_tetrahedra(self, path: Callable[[str], Path], gmsh: str | None, binary: bool, tets: bool) -> None:
+        """``mesh.msh`` and ``tets.vtu``: the conforming tetrahedral split (:mod:`cospherical.mesh.tetrahedra`)."""
+        from ..formats.gmsh import write_msh
+        from ..formats.vtu import VTK_CELL, write_grid
+        from ..mesh.tetrahedra import simplex_mesh, split_tetrahedra
+
+        mesh = self.assembled
+        split = split_tetrahedra(mesh)
+        simplices = simplex_mesh(mesh, split, self._result.faces)
+        if gmsh is not None:
+            write_msh(simplices, path("mesh.msh"), gmsh, binary)
+        if tets:
+            count = len(split)
+            write_grid(path("tets.vtu"), simplices.points, np.full(count, VTK_CELL["tetra"], dtype=np.uint8),
+                       split.nodes.reshape(-1), 4 * np.arange(1, count + 1),
+                       cell_data={"element": split.parent, "region": split.region})
 
     def _vtu_data(self, with_dual: bool) -> tuple[dict, dict]:
         """The point and cell data ``mesh.vtu`` adds with the dual: control volumes, boundary areas, circumcenters, delaunay_ok."""

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..api.mesh import build_mesh, mesh_writes, output_names, piece_name, tree_source
+from ..formats.gmsh import GMSH_VERSIONS
 from ..catalogue import CRITERIA
 from ..core.configuration import Box
 from ..core.exact import parse_rational
@@ -72,6 +73,14 @@ def add_arguments(parser) -> None:
                         help="the exact finite-volume dual: dual.npz in --out (edges, coefficients, control volumes), "
                         "point data control_volume, boundary_area and cell data circumcenter, delaunay_ok in mesh.vtu, "
                         "negative_coefficients and the mixed mesh beside a tetrahedral one in the report")
+    parser.add_argument("--gmsh", choices=GMSH_VERSIONS, metavar="VERSION",
+                        help="also mesh.msh in --out: the mesh split into conforming tetrahedra (no new vertex; the "
+                        "exact dual kept, the added edges coupling 0) as a Gmsh file of VERSION 2.2 (DEVSIM's) or "
+                        "4.1, each region a named physical volume, each contact and interface (a one-box domain: "
+                        "each side xmin..zmax) a named physical surface")
+    parser.add_argument("--gmsh-binary", action="store_true", help="mesh.msh in Gmsh's binary form (with --gmsh)")
+    parser.add_argument("--tets", action="store_true",
+                        help="also tets.vtu in --out: the same tetrahedra, cell data element (the parent) and region")
     parser.add_argument("--delaunay", choices=MODES, default=None,
                         help="global (default with the optimal criterion): the exact Delaunay subdivision of the "
                         "vertices, the leaves whose elements fail the exact check re-tessellated together; leaf "
@@ -166,12 +175,18 @@ def run(args) -> int:
         args.device = read_device(args.device)  # before the output folder: a bad file writes nothing
     elif args.refine is None and args.leaves is None:
         raise InputError("--domain needs the tree: --refine SHAPE (with --levels L) or --leaves FILE")
+    if args.gmsh_binary and args.gmsh is None:
+        raise InputError("--gmsh-binary chooses mesh.msh's form: give --gmsh VERSION too")
+    if (args.gmsh is not None or args.tets) and (args.out is None or pieces is not None):
+        option = "--gmsh" if args.gmsh is not None else "--tets"
+        raise InputError(f"{option} writes into --out DIR, the whole mesh in one process: with --out, not with "
+                         "--partitions")
     if args.out is None:
         return _run(args, None)
     if pieces is not None:
         names = ("mesh.pvtu", "report.json", *(piece_name(k) for k in range(pieces)))
     else:
-        names = output_names(args.dual, args.device is not None)
+        names = output_names(args.dual, args.device is not None, args.gmsh is not None, args.tets)
     with OutputFolder(args.out, "mesh", names, writes=mesh_writes) as out:  # locked from the start; every file or none
         return _run(args, out)
 
@@ -217,7 +232,7 @@ def _run(args, out: OutputFolder | None) -> int:
                           uniform=not args.no_uniform, progress=progress)
     clock = time.perf_counter()
     if out is not None:
-        mesh.write_files(out.path, at)
+        mesh.write_files(out.path, at, args.gmsh, args.gmsh_binary, args.tets)
     timings = {**mesh.report.timings, "outputs": time.perf_counter() - clock}
     report = mesh.report.to_dict()
     _print(args, report)

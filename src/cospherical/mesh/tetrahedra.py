@@ -228,13 +228,53 @@ def real_points(mesh) -> np.ndarray:
     return np.asarray(mesh.vertices, dtype=np.float64) * (np.array(mesh.box.to_float()) / int(mesh.grid))
 
 
-def simplex_mesh(mesh, tetrahedra: Tetrahedra | None = None) -> SimplexMesh:
-    """The mesh's tetrahedra per region and its named surfaces (see :class:`SimplexMesh`)."""
+def simplex_mesh(mesh, tetrahedra: Tetrahedra | None = None, faces=None) -> SimplexMesh:
+    """The mesh's tetrahedra per region and its named surfaces (see :class:`SimplexMesh`).
+
+    A device's mesh (regions from a device file) gives one volume per region, named as
+    the region, and one surface per contact and per interface (``"a|b"``), their
+    polygons fanned by the rule of :func:`split_tetrahedra` (so their triangles are
+    faces of the tetrahedra); its points are in device units (the device's origin
+    added).  ``faces``: the device's :class:`~cospherical.mesh.regions.RegionFaces`
+    when already computed.  Any other mesh: the volume ``domain`` and the box's sides.
+    """
     blocks = list(mesh.blocks())
     tets = split_tetrahedra(mesh, blocks) if tetrahedra is None else tetrahedra
-    outer = boundary_triangles(mesh, blocks)
-    return SimplexMesh(real_points(mesh), tets.nodes, tets.region, ("domain",), outer.nodes,
-                       outer.side.astype(np.int32), SIDES)
+    regions = getattr(mesh, "regions", None)
+    if regions is None or regions.layout is None:
+        outer = boundary_triangles(mesh, blocks)
+        return SimplexMesh(real_points(mesh), tets.nodes, tets.region, ("domain",), outer.nodes,
+                           outer.side.astype(np.int32), SIDES)
+    from .regions import region_faces
+
+    faces = region_faces(mesh) if faces is None else faces
+    device = regions.layout.device
+    contacts = tuple(c.name for c in device.contacts)
+    surfaces = contacts + tuple(faces.interface_names)
+    parts = [_fanned(faces.contact_nodes, faces.contact_face_contact),
+             _fanned(faces.interface_nodes, np.asarray(faces.interface_face_interface) + len(contacts))]
+    triangles = np.concatenate([p[0] for p in parts])
+    surface = np.concatenate([p[1] for p in parts]).astype(np.int32)
+    order = np.argsort(surface, kind="stable")  # surface by surface, each in its faces' order
+    points = real_points(mesh) + np.array([float(x) for x in device.origin])
+    return SimplexMesh(points, tets.nodes, tets.region, tuple(regions.names), triangles[order], surface[order],
+                       surfaces)
+
+
+def _fanned(polygons: np.ndarray, label: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of -1 padded polygons (fanned from each one's smallest id) and each triangle's label."""
+    polygons = np.asarray(polygons, dtype=np.int64).reshape(len(label), -1)
+    label = np.asarray(label, dtype=np.int64)
+    sizes = (polygons >= 0).sum(axis=1)
+    triangles, labels, rows = [np.zeros((0, 3), dtype=np.int64)], [np.zeros(0, dtype=np.int64)], []
+    for k in np.unique(sizes):
+        which = np.flatnonzero(sizes == k)
+        fans = fan_triangles(polygons[which, :k])
+        triangles.append(fans.reshape(-1, 3))
+        labels.append(np.repeat(label[which], k - 2))
+        rows.append(np.repeat(which, k - 2))
+    order = np.argsort(np.concatenate(rows), kind="stable") if rows else np.zeros(0, dtype=np.int64)
+    return np.concatenate(triangles)[order], np.concatenate(labels)[order]
 
 
 def dual_simplex_mesh(dual) -> SimplexMesh:
