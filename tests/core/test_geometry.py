@@ -29,13 +29,13 @@ def test_the_kernels_bulk_backends_agree():
     sides = geometry.sphere_sides(solid, points[20:], weights)
     assert sides.tolist() == geometry.sphere_sides(solid, points[20:], weights, python_integers=True).tolist()
     assert (sides[:20] == 0).all() and {-1, 1} <= set(sides[20:].tolist())
-    fast, exact = geometry.circumcentres(solid, weights), geometry.circumcentres(solid, weights, python_integers=True)
+    fast, exact = geometry.circumcenters(solid, weights), geometry.circumcenters(solid, weights, python_integers=True)
     assert fast[0].dtype == np.int64 and exact[0].dtype == object
     assert [a.tolist() for a in fast] == [a.tolist() for a in exact]
     # each centre is equidistant (weighted) from its four vertices
     for tet, num, den in zip(solid[:5].tolist(), *(a[:5].tolist() for a in exact)):
-        centre = [Fraction(n, d) for n, d in zip(num, den)]
-        assert len({sum(w * (x - c) ** 2 for w, x, c in zip(weights, p, centre)) for p in tet}) == 1
+        center = [Fraction(n, d) for n, d in zip(num, den)]
+        assert len({sum(w * (x - c) ** 2 for w, x, c in zip(weights, p, center)) for p in tet}) == 1
 
 
 def test_right_angles_are_decided_in_the_real_metric():

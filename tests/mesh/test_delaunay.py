@@ -128,7 +128,7 @@ def test_python_integers_give_the_same_cells(monkeypatch):
 
     leaf = assemble(build_octree(Box.parse(["1", "2", "4"]), 4, [parse_shape("plane:1,1,1,3")], "edge"))
     fast = mesh_cells(global_delaunay(leaf))
-    for name in ("six_volumes", "circumcentres", "sphere_sides"):
+    for name in ("six_volumes", "circumcenters", "sphere_sides"):
         monkeypatch.setattr(delaunay, name, partial(getattr(delaunay, name), python_integers=True))
     assert mesh_cells(global_delaunay(leaf)) == fast
 

@@ -14,7 +14,7 @@ Python integers: no tolerance anywhere.
 
 Python integers (and ``Fraction``s where a caller has them) in the scalar
 functions and the :class:`Frame`: they never overflow.  The bulk functions on
-numpy arrays (:func:`six_volumes`, :func:`sphere_sides`, :func:`circumcentres`)
+numpy arrays (:func:`six_volumes`, :func:`sphere_sides`, :func:`circumcenters`)
 choose their backend themselves, by a bound derived in their comments: numpy's
 int64 when every term provably stays below 2**62 or 2**63, else object arrays
 of Python integers; the same numbers either way (``python_integers=True`` takes
@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     import numpy as np
     from numpy.typing import NDArray
 
-__all__ = ["Frame", "Rational", "Sphere", "area_vector", "circumcentres", "collinear", "cross", "determinant", "dot",
+__all__ = ["Frame", "Rational", "Sphere", "area_vector", "circumcenters", "collinear", "cross", "determinant", "dot",
            "in_closed_box", "plane_normal", "plane_projection", "six_volume", "six_volumes", "sphere_sides", "sub", "tetra_six_volume"]
 
 _Vector = tuple[int, int, int]
@@ -230,7 +230,7 @@ def six_volumes(tets: NDArray[Any], python_integers: bool = False) -> NDArray[An
     return volumes
 
 
-def circumcentres(tets: NDArray[Any], weights: Sequence[int],
+def circumcenters(tets: NDArray[Any], weights: Sequence[int],
                   python_integers: bool = False) -> tuple[NDArray[Any], NDArray[Any]]:
     """Per tetrahedron of an integer array (n, 4, 3), its exact circumcentre in the same units, in bulk:
     ``(numerators, denominators)``, each (n, 3), every coordinate a reduced fraction with a positive
@@ -243,7 +243,7 @@ def circumcentres(tets: NDArray[Any], weights: Sequence[int],
     boxes, 1e-12 x 1 x 3e9, have 43 digits and do not fit int64 at all).
 
     >>> import numpy as np
-    >>> num, den = circumcentres(np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 4]]]), (1, 1, 1))
+    >>> num, den = circumcenters(np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 4]]]), (1, 1, 1))
     >>> num.tolist(), den.tolist()
     ([[1, 1, 2]], [[1, 1, 1]])
     """
@@ -274,7 +274,7 @@ def _cramer(d: NDArray[Any], w: NDArray[Any]) -> tuple[NDArray[Any], list[NDArra
     """The sphere through the origin and the rows d1, d2, d3 of ``d`` (n, 3, 3), in bulk: its centre c
     solves 2 W c . d_k = L(d_k) (L the lifted length, ``w`` . d_k^2), so W c = N / (2 det) for M the
     rows d_k, by Cramer's rule in integers.  Returns (det, [N_x, N_y, N_z]) in ``d``'s dtype; the
-    callers bound them (:func:`sphere_sides`, :func:`circumcentres`)."""
+    callers bound them (:func:`sphere_sides`, :func:`circumcenters`)."""
     import numpy as np
 
     lifted = (d * d * w).sum(axis=2)  # (n, 3): |d_k|^2 in the weighted metric

@@ -116,7 +116,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from ..core.geometry import Frame, area_vector, circumcentres, six_volumes, sphere_sides
+from ..core.geometry import Frame, area_vector, circumcenters, six_volumes, sphere_sides
 from ..core.incremental_delaunay import delaunay_tetrahedra
 from ..core.tessellation import tessellation_elements
 from ..errors import InputError
@@ -464,7 +464,7 @@ def _planes(mesh: Mesh) -> list[list[list[tuple[np.ndarray, np.ndarray, int]]]]:
 
 def _same_sphere(mesh: Mesh, tets: np.ndarray, weights) -> np.ndarray:
     """Per tetrahedron (global vertex ids), the class of its exact circumcenter: one class, one cell."""
-    num, den = circumcentres(mesh.vertices.astype(np.int64)[tets], weights)
+    num, den = circumcenters(mesh.vertices.astype(np.int64)[tets], weights)
     key = np.stack((num, den), axis=2).reshape(len(tets), 6)  # per axis its numerator and denominator
     if key.dtype == object:
         index: dict = {}
@@ -563,10 +563,10 @@ def _shape(offsets: list[tuple[int, int, int]], squared, types: dict, catalogue:
     at = {n: i for i, n in enumerate(order)}
     frame = Frame.build({i: points[n] for i, n in enumerate(order)}, squared)
     sphere = frame.circumsphere(range(len(order)))
-    centre = frame.center(sphere)
+    center = frame.center(sphere)
     return CellShape(element.type.id, tuple(offsets[n] for n in order),
                      tuple(tuple(at[n] for n in cycle) for cycle in element.polyhedron.faces),
-                     element.polyhedron.unit_volume, sphere, centre), order
+                     element.polyhedron.unit_volume, sphere, center), order
 
 
 def _scaled(shape: CellShape, g: int) -> CellShape:
