@@ -59,10 +59,10 @@ def timer(clock: dict):
 def sphere_tree(args, stage):
     """The table's lookup and the sphere octree centred in the domain, each timed."""
     box = Box.parse(args.domain)
-    centre = ",".join(str(float(length) / 2) for length in box.lengths)
+    center = ",".join(str(float(length) / 2) for length in box.lengths)
     table = stage("load table", lambda: load_patterns(args.patterns))
     lookup = table_lookup(table, "optimal", box, args.patterns)
-    tree = stage("octree", lambda: build_octree(box, args.levels, [parse_shape(f"sphere:{centre},{args.radius}")]))
+    tree = stage("octree", lambda: build_octree(box, args.levels, [parse_shape(f"sphere:{center},{args.radius}")]))
     return lookup, tree
 
 
@@ -83,7 +83,7 @@ def measure(args, record) -> None:
     mesh = stage("assembly", lambda: assemble(tree, lookup, cache=cache))
     volume = stage("volume", lambda: check_volume(mesh))
     conformity = stage("conformity", lambda: check_conformity(mesh))
-    centres = stage("circumcenters", lambda: check_circumcenters(mesh))
+    centers = stage("circumcenters", lambda: check_circumcenters(mesh))
     delaunay = stage("delaunay", lambda: check_delaunay(mesh))
     stage("statistics", lambda: mesh_statistics(mesh))
     whole = stage("global: re-tessellation", lambda: global_delaunay(mesh, delaunay))
@@ -102,7 +102,7 @@ def measure(args, record) -> None:
     checks = sum(clock[k][0] for k in ("volume", "conformity", "circumcenters"))
     print(f"volume + conformity + circumcenters {checks:.1f} s; delaunay {clock['delaunay'][0]:.1f} s; "
           f"peak {peak:.2f} GB")
-    print({**volume, **conformity, **centres, **{k: v for k, v in delaunay.items() if not k.startswith("_")}})
+    print({**volume, **conformity, **centers, **{k: v for k, v in delaunay.items() if not k.startswith("_")}})
     leaf_stages = ("assembly", "volume", "conformity", "circumcenters", "delaunay", "statistics")
     global_stages = ("assembly", "delaunay", *(name for name in clock if name.startswith("global: ")))
     leaf_mode, global_mode = (sum(clock[k][0] for k in stages) for stages in (leaf_stages, global_stages))

@@ -105,14 +105,14 @@ def box_method(tree, exact, source, cache: dict, lookup=None) -> dict:
             "build": built - start, "solve": time.perf_counter() - built}
 
 
-def cell_centred(tree, exact, source) -> dict:
+def cell_centered(tree, exact, source) -> dict:
     """discretize's cell-centred finite volumes on the same leaves (weak Dirichlet data on boundary faces)."""
     import discretize
     start = time.perf_counter()
     n = 2 ** tree.depth
     mesh = discretize.TreeMesh([[(1 / n, n)]] * 3, diagonal_balance=True)
-    centres = (tree.positions + 0.5) / (1 << tree.levels.astype(np.int64))[:, None]
-    mesh.insert_cells(centres, tree.levels.astype(int), finalize=True)
+    centers = (tree.positions + 0.5) / (1 << tree.levels.astype(np.int64))[:, None]
+    mesh.insert_cells(centers, tree.levels.astype(int), finalize=True)
     if mesh.n_cells != len(tree):
         raise RuntimeError(f"discretize made {mesh.n_cells} cells of our {len(tree)} leaves")
     volume = diags(mesh.cell_volumes)
@@ -160,7 +160,7 @@ def main(argv=None) -> list[dict]:
             trees = [octree(kind, level) for level in levels]
             for method in methods:
                 rows = [box_method(t, exact, source, cache, lookup) if method == "box"
-                        else cell_centred(t, exact, source) for t in trees]
+                        else cell_centered(t, exact, source) for t in trees]
                 for level, row, o_max, o_l2 in zip(levels, rows, order(rows, "max"), order(rows, "l2")):
                     line = (f"{name:9s} {kind:8s} {level:5d}  {method:10s} {row['unknowns']:9,d} {row['nonzeros']:10,d}"
                             f"  {row['max']:9.3e} {o_max:>6s}  {row['l2']:9.3e} {o_l2:>6s}")

@@ -230,13 +230,13 @@ def test_the_picture_cuts_what_vtk_cuts(tmp_path):
     checked = 0
     for polygon, t in zip(polygons, types):
         corners = np.c_[x0 + polygon[:, 0] * scale, y0 + (1 - polygon[:, 1]) * scale]  # pixel space
-        centre = corners.mean(axis=0)
+        center = corners.mean(axis=0)
         edges = np.roll(corners, -1, axis=0) - corners
-        to_centre = centre - corners
+        to_center = center - corners
         # distance of the centre from each edge's line: |2-D cross product| / edge length
-        away = np.abs(edges[:, 0] * to_centre[:, 1] - edges[:, 1] * to_centre[:, 0]) / np.hypot(*edges.T)
+        away = np.abs(edges[:, 0] * to_center[:, 1] - edges[:, 1] * to_center[:, 0]) / np.hypot(*edges.T)
         if away.min() > 2:
-            assert tuple(pixels[int(centre[1]), int(centre[0])]) == TAB20[commonest.index(t) % 20]
+            assert tuple(pixels[int(center[1]), int(center[0])]) == TAB20[commonest.index(t) % 20]
             checked += 1
     assert checked > len(polygons) / 2
 

@@ -25,10 +25,10 @@ def test_global_delaunay_equals_brute_force_on_a_brick():
     for e in range(len(mesh)):
         nodes = conn[e, :sizes[e]]
         x = points[nodes]
-        centre = np.linalg.lstsq(2 * (x[1:] - x[0]), (x[1:] ** 2).sum(1) - (x[0] ** 2).sum(), rcond=None)[0]
-        d2 = ((points - centre) ** 2).sum(1)
+        center = np.linalg.lstsq(2 * (x[1:] - x[0]), (x[1:] ** 2).sum(1) - (x[0] ** 2).sum(), rcond=None)[0]
+        d2 = ((points - center) ** 2).sum(1)
         d2[nodes] = np.inf
-        inside = int((d2 < ((x[0] - centre) ** 2).sum() * (1 - 1e-9)).sum())
+        inside = int((d2 < ((x[0] - center) ** 2).sum() * (1 - 1e-9)).sum())
         pairs, elements = pairs + inside, elements + (inside > 0)
     assert (found["delaunay_violating_pairs"], found["delaunay_violations"]) == (pairs, elements)
     assert found["delaunay_violations"] > 0

@@ -343,7 +343,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     levels = mesh.tree.levels.astype(np.int64)
     size = grid >> levels
     origin = mesh.tree.positions.astype(np.int64) * size[:, None]
-    rows_tessellation, rows_local, rows_leaf, centres, radii, n_nodes = [], [], [], [], [], []
+    rows_tessellation, rows_local, rows_leaf, centers, radii, n_nodes = [], [], [], [], [], []
     # A table element that is not co-spherical (a table may hold one) has no sphere to test, and
     # is not a cell of the Delaunay subdivision: it joins the elements that are not cells.
     without_sphere = [np.zeros(0, dtype=np.int64)]
@@ -355,13 +355,13 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
             if element.sphere is None:  # reported by check_circumcenters as not co-spherical
                 without_sphere.append(mesh.element_offsets[leaves].astype(np.int64) + j)
                 continue
-            centre = (origin[leaves] + np.array([float(x) for x in element.center])[None] * size[leaves, None]) * scale
+            center = (origin[leaves] + np.array([float(x) for x in element.center])[None] * size[leaves, None]) * scale
             first = points[mesh.slots[leaves, element.nodes[0]]]
             rows_tessellation.append(np.full(len(leaves), p, dtype=np.int32))
             rows_local.append(np.full(len(leaves), j, dtype=np.int16))
             rows_leaf.append(leaves.astype(np.int64))
-            centres.append(centre)
-            radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
+            centers.append(center)
+            radii.append(np.sqrt(((first - center) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(leaves), len(element.nodes), dtype=np.int64))
     if cells is not None and len(cells):
         # a cell is a row of tessellation -1 whose "leaf" is its index among the cells
@@ -370,26 +370,26 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         starts = np.searchsorted(cells.shape[fresh], np.arange(len(cells.shapes) + 1))
         for s, shape in enumerate(cells.shapes):
             rows = fresh[starts[s]:starts[s + 1]]
-            centre = (cells.anchor[rows] + np.array([float(x) for x in shape.center])[None]) * scale
+            center = (cells.anchor[rows] + np.array([float(x) for x in shape.center])[None]) * scale
             first = points[cells.nodes[rows, 0]]
             rows_tessellation.append(np.full(len(rows), -1, dtype=np.int32))
             rows_local.append(np.full(len(rows), s, dtype=np.int16))
             rows_leaf.append(rows.astype(np.int64))
-            centres.append(centre)
-            radii.append(np.sqrt(((first - centre) ** 2).sum(axis=1)))
+            centers.append(center)
+            radii.append(np.sqrt(((first - center) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(rows), len(shape.offsets), dtype=np.int64))
     if progress and cells is not None:
-        progress(len(mesh) - sum(len(c) for c in centres))
-    if not sum(len(c) for c in centres):
+        progress(len(mesh) - sum(len(c) for c in centers))
+    if not sum(len(c) for c in centers):
         return {"_leaves": np.zeros(0, dtype=np.int64), "_elements": np.zeros(0, dtype=np.int64),
                 "_not_cells": np.sort(np.concatenate(without_sphere)), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
                 "delaunay_ties": 0, "delaunay_exact_tests": 0}
     rows_tessellation, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_tessellation, rows_local, rows_leaf))
-    centres, radii, n_nodes = np.concatenate(centres), np.concatenate(radii), np.concatenate(n_nodes)
+    centers, radii, n_nodes = np.concatenate(centers), np.concatenate(radii), np.concatenate(n_nodes)
     reach = radii * (1 + 1e-9) + 1e-12 * float(np.abs(points).max())
     # Only vertices in the box around every reach can be within one: the rest are left out of the
     # search (a piece of a partitioned mesh holds all the vertices but searches its surroundings).
-    low, high = (centres - reach[:, None]).min(axis=0), (centres + reach[:, None]).max(axis=0)
+    low, high = (centers - reach[:, None]).min(axis=0), (centers + reach[:, None]).max(axis=0)
     lowest, highest = points.min(axis=0), points.max(axis=0)
     near = None  # every vertex (the whole mesh's check): no mask to build
     if (low > lowest).any() or (high < highest).any():
@@ -397,13 +397,13 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         if len(near) == len(points):
             near = None
     tree = cKDTree(points if near is None else points[near])
-    counts = np.empty(len(centres), dtype=np.int64)
+    counts = np.empty(len(centers), dtype=np.int64)
     chunk = 1 << 18
     # the spheres in Morton order: neighbouring queries walk the same branches of the tree (a quarter less CPU)
-    nearby = _morton_order(centres, lowest, highest)
-    for start in range(0, len(centres), chunk):
+    nearby = _morton_order(centers, lowest, highest)
+    for start in range(0, len(centers), chunk):
         part = nearby[start:start + chunk]
-        counts[part] = tree.query_ball_point(centres[part], reach[part], return_length=True, workers=workers)
+        counts[part] = tree.query_ball_point(centers[part], reach[part], return_length=True, workers=workers)
         if progress:
             progress(len(part))
     # the element's own nodes are on its sphere; anything more (or less) is looked at exactly
@@ -421,7 +421,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
         rows = suspect[start:max(end, start + 1)]
         if not len(rows):
             continue
-        found = tree.query_ball_point(centres[rows], reach[rows], workers=workers)
+        found = tree.query_ball_point(centers[rows], reach[rows], workers=workers)
         if any(x is None for x in found):  # a search thread that ran out of memory leaves None
             raise MemoryError
         lengths = np.fromiter((len(x) for x in found), dtype=np.int64, count=len(found))

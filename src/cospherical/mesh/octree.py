@@ -163,9 +163,9 @@ def _meets(shape: Shape, box: Box, level: int, cells: np.ndarray) -> np.ndarray:
         return inside
     lengths = _rational_lengths(box, shape)
     if shape.kind == "sphere":
-        centre, radius = v[:3], v[3]
+        center, radius = v[:3], v[3]
         # unit-frame centre c = X / len; distances squared weigh each axis by len**2.
-        unit = [centre[a] / lengths[a] for a in range(3)]
+        unit = [center[a] / lengths[a] for a in range(3)]
         den = math.lcm(*(u.denominator for u in unit))
         grid = den * 2**level  # cell [i, i+1] is [i*den, (i+1)*den] on this grid
         weights_den = math.lcm(*(length.denominator ** 2 for length in lengths), radius.denominator ** 2)

@@ -72,8 +72,8 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
             ra, rb = pa[rows][:, which], pb[rows][:, which]  # (rows, corners, 3)
             t = (za[rows][:, which] / (za[rows][:, which] - zb[rows][:, which]))[..., None]
             xy = (ra + t * (rb - ra))[..., :2]
-            centre = xy.mean(axis=1, keepdims=True)
-            angle = np.arctan2(xy[..., 1] - centre[..., 1], xy[..., 0] - centre[..., 0])
+            center = xy.mean(axis=1, keepdims=True)
+            angle = np.arctan2(xy[..., 1] - center[..., 1], xy[..., 0] - center[..., 0])
             xy = np.take_along_axis(xy, np.argsort(angle, axis=1)[..., None], axis=1) * scale[:2]
             polygons.extend(xy)
             types.extend([type_id] * len(rows))

@@ -113,9 +113,9 @@ def cell_polyhedron(node_mask: int, code: int, of_configuration: bool = True):
     if len(cells) != 1:
         raise NotACell(node_mask, code)
     # and a cell of the configuration: its sphere holds no other node of it, inside or on it (unit cube)
-    centre = cells[0].center
-    radius = sum((a - c) ** 2 for a, c in zip(points[0][1], centre))
-    if of_configuration and any(sum((a - c) ** 2 for a, c in zip(point, centre)) <= radius
+    center = cells[0].center
+    radius = sum((a - c) ** 2 for a, c in zip(points[0][1], center))
+    if of_configuration and any(sum((a - c) ** 2 for a, c in zip(point, center)) <= radius
                                 for n, point in nodes.items() if not node_mask >> n & 1):
         raise NotACell(node_mask, code)
     return points, polyhedron(frame, cells[0])
