@@ -52,7 +52,7 @@ def main() -> None:
 def measure(args, record) -> None:
     leaf = assemble(build_octree(Box.parse(args.domain), args.levels, [parse_shape(args.refine)], "vertex"))
     found = check_delaunay(leaf)
-    nodes = leaf.element_nodes(found["_not_cells"])
+    nodes = leaf.element_nodes(found.not_cells)
     region_vertices = len(np.unique(nodes[nodes >= 0]))
     tree = f"{' x '.join(args.domain)}, levels {args.levels}, {args.refine}"
     print(f"domain {tree}: {len(leaf.tree):,} leaves, {len(leaf.vertices):,} vertices; {len(nodes):,} elements "

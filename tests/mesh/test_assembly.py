@@ -28,11 +28,7 @@ def octant_tree(box=CUBE):
 
 
 def checks(mesh) -> dict:
-    found = {**check_volume(mesh), **check_conformity(mesh), **check_circumcenters(mesh), **check_delaunay(mesh)}
-    found.pop("_leaves")
-    found.pop("_elements")
-    found.pop("_not_cells")
-    return found
+    return {**check_volume(mesh), **check_conformity(mesh), **check_circumcenters(mesh), **check_delaunay(mesh).figures()}
 
 
 def small_table(path, box, codes):

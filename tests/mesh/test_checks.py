@@ -30,8 +30,8 @@ def test_global_delaunay_equals_brute_force_on_a_brick():
         d2[nodes] = np.inf
         inside = int((d2 < ((x[0] - center) ** 2).sum() * (1 - 1e-9)).sum())
         pairs, elements = pairs + inside, elements + (inside > 0)
-    assert (found["delaunay_violating_pairs"], found["delaunay_violations"]) == (pairs, elements)
-    assert found["delaunay_violations"] > 0
+    assert (found.violating_pairs, found.violations) == (pairs, elements)
+    assert found.violations > 0 and len(found.violating_elements) == found.violations
     assert check_circumcenters(mesh)["leaves_not_fvm_adequate"] > 0
 
 

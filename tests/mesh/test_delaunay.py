@@ -33,7 +33,7 @@ def mesh_cells(mesh) -> set[frozenset[int]]:
 
 
 def whole(mesh) -> dict:
-    found = {**check_volume(mesh), **check_conformity(mesh), **check_delaunay(mesh)}
+    found = {**check_volume(mesh), **check_conformity(mesh), **check_delaunay(mesh).figures()}
     return {k: found[k] for k in ("volume_ok", "nonconforming_faces", "delaunay_violations", "delaunay_ties")}
 
 
@@ -62,7 +62,7 @@ def test_global_mode_equals_qhull_merged_exactly(domain, levels, shapes, balance
     assert whole(mesh) == WHOLE
     if domain == ["1", "1", "1"]:
         assert mesh is leaf and mesh.cells is None  # cube octrees: already Delaunay, untouched
-    elif check_delaunay(leaf)["delaunay_violations"]:
+    elif check_delaunay(leaf).violations:
         assert mesh_cells(leaf) != expected and mesh.cells is not None and mesh.cells.clusters >= 1
     # every leaf element kept is a cell; the replaced leaves hold none of the mesh's leaf elements
     assert mesh_cells(leaf) & expected <= mesh_cells(mesh)
@@ -143,15 +143,14 @@ def test_the_final_check_skips_only_what_the_leaf_check_proved():
     mesh = global_delaunay(leaf, found)
     cells = mesh.cells
     conn, sizes = leaf.connectivity()
-    failed = {frozenset(conn[e, :sizes[e]].tolist()) for e in found["_not_cells"]}
+    failed = {frozenset(conn[e, :sizes[e]].tolist()) for e in found.not_cells}
     proven = {frozenset(row[row >= 0].tolist()) for row in cells.nodes[cells.proven]}
     assert proven and not proven & failed and proven <= mesh_cells(leaf)
     assert not cells.proven.all()
     again = dataclasses.replace(mesh, cells=dataclasses.replace(cells, proven=np.zeros(len(cells), dtype=bool)),
                                 _groups=None)
     short, full = check_delaunay(mesh), check_delaunay(again)
-    assert (full["delaunay_violations"], full["delaunay_ties"]) == (short["delaunay_violations"],
-                                                                    short["delaunay_ties"]) == (0, 0)
+    assert (full.violations, full.ties) == (short.violations, short.ties) == (0, 0)
 
 
 def _count_exact(monkeypatch) -> list:
@@ -306,7 +305,7 @@ def test_a_table_element_that_is_not_cospherical_is_replaced_by_delaunay_cells()
     mesh = assemble(tree, lookup)
     assert replaced and check_circumcenters(mesh)["elements_not_cospherical"] == 1
     found = check_delaunay(mesh)
-    assert len(found["_not_cells"]) == 1
+    assert len(found.not_cells) == 1
     result = global_delaunay(mesh, found)
     assert check_circumcenters(result)["elements_not_cospherical"] == 0
     assert whole(result) == WHOLE
@@ -343,6 +342,8 @@ def test_only_a_wrong_proposals_own_failure_sends_every_cluster_to_the_exact_eng
 def test_a_kept_element_found_again_is_a_bug_not_a_cluster(monkeypatch):
     # the final check tests only the fresh cells: a kept leaf element among its findings cannot be
     # attributed to a cluster (it was once read through a negative index), so it stops the run
+    import dataclasses
+
     import cospherical.mesh.delaunay as delaunay
 
     leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))
@@ -352,7 +353,7 @@ def test_a_kept_element_found_again_is_a_bug_not_a_cluster(monkeypatch):
     def planted(mesh, *args, **kwargs):
         found = check(mesh, *args, **kwargs)
         if mesh.cells is not None:
-            found["_not_cells"] = np.r_[0, found["_not_cells"]]
+            found = dataclasses.replace(found, not_cells=np.r_[0, found.not_cells])
         return found
     monkeypatch.setattr(delaunay, "check_delaunay", planted)
     with pytest.raises(RuntimeError, match="not a fresh cell"):

@@ -17,7 +17,9 @@ violation and every tie is decided exactly; the float slack only widens the net.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from fractions import Fraction
+from typing import Callable
 
 import numpy as np
 
@@ -36,7 +38,7 @@ from .octree import distinct
 _MAX_EXACT_TESTS = 1 << 24
 _PAIR_CHUNK = 1 << 22
 
-__all__ = ["check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "element_faces", "grid_weights",
+__all__ = ["DelaunayCheck", "check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "element_faces", "grid_weights",
            "match_seams", "on_domain_boundary", "pair_faces"]
 
 
@@ -319,16 +321,58 @@ def _outside_domain(mesh: Mesh) -> int:
     return outside
 
 
-def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
+@dataclass(frozen=True, eq=False)
+class DelaunayCheck:
+    """What :func:`check_delaunay` found on a mesh: the report's counts and the elements behind them.
+
+    Attributes
+    ----------
+    violations : int
+        Elements whose circumsphere strictly holds a mesh vertex (the report's ``delaunay_violations``).
+    violating_pairs : int
+        (element, vertex) pairs with the vertex strictly inside the element's sphere.
+    violating_leaves : int
+        Leaves holding a violating element (or giving up their place to a violating cell).
+    ties : int
+        (element, vertex) pairs with a vertex of another element on the sphere: the two could merge.
+    exact_tests : int
+        (element, vertex) pairs decided with integers.
+    violating_leaf_ids : numpy.ndarray
+        The violating leaves' indices, sorted.
+    violating_elements : numpy.ndarray
+        The violating elements' indices, sorted (the report's ``delaunay_ok`` cell data).
+    not_cells : numpy.ndarray
+        The elements that violate, tie or have no sphere, sorted: those that are not cells of the
+        Delaunay subdivision of the vertices, which :func:`~cospherical.mesh.delaunay.global_delaunay`
+        replaces.
+    """
+
+    violations: int
+    violating_pairs: int
+    violating_leaves: int
+    ties: int
+    exact_tests: int
+    violating_leaf_ids: np.ndarray
+    violating_elements: np.ndarray
+    not_cells: np.ndarray
+
+    def figures(self) -> dict[str, int]:
+        """The counts as the report names them (``delaunay_violations``, ...), in its order."""
+        return {"delaunay_violations": self.violations, "delaunay_violating_pairs": self.violating_pairs,
+                "delaunay_violating_leaves": self.violating_leaves, "delaunay_ties": self.ties,
+                "delaunay_exact_tests": self.exact_tests}
+
+    def leaf_mesh(self, elements: int) -> dict[str, int]:
+        """The report's ``leaf_mesh`` figures of a leaf mesh of ``elements`` elements that this check found."""
+        return {"elements": elements, "delaunay_violations": self.violations, "delaunay_ties": self.ties,
+                "elements_replaced": int(len(self.not_cells))}
+
+
+def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None] | None = None) -> DelaunayCheck:
     """No mesh vertex strictly inside any element's circumsphere, decided exactly.
 
-    Returns ``delaunay_violations`` (elements whose sphere strictly holds a vertex),
-    ``delaunay_violating_pairs`` (element, vertex), ``delaunay_violating_leaves``,
-    ``delaunay_ties`` (a vertex of another element on an element's sphere: it could
-    merge with a neighbour), ``delaunay_exact_tests`` (pairs decided with integers),
-    ``_leaves`` and ``_elements`` (the violating leaves' and elements' indices, arrays,
-    for the caller) and ``_not_cells`` (the elements that violate or tie: the ones
-    that are not cells of the Delaunay subdivision of the vertices).
+    Returns a :class:`DelaunayCheck`: the counts of violations and ties and the elements
+    that are not cells of the Delaunay subdivision of the vertices.
 
     In a mesh with re-tessellated cells (:func:`~cospherical.mesh.delaunay.global_delaunay`)
     the leaf elements and the cells marked ``proven`` passed this check on the same
@@ -381,9 +425,8 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     if progress and cells is not None:
         progress(len(mesh) - sum(len(c) for c in centers))
     if not sum(len(c) for c in centers):
-        return {"_leaves": np.zeros(0, dtype=np.int64), "_elements": np.zeros(0, dtype=np.int64),
-                "_not_cells": np.sort(np.concatenate(without_sphere)), "delaunay_violations": 0, "delaunay_violating_pairs": 0, "delaunay_violating_leaves": 0,
-                "delaunay_ties": 0, "delaunay_exact_tests": 0}
+        none = np.zeros(0, dtype=np.int64)
+        return DelaunayCheck(0, 0, 0, 0, 0, none, none, np.sort(np.concatenate(without_sphere)))
     rows_tessellation, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_tessellation, rows_local, rows_leaf))
     centers, radii, n_nodes = np.concatenate(centers), np.concatenate(radii), np.concatenate(n_nodes)
     reach = radii * (1 + 1e-9) + 1e-12 * float(np.abs(points).max())
@@ -468,10 +511,9 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress=None) -> dict:
     leaf_rows = bad_rows[rows_tessellation[bad_rows] >= 0]
     bad_leaves = distinct(np.r_[rows_leaf[leaf_rows], cells.leaf[rows_leaf[bad_rows[rows_tessellation[bad_rows] < 0]]]
                                  if cells is not None else np.zeros(0, dtype=np.int64)])
-    return {"_leaves": bad_leaves, "_elements": elements(bad_rows), "_not_cells": np.sort(np.r_[elements(distinct(pair_row[sides <= 0])), np.concatenate(without_sphere)]),
-            "delaunay_violations": int(len(bad_rows)), "delaunay_violating_pairs": int(inside.sum()),
-            "delaunay_violating_leaves": int(len(bad_leaves)), "delaunay_ties": int((sides == 0).sum()),
-            "delaunay_exact_tests": int(len(pair_row))}
+    not_cells = np.sort(np.r_[elements(distinct(pair_row[sides <= 0])), np.concatenate(without_sphere)])
+    return DelaunayCheck(int(len(bad_rows)), int(inside.sum()), int(len(bad_leaves)), int((sides == 0).sum()),
+                         int(len(pair_row)), bad_leaves, elements(bad_rows), not_cells)
 
 
 def _morton_order(points: np.ndarray, low: np.ndarray, high: np.ndarray, bits: int = 10) -> np.ndarray:

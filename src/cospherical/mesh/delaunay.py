@@ -121,7 +121,7 @@ from ..core.incremental_delaunay import delaunay_tetrahedra
 from ..core.tessellation import tessellation_elements
 from ..errors import InputError
 from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, distinct, type_info
-from .checks import check_delaunay, grid_weights
+from .checks import DelaunayCheck, check_delaunay, grid_weights
 
 __all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
@@ -137,7 +137,7 @@ class NotOneCell(Exception):
     """
 
 
-def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull", proposal=None) -> Mesh:
+def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: str = "qhull", proposal=None) -> Mesh:
     """The exact Delaunay subdivision of ``mesh``'s vertices, as a :class:`Mesh` (see the module's proof).
 
     ``found``: the result of :func:`check_delaunay` on ``mesh`` when the caller has it.
@@ -152,28 +152,27 @@ def global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull"
     >>> from cospherical.mesh.octree import build_octree, parse_shape
     >>> leaf = assemble(build_octree(Box.parse([1, 2, 4]), 3, [parse_shape("point:0.1,0.1,0.1")]))
     >>> whole = global_delaunay(leaf)
-    >>> [check_delaunay(m)["delaunay_violations"] for m in (leaf, whole)], whole.cells.clusters
+    >>> [check_delaunay(m).violations for m in (leaf, whole)], whole.cells.clusters
     ([5, 0], 1)
     """
     return _global_delaunay(mesh, found, engine, proposal)[0]
 
 
-def _global_delaunay(mesh: Mesh, found: dict | None = None, engine: str = "qhull",
-                     proposal=None) -> tuple[Mesh, dict | None]:
+def _global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: str = "qhull",
+                     proposal=None) -> tuple[Mesh, DelaunayCheck | None]:
     """:func:`global_delaunay`, and :func:`check_delaunay` on the result when it ran (a cluster was re-tessellated)."""
     if engine not in ENGINES:
         raise ValueError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
     if found is None:
         found = check_delaunay(mesh)
-    elements = found["_not_cells"]
+    elements = found.not_cells
     if not len(elements):
         return mesh, None
     if mesh.cells is not None:
         raise ValueError("the mesh already holds re-tessellated cells")
     types = dict(mesh.types)
-    checked: list = []
-    cells = retessellate(mesh, elements, types, engine, proposal, checked)
-    return with_cells(mesh, _leaves_of(mesh, elements), cells, types), checked[0]
+    cells, checked = retessellate(mesh, elements, types, engine, proposal)
+    return with_cells(mesh, _leaves_of(mesh, elements), cells, types), checked
 
 
 def _leaves_of(mesh: Mesh, elements: np.ndarray) -> np.ndarray:
@@ -183,8 +182,8 @@ def _leaves_of(mesh: Mesh, elements: np.ndarray) -> np.ndarray:
     return bad
 
 
-def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "qhull", proposal=None,
-                 checked: list | None = None) -> Cells:
+def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "qhull",
+                 proposal=None) -> tuple[Cells, DelaunayCheck]:
     """The cells of the Delaunay subdivision of ``mesh``'s vertices that replace the leaves holding ``elements``.
 
     ``elements``: the leaf elements that are not cells of it (see the module's proof).
@@ -196,7 +195,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
     proposes a cluster's tetrahedra in place of Qhull (rows of point indices; a seam
     for tests).  The cells are proven before they are returned (the module's last
     part): a cluster whose cells fail is tetrahedralised again by the exact engine.
-    ``checked`` (a list) receives :func:`check_delaunay` on the mesh with the cells.
+    Returns the cells and :func:`check_delaunay` on the mesh with the cells (which proved them).
     """
     nodes = mesh.element_nodes(elements)
     part, clusters = _clusters(nodes, len(mesh.vertices))
@@ -238,9 +237,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "q
             found = check_delaunay(trial)
             failing = _failing_clusters(trial, found, vertex_cluster, wanted)
             if not failing:
-                if checked is not None:
-                    checked.append(found)
-                return cells
+                return cells, found
         if failing <= exact:  # the exact engine's cells are Delaunay by construction: a bug, not rounding
             raise RuntimeError(f"the exact engine's cells of clusters {sorted(failing)[:5]} fail the exact checks")
         for r in failing - exact:
@@ -270,7 +267,7 @@ def _sums(key: np.ndarray, values: np.ndarray, base: int):
         yield divmod(int(key[start]), base), total
 
 
-def _failing_clusters(mesh: Mesh, found: dict, vertex_cluster: np.ndarray, wanted: list) -> set[int]:
+def _failing_clusters(mesh: Mesh, found: DelaunayCheck, vertex_cluster: np.ndarray, wanted: list) -> set[int]:
     """The clusters whose re-tessellated cells are not proven cells of the Delaunay subdivision (the module's proof).
 
     A cluster fails when one of its cells is not empty or ties with a vertex, or when
@@ -284,7 +281,7 @@ def _failing_clusters(mesh: Mesh, found: dict, vertex_cluster: np.ndarray, wante
     cell_cluster[fresh] = vertex_cluster[cells.nodes[fresh, 0]]
     # check_delaunay tests only the fresh cells (the kept leaf elements and the proven cells passed it on
     # the same vertex set), so every element it finds is a fresh cell: anything else is a bug, not a cluster.
-    not_cells = found["_not_cells"] - mesh.leaf_elements  # indices among the cells
+    not_cells = found.not_cells - mesh.leaf_elements  # indices among the cells
     if np.any(cell_cluster[fresh] == _NO_CLUSTER) or np.any(not_cells < 0) \
             or np.any(cell_cluster[not_cells] == _NO_CLUSTER):
         raise RuntimeError("an element that is not a fresh cell of a cluster was found not to be a cell")
@@ -584,7 +581,8 @@ def _scaled(shape: CellShape, g: int) -> CellShape:
 MODES = ("global", "leaf")
 
 
-def delaunay_mesh(mesh: Mesh, mode: str = "global", progress=None) -> tuple[Mesh, dict | None, dict | None]:
+def delaunay_mesh(mesh: Mesh, mode: str = "global", progress=None
+                  ) -> tuple[Mesh, dict[str, int] | None, DelaunayCheck | None]:
     """The mesh a user asked for: ``leaf`` (the leaf mesh as assembled) or ``global`` (its exact Delaunay subdivision).
 
     Returns the mesh; in ``global`` mode what the exact check found on the leaf mesh
@@ -599,7 +597,6 @@ def delaunay_mesh(mesh: Mesh, mode: str = "global", progress=None) -> tuple[Mesh
     if mode == "leaf":
         return mesh, None, None
     found = check_delaunay(mesh, progress=progress)
-    leaf = {"elements": len(mesh), "delaunay_violations": found["delaunay_violations"],
-            "delaunay_ties": found["delaunay_ties"], "elements_replaced": int(len(found["_not_cells"]))}
+    leaf = found.leaf_mesh(len(mesh))
     result, checked = _global_delaunay(mesh, found)
     return result, leaf, (found if result is mesh else checked)

@@ -130,18 +130,15 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: 
         mesh = with_cells(mesh, piece.replaced, piece.cells, {**mesh.types, **piece.types})
     elif piece.mode == "global":
         found = check_delaunay(mesh)
-        result["leaf_mesh"] = {"elements": len(mesh), "delaunay_violations": found["delaunay_violations"],
-                               "delaunay_ties": found["delaunay_ties"],
-                               "elements_replaced": int(len(found["_not_cells"]))}
-        failing = found["_not_cells"]
+        result["leaf_mesh"] = found.leaf_mesh(len(mesh))
+        failing = found.not_cells
         if len(failing):
             result["marked"] = piece.leaves[distinct(mesh.element_leaf[failing])]
             result["failing"] = (piece.leaves[mesh.element_leaf[failing]], mesh.element_local[failing])
             return result
         checked = found
     seams: list = []
-    figures = mesh_figures(mesh, piece.delaunay, checked=checked, seams=seams)
-    figures.pop("_violating", None)
+    figures, _ = mesh_figures(mesh, piece.delaunay, checked=checked, seams=seams)
     result.update(figures=figures, seams=seams)
     if piece.write is not None:
         piece.write(mesh, piece.path, piece.leaves)
@@ -208,7 +205,7 @@ def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, f
     mesh = assemble(sub, lookup[0](*lookup[1]) if lookup is not None else None, criterion=criterion,
                     vertices=(grid, keys), catalogue=catalogue)
     types = dict(mesh.types)
-    cells = retessellate(mesh, mesh.element_offsets[np.searchsorted(marked, failing[0])] + failing[1], types)
+    cells, _ = retessellate(mesh, mesh.element_offsets[np.searchsorted(marked, failing[0])] + failing[1], types)
     piece_of_leaf = np.empty(len(tree), dtype=np.int64)
     for k, leaves in enumerate(parts):
         piece_of_leaf[leaves] = k

@@ -43,7 +43,7 @@ from .device import Device, DeviceLayout, device_layout, device_octree
 from .dual import Dual, dual_summary, mesh_dual
 from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape
 from .regions import RegionFaces, device_mesh, device_report, mesh_region_parts, region_faces
-from .report import MeshReport, mesh_report
+from .report import MeshReport, checked_mesh_report
 
 __all__ = ["PipelineResult", "Progress", "TreeSource", "delaunay_mode", "full_dual", "run_pipeline", "tree_from_device",
            "tree_from_leaves", "tree_from_octree", "tree_from_refine"]
@@ -200,10 +200,10 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         mesh = assemble(tree, lookup, progress=told("assembly", len(tree)), criterion=criterion)
         clock.stage("global Delaunay" if mode == "global" else None)
         mesh, leaf_mesh, checked = delaunay_mesh(mesh, mode, progress=told("regions", len(mesh)))
-    violating: list = []
-    report = mesh_report(mesh, source.described, patterns, criterion, uniform=uniform, delaunay=check_delaunay,
-                         stage=clock.stage, progress=told("delaunay", len(mesh)), violating=violating,
-                         leaf_mesh=leaf_mesh, checked=checked)
+    checked_report = checked_mesh_report(mesh, source.described, patterns, criterion, uniform=uniform,
+                                         delaunay=check_delaunay, stage=clock.stage,
+                                         progress=told("delaunay", len(mesh)), leaf_mesh=leaf_mesh, checked=checked)
+    report = checked_report.report
     found = faces = None
     if dual:
         clock.stage("dual")
@@ -217,7 +217,8 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         report["device"] = device_report(mesh, faces, found.regions if found is not None else None, found)
     clock.stage(None)
     return PipelineResult(source, mesh, MeshReport.from_dict(report, timings), found,
-                          violating[0] if violating else None, faces)
+                          checked_report.delaunay.violating_elements if checked_report.delaunay is not None else None,
+                          faces)
 
 
 def full_dual(mesh: Mesh, faces: RegionFaces | None, dual: Dual | None = None) -> Dual:

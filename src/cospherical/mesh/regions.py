@@ -34,7 +34,7 @@ from fractions import Fraction
 import numpy as np
 
 from .assembly import Cells, Lookup, Mesh, assemble, vertex_keys
-from .checks import check_conformity
+from .checks import DelaunayCheck, check_conformity
 from .delaunay import delaunay_mesh, with_cells
 from .dual import Dual, RegionParts, mesh_dual
 from .device import DeviceLayout, Regions, leaf_owner
@@ -88,8 +88,11 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
         parts.append(Cells(cells.shapes, cells.shape, cells.anchor, nodes, leaves[cells.leaf], cells.spanning,
                            cells.proven, cells.clusters, cells.largest_cluster))
     leaf = {key: sum(f[key] for f in found) for key in found[0]}
-    checked = {key: (sum(c[key] for c in checks) if not key.startswith("_") else np.zeros(0, dtype=np.int64))
-               for key in checks[0]}
+    # the boxes' counts add up; their element indices are the boxes' own, so none is kept
+    none = np.zeros(0, dtype=np.int64)
+    checked = DelaunayCheck(*(sum(getattr(c, name) for c in checks)
+                              for name in ("violations", "violating_pairs", "violating_leaves", "ties", "exact_tests")),
+                            none, none, none)
     if not parts:
         return mesh, leaf, checked
     merged = _merged(parts)

@@ -18,11 +18,12 @@ import numpy as np
 
 from ..version import __version__
 from .assembly import Mesh
-from .checks import check_circumcenters, check_conformity, check_delaunay, check_volume, match_seams
+from .checks import DelaunayCheck, check_circumcenters, check_conformity, check_delaunay, check_volume, match_seams
 from .octree import Octree
 from .statistics import level_counts, occurrences, statistics, uniform_study
 
-__all__ = ["MeshReport", "merged_report", "mesh_figures", "mesh_report", "outside_catalogue"]
+__all__ = ["CheckedReport", "MeshReport", "checked_mesh_report", "merged_report", "mesh_figures", "mesh_report",
+           "outside_catalogue"]
 
 # Figures of the pieces that the whole's report adds up.
 _SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_faces", "circumcenters_outside_leaf",
@@ -52,13 +53,13 @@ def outside_catalogue(mesh: Mesh) -> list[dict]:
 
 
 def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None] | None = None,
-                 progress: Callable[[int], None] | None = None, checked: dict | None = None,
-                 seams: list | None = None) -> dict:
-    """Every exact check and count of ``mesh`` (or of one piece of a partitioned mesh), as figures that add up.
+                 progress: Callable[[int], None] | None = None, checked: DelaunayCheck | None = None,
+                 seams: list | None = None) -> tuple[dict, DelaunayCheck | None]:
+    """Every exact check and count of ``mesh`` (or of one piece of a partitioned mesh), as figures that add up,
+    and the global Delaunay check (``checked`` when the caller has it; ``None`` when ``delaunay`` is false).
 
     ``seams``, a list, receives the faces a piece leaves open (see
-    :func:`~cospherical.mesh.checks.check_conformity`).  The figures hold
-    ``_violating``: the elements whose sphere strictly holds a vertex (an array).
+    :func:`~cospherical.mesh.checks.check_conformity`).
     """
     def start(name: str) -> None:
         if stage:
@@ -73,15 +74,14 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
     figures.update(check_conformity(mesh, seams=seams))
     start("circumcenters")
     figures.update(check_circumcenters(mesh))
+    found = None
     if delaunay:
         start("delaunay")
-        found = dict(checked) if checked is not None else check_delaunay(mesh, progress=progress)
-        bad_leaves = found.pop("_leaves")
-        figures["_violating"] = found.pop("_elements")
-        found.pop("_not_cells")
-        figures.update(found)
+        found = checked if checked is not None else check_delaunay(mesh, progress=progress)
+        figures.update(found.figures())
         # the point of counting them: a leaf can be fvm_adequate on its own and still not globally Delaunay
-        fvm = np.array([p.fvm_adequate for p in mesh.tessellations], dtype=bool)[mesh.leaf_tessellation[bad_leaves]]
+        fvm = np.array([p.fvm_adequate for p in mesh.tessellations],
+                       dtype=bool)[mesh.leaf_tessellation[found.violating_leaf_ids]]
         figures["delaunay_violating_fvm_leaves"] = int(fvm.sum())
     start("statistics")
     figures["type_counts"], figures["configurations"] = occurrences(mesh)
@@ -90,7 +90,7 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
     figures["leaves_tessellated_on_the_fly"] = int(sum(
         len(leaves) for _, p, leaves in mesh.groups(all_leaves=True) if p.on_the_fly))
     figures["types"] = dict(mesh.types)
-    return figures
+    return figures, found
 
 
 def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dict, patterns: str | None,
@@ -174,10 +174,27 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
     return report
 
 
+@dataclass(frozen=True)
+class CheckedReport:
+    """A mesh's report and the global Delaunay check behind it.
+
+    Attributes
+    ----------
+    report : dict
+        The report (the keys of ``schemas/mesh-report.schema.json``, as :func:`mesh_report` gives it).
+    delaunay : DelaunayCheck or None
+        What the exact global Delaunay check found (its elements give the ``delaunay_ok`` cell
+        data); ``None`` when the check was skipped.
+    """
+
+    report: dict
+    delaunay: DelaunayCheck | None
+
+
 def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal", uniform: bool = True,
                 delaunay: bool = True, stage: Callable[[str], None] | None = None,
-                progress: Callable[[int], None] | None = None, violating: list | None = None,
-                leaf_mesh: dict | None = None, checked: dict | None = None) -> dict:
+                progress: Callable[[int], None] | None = None,
+                leaf_mesh: dict | None = None, checked: DelaunayCheck | None = None) -> dict:
     """Run every check on ``mesh`` and gather the report (the keys of ``schemas/mesh-report.schema.json``).
 
     ``tree`` describes where the octree came from; ``patterns`` names the table read
@@ -185,8 +202,7 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     bisection study of the box beside the mesh's frequencies; ``delaunay=False``
     skips the global Delaunay check (``delaunay_violations`` is then ``null``);
     ``stage(name)`` is told as each check starts, ``progress(n)`` as the Delaunay check
-    goes through the elements; ``violating``, a list, receives the array of the elements
-    whose sphere strictly holds a vertex (for the ``delaunay_ok`` cell data).
+    goes through the elements (:func:`checked_mesh_report` gives the check too).
     ``leaf_mesh``: what :func:`~cospherical.mesh.delaunay.delaunay_mesh` found on the
     leaf mesh when ``mesh`` is its global Delaunay subdivision (``delaunay_mode`` is
     then ``global``, else ``leaf``); ``checked``: the result of
@@ -202,12 +218,20 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
     >>> [report[k] for k in ("leaves", "elements", "volume_ok", "nonconforming_faces", "delaunay_violations")]
     [15, 48, True, 0, 0]
     """
-    figures = mesh_figures(mesh, delaunay, stage, progress, checked)
-    if violating is not None and delaunay:
-        violating.append(figures["_violating"])
+    return checked_mesh_report(mesh, tree, patterns, criterion, uniform, delaunay, stage, progress, leaf_mesh,
+                               checked).report
+
+
+def checked_mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal",
+                        uniform: bool = True, delaunay: bool = True, stage: Callable[[str], None] | None = None,
+                        progress: Callable[[int], None] | None = None, leaf_mesh: dict | None = None,
+                        checked: DelaunayCheck | None = None) -> CheckedReport:
+    """:func:`mesh_report` (the same arguments), and the global Delaunay check it ran or was given."""
+    figures, found = mesh_figures(mesh, delaunay, stage, progress, checked)
     cells = (mesh.cells.clusters, mesh.cells.largest_cluster) if mesh.cells is not None else (0, 0)
-    return merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
-                         leaf_mesh, cells, catalogue=mesh.catalogue, domain_share=mesh.domain_share)
+    report = merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
+                           leaf_mesh, cells, catalogue=mesh.catalogue, domain_share=mesh.domain_share)
+    return CheckedReport(report, found)
 
 
 # The report's keys that are left out, rather than written as null, when they were not computed:
