@@ -44,6 +44,7 @@ SMALLER = [
     (re.compile(r"^(python examples/poisson.py).*"), r"\1 --uniform 2 3 --graded 4"),
     (re.compile(r"^(python examples/devsim/laplace.py).*"), r"\1 --levels 3 3"),
     (re.compile(r"^(python examples/devsim/diode.py).*"), r"\1 --levels 2 --biases 0.1 --step 0.1"),
+    (re.compile(r"^(python examples/devsim/moscap.py).*"), r"\1 --levels 3"),
     (re.compile(r"^(python benchmarks/bench_dual.py --poisson).*"), r"\1 --uniform 2 --graded 4"),
     (re.compile(r"^(python benchmarks/bench_dual.py)(?! --poisson)"), r"\1 --levels 4"),
 ]

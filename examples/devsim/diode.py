@@ -140,12 +140,73 @@ def octree_currents(devsim, level: int, biases, step: float = 0.05) -> dict:
     return result
 
 
+def gmsh_box(fine: float, coarse: float = 0.25, width: float = 0.1):
+    """Gmsh's tetrahedral mesh of the unit cube, size ``fine`` within ``width`` of the junction plane, ``coarse``
+    elsewhere: (points, tetrahedra, triangles of the sides x = 0 and x = 1 with their side 0 or 1)."""
+    import gmsh
+
+    gmsh.initialize(readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)  # one thread: the same mesh every run
+        gmsh.model.add("diode")
+        gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+        gmsh.model.occ.synchronize()
+        field = gmsh.model.mesh.field.add("Box")
+        for key, value in (("VIn", fine), ("VOut", coarse), ("XMin", 0.5 - width), ("XMax", 0.5 + width),
+                           ("YMin", -1), ("YMax", 2), ("ZMin", -1), ("ZMax", 2), ("Thickness", 0.3)):
+            gmsh.model.mesh.field.setNumber(field, key, value)
+        gmsh.model.mesh.field.setAsBackgroundMesh(field)
+        for option in ("Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromPoints", "Mesh.MeshSizeFromCurvature"):
+            gmsh.option.setNumber(option, 0)
+        gmsh.model.mesh.generate(3)
+        tags, coords, _ = gmsh.model.mesh.getNodes()
+        index = np.zeros(int(tags.max()) + 1, dtype=np.int64)
+        index[tags.astype(np.int64)] = np.arange(len(tags))
+        _, _, nodes = gmsh.model.mesh.getElements(3)
+        tets = index[np.asarray(nodes[0], dtype=np.int64)].reshape(-1, 4)
+        sides = []
+        for end, x in enumerate((0.0, 1.0)):
+            for _, tag in gmsh.model.getEntitiesInBoundingBox(x - 1e-6, -1, -1, x + 1e-6, 2, 2, dim=2):
+                _, _, nodes = gmsh.model.mesh.getElements(2, tag)
+                triangles = index[np.asarray(nodes[0], dtype=np.int64)].reshape(-1, 3)
+                sides.append((triangles, np.full(len(triangles), end)))
+        return (np.asarray(coords).reshape(-1, 3), tets, np.concatenate([t for t, _ in sides]),
+                np.concatenate([e for _, e in sides]))
+    finally:
+        gmsh.finalize()
+
+
+def gmsh_currents(devsim, fine: float, biases, step: float = 0.05) -> dict:
+    """The anode current on Gmsh's mesh of the cube (DEVSIM's own geometry: a Gmsh mesh has no exact dual)."""
+    points, tets, triangles, side = gmsh_box(fine)
+    name = f"diode-gmsh-{fine:g}"
+    elements = np.concatenate([np.column_stack([np.full(len(triangles), 2), 1 + side, triangles]).reshape(-1),
+                               np.column_stack([np.full(len(tets), 3), np.zeros(len(tets), dtype=np.int64),
+                                                tets]).reshape(-1)])
+    quiet(devsim.create_gmsh_mesh, mesh=name, coordinates=(points * UM).reshape(-1).tolist(),
+          physical_names=["domain", "xmin", "xmax"], elements=elements.astype(np.int64).tolist())
+    quiet(devsim.add_gmsh_region, gmsh_name="domain", mesh=name, region="domain", material="Silicon")
+    for contact in ("xmin", "xmax"):
+        quiet(devsim.add_gmsh_contact, gmsh_name=contact, mesh=name, name=contact, region="domain", material="metal")
+    quiet(devsim.finalize_mesh, mesh=name)
+    quiet(devsim.create_device, mesh=name, device=name)
+    quiet(physics, devsim, name, "domain")
+    result = {"fine": fine, "nodes": len(points), "devsim": sweep(devsim, name, "xmin", biases, step)}
+    devsim.delete_device(device=name)
+    devsim.delete_mesh(mesh=name)
+    return result
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--levels", nargs="+", type=int, default=[3, 4], help="octree levels of the meshes")
+    parser.add_argument("--levels", nargs="*", type=int, default=[3, 4], help="octree levels of the meshes")
     parser.add_argument("--biases", nargs="+", type=float, default=[round(0.05 * k, 2) for k in range(1, 15)],
                         help="forward biases (V), increasing")
     parser.add_argument("--step", type=float, default=0.05, help="largest bias step of the ramp (V)")
+    parser.add_argument("--gmsh", nargs="*", type=float, default=[], metavar="SIZE",
+                        help="also Gmsh meshes of the cube, of these element sizes (um) near the junction (0.25 "
+                        "elsewhere), solved with DEVSIM's own geometry")
     parser.add_argument("--plot", metavar="FILE", help="write the curves and errors as a PNG")
     args = parser.parse_args(argv)
     devsim = import_devsim()
@@ -154,11 +215,15 @@ def main(argv=None) -> int:
     area = UM * UM
     exact_current = reference(devsim, biases, step=args.step) * area
     rows = [octree_currents(devsim, level, biases, args.step) for level in args.levels]
+    meshed = [gmsh_currents(devsim, size, biases, args.step) for size in args.gmsh]
     print(f"anode current at {biases[-1]:g} V: 1D reference {exact_current[-1]:.6e} A")
-    print(f"{'level':>5} {'nodes':>6} {'exact dual':>11} {'DEVSIM geometry':>16}")
+    print(f"{'mesh':>14} {'nodes':>6} {'exact dual':>11} {'DEVSIM geometry':>16}")
     for r in rows:
         errors = [(r[g][-1] - exact_current[-1]) / exact_current[-1] for g in GEOMETRIES]
-        print(f"{r['level']:>5} {r['nodes']:>6} {errors[0]:>+10.2%} {errors[1]:>+15.2%}")
+        print(f"{'octree L' + str(r['level']):>14} {r['nodes']:>6} {errors[0]:>+10.2%} {errors[1]:>+15.2%}")
+    for r in meshed:
+        error = (r["devsim"][-1] - exact_current[-1]) / exact_current[-1]
+        print(f"{'Gmsh ' + format(r['fine'], 'g'):>14} {r['nodes']:>6} {'-':>11} {error:>+15.2%}")
     if args.plot:
         import matplotlib
 
@@ -172,6 +237,10 @@ def main(argv=None) -> int:
                 label = f"L{r['level']} ({r['nodes']} nodes), {'exact dual' if geometry == 'exact' else 'DEVSIM geometry'}"
                 curves.semilogy(biases, r[geometry], style, ms=3, label=label)
                 errors.plot(biases, 100 * (r[geometry] - exact_current) / exact_current, style, ms=3, label=label)
+        for r in meshed:
+            label = f"Gmsh {r['fine']:g} um ({r['nodes']} nodes), DEVSIM geometry"
+            curves.semilogy(biases, r["devsim"], ":s", ms=3, label=label)
+            errors.plot(biases, 100 * (r["devsim"] - exact_current) / exact_current, ":s", ms=3, label=label)
         curves.set(xlabel="anode bias (V)", ylabel="anode current (A)", title="3D pn diode, 1 um cube")
         errors.set(xlabel="anode bias (V)", ylabel="relative error (%)", title="against the 1D reference")
         errors.axhline(0, color="k", lw=0.5)
