@@ -552,11 +552,19 @@ def test_sigkill_of_an_intersection_study_leaves_no_process(tmp_path):
             os.kill(pid, signal.SIGKILL)
 
 
-def test_stale_temporaries_of_our_naming_are_removed(tmp_path, capsys):
+def test_stale_temporaries_of_killed_runs_are_removed(tmp_path, capsys):
+    from cospherical.files.outputs import _new_temporary
+
     out = tmp_path / "out"
     out.mkdir()
-    stale = [out / ".bisection-1x2x4.json.k3j_x9a2.tmp", out / ".bisection-1x2x4.yaml.abcdefgh.tmp"]
-    foreign = [out / ".other.txt.abcdefgh.tmp", out / "notes.tmp", out / ".bisection-1x2x4.json.tmp"]
+    stale = []
+    for name in ("bisection-1x2x4.json", "bisection-1x2x4.yaml"):  # what a killed run leaves: its marked files
+        fd, path = _new_temporary(out / name)
+        os.close(fd)
+        stale.append(path)
+    # named like temporary files, but the user's: a name alone never gets a file removed
+    foreign = [out / ".other.txt.abcdefgh.tmp", out / "notes.tmp", out / ".bisection-1x2x4.json.tmp",
+               out / ".bisection-1x2x4.json.k3j_x9a2.tmp", out / ".bisection-1x2x4.yaml.1-2.tmp"]
     for path in stale + foreign:
         path.write_text("x")
     assert main(["study", "bisection", "--box", "1", "2", "4", "--out", str(out)]) == 0

@@ -2,9 +2,11 @@
 every option's help, the collector frozen only as the process's command, the scheduler option's warning, a
 signal ending the run as signalled whatever a library makes of it."""
 
+import re
 import signal
 import sys
 import time
+from pathlib import Path
 
 import pytest
 from commands import cospherical
@@ -191,6 +193,28 @@ def test_an_error_line_names_a_hostile_path_or_value_on_one_printable_line(tmp_p
     assert len(lines) == 1 and captured.err.endswith("\n"), captured.err
     assert lines[0].isprintable() and len(lines[0]) < 300, lines[0]
     assert "\\x1b[2J" in lines[0] or "..." in lines[0], lines[0]  # named, escaped (or cut before it)
+
+
+def test_a_result_line_names_a_hostile_path_on_one_printable_line(tmp_path, capsys):
+    # stdout too: check's "ok" line, render's "wrote" line and diff's file names name a path as
+    # written, escaped; a newline in it must not forge a line ("fake: ok"), an ESC not reach the terminal
+    from cospherical.cli import main
+
+    folder = tmp_path / HOSTILE_NAME
+    folder.mkdir()
+    catalogue = (Path(__file__).resolve().parents[2] / "catalogue" / "catalogue.yaml").read_text()
+    old, new = folder / "old.yaml", folder / "new.yaml"
+    old.write_text(catalogue)
+    new.write_text(re.sub(r"(?m)^version: .*$", "version: abcdef012345", catalogue, count=1))
+    summary = Path(__file__).resolve().parents[2] / "results" / "bisection-1x1x1.json"
+    for argv, status in ((["check", old], 0), (["diff", old, new], 1),
+                         (["render", "--summary", summary, "--out", folder / "tables"], 0)):
+        assert main([str(word) for word in argv]) == status
+        out = capsys.readouterr().out
+        lines = out.splitlines()  # every kind of line break: NEL, LS and PS too
+        assert lines and out.endswith("\n") and all(line.isprintable() for line in lines), out
+        assert not any(line.startswith("fake: ok") for line in lines), out
+        assert "out\\nfake: ok\\r\\x1b[2J" in lines[0], lines[0]
 
 
 def test_an_os_error_names_its_file_on_one_printable_line(capsys, monkeypatch):

@@ -168,3 +168,45 @@ def test_a_folder_of_the_users_named_like_a_staging_folder_is_never_removed(tmp_
     for name, text in users.items():
         assert (out / name / "data.txt").read_text() == text, name
     assert (out / ".cospherical-staging.link").is_symlink() and stale.is_dir()
+
+
+def test_only_a_killed_runs_own_temporary_files_are_removed(tmp_path):
+    # a temporary file proves itself by its name: its own device and inode; a name alone proves nothing
+    from cospherical.files.outputs import _new_temporary, atomic_write
+
+    target = tmp_path / "report.json"
+
+    def killed_run() -> Path:
+        fd, tmp = _new_temporary(target)
+        tmp.write_text("half")
+        os.close(fd)  # the process died: its lock is gone, its file stays
+        return tmp
+
+    stale = killed_run()
+    assert re.fullmatch(r"\.report\.json\.[0-9a-f]+-[0-9a-f]+\.tmp", stale.name)
+    users = {}
+    for name in (".report.json.abcd1234.tmp", ".report.json.k3j_x9a2.tmp", ".report.json.0-0.tmp"):
+        users[name] = name  # named like a temporary file (by hand, or as an earlier version named them)
+    folder = os.stat(tmp_path)
+    users[f".report.json.{folder.st_dev:x}-{folder.st_ino:x}.tmp"] = "another file's identity"
+    for name, text in users.items():
+        (tmp_path / name).write_text(text)
+    restored = killed_run()  # a killed run's file copied back from a backup: another inode
+    shutil.copy(restored, tmp_path / "backup")
+    os.replace(tmp_path / "backup", restored)
+    users[restored.name] = "half"
+    linked = killed_run()  # a link named after the file it points to is not that file
+    moved = tmp_path / "target-of-link"
+    os.replace(linked, moved)
+    linked.symlink_to(moved)
+    fd, live = _new_temporary(target)  # a concurrent run, still writing
+    try:
+        atomic_write(target, "{}")
+        assert not stale.exists()
+        assert live.exists()
+        for name, text in users.items():
+            assert (tmp_path / name).read_text() == text, name
+        assert linked.is_symlink() and moved.read_text() == "half"
+    finally:
+        os.close(fd)
+    assert target.read_text() == "{}"

@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import filecmp
+import os
 from pathlib import Path
+
+from cospherical.files.outputs import _new_temporary
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -24,7 +27,9 @@ def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypat
     (root / "catalogue" / "catalogue.yaml").write_text("types: [unclosed\n")
     (root / "results").mkdir()
     (root / "results" / "summary.md").write_text("stale")
-    (root / "results" / ".summary.md.abcd1234.tmp").write_text("left by a killed run")
+    fd, stale = _new_temporary(root / "results" / "summary.md")
+    stale.write_text("left by a killed run")
+    os.close(fd)
     try:
         assert main(["reproduce", "--root", str(root)]) == 0, capsys.readouterr().err
     finally:

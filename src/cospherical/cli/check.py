@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..catalogue import catalogue_path, load_catalogue
 from ..formats.check import check_catalogue, check_patterns, read_document_file
-from .output import path_argument
+from .output import path_argument, say
 
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -43,14 +43,14 @@ def run(args) -> int:
         kind, document = read_document_file(path)
         if kind == "catalogue":
             check_catalogue(document, str(path))
-            print(f"{path}: ok, catalogue of {len(document['types'])} element types")
+            say(f"{path}: ok, catalogue of {len(document['types'])} element types")
             continue
         if catalogue is None:
             catalogue_file = args.catalogue or catalogue_path()
             catalogue = load_catalogue(catalogue_file)
             check_catalogue(catalogue, str(catalogue_file))
         check_patterns(document, catalogue, str(path), tiling=not args.no_tiling)
-        print(f"{path}: ok, pattern table of {len(document.configurations)} configurations")
+        say(f"{path}: ok, pattern table of {len(document.configurations)} configurations")
     return 0
 
 
@@ -61,15 +61,22 @@ def _check_dual(path: Path) -> None:
     dual = read_dual(path)
     total = dual.volume_sum()
     if total != 1:
-        raise FormatError(f"{path}: the control volumes sum to {total} of the domain, not 1")
+        raise FormatError(f"{path}: the control volumes sum to {_cut(total)} of the domain, not 1")
     sides = dual.boundary_area_sums()
     if sides != (2, 2, 2):
-        raise FormatError(f"{path}: the boundary areas sum to {', '.join(map(str, sides))} sides normal to x, y, z, "
+        raise FormatError(f"{path}: the boundary areas sum to {', '.join(map(_cut, sides))} sides normal to x, y, z, "
                           "not 2 each")
     verify_dual(dual, path)  # a re-signed change that keeps the sums: every value computed again
     negative = dual.negative_coefficients()
-    print(f"{path}: ok, dual of {len(dual.vertices)} vertices and {len(dual.edges)} edges, every value equal to "
+    say(f"{path}: ok, dual of {len(dual.vertices)} vertices and {len(dual.edges)} edges, every value equal to "
           f"its elements' exactly, its elements a mesh of the domain (every face shared by two in opposite "
           f"orientations or in the boundary), control volumes sum to the domain and boundary areas to its surface, "
           f"{negative['interior']} interior and "
           f"{negative['boundary']} boundary negative coefficients")
+
+
+def _cut(value, most: int = 40) -> str:
+    """An exact sum as an error line names it: its text, cut after ``most`` characters (a forged
+    denominator of a thousand digits is named, not echoed)."""
+    text = str(value)
+    return text if len(text) <= most else text[:most] + "..."

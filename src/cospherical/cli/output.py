@@ -7,10 +7,11 @@ import functools
 import sys
 from pathlib import Path
 
+from ..errors import one_line
 from ..files.jsontext import dump, to_json
 from ..files.outputs import FolderLock
 
-__all__ = ["FACE_POINTS_HELP", "FORMATS", "dump", "emit", "holding_out", "path_argument", "to_json"]
+__all__ = ["FACE_POINTS_HELP", "FORMATS", "dump", "emit", "holding_out", "path_argument", "say", "to_json"]
 
 FORMATS = ("json", "yaml")
 FACE_POINTS_HELP = "octree (default): add face and body points of refined neighbours; none: corners and edge points only"
@@ -26,6 +27,17 @@ def path_argument(text: str) -> Path:
 
 def emit(data, fmt: str) -> None:
     sys.stdout.write(dump(data, fmt))
+
+
+def say(line: str) -> None:
+    """Write one line of a command's result on stdout as a terminal shows it as written
+    (:func:`~cospherical.errors.one_line`).
+
+    A result line names paths and values from outside (a file name may hold a newline
+    or an ESC sequence): printed raw, one would forge a line of the result (``x: ok``),
+    the other would drive the terminal.
+    """
+    sys.stdout.write(one_line(line) + "\n")
 
 
 def holding_out(run):

@@ -14,7 +14,7 @@ from ..files.yamlio import load_yaml, validate
 from ..outputs.latex import render_tables
 from ..studies.engine import bisection_codes, run_study
 from ..studies.summary import study_summary
-from .output import FACE_POINTS_HELP, path_argument
+from .output import FACE_POINTS_HELP, path_argument, say
 from .progress import progress_bar
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -99,9 +99,9 @@ def run(args) -> int:
         catalogue = shipped_catalogue()
     written = render_tables(summaries, catalogue, args.out, "Delaunay tessellations of 1-irregular elements",
                             pdf=args.pdf)
-    print(f"wrote {len(written)} files in {args.out}")
+    say(f"wrote {len(written)} files in {args.out}")
     if args.pdf:
-        print(f"wrote {args.out / 'document.pdf'}")
+        say(f"wrote {args.out / 'document.pdf'}")
     elif (args.out / "document.pdf").exists():
         # an earlier render's PDF went with the manifest's leave; one still here is not ours to remove, and
         # it does not show these tables

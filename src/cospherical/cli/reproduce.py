@@ -7,7 +7,7 @@ from pathlib import Path
 from ..outputs.reproduce import reproduce
 from ..studies.reproduce import paper_studies_total
 from .progress import progress_bar
-from .output import path_argument
+from .output import path_argument, say
 
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -27,5 +27,5 @@ def add_arguments(parser) -> None:
 def run(args) -> int:
     with progress_bar(paper_studies_total(), "reproduce") as advance:
         message = reproduce(args.root, progress=advance)
-    print(message)
+    say(message)
     return 0

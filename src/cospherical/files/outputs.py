@@ -79,31 +79,72 @@ def refuse_special(path: Path) -> None:
         raise InputError(f"{_user_path(path)}: exists and is {kind}, not a regular file: not replacing it")
 
 
-def _remove_stale_temporaries(path: Path) -> None:
-    """Remove ``.NAME.XXXXXXXX.tmp`` files of earlier runs that were killed (SIGKILL, power loss).
+def _temporary_name(path: Path, identity: os.stat_result) -> str:
+    """The name of ``path``'s temporary file: ``.NAME.DEV-INO.tmp``, its own device and inode (hexadecimal).
 
-    A live writer holds an exclusive lock on its temporary file, so a file whose
-    lock can be taken belongs to a dead process: removing it never disturbs a
-    concurrent run.
+    The name is the file's mark: a later run removes a temporary file left by a killed
+    one only when the name states the very file it is on (see
+    :func:`_remove_stale_temporaries`).  A file the user made, copied or unpacked under
+    such a name is another inode and is never removed.
+    """
+    return f".{path.name}.{identity.st_dev:x}-{identity.st_ino:x}.tmp"
+
+
+def _remove_stale_temporaries(path: Path) -> None:
+    """Remove the temporary files of ``path`` that earlier runs left when they were killed (SIGKILL, power loss).
+
+    A temporary file is removed only when it proves itself one: a regular file of
+    this user, its name stating its own device and inode (:func:`_temporary_name`),
+    and its lock free.  A live writer holds an exclusive lock on its temporary file,
+    so a file whose lock can be taken belongs to a dead process: removing it never
+    disturbs a concurrent run.  A name alone proves nothing: a user's file named like
+    one stays.
     """
     prefix = f".{path.name}."
     try:
         candidates = [p for p in path.parent.iterdir() if p.name.startswith(prefix) and p.name.endswith(".tmp")
-                      and re.fullmatch(r"[a-z0-9_]{8}", p.name[len(prefix):-4])]
+                      and re.fullmatch(r"[0-9a-f]{1,16}-[0-9a-f]{1,16}", p.name[len(prefix):-4])]
     except OSError:
         return
     for candidate in candidates:
         try:
-            fd = os.open(candidate, os.O_RDONLY | os.O_NOFOLLOW)
+            fd = os.open(candidate, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
         except OSError:
             continue
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            candidate.unlink(missing_ok=True)
+            identity = os.fstat(fd)
+            if stat.S_ISREG(identity.st_mode) and identity.st_uid == os.getuid() and \
+                    candidate.name == _temporary_name(path, identity):
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                candidate.unlink(missing_ok=True)
         except OSError:
             pass  # locked: a live writer
         finally:
             os.close(fd)
+
+
+def _new_temporary(path: Path) -> tuple[int, Path]:
+    """A new temporary file beside ``path``, locked, under its marked name (:func:`_temporary_name`).
+
+    ``mkstemp`` makes it under a random name; it is then linked under the name that
+    states its identity (a link never replaces an existing file) and the random name
+    removed.  A run killed between the two leaves an empty file under the random
+    name, which no later run removes: only a marked name is ever removed.
+    """
+    fd, first = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".new", dir=path.parent)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)  # held until the rename: marks the file as live
+        marked = path.parent / _temporary_name(path, os.fstat(fd))
+        try:
+            os.link(first, marked)
+        except OSError:  # a name too long, or taken: the file stays under its random name, never removed by a run
+            return fd, Path(first)
+        os.unlink(first)
+    except BaseException:
+        os.close(fd)
+        Path(first).unlink(missing_ok=True)
+        raise
+    return fd, marked
 
 
 def _umask() -> int:
@@ -126,11 +167,10 @@ def atomic_path(path: str | Path):
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         _remove_stale_temporaries(path)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        fd, tmp = _new_temporary(path)
     except OSError as error:
         raise _output_error(path, error) from None
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX)  # held until the rename: marks the file as live
         try:
             yield Path(tmp)
             refuse_special(path)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections import Counter
 
-from ..errors import FormatError
+from ..errors import FormatError, one_line
 from .patterns import Entries, entry_elements
 
 __all__ = ["diff_catalogues", "diff_documents", "diff_patterns", "document_kind", "text_report"]
@@ -132,7 +132,9 @@ def has_changes(report: dict) -> bool:
 
 
 def text_report(report: dict, old_name: str, new_name: str) -> str:
-    """Human-readable diff; empty when nothing changed."""
+    """Human-readable diff; empty when nothing changed.  Each line as a terminal shows it as written
+    (:func:`~cospherical.errors.one_line`): the file names and the names from the files are data, and a
+    newline or an ESC sequence in one must neither forge a line nor drive the terminal."""
     if not has_changes(report):
         return ""
     lines = [f"--- {old_name}", f"+++ {new_name}"]
@@ -167,4 +169,4 @@ def text_report(report: dict, old_name: str, new_name: str) -> str:
                 note = {"types": "", "nodes": " (same types, other nodes)",
                         "circumcenters": " (same elements, other circumcenters)"}[entry["what"]]
                 lines.append(f"~ {entry['code']} [{criterion}]{note}: {', '.join(entry['old'])} -> {', '.join(entry['new'])}")
-    return "\n".join(lines) + "\n"
+    return "".join(one_line(line) + "\n" for line in lines)

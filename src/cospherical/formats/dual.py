@@ -374,7 +374,7 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
         if not pattern.fullmatch(manifest[key]):
             raise FormatError(f"{path}: manifest: {key} is not a positive integer or fraction of at most 1000 digits")
     if not 0 < manifest["grid"] <= _MAX_GRID:
-        raise FormatError(f"{path}: manifest: grid {manifest['grid']} is not in 1..{_MAX_GRID}")
+        raise FormatError(f"{path}: manifest: grid {shown(manifest['grid'])} is not in 1..{_MAX_GRID}")
     try:
         box = Box.parse(manifest["domain"])
         grid = int(manifest["grid"])
