@@ -7,6 +7,7 @@ import os
 import sys
 
 from ..catalogue import shipped_catalogue
+from ..choices import INSERTION_ORDERS
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..errors import UsageError, one_line
@@ -14,7 +15,6 @@ from ..files.yamlio import atomic_write
 from ..outputs.report import text_report
 from ..paper import paper_comparison, paper_study_key
 from ..studies.engine import bisection_codes, run_study
-from ..studies.insertion import INSERTION_ORDERS
 from ..studies.leaves import leaf_codes, run_leaves
 from ..studies.summary import compared_with, study_summary
 from .output import FACE_POINTS_HELP, dump, emit, holding_out, path_argument

@@ -22,6 +22,7 @@ from functools import cached_property
 from typing import Sequence
 
 from ..caches import cached
+from ..choices import DelaunayBackend, OrbitBackend, PointPolicy
 from .configuration import Box, Configuration
 from .shapes import ELEMENTS, Shape, standard_shape
 from .symmetry import Symmetry, orbit_representatives, shape_symmetries
@@ -39,7 +40,7 @@ class BaseElement:
 
     name: str
     box: Box
-    face_points: str = "octree"
+    face_points: PointPolicy = "octree"
 
     @cached_property
     def shape(self) -> Shape:
@@ -59,19 +60,19 @@ class BaseElement:
         """The isometries of the element in its box, identity first."""
         return shape_symmetries(self.shape)
 
-    def orbit_representatives(self, codes: Sequence[str], backend: str = "python") -> tuple[list[str], list[int]]:
+    def orbit_representatives(self, codes: Sequence[str], backend: OrbitBackend = "python") -> tuple[list[str], list[int]]:
         """For each code, its orbit's representative (the smallest image) and the index in
         :attr:`symmetries` of a symmetry taking the code to it (``backend``: the cube's fast
         path, as in :func:`~cospherical.core.symmetry.orbit_representatives`)."""
         return orbit_representatives(codes, self.symmetries, backend)
 
-    def tessellate(self, configuration: Configuration, backend: str = "python") -> Tessellation:
+    def tessellate(self, configuration: Configuration, backend: DelaunayBackend = "python") -> Tessellation:
         """The Delaunay tessellation of one of this element's configurations (``backend``: the
         Delaunay walk's, as in :func:`~cospherical.core.tessellation.tessellate`)."""
         return tessellate(configuration, backend)
 
 @cached(maxsize=64)  # a study maps every member's configuration through it
-def base_element(name: str, box: Box, face_points: str = "octree") -> BaseElement:
+def base_element(name: str, box: Box, face_points: PointPolicy = "octree") -> BaseElement:
     """The :class:`BaseElement` named ``name`` in ``box`` (one object per element, box and policy)."""
     element = BaseElement(name, box, face_points)
     element.shape  # a name that is no standard shape is refused here, not at first use

@@ -15,6 +15,7 @@ from fractions import Fraction
 from functools import cached_property
 from typing import Iterable, Mapping, Sequence, cast
 
+from ..choices import FACE_POINT_SOURCES, POINT_POLICIES, FacePointSource
 from ..errors import InputError, shown
 from .codes import digit_parameters, edge_code_pattern, parameter_digits, parse_point_suffix, point_suffix
 from .exact import parse_rational
@@ -24,8 +25,6 @@ from .shapes import Box, Point, Shape, standard_shape
 # Box: the type of a configuration's box (Configuration.box), public here with the class that takes it
 __all__ = ["Box", "Configuration", "FACE_POINT_SOURCES", "POINT_POLICIES", "steiner_parameters"]
 
-POINT_POLICIES = ("octree", "none")
-FACE_POINT_SOURCES = (*POINT_POLICIES, "explicit")
 
 
 def steiner_parameters(steiner: Mapping[object, object] | Iterable[tuple[object, object]] | None, edges: int = 12,
@@ -130,7 +129,7 @@ class Configuration:
 
     shape: Shape
     steiner: tuple[Fraction | None, ...]
-    face_points: str = "octree"
+    face_points: FacePointSource = "octree"
     faces: frozenset[int] | None = None
     body: bool = False
 
@@ -165,7 +164,7 @@ class Configuration:
         cls,
         box: Box | Iterable[str | int | Fraction] | None = None,
         steiner: Mapping[object, object] | Iterable[tuple[object, object]] | None = None,
-        face_points: str = "octree",
+        face_points: FacePointSource = "octree",
         faces: Iterable[object] | None = None,
         body: bool = False,
         shape: Shape | None = None,
@@ -184,7 +183,7 @@ class Configuration:
         cls,
         code: str,
         box: Box | Iterable[str | int | Fraction] | None = None,
-        face_points: str = "octree",
+        face_points: FacePointSource = "octree",
         faces: Iterable[object] | None = None,
         body: bool = False,
         shape: Shape | None = None,
@@ -218,7 +217,7 @@ class Configuration:
         return cls._build(shape, params, face_points, faces, body)
 
     @classmethod
-    def _build(cls, shape: Shape, params: tuple[Fraction | None, ...], face_points: str,
+    def _build(cls, shape: Shape, params: tuple[Fraction | None, ...], face_points: FacePointSource,
                faces: Iterable[object] | None, body: bool) -> "Configuration":
         if faces is not None or body:  # __post_init__ checks and normalises the faces
             return cls(shape, params, "explicit", cast("frozenset[int]", tuple(faces or ())), body)

@@ -19,6 +19,7 @@ from functools import cmp_to_key
 from itertools import combinations
 from typing import Sequence
 
+from ..choices import DELAUNAY_BACKENDS, DelaunayBackend
 from .geometry import Frame, Sphere, determinant, dot, plane_normal, sub
 
 __all__ = ["Cell", "delaunay_cells", "hull_faces"]
@@ -121,10 +122,7 @@ def _first_cell(frame: Frame) -> tuple[list[int], Sphere]:
     raise ValueError("no empty sphere: the points do not span 3D")
 
 
-_BACKENDS = ("python", "compiled")
-
-
-def delaunay_cells(frame: Frame, backend: str = "python") -> list[Cell]:
+def delaunay_cells(frame: Frame, backend: DelaunayBackend = "python") -> list[Cell]:
     """The Delaunay subdivision of the frame's points, cells sorted by node ids.
 
     ``backend``: ``"python"`` (the default) walks in Python integers;
@@ -136,8 +134,8 @@ def delaunay_cells(frame: Frame, backend: str = "python") -> list[Cell]:
     study: 144 orbits) keeps the default and bulk work (the intersection study)
     asks for ``"compiled"``.
     """
-    if backend not in _BACKENDS:
-        raise ValueError(f"backend {backend!r}: one of {', '.join(_BACKENDS)}")
+    if backend not in DELAUNAY_BACKENDS:
+        raise ValueError(f"backend {backend!r}: one of {', '.join(DELAUNAY_BACKENDS)}")
     if backend == "compiled":
         cells = _compiled_cells(frame)
         if cells is not None:

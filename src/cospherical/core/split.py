@@ -25,6 +25,7 @@ from __future__ import annotations
 from itertools import combinations
 from typing import Sequence
 
+from ..choices import CRITERIA, SPLIT_CRITERIA, SplitCriterion
 from .delaunay import hull_faces
 from .geometry import Frame, dot, plane_normal, six_volume
 from .polyhedron import Polyhedron, face_kind
@@ -39,14 +40,12 @@ _OpenFaces = dict[frozenset[int], tuple[tuple[int, ...], Sequence[int]]]
 
 __all__ = ["CRITERIA", "SPLIT_CRITERIA", "subdivisions"]
 
-CRITERIA = ("optimal", "internal_faces", "internal_edges_and_faces")
-SPLIT_CRITERIA = CRITERIA[1:]
 
 
 class _Element:
     """An element in frame indices, with what the criteria need to know about it."""
 
-    def __init__(self, frame: Frame, poly: Polyhedron, criterion: str):
+    def __init__(self, frame: Frame, poly: Polyhedron, criterion: SplitCriterion):
         if criterion not in SPLIT_CRITERIA:
             raise ValueError(f"criterion {criterion!r}: choose one of {', '.join(SPLIT_CRITERIA)}")
         self.frame = frame
@@ -134,7 +133,7 @@ class _Element:
         return [m for m, x, y, z in self.points if nx * x + ny * y + nz * z > offset]
 
 
-def subdivisions(frame: Frame, poly: Polyhedron, criterion: str, limit: int = 200_000) -> list[tuple[Polyhedron, ...]]:
+def subdivisions(frame: Frame, poly: Polyhedron, criterion: SplitCriterion, limit: int = 200_000) -> list[tuple[Polyhedron, ...]]:
     """Every split of ``poly`` allowed by ``criterion``, the element itself included.
 
     Each split is a tuple of pieces sorted by node ids; splits come in a fixed order.

@@ -24,6 +24,7 @@ if TYPE_CHECKING:
 # import is a third of a command's start-up).
 
 from ..caches import cached
+from ..choices import KEY_BACKENDS, ORBIT_BACKENDS, KeyBackend, OrbitBackend
 from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, point_suffix
 from .configuration import Box, Configuration
 from .geometry import Rational, cross, determinant, sub, tetra_six_volume
@@ -177,11 +178,8 @@ def map_polyhedron(poly: Polyhedron, nodes: Sequence[int], proper: bool,
     )
 
 
-_KEY_BACKENDS = ("numpy", "compiled")
-
-
 def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry],
-               backend: str = "numpy") -> tuple[np.ndarray, np.ndarray]:
+               backend: KeyBackend = "numpy") -> tuple[np.ndarray, np.ndarray]:
     """For rows of 12 hex digits: the orbit representative's code as a base-16 number (the
     smallest image) and the index of the first symmetry taking the row to it
     (``backend`` as in :func:`orbit_point_keys`)."""
@@ -190,7 +188,7 @@ def orbit_keys(digits: np.ndarray, symmetries: Sequence[Symmetry],
 
 
 def orbit_point_keys(
-    digits: np.ndarray, masks: np.ndarray | None, symmetries: Sequence[Symmetry], backend: str = "numpy"
+    digits: np.ndarray, masks: np.ndarray | None, symmetries: Sequence[Symmetry], backend: KeyBackend = "numpy"
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`orbit_keys` for whole point sets: rows of 12 hex digits with a point mask each
     (bit f: face f carries a point, bit 6: the body point; ``None``: no face points).  The smallest image compares the
@@ -205,8 +203,8 @@ def orbit_point_keys(
     for the kernel."""
     import numpy as np
 
-    if backend not in _KEY_BACKENDS:
-        raise ValueError(f"backend {backend!r}: one of {', '.join(_KEY_BACKENDS)}")
+    if backend not in KEY_BACKENDS:
+        raise ValueError(f"backend {backend!r}: one of {', '.join(KEY_BACKENDS)}")
     digits = np.ascontiguousarray(digits).reshape(-1, 12)  # any integer type: millions of rows stay small
     masks = np.zeros(len(digits), dtype=np.int64) if masks is None else np.ascontiguousarray(masks, dtype=np.int64)
     targets = np.array([[target for target, _ in sym.edge_map] for sym in symmetries], dtype=np.int64).reshape(-1, 12)
@@ -244,7 +242,7 @@ def _orbit_keys_numpy(digits: np.ndarray, targets: np.ndarray, reverse: np.ndarr
 
 
 def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry],
-                          backend: str = "python") -> tuple[list[str], list[int]]:
+                          backend: OrbitBackend = "python") -> tuple[list[str], list[int]]:
     """For each code, its orbit's representative (the smallest image: edge digits as a base-16
     number, then the face and body points) and the index of the first symmetry taking the code to it.
 
@@ -266,8 +264,8 @@ def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry],
     >>> orbit_representatives(["800000000000", "000000000008"], box_symmetries(Box.parse(["1", "1", "1"])))[0]
     ['000000000008', '000000000008']
     """
-    if backend not in ("python", *_KEY_BACKENDS):
-        raise ValueError(f"backend {backend!r}: one of python, {', '.join(_KEY_BACKENDS)}")
+    if backend not in ORBIT_BACKENDS:
+        raise ValueError(f"backend {backend!r}: one of {', '.join(ORBIT_BACKENDS)}")
     if not symmetries:
         raise ValueError("orbit representatives: no symmetries (the identity at least)")
     shape = symmetries[0].shape

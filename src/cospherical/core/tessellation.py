@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Mapping, Sequence
 
+from ..choices import DelaunayBackend
 from .configuration import Configuration
 from .delaunay import delaunay_cells
 from .element_types import ElementType, classify
@@ -71,7 +72,7 @@ class Tessellation:
         return (float(center[0]) * scale[0], float(center[1]) * scale[1], float(center[2]) * scale[2])
 
 
-def tessellate(configuration: Configuration, backend: str = "python") -> Tessellation:
+def tessellate(configuration: Configuration, backend: DelaunayBackend = "python") -> Tessellation:
     """The Delaunay tessellation of a configuration, its elements the largest co-spherical sets.
 
     Every cell is the convex hull of all points on one empty sphere, decided in
@@ -120,7 +121,7 @@ def tessellate(configuration: Configuration, backend: str = "python") -> Tessell
 
 
 def tessellation_elements(nodes: Mapping[int, Sequence[Rational]], squared: Sequence[Rational],
-                          backend: str = "python") -> tuple[Element, ...]:
+                          backend: DelaunayBackend = "python") -> tuple[Element, ...]:
     """The classified Delaunay elements of points ``{node id: unit coordinates}`` in a box
     with these squared lengths: the one pipeline of every base element (cuboid or other shape).
     ``backend``: the Delaunay walk's, as in :func:`tessellate`."""

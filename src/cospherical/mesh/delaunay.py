@@ -116,6 +116,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..choices import ENGINES, MODES, DelaunayMode, Engine
 from ..core.geometry import Frame, area_vector, circumcenters, six_volumes, sphere_sides
 from ..core.incremental_delaunay import delaunay_tetrahedra
 from ..core.tessellation import tessellation_elements
@@ -125,7 +126,6 @@ from .checks import DelaunayCheck, check_delaunay, grid_weights
 
 __all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
-ENGINES = ("qhull", "exact")
 _NO_CLUSTER = -1  # the cluster of a leaf element that is kept, and of a vertex of no cluster
 
 
@@ -137,7 +137,7 @@ class NotOneCell(Exception):
     """
 
 
-def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: str = "qhull", proposal=None) -> Mesh:
+def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull", proposal=None) -> Mesh:
     """The exact Delaunay subdivision of ``mesh``'s vertices, as a :class:`Mesh` (see the module's proof).
 
     ``found``: the result of :func:`check_delaunay` on ``mesh`` when the caller has it.
@@ -158,7 +158,7 @@ def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: str 
     return _global_delaunay(mesh, found, engine, proposal)[0]
 
 
-def _global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: str = "qhull",
+def _global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull",
                      proposal=None) -> tuple[Mesh, DelaunayCheck | None]:
     """:func:`global_delaunay`, and :func:`check_delaunay` on the result when it ran (a cluster was re-tessellated)."""
     if engine not in ENGINES:
@@ -182,7 +182,7 @@ def _leaves_of(mesh: Mesh, elements: np.ndarray) -> np.ndarray:
     return bad
 
 
-def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: str = "qhull",
+def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: Engine = "qhull",
                  proposal=None) -> tuple[Cells, DelaunayCheck]:
     """The cells of the Delaunay subdivision of ``mesh``'s vertices that replace the leaves holding ``elements``.
 
@@ -578,10 +578,7 @@ def _scaled(shape: CellShape, g: int) -> CellShape:
                      shape.grid_volume * g ** 3, shape.sphere.scaled(g), tuple(g * c for c in shape.center))
 
 
-MODES = ("global", "leaf")
-
-
-def delaunay_mesh(mesh: Mesh, mode: str = "global", progress=None
+def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress=None
                   ) -> tuple[Mesh, dict[str, int] | None, DelaunayCheck | None]:
     """The mesh a user asked for: ``leaf`` (the leaf mesh as assembled) or ``global`` (its exact Delaunay subdivision).
 

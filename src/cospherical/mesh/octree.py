@@ -25,6 +25,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from ..choices import BALANCES, Balance
 from ..core.configuration import Box
 from ..core.exact import parse_rational
 from ..errors import CosphericalWarning, InputError, shown
@@ -35,7 +36,6 @@ __all__ = ["BALANCES", "BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_
 
 MAX_LEVEL = 16  # keys (2**16)**3 and the half-spacing grid (2**17 + 1)**3 stay inside int64
 # Balance across faces alone is not among them: it is not 1-irregular (an edge can get two points).
-BALANCES = ("vertex", "edge")
 # Peak memory of `cospherical mesh` with every check, per leaf: 1.5 kB measured at 131,258
 # leaves (plane:1,1,1,1.5, levels 7); rounded up.
 BYTES_PER_LEAF = 2048
@@ -284,7 +284,7 @@ def _cells_of(level: int, keys: np.ndarray) -> np.ndarray:
     return np.stack([keys // (n * n), (keys // n) % n, keys % n], axis=1)
 
 
-def _offsets(balance: str) -> np.ndarray:
+def _offsets(balance: Balance) -> np.ndarray:
     """Neighbour offsets touching a cell across a face and an edge (``edge``), or also a corner (``vertex``)."""
     most = 3 if balance == "vertex" else 2
     return np.array([d for d in product((-1, 0, 1), repeat=3) if sum(map(abs, d)) <= most], dtype=np.int64)
@@ -356,7 +356,7 @@ def check_leaf_count(count: int, what: str, max_leaves: int | None = None) -> No
                          f"(half this machine's memory at {BYTES_PER_LEAF} bytes a leaf; --max-leaves N sets it)")
 
 
-def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = "vertex",
+def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balance = "vertex",
                  max_leaves: int | None = None,
                  must_split: Callable[[int, np.ndarray], np.ndarray] | None = None, resolve: int = 0) -> Octree:
     """Refine every cell whose closed box meets a shape down to ``levels``, then 2:1 balance (coarsest).

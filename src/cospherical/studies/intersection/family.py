@@ -28,7 +28,7 @@ from ...core.configuration import Box
 from ...core.shapes import edge_axis
 from ...core.symmetry import box_symmetries, orbit_keys
 from ...errors import InputError
-from ..insertion import INSERTION_ORDERS
+from ...choices import INSERTION_ORDERS
 
 __all__ = ["INSERTION_ORDERS", "PARALLEL_EDGES", "all_configurations", "intersection_codes", "orbits", "set_patterns"]
 
