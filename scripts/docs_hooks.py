@@ -43,6 +43,8 @@ def _assets() -> dict[str, Path]:
         assets[f"figures/sweep/{path.name}"] = path
     for path in sorted(RESULTS.glob("mesh/*/mesh.png")):
         assets[f"figures/mesh/{path.parent.name}.png"] = path
+    for path in sorted(RESULTS.glob("devices/*/mesh.png")):
+        assets[f"figures/devices/{path.parent.name}.png"] = path
     return assets
 
 
@@ -332,6 +334,38 @@ def mesh_table(up: str) -> str:
         rows.append(f"| {label} | " + " | ".join(_n(value(r)) for _, r in reports) + " |")
     pictures = [f"![{_text(name)}]({up}figures/mesh/{_url(name)}.png)" for name, _ in reports]
     return "\n".join(rows) + "\n\n" + "\n\n".join(pictures)
+
+
+def device_report(up: str, name: str) -> str:
+    """One example device's mesh (``results/devices/NAME/``): its picture coloured by region and its report's
+    figures per region, contact and interface."""
+    report = _json(RESULTS / "devices" / name / "report.json")
+    device = report["device"]
+    dual = report.get("dual") or {}
+    lines = [f"![{_text(name)}]({up}figures/devices/{_url(name)}.png)", "",
+             f"{_n(report['leaves'])} leaves (depth {_n(device['depth'])}, the boxes resolved at level "
+             f"{_n(device['resolving_level'])}), {_n(report['vertices'])} vertices, {_n(report['elements'])} "
+             f"elements, {_n(dual.get('edges'))} dual edges; volume exact: {_text(report['volume_ok'])}, "
+             f"non-conforming faces: {_n(report['nonconforming_faces'])}, Delaunay mode "
+             f"{_text(report['delaunay_mode'])}.", "",
+             "| region | material | elements | nodes | volume | control volumes sum | negative interior coefficients |",
+             "|---|---|---:|---:|---:|---:|---:|"]
+    for region in device["regions"]:
+        negative = region.get("negative_coefficients") or {}
+        lines.append(f"| {_text(region['name'])} | {_text(region['material'])} | {_n(region['elements'])} | "
+                     f"{_n(region['nodes'])} | {_text(region['volume'])} | {_text(region.get('control_volume_sum', '-'))} | "
+                     f"{_n(negative.get('interior'))} |")
+    if device["contacts"]:
+        lines += ["", "| contact | region | faces | nodes | area | area parts sum |", "|---|---|---:|---:|---:|---:|"]
+        for contact in device["contacts"]:
+            lines.append(f"| {_text(contact['name'])} | {_text(contact['region'])} | {_n(contact['faces'])} | "
+                         f"{_n(contact['nodes'])} | {_text(contact['area'])} | "
+                         f"{_text(contact.get('area_parts_sum', '-'))} |")
+    if device["interfaces"]:
+        lines += ["", "| interface | faces | nodes |", "|---|---:|---:|"]
+        for interface in device["interfaces"]:
+            lines.append(f"| {_text(interface['name'])} | {_n(interface['faces'])} | {_n(interface['nodes'])} |")
+    return "\n".join(lines)
 
 
 def dual_table(up: str) -> str:
@@ -646,6 +680,7 @@ GENERATORS = {
     "intersection": intersection_table,
     "meshes": mesh_table,
     "dual": dual_table,
+    "device": device_report,
     "gallery": gallery,
     "sweep": sweep_figures,
     "schemas": schemas_list,

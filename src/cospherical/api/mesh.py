@@ -398,7 +398,7 @@ class OctreeMesh:
         at = 0.5 if cut is None else cut
         low, high = device.bounds[axis]
         cut_png(mesh, path("mesh.png"), at=at, axis=axis, by_region=True,
-                title=f"{device.name}: {len(regions.names)} regions, {report.leaves:,} leaves, "
+                title=f"{device.name}: {len(regions.names)} region{'' if len(regions.names) == 1 else 's'}, {report.leaves:,} leaves, "
                       f"{report.elements:,} elements (cut at {'xyz'[axis]} = {float(low + (high - low) * at):.4g})")
         write_report(report.to_dict(), path("report.json"))
 
