@@ -110,7 +110,7 @@ def measure(args, record) -> None:
     leaf_cpu, global_cpu = (sum(clock[k][1] for k in stages) for stages in (leaf_stages, global_stages))
     cells = whole.cells
     print(f"global: {len(whole):,} elements, {len(cells) if cells else 0:,} cells in "
-          f"{cells.regions if cells else 0} regions (largest {cells.largest_region if cells else 0:,} vertices), "
+          f"{cells.clusters if cells else 0} clusters (largest {cells.largest_cluster if cells else 0:,} vertices), "
           f"{int(cells.spanning.sum()) if cells else 0:,} spanning leaves")
     print({k: v for k, v in found.items() if not k.startswith("_") and k != "nonconforming_examples"})
     print(f"leaf mode {leaf_mode:.1f} s wall, {leaf_cpu:.1f} s cpu; global mode {global_mode:.1f} s wall, "
@@ -122,7 +122,7 @@ def measure(args, record) -> None:
         record.add(name, f"{cpu:.2f} s CPU, {wall:.2f} s wall")
     record.add("leaf mode (assembly, checks, statistics) vs global mode", f"{leaf_cpu:.1f} s vs {global_cpu:.1f} s CPU: "
                f"{global_cpu / leaf_cpu:.2f}x CPU, {global_mode / leaf_mode:.2f}x wall")
-    record.add("global mode's result", f"{len(whole):,} cells, {cells.regions if cells else 0} regions, "
+    record.add("global mode's result", f"{len(whole):,} cells, {cells.clusters if cells else 0} clusters, "
                f"{found.get('delaunay_violations')} Delaunay violations, {found.get('delaunay_ties')} ties")
     record.add("peak memory (the process)", f"{peak:.2f} GB")
 

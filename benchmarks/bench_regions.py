@@ -64,9 +64,9 @@ def measure(args, record) -> None:
         seconds = cpu() - start
         results[engine] = (seconds, cells(mesh))
         print(f"  {engine:5s}: {seconds:7.2f} CPU-s, {region_vertices / seconds:9,.0f} region vertices per CPU-s, "
-              f"{mesh.cells.regions} regions, largest {mesh.cells.largest_region:,} vertices")
+              f"{mesh.cells.clusters} clusters, largest {mesh.cells.largest_cluster:,} vertices")
         record.add(f"{engine} engine, {tree} ({region_vertices:,} region vertices, largest region "
-                   f"{mesh.cells.largest_region:,})", f"{region_vertices / seconds:,.0f} region vertices per CPU-s")
+                   f"{mesh.cells.largest_cluster:,})", f"{region_vertices / seconds:,.0f} region vertices per CPU-s")
     assert results["qhull"][1] == results["exact"][1], "the engines disagree"
     ratio = results["exact"][0] / results["qhull"][0]
     print(f"  same cells; exact / qhull CPU: {ratio:.1f}")
