@@ -63,25 +63,29 @@ def test_devsim_assembles_with_the_exact_dual(devsim, graded):
         drop(devsim, handed.name)
 
 
-def test_a_device_gives_regions_interfaces_and_each_region_its_part_of_the_dual(devsim):
-    """The MOS capacitor (level 3): substrate and oxide with their materials, the bulk and gate contacts, the
-    interface; each region assembles with its own part of the dual, summing to the region's volume."""
+def test_a_device_gives_regions_interfaces_and_each_region_its_part_of_the_dual(devsim, tmp_path):
+    """The MOS capacitor (level 3), in memory and from its mesh folder: substrate and oxide with their materials,
+    the bulk and gate contacts, the interface; each region assembles with its own part of the dual, summing to
+    the region's volume."""
     from dataclasses import replace
 
     from cospherical.api.mesh import build_mesh
     from cospherical.formats.device_file import read_device
 
     device = read_device(ROOT / "examples" / "devices" / "mos-capacitor.yaml")
-    handed = create_device(build_mesh(device=replace(device, levels=3)), device="mos")
-    try:
-        assert handed.regions == ("substrate", "oxide") and handed.contacts == ("bulk", "gate")
-        assert tuple(devsim.get_interface_list(device="mos")) == ("substrate|oxide",)
-        assert [devsim.get_material(device="mos", region=r) for r in handed.regions] == ["Si", "SiO2"]
-        for region, volume in (("substrate", 0.75), ("oxide", 0.25)):
-            volumes, couple, length = assembled_with(devsim, "mos", region)
-            assert abs(volumes.sum() - volume) < 1e-12 and abs((couple * length).sum() - 3 * volume) < 1e-12
-    finally:
-        drop(devsim, "mos")
+    mesh = build_mesh(device=replace(device, levels=3), dual=True, uniform=False)
+    mesh.write(tmp_path)  # its folder (dual.npz with the parts per region) gives the same device
+    for name, source in (("mos", mesh), ("mos-folder", tmp_path)):
+        handed = create_device(source, device=name)
+        try:
+            assert handed.regions == ("substrate", "oxide") and handed.contacts == ("bulk", "gate")
+            assert tuple(devsim.get_interface_list(device=name)) == ("substrate|oxide",)
+            assert [devsim.get_material(device=name, region=r) for r in handed.regions] == ["Si", "SiO2"]
+            for region, volume in (("substrate", 0.75), ("oxide", 0.25)):
+                volumes, couple, length = assembled_with(devsim, name, region)
+                assert abs(volumes.sum() - volume) < 1e-12 and abs((couple * length).sum() - 3 * volume) < 1e-12
+        finally:
+            drop(devsim, name)
 
 
 def test_a_mesh_folder_gives_the_same_device(devsim, graded, tmp_path):

@@ -104,6 +104,7 @@ class _Source:
     dual: Dual
     geometry: dict
     contact_region: dict
+    materials: tuple = ()
 
 
 def _source(mesh) -> _Source:
@@ -124,7 +125,12 @@ def _source(mesh) -> _Source:
                              "mesh --dual --out DIR)")
         dual = read_dual(path)
         simplices = dual_simplex_mesh(dual)
-        return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area)}, {})
+        if dual.regions is None:
+            return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area)}, {})
+        parts = dual.regions
+        return _Source(simplices, dual, _region_geometry(dual, parts),
+                       {name: parts.names[r] for name, r in zip(parts.contact_names, parts.contact_regions)},
+                       tuple(parts.materials))
     assembled = getattr(mesh, "assembled", mesh)  # the API's mesh holds the assembled one
     if not hasattr(assembled, "blocks"):
         raise InputError(f"create_device: {type(mesh).__name__} is not a mesh (give the API's mesh, "
@@ -140,6 +146,13 @@ def _source(mesh) -> _Source:
     faces = region_faces(assembled)
     simplices = simplex_mesh(assembled, faces=faces)
     parts = dual.regions if dual.regions is not None else mesh_region_parts(assembled, dual, faces)
+    geometry = _region_geometry(dual, parts)
+    device = regions.layout.device
+    return _Source(simplices, dual, geometry, {c.name: c.region for c in device.contacts}, tuple(regions.materials))
+
+
+def _region_geometry(dual: Dual, parts) -> dict:
+    """Per region name: its node volume per vertex and its dual-face area per edge (0 where it has none)."""
     geometry = {}
     for r, name in enumerate(parts.names):
         volume = np.zeros(len(dual.vertices))
@@ -150,8 +163,7 @@ def _source(mesh) -> _Source:
         edges = parts.coupling_edge[rows]
         area[edges] = parts.coupling_part[rows] * dual.length[edges]
         geometry[name] = (volume, area)
-    device = regions.layout.device
-    return _Source(simplices, dual, geometry, {c.name: c.region for c in device.contacts})
+    return geometry
 
 
 def create_device(mesh, device: str = "device", contacts=None, material: str = "Silicon",
@@ -159,7 +171,9 @@ def create_device(mesh, device: str = "device", contacts=None, material: str = "
     """Build DEVSIM's mesh and device from ``mesh``, the exact dual installed as its geometry.
 
     ``mesh``: the API's mesh, an assembled :class:`~cospherical.mesh.assembly.Mesh`, or a
-    mesh folder with ``dual.npz`` (``cospherical mesh --dual --out DIR``).
+    mesh folder with ``dual.npz`` (``cospherical mesh --dual --out DIR``; a device's
+    ``dual.npz`` holds its parts per region and its contact faces, the interfaces are
+    where tetrahedra of two regions meet).
 
     A device's mesh (``build_mesh(device=...)``) gives one DEVSIM region per region,
     with its name and material, one contact per contact of the device (``contacts``:
@@ -198,7 +212,8 @@ def create_device(mesh, device: str = "device", contacts=None, material: str = "
         np.column_stack([np.full(len(simplices.triangles), 2), simplices.surface + offset, simplices.triangles]
                         ).reshape(-1),
         np.column_stack([np.full(len(simplices.tetrahedra), 3), simplices.volume, simplices.tetrahedra]).reshape(-1)])
-    materials = _materials(mesh, simplices.volumes, material)
+    materials = {name: given or material for name, given in zip(simplices.volumes, source.materials or
+                                                                 ("",) * len(simplices.volumes))}
     log = io.StringIO()
     try:
         with contextlib.redirect_stdout(log):  # DEVSIM prints through Python's sys.stdout
@@ -224,14 +239,6 @@ def create_device(mesh, device: str = "device", contacts=None, material: str = "
         raise InputError(f"DEVSIM refused the mesh of device {shown(device)}: {text[:200]}") from None
     return DevsimDevice(device, tuple(simplices.volumes), contacts, simplices, source.dual, node_ids, edge_ids,
                         tuple(interfaces), log.getvalue())
-
-
-def _materials(mesh, regions, default: str) -> dict:
-    """Each region's material: the device's (when it names one), else ``default``."""
-    assembled = getattr(mesh, "assembled", mesh)
-    found = getattr(getattr(assembled, "regions", None), "materials", None) or ()
-    given = dict(zip(regions, found)) if len(found) == len(regions) else {}
-    return {name: given.get(name) or default for name in regions}
 
 
 def _pair(interface: str, regions) -> tuple[str, str]:

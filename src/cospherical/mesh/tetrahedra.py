@@ -278,19 +278,52 @@ def _fanned(polygons: np.ndarray, label: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def dual_simplex_mesh(dual) -> SimplexMesh:
-    """:func:`simplex_mesh` of the elements a :class:`~cospherical.mesh.dual.Dual` holds (a ``dual.npz``)."""
+    """:func:`simplex_mesh` of the elements a :class:`~cospherical.mesh.dual.Dual` holds (a ``dual.npz``).
+
+    With a device's parts (``dual.regions``): a volume per region, a surface per contact
+    (its faces fanned) and per interface, the triangles where tetrahedra of two regions
+    meet, named ``"a|b"`` (``a`` the lower region index) and oriented out of ``a``.
+    """
     blocks = element_blocks(dual.grid_vertices, dual.box.squared, dual.element_nodes, dual.element_sizes)
-    tets = split_tetrahedra(_ElementList(len(dual.element_sizes)), blocks)
-    outer = boundary_triangles(dual, blocks)
-    return SimplexMesh(np.asarray(dual.vertices, dtype=np.float64), tets.nodes, tets.region, ("domain",), outer.nodes,
-                       outer.side.astype(np.int32), SIDES)
+    parts = dual.regions
+    count = len(dual.element_sizes)
+    tets = split_tetrahedra(_ElementList(count, None if parts is None else parts.element_region), blocks)
+    points = np.asarray(dual.vertices, dtype=np.float64)
+    if parts is None:
+        outer = boundary_triangles(dual, blocks)
+        return SimplexMesh(points, tets.nodes, tets.region, ("domain",), outer.nodes, outer.side.astype(np.int32),
+                           SIDES)
+    contacts = _fanned(parts.contact_face_nodes, parts.contact_face_contact)
+    between, pairs = _interfaces(tets)
+    names = tuple(parts.contact_names) + tuple(f"{parts.names[a]}|{parts.names[b]}" for a, b in pairs)
+    triangles = np.concatenate([contacts[0], between[0]])
+    surface = np.concatenate([contacts[1], between[1] + len(parts.contact_names)]).astype(np.int32)
+    order = np.argsort(surface, kind="stable")
+    return SimplexMesh(points, tets.nodes, tets.region, tuple(parts.names), triangles[order], surface[order], names)
+
+
+def _interfaces(tets: Tetrahedra) -> tuple[tuple[np.ndarray, np.ndarray], list[tuple[int, int]]]:
+    """The triangles shared by tetrahedra of two regions, out of the lower region, with their pair's index."""
+    outward = tets.nodes[:, [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]]].reshape(-1, 3)
+    region = np.repeat(tets.region, 4)
+    keys = np.sort(outward, axis=1)
+    order = np.lexsort((region, keys[:, 2], keys[:, 1], keys[:, 0]))
+    keys, outward, region = keys[order], outward[order], region[order]
+    same = (keys[1:] == keys[:-1]).all(axis=1) & (region[1:] != region[:-1])
+    first = np.flatnonzero(same)  # the lower region's copy comes first (sorted by region)
+    pair_rows = np.column_stack([region[first], region[first + 1]])
+    pairs = sorted({(int(a), int(b)) for a, b in pair_rows.tolist()})
+    index = {p: k for k, p in enumerate(pairs)}
+    labels = np.array([index[int(a), int(b)] for a, b in pair_rows.tolist()], dtype=np.int64)
+    return (outward[first], labels), pairs
 
 
 class _ElementList:
-    """A mesh of ``count`` elements in one region, for :func:`split_tetrahedra` given its blocks."""
+    """``count`` elements with their regions (or one region), for :func:`split_tetrahedra` given its blocks."""
 
-    def __init__(self, count: int):
+    def __init__(self, count: int, element_region: np.ndarray | None = None):
         self.count = count
+        self.element_region = element_region
 
     def __len__(self) -> int:
         return self.count
