@@ -278,27 +278,6 @@ def test_block_style_yaml_beyond_the_parser_bound_is_refused_at_once(tmp_path):
     assert seconds < 15
 
 
-def test_a_table_not_in_our_line_form_is_told_apart_without_cutting_it_into_lines():
-    # the one-line-per-entry reader gives up at the first line of another form, before it makes the
-    # lines (20 MB of block style made 132 MB of them; a 100 MB file took 0.83 GB to be refused)
-    import tracemalloc
-
-    from cospherical.files.flowyaml import split_section
-
-    row = "  - type: v8f6-c3cb81\n    nodes:\n    - 0\n    - 1\n"
-    text = "schema_version: 1\nconfigurations:\n  '000000000000':\n    optimal:\n" + row * (20_000_000 // len(row))
-    tracemalloc.start()
-    try:
-        assert split_section(text, "configurations") is None
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
-    assert peak < 1 << 20, peak
-    ours = (PATTERNS / "bisection-tetrahedron-1x1x1.yaml").read_text()
-    header, entries = split_section(ours, "configurations")  # our own form still takes the fast path
-    assert entries and "configurations" not in header
-
-
 @pytest.mark.parametrize("count, needle", [(2000, "4 to 64 corners"), (60, "coplanar")])
 def test_shape_corners_are_bounded_and_coplanarity_is_one_pass(tmp_path, count, needle):
     # every corner on the parabola y = x**2 in z = 0: no three on a line, all on one plane
