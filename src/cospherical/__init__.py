@@ -39,7 +39,7 @@ from .errors import CosphericalError, FormatError, InputError, UsageError
 from .version import __version__
 
 # name -> module that defines it
-_API = {
+_API: dict[str, str | tuple[str, str]] = {
     "Box": "cospherical.core.configuration",
     "Configuration": "cospherical.core.configuration",
     "Length": "cospherical.core.exact",
@@ -66,7 +66,8 @@ __all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "__ver
 def __getattr__(name: str):
     if name not in _API:
         raise AttributeError(f"module 'cospherical' has no attribute {name!r}")
-    module, attribute = _API[name] if isinstance(_API[name], tuple) else (_API[name], name)
+    where = _API[name]
+    module, attribute = where if isinstance(where, tuple) else (where, name)
     value = getattr(importlib.import_module(module), attribute)
     globals()[name] = value  # once loaded, an ordinary attribute
     return value

@@ -22,7 +22,7 @@ from functools import cached_property
 from typing import Sequence
 
 from ..caches import cached
-from ..choices import DelaunayBackend, OrbitBackend, PointPolicy
+from ..choices import DelaunayBackend, FacePointSource, OrbitBackend
 from .configuration import Box, Configuration
 from .shapes import ELEMENTS, Shape, standard_shape
 from .symmetry import Symmetry, orbit_representatives, shape_symmetries
@@ -40,7 +40,7 @@ class BaseElement:
 
     name: str
     box: Box
-    face_points: PointPolicy = "octree"
+    face_points: FacePointSource = "octree"
 
     @cached_property
     def shape(self) -> Shape:
@@ -72,7 +72,7 @@ class BaseElement:
         return tessellate(configuration, backend)
 
 @cached(maxsize=64)  # a study maps every member's configuration through it
-def base_element(name: str, box: Box, face_points: PointPolicy = "octree") -> BaseElement:
+def base_element(name: str, box: Box, face_points: FacePointSource = "octree") -> BaseElement:
     """The :class:`BaseElement` named ``name`` in ``box`` (one object per element, box and policy)."""
     element = BaseElement(name, box, face_points)
     element.shape  # a name that is no standard shape is refused here, not at first use

@@ -278,7 +278,13 @@ class OutputFolder:
         self._check_name(name)
         if name not in self._staged:
             self._staged.append(name)
-        return self.staging / name
+        return self._open_staging() / name
+
+    def _open_staging(self) -> Path:
+        """The staging folder, made when the ``with`` block was entered."""
+        if self.staging is None:
+            raise RuntimeError(f"{self.folder}: the output folder is not open (write inside its with block)")
+        return self.staging
 
     def __exit__(self, kind, value, traceback) -> None:
         if kind is not None:
@@ -335,19 +341,20 @@ class OutputFolder:
                 for writer, files in data.items() if isinstance(writer, str) and isinstance(files, dict)}
 
     def _commit(self) -> None:
-        missing = [name for name in self._staged if not os.path.isfile(self.staging / name)]
+        staging = self._open_staging()
+        missing = [name for name in self._staged if not os.path.isfile(staging / name)]
         if missing:
             raise InputError(f"{self.folder / missing[0]}: was not written")
         for name in [*self._staged, MANIFEST]:  # every name checked before the first rename
             refuse_special(self.folder / name)
         manifest = self._read_manifest()
-        ours = {name: _sha256(self.staging / name) for name in self._staged}
+        ours = {name: _sha256(staging / name) for name in self._staged}
         earlier = manifest.get(self.writer, {})
         mode = 0o666 & ~_umask()
         try:
             for name in self._staged:
-                os.chmod(self.staging / name, mode)  # files made by mkstemp or pdflatex: ordinary permissions
-                os.replace(self.staging / name, self.folder / name)
+                os.chmod(staging / name, mode)  # files made by mkstemp or pdflatex: ordinary permissions
+                os.replace(staging / name, self.folder / name)
             for name, digest in sorted(earlier.items()):
                 if name not in ours and self._writes is not None and self._writes(name):
                     self._remove_if_ours(self.folder / name, digest)
@@ -368,7 +375,8 @@ class OutputFolder:
         if self.staging is not None:
             shutil.rmtree(self.staging, ignore_errors=True)
             self.staging = None
-        self._lock.release(failed)
+        if self._lock is not None:
+            self._lock.release(failed)
 
 
 def _identity(path_stat: os.stat_result) -> str:

@@ -8,6 +8,7 @@ import os
 import re
 import stat
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import yaml
 
@@ -21,7 +22,13 @@ __all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "a
 _Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 
 
-class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
+if TYPE_CHECKING:  # the C loader where libyaml is there: the same API
+    _SafeLoader = yaml.SafeLoader
+else:
+    _SafeLoader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+class _Loader(_SafeLoader):
     """Safe loading that refuses a mapping with a repeated key (YAML would keep the last).
 
     Timestamps are not resolved: a date stays a string (an impossible date such as
@@ -243,4 +250,4 @@ def validate(data, schema: str, path: str | Path) -> None:
         _validator(schema)(data)
     except fastjsonschema.JsonSchemaValueException as error:
         where = ".".join(str(p) for p in error.path[1:]) if error.path else "top level"
-        raise FormatError(f"{path}: {schema} format: at {where or 'top level'}: {error.message.replace(error.name, 'value', 1)[:200]}") from None
+        raise FormatError(f"{path}: {schema} format: at {where or 'top level'}: {error.message.replace(error.name or '', 'value', 1)[:200]}") from None

@@ -46,7 +46,9 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
     across = (*_PLANES[axis], axis)
     z0 = round(at * grid) + 1 / 3
     scale = np.array(mesh.box.to_float())[list(across)] / grid
-    polygons, types, elements = [], [], []
+    polygons: list[np.ndarray] = []
+    types: list[str] = []
+    elements: list[int] = []
     # a leaf's elements lie in its box: only the leaves the plane crosses can hold a section (a cell of
     # the global Delaunay subdivision may reach beyond its first leaf: cells are always looked at)
     low = mesh.tree.positions[:, axis].astype(np.int64) * mesh.leaf_size()
@@ -97,8 +99,9 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
 
     polygons, types, elements = _sections(mesh, at, axis)
     if by_region:
-        regions = mesh.element_region
-        types = [mesh.regions.names[r] for r in regions[np.array(elements, dtype=np.int64)].tolist()]
+        regions, names = mesh.element_region, mesh.regions
+        assert regions is not None and names is not None, "by region: a device's mesh"
+        types = [names.names[r] for r in regions[np.array(elements, dtype=np.int64)].tolist()]
     counts: dict[str, int] = {}
     for t in types:
         counts[t] = counts.get(t, 0) + 1

@@ -17,7 +17,7 @@ from functools import partial
 from typing import Callable, Iterator, Sequence
 
 from ..catalogue import CRITERIA, Choice, choose
-from ..choices import PointPolicy
+from ..choices import FacePointSource
 from ..core.base_element import base_element
 from ..core.configuration import Box, Configuration
 from ..core.element_types import ElementType
@@ -62,7 +62,7 @@ class Study:
 
     name: str
     box: Box
-    face_points: PointPolicy
+    face_points: FacePointSource
     codes: tuple[str, ...]
     representative: dict[str, tuple[str, Symmetry]]  # code -> (orbit representative, symmetry to it)
     choices: dict[str, Choice]  # criterion -> kept types and the representatives' tessellations
@@ -150,7 +150,7 @@ def run_study(
     name: str,
     box: Box,
     codes: Sequence[str],
-    face_points: PointPolicy = "octree",
+    face_points: FacePointSource = "octree",
     progress: Progress | None = None,
     criteria: Sequence[str] = CRITERIA,
     element: str = "cuboid",

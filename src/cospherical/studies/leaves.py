@@ -42,7 +42,7 @@ def leaf_codes() -> list[str]:
     >>> [code for code in codes if code.startswith("888800000000")]
     ['888800000000+f', '888800000000+f4']
     """
-    codes = []
+    codes: list[str] = []
     for code in bisection_codes():
         split = [f for f in range(6) if all(code[k] == "8" for k in FACE_EDGES[f])]
         for size in range(len(split) + 1):

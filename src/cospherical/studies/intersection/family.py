@@ -28,7 +28,7 @@ from ...core.configuration import Box
 from ...core.shapes import edge_axis
 from ...core.symmetry import box_symmetries, orbit_keys
 from ...errors import InputError
-from ...choices import INSERTION_ORDERS
+from ...choices import INSERTION_ORDERS, KeyBackend
 
 __all__ = ["INSERTION_ORDERS", "PARALLEL_EDGES", "all_configurations", "intersection_codes", "orbits", "set_patterns"]
 
@@ -72,7 +72,7 @@ def set_patterns(resolution: int = 16, order: str = "edge") -> list[tuple[int, i
     if resolution < 2 or resolution & (resolution - 1) or resolution > 16:
         raise InputError(f"resolution {resolution}: a power of two from 2 to 16")
     depth = resolution.bit_length() - 1
-    patterns = set()
+    patterns: set[tuple[int, int, int, int]] = set()
     for k in range(5):
         for carriers in combinations(range(4), k):
             for levels in _ordered_partitions(k) if k else [()]:
@@ -83,7 +83,7 @@ def set_patterns(resolution: int = 16, order: str = "edge") -> list[tuple[int, i
                     where = _positions(levels, order)
                     for edge, level in zip(carriers, levels):
                         digits[edge] = int(where[level] * 16)
-                patterns.add(tuple(digits))
+                patterns.add((digits[0], digits[1], digits[2], digits[3]))
     return sorted(patterns)
 
 
@@ -100,7 +100,7 @@ def intersection_codes(resolution: int = 16, order: str = "edge") -> np.ndarray:
     return grid.reshape(-1, 12)
 
 
-def orbits(resolution: int = 16, order: str = "edge", backend: str = "compiled") -> tuple[np.ndarray, np.ndarray, int]:
+def orbits(resolution: int = 16, order: str = "edge", backend: KeyBackend = "compiled") -> tuple[np.ndarray, np.ndarray, int]:
     """Orbit representatives (codes as base-16 numbers, sorted) with their sizes, and the configuration count.
 
     The family is not closed under the cube's symmetries (a reflected configuration

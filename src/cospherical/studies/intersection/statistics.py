@@ -52,7 +52,7 @@ def statistics(sizes: np.ndarray, cells: dict, element_of: np.ndarray, entries: 
 
     criteria = {}
     for criterion in ("optimal", *SPLIT_CRITERIA):
-        pieces = [(entry.type,) for entry in entries]
+        pieces: list[tuple[str, ...]] = [(entry.type,) for entry in entries]
         splits: dict[str, dict[tuple[str, ...], int]] = {}
         if criterion != "optimal":
             kept, chosen = choose_kept([entries[e].options[criterion] for e in used], [int(weight[e]) for e in used])
