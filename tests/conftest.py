@@ -14,6 +14,14 @@ def pytest_addoption(parser):
                      help="heavy oracles check every case, not the seeded sample the default run checks")
 
 
+def pytest_configure(config):
+    """Tell the helpers whether ``--full`` was given before the test modules are imported: a module's
+    hypothesis settings (test_fuzz.py's counts) are fixed when it is imported, before any fixture runs."""
+    import sampling
+
+    sampling.FULL = bool(config.getoption("--full", False))
+
+
 def pytest_sessionstart(session):
     """Under xdist, compile the numba kernels once, into their on-disk cache, before the workers start.
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 from examples import (ROOT, heavy_lines_without_figures, make_scratch, python_examples, run_python_example,
-                      run_shell_example, shell_examples)
+                      run_shell_example, shell_examples, smaller)
 
 DOCS = ROOT / "docs"
 PAGES = {path.relative_to(DOCS).as_posix(): path.read_text() for path in sorted(DOCS.rglob("*.md"))}
@@ -31,8 +31,10 @@ README_LINES = set(shell_examples((ROOT / "README.md").read_text()))
 # Not run here, and why: the set-up made this environment; the site build and the compiled
 # store reader are run by the tests below (test_site_builds_strict, test_c_reader_...); the leaf
 # study of the 1 x 2 x 4 box, the same command, by cli/test_study.py (test_study_leaves_json_and_tables),
-# which checks its output.
-NOT_RUN = ("scripts/setup.sh", "mkdocs ", "out/lookup out/", "cospherical study leaves --box 1 2 4 --format json --out ")
+# which checks its output; the bisection study of the 1 x 2 x 4 box as JSON into a folder by
+# cli/test_study.py (test_study_cli_json_shape: the same command with --compare-paper), which checks its output.
+NOT_RUN = ("scripts/setup.sh", "mkdocs ", "out/lookup out/", "cospherical study leaves --box 1 2 4 --format json --out ",
+           "cospherical study bisection --box 1 2 4 --format json --out ")
 MKDOCS = Path(sys.executable).parent / "mkdocs"
 
 
@@ -145,8 +147,15 @@ def test_every_benchmark_example_runs_at_a_small_size():
 
 
 def _docs_lines() -> list[str]:
+    """The lines to run: each command once as it runs (two lines that differ only in a size the ``SMALLER``
+    rules shrink, such as the intersection study's tables at R = 8 and R = 16, are one run)."""
     lines = dict.fromkeys(line for text in PAGES.values() for line in shell_examples(text))
-    return [line for line in lines if line not in README_LINES and not any(skip in line for skip in NOT_RUN)]
+    readme = {smaller(line) for line in README_LINES}
+    run = {}
+    for line in lines:
+        if smaller(line) not in readme and not any(skip in line for skip in NOT_RUN):
+            run.setdefault(smaller(line), line)
+    return list(run.values())
 
 
 @pytest.mark.parametrize("line", _docs_lines())

@@ -1,8 +1,9 @@
 """Fuzzing the readers and the command line: no input may fail with anything but the clean error.
 
 Counts (max_examples): codes 2500, Steiner maps 1500, Steiner lists 1000, YAML documents 2000,
-command lines 2000: 9,000 generated inputs per run (the number grammar and the box lengths are
-fuzzed where their module's tests are, core/test_exact.py).
+command lines 2000: 9,000 generated inputs with ``pytest --full``, a quarter of each count by default
+(``sampling.examples``: fresh inputs every run). The number grammar and the box lengths are fuzzed
+where their module's tests are, core/test_exact.py.
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from sampling import examples
+
 from cospherical import Configuration, InputError
 from cospherical.cli import main
 from cospherical.errors import FormatError
@@ -23,7 +26,7 @@ from cospherical.formats.patterns import table_from_data
 
 
 def fuzz(n: int):
-    return settings(max_examples=n, deadline=None, suppress_health_check=list(HealthCheck))
+    return settings(max_examples=examples(n), deadline=None, suppress_health_check=list(HealthCheck))
 
 
 HEX = "0123456789abcdefABCDEF"

@@ -185,10 +185,11 @@ def test_vtu_never_replaces_special_files(tmp_path, capsys, kind):
 def test_study_out_never_replaces_special_files(tmp_path, capsys):
     out = tmp_path / "out"
     out.mkdir()
-    os.mkfifo(out / "bisection-1x2x4.json")
-    (out / "bisection-1x2x4.yaml").symlink_to(tmp_path / "elsewhere.yaml")
-    refused(capsys, "study", "bisection", "--box", "1", "2", "4", "--out", out)
-    assert stat.S_ISFIFO(os.lstat(out / "bisection-1x2x4.json").st_mode)
+    # the tetrahedron's 64 configurations: the files are refused when written, whatever the study
+    os.mkfifo(out / "bisection-tetrahedron-1x1x1.json")
+    (out / "bisection-tetrahedron-1x1x1.yaml").symlink_to(tmp_path / "elsewhere.yaml")
+    refused(capsys, "study", "bisection", "--element", "tetrahedron", "--out", out)
+    assert stat.S_ISFIFO(os.lstat(out / "bisection-tetrahedron-1x1x1.json").st_mode)
     assert not (tmp_path / "elsewhere.yaml").exists()
 
 
@@ -558,16 +559,18 @@ def test_stale_temporaries_of_killed_runs_are_removed(tmp_path, capsys):
     out = tmp_path / "out"
     out.mkdir()
     stale = []
-    for name in ("bisection-1x2x4.json", "bisection-1x2x4.yaml"):  # what a killed run leaves: its marked files
+    # what a killed run leaves: its marked files (the tetrahedron's 64-configuration study writes them)
+    for name in ("bisection-tetrahedron-1x1x1.json", "bisection-tetrahedron-1x1x1.yaml"):
         fd, path = _new_temporary(out / name)
         os.close(fd)
         stale.append(path)
     # named like temporary files, but the user's: a name alone never gets a file removed
-    foreign = [out / ".other.txt.abcdefgh.tmp", out / "notes.tmp", out / ".bisection-1x2x4.json.tmp",
-               out / ".bisection-1x2x4.json.k3j_x9a2.tmp", out / ".bisection-1x2x4.yaml.1-2.tmp"]
+    foreign = [out / ".other.txt.abcdefgh.tmp", out / "notes.tmp", out / ".bisection-tetrahedron-1x1x1.json.tmp",
+               out / ".bisection-tetrahedron-1x1x1.json.k3j_x9a2.tmp",
+               out / ".bisection-tetrahedron-1x1x1.yaml.1-2.tmp"]
     for path in stale + foreign:
         path.write_text("x")
-    assert main(["study", "bisection", "--box", "1", "2", "4", "--out", str(out)]) == 0
+    assert main(["study", "bisection", "--element", "tetrahedron", "--out", str(out)]) == 0
     capsys.readouterr()
     assert not any(p.exists() for p in stale)
     assert all(p.exists() for p in foreign)

@@ -1,6 +1,7 @@
 """Exact numbers: the number grammar (``parse_rational``) and box lengths (``Length``), fuzzed.
 
-Counts (max_examples): number grammar 2000, box lengths 2500.
+Counts (max_examples): number grammar 2000, box lengths 2500 with ``pytest --full``; a quarter of
+each by default (``sampling.examples``: fresh inputs every run).
 """
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ import re
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from sampling import examples
 
 from cospherical import InputError, Length
 from cospherical.core.exact import parse_rational
@@ -22,7 +24,7 @@ LOOKALIKES = "\u0661\u0662\u0663\u06f1\u0967\uff10\uff11\uff12\u00b2\u2212\u00a0
 
 
 def fuzz(n: int):
-    return settings(max_examples=n, deadline=None, suppress_health_check=list(HealthCheck))
+    return settings(max_examples=examples(n), deadline=None, suppress_health_check=list(HealthCheck))
 
 
 @fuzz(2000)

@@ -12,14 +12,16 @@ from pathlib import Path
 import pytest
 import yaml
 from commands import cospherical
-from sampling import sampled_table
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from sampling import examples, sampled_table
 
 from cospherical import Box, Configuration, standard_shape, tessellate
 from cospherical.catalogue import catalogue_path, load_catalogue, shipped_catalogue
 from cospherical.errors import FormatError
 from cospherical.files.yamlio import dump_yaml, load_yaml
 from cospherical.formats.check import check_catalogue, check_patterns
-from cospherical.formats.patterns import load, pattern_name, write_patterns
+from cospherical.formats.patterns import entry_elements, load, pattern_name, write_patterns
 from cospherical.studies.engine import bisection_codes, run_study
 from cospherical.studies.leaves import leaf_codes
 from tests.core.test_shapes import SHAPES
@@ -89,9 +91,9 @@ def test_committed_tables_answer_as_the_previous_format(committed_tables):
     assert sorted(tables) == sorted(p.stem for p in (ROOT / "patterns").glob("*.yaml"))
     for stem, table in tables.items():
         digest = hashlib.sha256()
-        for code in table.configurations:
+        for code, entry in table.configurations.items():  # every entry read and validated, a chunk at a time
             for criterion in table.header["criteria"]:
-                digest.update(json.dumps([code, criterion, table.elements(code, criterion)]).encode())
+                digest.update(json.dumps([code, criterion, entry_elements(entry, criterion)]).encode())
         assert digest.hexdigest() == PREVIOUS_FORMAT_DIGESTS[stem], stem
 
 
@@ -212,3 +214,45 @@ def test_committed_shape_tables_pass_check(name):
             {"type": e.type.id, "nodes": list(e.nodes), "circumcenter": list(tess.circumcenter(e)),
              **({"mirror": True} if e.mirrored else {})} for e in tess.elements]
         assert table.configurations[code]["fvm_adequate"] == tess.fvm_adequate
+
+
+ELEMENT_VALUES = st.one_of(st.none(), st.booleans(), st.integers(-1, 28), st.floats(), st.text(max_size=3),
+                           st.sampled_from(["v4f4-8f0284", "v4f4-8f0284\n", "optimal", "internal_faces", 1.0]))
+
+
+@st.composite
+def _mutated_entries(draw):
+    """An entry of the committed cube table, with a few of its values, keys or lists changed."""
+    entry = copy.deepcopy(draw(st.sampled_from(_SOME_ENTRIES)))
+    for _ in range(draw(st.integers(0, 3))):
+        criterion = draw(st.sampled_from(sorted(entry)))
+        elements = entry[criterion]
+        if not (isinstance(elements, list) and elements and all(isinstance(e, dict) for e in elements)) \
+                or draw(st.booleans()):
+            entry[criterion] = draw(st.one_of(ELEMENT_VALUES, st.lists(ELEMENT_VALUES, max_size=2)))
+            continue
+        element = draw(st.sampled_from(elements))
+        field = draw(st.sampled_from(["type", "nodes", "circumcenter", "mirror", "other"]))
+        if field == "nodes" and draw(st.booleans()):
+            element["nodes"] = draw(st.lists(ELEMENT_VALUES, max_size=28))
+        else:
+            element[field] = draw(st.one_of(ELEMENT_VALUES, st.lists(ELEMENT_VALUES, max_size=4)))
+    return entry
+
+
+_CUBE_TABLE = load(PATTERNS / "bisection-1x1x1.yaml")
+_SOME_ENTRIES = [_CUBE_TABLE.configurations[code] for code in ("000000000000", "800000000000", "888888888888",
+                                                                "808080808080")]
+
+
+@settings(max_examples=examples(800), deadline=None, suppress_health_check=list(HealthCheck))
+@given(_mutated_entries(), st.sampled_from(["800000000000", "8000000000000", "80000000000g", "888888888888+f01"]))
+def test_the_plain_entry_rules_accept_only_what_the_schema_accepts(entry, code):
+    # formats/patterns.py checks entries by hand where it can, and leaves the rest to the schema's
+    # validator: what it accepts, the schema must accept too (the schema's verdict is the only one)
+    from cospherical.files.yamlio import validate
+    from cospherical.formats.patterns import _plainly_valid
+
+    data = {**_CUBE_TABLE.header, "configurations": {code: entry}}
+    if _plainly_valid(data, "t.yaml"):
+        validate(data, "patterns", "t.yaml")

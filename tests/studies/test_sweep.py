@@ -46,8 +46,8 @@ def test_each_threshold_holds_on_both_sides_and_at_itself(profiles, ray):
             assert (direct["fvm_adequate"], direct["types"]) == (step.fvm_adequate, len(step.types)), (ray, probe)
 
 
-def test_largest_fully_adequate_ratios():
-    summary = profile_summary(Ray.parse("1,r,r"), Fraction(1), Fraction(9, 5), ray_profile(Ray.parse("1,r,r"), Fraction(1), Fraction(9, 5)))
+def test_largest_fully_adequate_ratios(profiles):
+    summary = profile_summary(Ray.parse("1,r,r"), *RANGES["1,r,r"], profiles["1,r,r"])  # the fixture's profile
     assert summary["largest_fully_adequate"] == {"r": "sqrt(2)", "attained": True}
     # just above sqrt 2 some configuration fails
     assert box_statistics(("1", "1.4143", "1.4143"))["fvm_adequate"] < 4096

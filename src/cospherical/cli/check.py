@@ -36,6 +36,7 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     catalogue = None
+    measured: dict = {}  # elements measured once across the tables (one catalogue for all of them)
     for path in args.files:
         if path.suffix == ".npz":
             _check_dual(path)
@@ -49,7 +50,7 @@ def run(args) -> int:
             catalogue_file = args.catalogue or catalogue_path()
             catalogue = load_catalogue(catalogue_file)
             check_catalogue(catalogue, str(catalogue_file))
-        check_patterns(document, catalogue, str(path), tiling=not args.no_tiling)
+        check_patterns(document, catalogue, str(path), tiling=not args.no_tiling, measured=measured)
         say(f"{path}: ok, pattern table of {len(document.configurations)} configurations")
     return 0
 

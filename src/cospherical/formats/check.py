@@ -68,9 +68,12 @@ def _check_unique(data: dict, name: str) -> None:
             raise FormatError(f"{name}: types: {field} {repeated[0]!r} appears more than once")
 
 
-def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True) -> None:
-    """Check a loaded :class:`~cospherical.formats.patterns.PatternTable` against the catalogue and geometry."""
-    check = EntryCheck(table.header, catalogue, name, tiling)
+def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True, measured: dict | None = None) -> None:
+    """Check a loaded :class:`~cospherical.formats.patterns.PatternTable` against the catalogue and geometry.
+
+    ``measured``: a dict the checks of several tables share (against one catalogue), so that an
+    element that recurs across tables of the same box and base element is measured once."""
+    check = EntryCheck(table.header, catalogue, name, tiling, measured)
     for code, entry in table.configurations.items():
         check(code, entry)
 
@@ -93,10 +96,12 @@ class EntryCheck:
     :class:`FormatError` naming the table, the configuration and the element.
 
     An element (its type, mirror flag and points) recurs across a table's configurations
-    and criteria: it is measured once.
+    and criteria: it is measured once (once across tables too, given one ``measured`` dict
+    for the checks of several tables against the same catalogue).
     """
 
-    def __init__(self, header: dict, catalogue: dict | None, name: str, geometry: bool = True):
+    def __init__(self, header: dict, catalogue: dict | None, name: str, geometry: bool = True,
+                 measured: dict | None = None):
         self._types = {t["id"]: t for t in catalogue["types"]} if catalogue else None
         self._name = name
         self._geometry = geometry and bool(self._types)
@@ -108,7 +113,11 @@ class EntryCheck:
         self._scale = box.to_float()
         self._criteria = header["criteria"]
         self._family = base_element(header.get("element", "cuboid"), box, header["face_points"])
-        self._measured: dict[tuple, _Measured | str] = {}
+        # what an element's measure depends on besides its type, mirror flag and points
+        measured = {} if measured is None else measured
+        self._measured: dict[tuple, _Measured | str] = measured.setdefault(
+            (self._squared, self._family.shape, self._scale), {})
+        self._placed: dict[tuple, _Placed | str] = {}
 
     def __call__(self, code: str, entry: dict) -> None:
         where = f"{self._name}: configurations/{code}"
@@ -121,7 +130,7 @@ class EntryCheck:
         # Fractions would be most of the check's time.
         positions = {n: tuple((x.numerator, x.denominator) for x in point) for n, point in nodes.items()}
         checked: list = []
-        centers = []
+        inside = True
         for c, criterion in enumerate(self._criteria):
             elements = entry_elements(entry, criterion)
             if any(elements is other for other in checked):  # a reference to an earlier criterion's elements
@@ -129,29 +138,32 @@ class EntryCheck:
             checked.append(elements)
             measured = self._elements(elements, positions, cfg.shape, f"{where}/{criterion}")
             if c == 0:
-                centers = [m.center for m in measured]
+                inside = all(m.inside for m in measured)
         if self._geometry:
-            adequate = all(cfg.contains(center) for center in centers)
-            if entry["fvm_adequate"] != adequate:
-                raise FormatError(f"{where}: fvm_adequate is {entry['fvm_adequate']}, recomputed {adequate}")
+            if entry["fvm_adequate"] != inside:
+                raise FormatError(f"{where}: fvm_adequate is {entry['fvm_adequate']}, recomputed {inside}")
 
-    def _elements(self, elements: list, positions: dict, shape: Shape, where: str) -> list[_Measured]:
+    def _elements(self, elements: list, positions: dict, shape: Shape, where: str) -> list[_Placed]:
         """Check one criterion's elements (see the class); returns them measured."""
         measured = []
         total = Fraction(0)
         faces: Counter = Counter()  # (oriented face, on the boundary) -> the elements that have it
+        across: dict = {}  # a face inside the base element -> the same face seen from its other side
+        where_is = positions.get
         for k, element in enumerate(elements):
-            missing = [n for n in element["nodes"] if n not in positions]
-            if missing:
+            nodes = element["nodes"]
+            points = tuple(map(where_is, nodes))
+            if None in points:
+                missing = [n for n in nodes if n not in positions]
                 raise FormatError(f"{where}/{k}: node {missing[0]} is not a point of this configuration")
             if self._types is not None and element["type"] not in self._types:
                 raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
             if not self._geometry:
                 continue
-            found = self._measure(element, tuple(positions[n] for n in element["nodes"]), shape)
+            found = self._place(element, tuple(nodes), points, shape)
             if isinstance(found, str):
                 raise FormatError(f"{where}/{k}: {found}")
-            if [float(x) for x in element["circumcenter"]] != found.real_center:
+            if element["circumcenter"] != found.real_center:  # numbers (the schema): 1 == 1.0, as float() made them
                 raise FormatError(f"{where}/{k}: circumcenter {element['circumcenter']}, recomputed "
                                   f"{found.real_center}")
             total += found.volume
@@ -160,17 +172,27 @@ class EntryCheck:
             if total > shape.unit_volume:
                 raise FormatError(f"{where}: the elements do not fill the {_shape_name(shape)}: the first {k + 1} "
                                   f"already have volume {total} of {shape.unit_volume}")
-            nodes = element["nodes"]
-            for cycle, on_boundary in zip(found.faces, found.on_boundary):
-                faces[_turned(tuple(nodes[p] for p in cycle)), on_boundary] += 1
+            faces.update(found.faces)
+            across.update(found.across)
             measured.append(found)
         if not self._geometry:
             return measured
         if total != shape.unit_volume:
             raise FormatError(f"{where}: the elements do not fill the {_shape_name(shape)} "
                               f"(volume {total} of {shape.unit_volume})")
-        _check_faces(faces, where)
+        _check_faces(faces, across, where)
         return measured
+
+    def _place(self, element: dict, nodes: tuple, points: tuple, shape: Shape) -> _Placed | str:
+        """The element measured (once per type, mirror flag and points) and its faces in node ids
+        (once per node list at those points: the same nodes recur across a table's configurations)."""
+        mirror = bool(element.get("mirror"))
+        key = (element["type"], mirror, nodes, points)
+        placed = self._placed.get(key)
+        if placed is None:
+            found = self._measure(element, points, shape)
+            placed = self._placed[key] = found if isinstance(found, str) else _Placed.of(found, nodes, shape)
+        return placed
 
     def _measure(self, element: dict, points: tuple, shape: Shape) -> _Measured | str:
         key = (element["type"], bool(element.get("mirror")), points)
@@ -192,6 +214,24 @@ class _Measured:
     on_boundary: tuple[bool, ...]
     center: tuple[Fraction, Fraction, Fraction]
     real_center: list[float]
+
+
+@dataclass(frozen=True)
+class _Placed:
+    """A measured element at its nodes: what an entry's check sums and counts, made once."""
+
+    volume: Fraction
+    real_center: list[float]
+    inside: bool  # its exact circumcenter in the closed base element (the FVM test)
+    faces: tuple[tuple[tuple[int, ...], bool], ...]  # (oriented face in node ids, on the boundary)
+    across: dict  # each face inside the base element -> the same face from its other side
+
+    @classmethod
+    def of(cls, found: _Measured, nodes: tuple, shape: Shape) -> _Placed:
+        faces = tuple((_turned(tuple(nodes[p] for p in cycle)), on_boundary)
+                      for cycle, on_boundary in zip(found.faces, found.on_boundary))
+        across = {face: (_turned(face[0][::-1]), False) for face in faces if not face[1]}
+        return cls(found.volume, found.real_center, shape.contains(found.center), faces, across)
 
 
 def _measure_element(type_id: str, mirror: bool, points: tuple, squared, catalogued: dict, scale,
@@ -226,13 +266,15 @@ def _turned(cycle) -> tuple[int, ...]:
     return tuple(cycle[start:]) + tuple(cycle[:start])
 
 
-def _check_faces(faces: Counter, where: str) -> None:
+def _check_faces(faces: Counter, across: dict, where: str) -> None:
     """Elements that meet face to face: every face met once from each side, or once on the base
-    element's boundary (``faces``: (oriented face, on the boundary) -> how many elements have it)."""
-    for (face, on_boundary), count in faces.items():
+    element's boundary (``faces``: (oriented face, on the boundary) -> how many elements have it;
+    ``across``: a face inside the base element -> the same face seen from its other side)."""
+    for key, count in faces.items():
+        face = key[0]
         if count > 1:
             raise FormatError(f"{where}: face {list(face)} belongs to {count} elements on the same side: they overlap")
-        if not on_boundary and faces.get((_turned(face[::-1]), False)) != 1:
+        if not key[1] and faces.get(across[key]) != 1:
             raise FormatError(f"{where}: face {list(face)} has no element on its other side: the elements do not "
                               "meet face to face")
 
