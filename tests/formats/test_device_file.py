@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from cospherical.cli import main
+from cospherical.errors import FormatError
 from cospherical.formats.device_file import MAX_DEVICE_BYTES, parse_device, read_device
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "devices"
@@ -65,3 +66,12 @@ def test_a_device_does_not_take_a_tree_of_its_own(tmp_path, capsys):
 def test_numbers_stay_exact_and_names_are_data():
     device = parse_device("device: d\nregions:\n  - {name: 'a.b+c-1', material: 'x', boxes: [[0, 0, 0, 0.1, '1/2', 1e-1]]}\n")
     assert device.regions[0].boxes[0][3:] == (Fraction(1, 10), Fraction(1, 2), Fraction(1, 10))
+
+
+@pytest.mark.parametrize("number", ["010", "1:30", "0x10", "0b11", "1_0", "-07"])
+def test_an_integer_that_yaml_would_read_as_another_number_is_refused(number):
+    # YAML 1.1 reads 010 as 8 and 1:30 as 90: a coordinate would silently be another number
+    text = f"device: d\nregions:\n  - {{name: si, material: Si, boxes: [[0, 0, 0, {number}, 1, 1]]}}\n"
+    with pytest.raises(FormatError, match="is not a decimal integer"):
+        parse_device(text)
+    assert parse_device(text.replace(number, "10")).regions[0].boxes[0][3] == 10  # plain digits are read as written

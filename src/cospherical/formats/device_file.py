@@ -26,6 +26,7 @@ counts above) before anything is computed from it.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import yaml
@@ -62,6 +63,22 @@ class _ExactLoader(yaml.SafeLoader):
 
 
 _ExactLoader.add_constructor("tag:yaml.org,2002:float", lambda loader, node: loader.construct_scalar(node))
+
+# YAML 1.1 integers that are not what they look like: 010 is 8 (octal), 1:30 is 90 (base 60), 0x10 is 16
+_DECIMAL_INTEGER = re.compile(r"[-+]?(0|[1-9][0-9]*)")
+
+
+def _decimal_integer(loader, node) -> int:
+    """An integer written in decimal digits; YAML 1.1's other forms are refused rather than read as another number."""
+    text = loader.construct_scalar(node)
+    if not _DECIMAL_INTEGER.fullmatch(text):
+        raise yaml.constructor.ConstructorError(None, None, f"{text[:40]!r} is not a decimal integer (YAML reads 010 "
+                                                "as 8, 1:30 as 90, 0x10 as 16): write its decimal digits, without "
+                                                "leading zeros", node.start_mark)
+    return int(text)
+
+
+_ExactLoader.add_constructor("tag:yaml.org,2002:int", _decimal_integer)
 
 
 def read_device(path: str | Path) -> Device:
