@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -372,28 +372,61 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
     """No mesh vertex strictly inside any element's circumsphere, decided exactly.
 
     Returns a :class:`DelaunayCheck`: the counts of violations and ties and the elements
-    that are not cells of the Delaunay subdivision of the vertices.
+    that are not cells of the Delaunay subdivision of the vertices.  Four steps: every
+    element's sphere (:func:`_spheres`), the vertices floats find near each
+    (:func:`_candidates`, a k-d tree), each of those decided exactly
+    (:func:`_exact_sides`), and what the signs say (:func:`_found`).
 
     In a mesh with re-tessellated cells (:func:`~cospherical.mesh.delaunay.global_delaunay`)
     the leaf elements and the cells marked ``proven`` passed this check on the same
     vertex set when they were kept, so only the other cells are tested (and counted in
     ``delaunay_exact_tests``); ``progress`` is told of the others at once.
     """
-    from scipy.spatial import cKDTree
+    points = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+    spheres = _spheres(mesh, points)
+    if progress and mesh.cells is not None:
+        progress(len(mesh) - len(spheres.centers))
+    if not len(spheres.centers):
+        none = np.zeros(0, dtype=np.int64)
+        return DelaunayCheck(0, 0, 0, 0, 0, none, none, spheres.without_sphere)
+    pair_row, pair_vertex = _candidates(mesh, points, spheres, workers, progress)
+    return _found(mesh, spheres, pair_row, _exact_sides(mesh, spheres, pair_row, pair_vertex))
 
+
+class _Spheres(NamedTuple):
+    """The spheres :func:`check_delaunay` tests, one row each: a leaf element's or a fresh cell's.
+
+    ``tessellation``: the leaf's tessellation (-1: a cell); ``local``: the element in it (a
+    cell: its shape); ``leaf``: the leaf (a cell: its index among the cells); ``centers`` and
+    ``radii`` in real units (floats: they only propose); ``nodes``: the element's vertex
+    count; ``without_sphere``: the leaf elements that have none (not co-spherical), sorted.
+    """
+
+    tessellation: np.ndarray
+    local: np.ndarray
+    leaf: np.ndarray
+    centers: np.ndarray
+    radii: np.ndarray
+    nodes: np.ndarray
+    without_sphere: np.ndarray
+
+
+def _spheres(mesh: Mesh, points: np.ndarray) -> _Spheres:
+    """Every sphere to test: each leaf element's (a mesh without cells), else each fresh cell's.
+
+    The leaf elements kept beside re-tessellated cells, and the cells marked proven, passed
+    this very check on the same vertex set when they were chosen: only the other cells are
+    tested again.
+    """
     grid = mesh.grid
     scale = np.array(mesh.box.to_float()) / grid
-    points = mesh.vertices * scale
-    levels = mesh.tree.levels.astype(np.int64)
-    size = grid >> levels
+    size = grid >> mesh.tree.levels.astype(np.int64)
     origin = mesh.tree.positions.astype(np.int64) * size[:, None]
     rows_tessellation, rows_local, rows_leaf, centers, radii, n_nodes = [], [], [], [], [], []
     # A table element that is not co-spherical (a table may hold one) has no sphere to test, and
     # is not a cell of the Delaunay subdivision: it joins the elements that are not cells.
     without_sphere = [np.zeros(0, dtype=np.int64)]
     cells = mesh.cells
-    # the leaf elements kept beside re-tessellated cells, and the cells marked proven, passed this very
-    # check on the same vertex set when they were chosen: only the other cells are tested again
     for p, tessellation, leaves in (mesh.groups() if cells is None else ()):
         for j, element in enumerate(tessellation.elements):
             if element.sphere is None:  # reported by check_circumcenters as not co-spherical
@@ -422,14 +455,28 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
             centers.append(center)
             radii.append(np.sqrt(((first - center) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(rows), len(shape.offsets), dtype=np.int64))
-    if progress and cells is not None:
-        progress(len(mesh) - sum(len(c) for c in centers))
     if not sum(len(c) for c in centers):
         none = np.zeros(0, dtype=np.int64)
-        return DelaunayCheck(0, 0, 0, 0, 0, none, none, np.sort(np.concatenate(without_sphere)))
-    rows_tessellation, rows_local, rows_leaf = (np.concatenate(x) for x in (rows_tessellation, rows_local, rows_leaf))
-    centers, radii, n_nodes = np.concatenate(centers), np.concatenate(radii), np.concatenate(n_nodes)
-    reach = radii * (1 + 1e-9) + 1e-12 * float(np.abs(points).max())
+        return _Spheres(none.astype(np.int32), none.astype(np.int16), none, np.zeros((0, 3)), np.zeros(0), none,
+                        np.sort(np.concatenate(without_sphere)))
+    return _Spheres(np.concatenate(rows_tessellation), np.concatenate(rows_local), np.concatenate(rows_leaf),
+                    np.concatenate(centers), np.concatenate(radii), np.concatenate(n_nodes),
+                    np.sort(np.concatenate(without_sphere)))
+
+
+def _candidates(mesh: Mesh, points: np.ndarray, spheres: _Spheres, workers: int,
+                progress: Callable[[int], None] | None) -> tuple[np.ndarray, np.ndarray]:
+    """(sphere row, vertex) pairs to decide exactly: the vertices that floats put near a sphere, the
+    sphere's own nodes left out, for every sphere that does not hold exactly its own nodes.
+
+    A k-d tree of the vertices counts those within each sphere's radius (a hair more); the count
+    is the element's node count for a sphere with nothing else near it, and only the others
+    (the suspects) have their vertices listed and go to the exact test.
+    """
+    from scipy.spatial import cKDTree
+
+    centers = spheres.centers
+    reach = spheres.radii * (1 + 1e-9) + 1e-12 * float(np.abs(points).max())
     # Only vertices in the box around every reach can be within one: the rest are left out of the
     # search (a piece of a partitioned mesh holds all the vertices but searches its surroundings).
     low, high = (centers - reach[:, None]).min(axis=0), (centers + reach[:, None]).max(axis=0)
@@ -450,7 +497,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
         if progress:
             progress(len(part))
     # the element's own nodes are on its sphere; anything more (or less) is looked at exactly
-    suspect = np.flatnonzero(counts != n_nodes)
+    suspect = np.flatnonzero(counts != spheres.nodes)
     tests = int(counts[suspect].sum())
     if tests > _MAX_EXACT_TESTS:
         raise InputError(f"the exact Delaunay check needs {tests:,} sphere tests, above the bound of "
@@ -474,18 +521,27 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
     pair_row = np.concatenate(pairs_row) if pairs_row else np.zeros(0, dtype=np.int64)
     pair_vertex = np.concatenate(pairs_vertex) if pairs_vertex else np.zeros(0, dtype=np.int64)
     # drop each element's own nodes
-    is_cell = rows_tessellation[pair_row] < 0
+    is_cell = spheres.tessellation[pair_row] < 0
     own = np.zeros(len(pair_row), dtype=bool)
     leafy = np.flatnonzero(~is_cell)
-    leaf_of_pair = rows_leaf[pair_row[leafy]]
-    nodes = mesh.element_nodes(mesh.element_offsets[leaf_of_pair] + rows_local[pair_row[leafy]])
+    leaf_of_pair = spheres.leaf[pair_row[leafy]]
+    nodes = mesh.element_nodes(mesh.element_offsets[leaf_of_pair] + spheres.local[pair_row[leafy]])
     own[leafy] = (nodes == pair_vertex[leafy, None]).any(axis=1)
     celly = np.flatnonzero(is_cell)
     if len(celly):
-        own[celly] = (cells.nodes[rows_leaf[pair_row[celly]]] == pair_vertex[celly, None]).any(axis=1)
-    pair_row, pair_vertex = pair_row[~own], pair_vertex[~own]
+        own[celly] = (mesh.cells.nodes[spheres.leaf[pair_row[celly]]] == pair_vertex[celly, None]).any(axis=1)
+    return pair_row[~own], pair_vertex[~own]
+
+
+def _exact_sides(mesh: Mesh, spheres: _Spheres, pair_row: np.ndarray, pair_vertex: np.ndarray) -> np.ndarray:
+    """Per (sphere row, vertex) pair, where the vertex lies against the sphere, decided in integers in the
+    element's own frame: -1 strictly inside, 0 on it, 1 outside (int8)."""
+    cells = mesh.cells
+    size = mesh.grid >> mesh.tree.levels.astype(np.int64)
+    origin = mesh.tree.positions.astype(np.int64) * size[:, None]
     sides = np.zeros(len(pair_row), dtype=np.int8)
     weights = grid_weights(mesh)
+    rows_tessellation, rows_local, rows_leaf = spheres.tessellation, spheres.local, spheres.leaf
     for i, (row, vertex) in enumerate(zip(pair_row.tolist(), pair_vertex.tolist())):
         if rows_tessellation[row] < 0:
             shape = cells.shapes[rows_local[row]]
@@ -499,6 +555,15 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
             x = [tessellation.scale * (int(v) - int(o)) for v, o in zip(mesh.vertices[vertex], origin[leaf])]
             side = element.sphere.side_at(x, tessellation.weights, m)
         sides[i] = (side > 0) - (side < 0)
+    return sides
+
+
+def _found(mesh: Mesh, spheres: _Spheres, pair_row: np.ndarray, sides: np.ndarray) -> DelaunayCheck:
+    """What the exact sides of the (sphere row, vertex) pairs say: the violations, the ties, and the
+    elements that are not cells of the Delaunay subdivision (those violating or tying, and those
+    without a sphere)."""
+    cells = mesh.cells
+    rows_tessellation, rows_local, rows_leaf = spheres.tessellation, spheres.local, spheres.leaf
     inside = sides < 0
     bad_rows = distinct(pair_row[inside])
 
@@ -511,7 +576,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
     leaf_rows = bad_rows[rows_tessellation[bad_rows] >= 0]
     bad_leaves = distinct(np.r_[rows_leaf[leaf_rows], cells.leaf[rows_leaf[bad_rows[rows_tessellation[bad_rows] < 0]]]
                                  if cells is not None else np.zeros(0, dtype=np.int64)])
-    not_cells = np.sort(np.r_[elements(distinct(pair_row[sides <= 0])), np.concatenate(without_sphere)])
+    not_cells = np.sort(np.r_[elements(distinct(pair_row[sides <= 0])), spheres.without_sphere])
     return DelaunayCheck(int(len(bad_rows)), int(inside.sum()), int(len(bad_leaves)), int((sides == 0).sum()),
                          int(len(pair_row)), bad_leaves, elements(bad_rows), not_cells)
 
