@@ -30,6 +30,7 @@ SMALLER = [
     (re.compile(r"^(python benchmarks/bench_tessellate.py)"), r"\1 --samples 5"),
     (re.compile(r"^(python benchmarks/bench_mesh.py)"), r"\1 --levels 4"),
     (re.compile(r"^(python benchmarks/bench_regions.py)"), r"\1 --levels 4"),
+    (re.compile(r"^(python benchmarks/bench_devices.py).*"), r"\1 --levels 4"),
     (re.compile(r"^(python benchmarks/bench_scale.py)"), r"\1 --levels 3"),  # L 10 is two processes of minutes and GBs
     (re.compile(r"^(python benchmarks/bench_outputs.py)"), r"\1 --levels 3"),
     (re.compile(r"^(python benchmarks/bench_startup.py)"), r"\1 --runs 1 --every 64 --tables 'bisection-tetra*'"),

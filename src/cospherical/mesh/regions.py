@@ -258,7 +258,8 @@ class _Vertices:
 def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_region: np.ndarray,
                  names: tuple[str, ...], materials: tuple[str, ...], contacts: tuple = (),
                  contact_face_nodes: np.ndarray | None = None, contact_face_contact: np.ndarray | None = None,
-                 lengths: tuple[Fraction, Fraction, Fraction] | None = None, origin=("0", "0", "0")) -> RegionParts:
+                 lengths: tuple[Fraction, Fraction, Fraction] | None = None, origin=("0", "0", "0"),
+                 region_duals: list[Dual] | None = None) -> RegionParts:
     """The dual of each region's elements alone (exact), as parts of ``dual`` (see :class:`RegionParts`).
 
     A region's part of a control volume or of a coupling is the dual of its own
@@ -267,14 +268,17 @@ def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_regio
     exactly.  ``contacts``: per contact ``(name, region index, box texts, axis)``, with
     its faces; a face's area goes to its vertices as the box method's boundary pieces
     do (the triangles between each vertex, its edges' midpoints and the face's circle
-    centre), exactly; ``lengths``: the bounding box's rational lengths.
+    centre), exactly; ``lengths``: the bounding box's rational lengths.  ``region_duals``:
+    each region's dual when the caller has it (:func:`mesh_region_parts` computes it leaf
+    configuration by configuration, much faster than from the element list).
     """
     keys = dual.edges[:, 0].astype(np.int64) * len(vertices) + dual.edges[:, 1]
     mesh = _Vertices(box, grid, vertices)
     vv, vr, ve, ce, cr, cx, vden, cden = [], [], [], [], [], [], [], []
     for r in range(len(names)):
         rows = np.flatnonzero(element_region == r)
-        part = mesh_dual(mesh, (dual.element_nodes[rows], dual.element_sizes[rows]))
+        part = region_duals[r] if region_duals is not None else \
+            mesh_dual(mesh, (dual.element_nodes[rows], dual.element_sizes[rows]))
         used = np.flatnonzero(np.asarray(part.volume_exact != 0) | _used(dual.element_nodes[rows], len(vertices)))
         vv.append(used)
         vr.append(np.full(len(used), r, dtype=np.int32))
@@ -380,9 +384,26 @@ def mesh_region_parts(mesh: Mesh, dual: Dual, faces: RegionFaces) -> RegionParts
     names = [r.name for r in device.regions]
     contacts = tuple((c.name, names.index(c.region), tuple(str(x) for x in c.box), c.axis) for c in device.contacts)
     lengths = tuple(high - low for low, high in device.bounds)
+    duals = [mesh_dual(_region_mesh(mesh, r)) for r in range(len(names))]
     return region_parts(mesh.box, mesh.grid, mesh.vertices, dual, mesh.element_region, mesh.regions.names,
                         mesh.regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths,
-                        device.origin)
+                        device.origin, duals)
+
+
+def _region_mesh(mesh: Mesh, region: int) -> Mesh:
+    """The mesh of one region's elements alone (the other leaves marked replaced, the other cells left out)."""
+    leaf_region = mesh.regions.leaf_region
+    other = leaf_region != region
+    if mesh.replaced is not None:
+        other = other | mesh.replaced
+    cells = mesh.cells
+    if cells is None:
+        cells = Cells([], np.zeros(0, np.int32), np.zeros((0, 3), np.int64), np.zeros((0, 4), np.int32),
+                      np.zeros(0, np.int64), np.zeros(0, bool), np.zeros(0, bool))
+    rows = np.flatnonzero(leaf_region[cells.leaf] == region)
+    mine = Cells(cells.shapes, cells.shape[rows], cells.anchor[rows], cells.nodes[rows], cells.leaf[rows],
+                 cells.spanning[rows], cells.proven[rows], cells.clusters, cells.largest_cluster)
+    return with_cells(mesh, other, mine, mesh.types)
 
 
 def region_volumes(mesh: Mesh) -> list[Fraction]:

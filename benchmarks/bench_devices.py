@@ -1,0 +1,87 @@
+"""Devices: time and memory of the example devices, and a diode beside the one-box mesh of the same size.
+
+    python benchmarks/bench_devices.py [--levels 7]
+
+Whole processes, each measured by the kernel (``os.wait4``: user + system CPU, peak
+resident memory) and by the wall clock, every output written (``--dual --out``):
+
+(1) ``cospherical mesh --device examples/devices/NAME.yaml --dual --out DIR`` for each
+    example device, as shipped;
+(2) the pn diode (one silicon cube refined at its junction plane z = 1/2, two contacts)
+    at ``--levels L`` against ``cospherical mesh --domain 1 1 1 --refine plane:0,0,1,0.5
+    --levels L --dual --out DIR``, the same tree and the same elements as one box: what a
+    device adds (its region arrays, the dual's parts per region, the contact and interface
+    faces, contacts.vtu) over a mesh without regions.  The goal: the device at most 1.3
+    times the box's CPU.  Level 7 gives 164 k elements; level 8 about 650 k and level 9
+    about 2.6 M (minutes and GBs: run them on a quiet machine).
+
+Writes results/benchmarks/bench_devices.json (benchmarks/record.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from record import recorded  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples" / "devices"
+
+
+def run_usage(command: list[str]) -> tuple[float, float, float]:
+    """Wall seconds, CPU seconds (user + system) and peak GB of one whole process (``os.wait4``)."""
+    start = time.perf_counter()
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        process = subprocess.Popen(command, stdout=out, stderr=err, text=True)
+        _, status, usage = os.wait4(process.pid, 0)
+        wall = time.perf_counter() - start
+        if os.waitstatus_to_exitcode(status):
+            err.seek(0)
+            sys.exit(f"{' '.join(command)}: {err.read().strip()[-500:]}")
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024**2
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--levels", type=int, default=7, help="the diode's level for the comparison (default 7)")
+    args = parser.parse_args()
+    cospherical = [sys.executable, "-m", "cospherical", "mesh"]
+    with recorded(__file__) as record, tempfile.TemporaryDirectory() as scratch:
+        rows = []
+        for path in sorted(EXAMPLES.glob("*.yaml")):
+            out = Path(scratch) / path.stem
+            wall, cpu, peak = run_usage(cospherical + ["--device", str(path), "--dual", "--out", str(out)])
+            report = json.loads((out / "report.json").read_text())
+            rows.append([path.stem, f"{report['elements']:,}", f"{cpu:.2f}", f"{wall:.2f}", f"{peak:.2f}"])
+            print(f"{path.stem:14s} {report['elements']:>9,} elements  {cpu:6.2f} CPU-s  {wall:6.2f} s  {peak:.2f} GB")
+        record.table(["example", "elements", "CPU s", "wall s", "peak GB"], rows)
+        diode = Path(scratch) / "diode.yaml"
+        diode.write_text((EXAMPLES / "pn-diode.yaml").read_text().replace("levels: 5", f"levels: {args.levels}"))
+        pair = {}
+        for name, command in (("one box", ["--domain", "1", "1", "1", "--refine", "plane:0,0,1,0.5",
+                                           "--levels", str(args.levels), "--no-uniform"]),
+                              ("diode device", ["--device", str(diode), "--no-uniform"])):
+            out = Path(scratch) / name.replace(" ", "-")
+            pair[name] = run_usage(cospherical + command + ["--dual", "--out", str(out)])
+            elements = json.loads((out / "report.json").read_text())["elements"]
+            wall, cpu, peak = pair[name]
+            print(f"{name:14s} level {args.levels}: {elements:,} elements  {cpu:6.2f} CPU-s  {wall:6.2f} s  "
+                  f"{peak:.2f} GB")
+            record.add(f"{name}, level {args.levels} ({elements:,} elements, --dual --out)",
+                       f"{cpu:.2f} CPU-s, {wall:.2f} s wall, {peak:.2f} GB peak")
+        ratio = pair["diode device"][1] / pair["one box"][1]
+        memory = pair["diode device"][2] / pair["one box"][2]
+        print(f"device / box: {ratio:.2f} x CPU, {memory:.2f} x peak memory (goal: CPU at most 1.3 x)")
+        record.add("diode device / one box", f"{ratio:.2f} x CPU, {memory:.2f} x peak memory (goal: CPU <= 1.3 x)")
+
+
+if __name__ == "__main__":
+    main()
