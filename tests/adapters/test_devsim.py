@@ -174,3 +174,19 @@ def test_devsim_missing_is_one_line(monkeypatch, graded):
     monkeypatch.setitem(sys.modules, "devsim_openblas", None)
     with pytest.raises(InputError, match=r"DEVSIM is not installed.*cospherical\[devsim\]"):
         create_device(graded, device="absent")
+
+
+def test_a_failure_half_way_leaves_no_device_behind(devsim, graded, monkeypatch):
+    """An error after DEVSIM made the mesh (here in installing the dual) removes what was made: the name is free."""
+    import cospherical.adapters.devsim as adapter
+
+    def fail(*args, **kwargs):
+        raise InputError("stop")
+
+    monkeypatch.setattr(adapter, "_install_dual", fail)
+    with pytest.raises(InputError, match="stop"):
+        create_device(graded, device="half")
+    assert "half" not in devsim.get_device_list() and "half" not in devsim.get_mesh_list()
+    monkeypatch.undo()
+    handed = create_device(graded, device="half")
+    drop(devsim, handed.name)

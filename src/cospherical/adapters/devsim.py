@@ -234,9 +234,17 @@ def create_device(mesh, device: str = "device", contacts=None, material: str = "
             for name in simplices.volumes:
                 node_ids[name], edge_ids[name] = _install_dual(devsim, device, name, points, source.dual,
                                                                source.geometry[name], float(scale))
-    except devsim.error as error:
-        text = " ".join(str(error).split())
-        raise InputError(f"DEVSIM refused the mesh of device {shown(device)}: {text[:200]}") from None
+    except BaseException as error:
+        # nothing half made: DEVSIM keeps what it was given, a later call of the same name would be refused
+        with contextlib.redirect_stdout(io.StringIO()):
+            if device in devsim.get_device_list():
+                devsim.delete_device(device=device)
+            if device in devsim.get_mesh_list():
+                devsim.delete_mesh(mesh=device)
+        if isinstance(error, devsim.error):
+            text = " ".join(str(error).split())
+            raise InputError(f"DEVSIM refused the mesh of device {shown(device)}: {text[:200]}") from None
+        raise
     return DevsimDevice(device, tuple(simplices.volumes), contacts, simplices, source.dual, node_ids, edge_ids,
                         tuple(interfaces), log.getvalue())
 
