@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from typing import Sequence
 from pathlib import Path
 
 from ..core.canonical import canonical_form
@@ -81,7 +82,7 @@ def intersection_examples(path: str | Path | None = None) -> list[dict]:
     return found
 
 
-def build_catalogue(studies, extra: list[dict] = ()) -> dict:
+def build_catalogue(studies, extra: Sequence[dict] = ()) -> dict:
     """The catalogue of every element type met in the studies, as YAML-ready data.
 
     ``extra``: examples of further types (:func:`intersection_examples`), after the studies'.

@@ -177,6 +177,7 @@ def choose_kept(instances: Sequence[Sequence[tuple[str, ...]]], weights: Sequenc
         total = sum(weight * len(options[i]) for weight, options, i in zip(weights, instances, chosen))
         if best is None or (total, sorted(kept)) < best[0]:
             best = ((total, sorted(kept)), kept, chosen)
+    assert best is not None, "minimal_kept_sets gives at least one set"
     return best[1], best[2]
 
 

@@ -67,7 +67,7 @@ def write_pattern_table(run, catalogue_version: str, yaml_path=None, store=None)
     with (atomic_open(yaml_path) if yaml_path else nullcontext()) as handle:
         if handle:
             handle.write(yaml_text(header) + "configurations:\n")
-        if store:
+        if store and dictionary is not None:  # made above exactly when there is a store
             write_store(store, header, dictionary, rows_in_order(handle))
         else:
             for _ in rows_in_order(handle):

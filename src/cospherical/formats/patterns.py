@@ -216,7 +216,7 @@ class PatternTable:
     header: dict
     configurations: Mapping[str, dict]
 
-    def elements(self, code: str, criterion: str = "optimal") -> list[dict]:
+    def elements(self, code: str, criterion: str = "optimal") -> list[dict] | None:
         """The elements of one configuration: dicts with ``type``, ``nodes``, ``circumcenter``.
 
         A code the table does not hold, or that is not a string, raises :class:`KeyError`

@@ -44,7 +44,7 @@ LEVEL = 1
 
 def _compressed(array: np.ndarray) -> bytes:
     """An array in VTK's compressed layout: (blocks, block size, last block size, compressed sizes), blocks."""
-    raw = memoryview(np.ascontiguousarray(array).view(np.uint8).reshape(-1))
+    raw = np.ascontiguousarray(array).view(np.uint8).reshape(-1).data  # a memoryview of the bytes
     blocks = [zlib.compress(raw[i:i + BLOCK], LEVEL) for i in range(0, len(raw), BLOCK)]
     header = np.array([len(blocks), BLOCK, len(raw) % BLOCK] + [len(b) for b in blocks], dtype="<u8")
     return header.tobytes() + b"".join(blocks)
@@ -84,6 +84,8 @@ def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, con
     and the points) and ``faceoffsets`` where that stream ends (-1 for other cells).
     Data arrays have one row per point, per cell, or any length (field data).
     """
+    if (faces is None) != (faceoffsets is None):
+        raise ValueError("write_grid: faces and faceoffsets go together")
     arrays: list[tuple[str, list[tuple[str, np.ndarray, int]]]] = [
         ("FieldData", [_array(k, v) for k, v in (field_data or {}).items()]),
         ("PointData", [_array(k, v) for k, v in (point_data or {}).items()]),
@@ -91,7 +93,8 @@ def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, con
         ("Points", [_array("Points", np.asarray(points, dtype=np.float64))]),
         ("Cells", [_array("connectivity", narrow(connectivity)), _array("offsets", narrow(offsets)),
                    _array("types", np.asarray(cell_types, dtype=np.uint8))]
-         + ([_array("faces", narrow(faces)), _array("faceoffsets", narrow(faceoffsets))] if faces is not None else [])),
+         + ([_array("faces", narrow(faces)), _array("faceoffsets", narrow(faceoffsets))]
+            if faces is not None and faceoffsets is not None else [])),
     ]
     n_points, n_cells = len(points), len(cell_types)
     for section, items in arrays[1:3]:
@@ -145,7 +148,7 @@ def write_vtu(tess: Tessellation, path: str | Path) -> None:
     for element in tess.elements:
         connectivity += [index[n] for n in element.nodes]
         offsets.append(len(connectivity))
-        types.append(VTK_CELL[element.type.vtk if standard else "polyhedron"])
+        types.append(VTK_CELL[(element.type.vtk if standard else None) or "polyhedron"])
         if not standard:
             faces.append(len(element.polyhedron.faces))
             for face in element.polyhedron.faces:

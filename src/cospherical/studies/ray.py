@@ -41,7 +41,8 @@ class Ray:
         parts = [p.strip().lower() for p in text.split(",")]
         if len(parts) != 3 or any(p not in ("1", "r") for p in parts) or "r" not in parts:
             raise InputError(f"ray {text!r}: write three lengths, each 1 or r, for example 1,r,r")
-        return cls(tuple(p == "r" for p in parts))
+        a, b, c = (p == "r" for p in parts)
+        return cls((a, b, c))
 
     @property
     def text(self) -> str:
@@ -52,11 +53,13 @@ class Ray:
 
     @property
     def w0(self) -> tuple[int, int, int]:
-        return tuple(0 if s else 1 for s in self.scaled)
+        a, b, c = (0 if s else 1 for s in self.scaled)
+        return (a, b, c)
 
     @property
     def w1(self) -> tuple[int, int, int]:
-        return tuple(1 if s else 0 for s in self.scaled)
+        a, b, c = (1 if s else 0 for s in self.scaled)
+        return (a, b, c)
 
 
 class _Critical(Exception):
@@ -77,7 +80,9 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
     for element in tess.elements:
         members = [index[n] for n in element.polyhedron.nodes]
         quad = f0.spanning(members)
+        assert quad is not None, "a Delaunay element is solid"
         s0, s1 = f0.sphere(*quad), f1.sphere(*quad)
+        assert s0 is not None and s1 is not None, "four points that span a solid lie on one sphere"
         for x in range(len(f0.ids)):
             a, b = s0.side(f0.lifted[x]), s1.side(f1.lifted[x])
             if x in members:
