@@ -186,61 +186,6 @@ def test_a_full_disk_leaves_the_old_file(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["mesh.vtu"]
 
 
-@pytest.mark.oracle_vtk
-def test_the_picture_cuts_what_vtk_cuts(tmp_path):
-    """The picture's sections are VTK's cut of the same grid by the same plane (vtkCutter), element for element."""
-    from cospherical.outputs.mesh_picture import cut_polygons
-
-    mesh = mixed_mesh()
-    write_vtu(mesh, tmp_path / "mesh.vtu")
-    at = 0.3
-    polygons, types = cut_polygons(mesh, at)
-    plane = vtk.vtkPlane()
-    plane.SetOrigin(0, 0, (round(at * mesh.grid) + 1 / 3) / mesh.grid)
-    plane.SetNormal(0, 0, 1)
-    cutter = vtk.vtkCutter()
-    cutter.SetCutFunction(plane)
-    cutter.SetInputData(read_vtk(tmp_path / "mesh.vtu"))
-    sizes = vtk.vtkCellSizeFilter()
-    sizes.SetInputConnection(cutter.GetOutputPort())
-    sizes.Update()
-    cut = sizes.GetOutput()
-    element = vtk_to_numpy(cut.GetCellData().GetArray("element"))
-    area = np.bincount(element, vtk_to_numpy(cut.GetCellData().GetArray("Area")), minlength=len(mesh))
-    theirs = np.sort(area[area > 0])
-
-    def shoelace(p):
-        x, y = p[:, 0], p[:, 1]
-        return 0.5 * (x * np.roll(y, -1) - np.roll(x, -1) * y).sum()
-
-    ours = np.array([shoelace(p) for p in polygons])
-    assert (ours > 0).all()  # convex, counter-clockwise
-    assert len(ours) == len(theirs) == len(types)
-    assert np.allclose(np.sort(ours), theirs, rtol=1e-9, atol=1e-15)
-    assert abs(ours.sum() - 1) < 1e-12
-    # the picture shows these sections: deep inside each (2 pixels from every side), its type's colour
-    from PIL import Image
-
-    from cospherical.outputs.mesh_picture import TAB20, cut_png, frame
-
-    cut_png(mesh, tmp_path / "mesh.png", at=at)
-    pixels = np.asarray(Image.open(tmp_path / "mesh.png").convert("RGB"))
-    _, _, x0, y0, scale = frame(1.0, 1.0)
-    commonest = sorted(set(types), key=lambda t: (-types.count(t), t))
-    checked = 0
-    for polygon, t in zip(polygons, types):
-        corners = np.c_[x0 + polygon[:, 0] * scale, y0 + (1 - polygon[:, 1]) * scale]  # pixel space
-        center = corners.mean(axis=0)
-        edges = np.roll(corners, -1, axis=0) - corners
-        to_center = center - corners
-        # distance of the centre from each edge's line: |2-D cross product| / edge length
-        away = np.abs(edges[:, 0] * to_center[:, 1] - edges[:, 1] * to_center[:, 0]) / np.hypot(*edges.T)
-        if away.min() > 2:
-            assert tuple(pixels[int(center[1]), int(center[0])]) == TAB20[commonest.index(t) % 20]
-            checked += 1
-    assert checked > len(polygons) / 2
-
-
 def test_text_leaf_list(tmp_path):
     path = tmp_path / "leaves.txt"
     path.write_text("# octant\n" + "\n".join(" ".join(map(str, leaf)) for leaf in OCTANT) + "\n")
