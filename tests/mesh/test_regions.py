@@ -172,6 +172,19 @@ def test_example_devices_pass_the_oracle(example, tmp_path):
     assert report.volume_ok and report.nonconforming_faces == 0
     device = report.device
     assert all(r["volume_ok"] for r in device["regions"]) and all(c["area_ok"] for c in device["contacts"])
+    # mesh.vtu read by VTK: each cell's region, the names in field data
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(tmp_path / "mesh.vtu"))
+    reader.Update()
+    grid = reader.GetOutput()
+    element = vtk_to_numpy(grid.GetCellData().GetArray("element"))
+    region = vtk_to_numpy(grid.GetCellData().GetArray("region"))
+    assert np.array_equal(region, m.assembled.element_region[element])
+    names = bytes(vtk_to_numpy(grid.GetFieldData().GetArray("region_names"))).decode().split("\n")
+    assert names == [r["name"] for r in yaml.safe_load(example.read_text())["regions"]]
 
 
 @st.composite
@@ -264,3 +277,76 @@ def test_check_proves_the_region_parts_and_refuses_altered_ones(mos_dual, tmp_pa
         assert main(["check", str(target)]) == 2
         err = capsys.readouterr().err
         assert len(err.strip().splitlines()) == 1 and name.rsplit("_", 1)[0] in err, err
+
+
+_STACK = """device: stack
+regions:
+  - {name: a, material: Si, boxes: [[0, 0, 0, 1, 2, 2]]}
+  - {name: b, material: Ox, boxes: [[0, 0, 2, 1, 2, 3], [0, 0, 3, 1, 2, 4]]}
+refine: [{point: [0.1, 0.1, 1.9]}]
+levels: 4
+"""
+
+
+@pytest.mark.parametrize("source", ["stack", "fin"])
+def test_within_each_box_every_element_is_an_empty_sphere_of_the_box_vertices(source, tmp_path):
+    """What the devices page promises, decided here with Fractions: each element's nodes lie on one sphere that
+    holds no vertex of the element's own box strictly inside, nor on it but the element's nodes.  The 1 x 2 x 4
+    stack has leaves that are not cubes (its leaf mesh is not Delaunay: cells are re-tessellated per box)."""
+    path = tmp_path / "device.yaml"
+    path.write_text(_STACK if source == "stack" else (EXAMPLES[0].parent / "fin.yaml").read_text())
+    m = build_mesh(device=path, uniform=False)
+    if source == "stack":
+        assert m.report.regions_retessellated >= 1
+    regions, _, low, length = _device_boxes(yaml.safe_load(path.read_text()))
+    mesh = m.assembled
+    grid = mesh.grid
+    # integer coordinates proportional to the real ones (the box's lengths are rational)
+    scale = [Fraction(x) / grid for x in length]
+    common = 1
+    for s in scale:
+        common = common * s.denominator // np.gcd(common, s.denominator)
+    factor = [int(s * common) for s in scale]
+    points = [[int(g) * f for g, f in zip(row, factor)] for row in mesh.vertices.tolist()]
+    boxes = [[int((b[i] - low[i % 3]) / length[i % 3] * grid) for i in range(6)] for r in regions for b in r]
+    members = [np.flatnonzero(np.all((mesh.vertices >= b[:3]) & (mesh.vertices <= b[3:]), axis=1)) for b in boxes]
+    real = np.array(points, dtype=np.float64)
+    conn, sizes = mesh.connectivity()
+    checked = 0
+    for nodes in conn.tolist():
+        nodes = [v for v in nodes if v >= 0]
+        quad = [sum(mesh.vertices[v][a] for v in nodes) for a in range(3)]
+        box = next(k for k, b in enumerate(boxes) if all(b[a] * len(nodes) <= quad[a] <= b[a + 3] * len(nodes)
+                                                         for a in range(3)))
+        p = [points[v] for v in nodes]
+        centre = _circumcentre(p)
+        radius = sum((x - c) ** 2 for x, c in zip(p[0], centre))
+        assert all(sum((x - c) ** 2 for x, c in zip(q, centre)) == radius for q in p)
+        own = set(nodes)
+        # floats only narrow the vertices down (a wide margin); each one near the sphere is decided exactly
+        near = members[box][((real[members[box]] - [float(c) for c in centre]) ** 2).sum(axis=1)
+                            <= float(radius) * (1 + 1e-6) + 1e-9]
+        for v in near.tolist():
+            if v not in own:
+                assert sum((x - c) ** 2 for x, c in zip(points[v], centre)) > radius
+        checked += 1
+    assert checked == len(mesh)
+
+
+def _circumcentre(p: list[list[int]]) -> list[Fraction]:
+    """The centre of the sphere through the first four affinely independent points (Cramer's rule, exact)."""
+    import itertools
+
+    for i, j, k in itertools.combinations(range(1, len(p)), 3):
+        rows = [[2 * (q[a] - p[0][a]) for a in range(3)] for q in (p[i], p[j], p[k])]
+        rhs = [sum(x * x for x in q) - sum(x * x for x in p[0]) for q in (p[i], p[j], p[k])]
+        det = _det(rows)
+        if det:
+            return [Fraction(_det([[rhs[r] if c == a else rows[r][c] for c in range(3)] for r in range(3)]), det)
+                    for a in range(3)]
+    raise AssertionError("a flat element")
+
+
+def _det(m: list[list[int]]) -> int:
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
