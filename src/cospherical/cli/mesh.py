@@ -252,6 +252,8 @@ def _run(args, out: OutputFolder | None) -> int:
 _BARS = {"assembly": ("assembling", "leaf"), "regions": ("Delaunay check (leaf mesh)", "element"),
          "delaunay": ("Delaunay check", "element")}
 _LARGE_TREE = 50_000
+# --partitions: a piece takes seconds on any tree worth cutting, so its bars are drawn whatever the size
+_PIECE_BARS = {"pieces": ("meshing pieces", "piece"), "again": ("pieces re-tessellated across seams", "piece")}
 
 
 @contextmanager
@@ -321,12 +323,18 @@ def _in_pieces(args, source: TreeSource, out: OutputFolder | None) -> int:
 
     pieces = int(args.partitions)
     paths = [str(out.path(piece_name(k))) for k in range(pieces)] if out is not None else None
-    report = mesh_in_pieces(tree, pieces, (table_lookup, table) if table is not None else None, args.criterion,
-                            mode, described, args.patterns.name if args.patterns else None,
-                            uniform=not args.no_uniform, delaunay=not args.no_delaunay,
-                            write=write if out is not None else None,
-                            path=paths.__getitem__ if paths is not None else None, jobs=args.jobs,
-                            scheduler=args.scheduler, dask_workers=args.dask_workers)
+    stages: dict[str, tuple[int | None, str, str]] = {}
+    with stage_bars(stages) as advance:  # a bar per round of pieces, advanced as each piece finishes
+        def progress(stage: str, total: int, n: int) -> None:
+            stages.setdefault(stage, (total, *_PIECE_BARS[stage]))
+            advance(stage, n)
+
+        report = mesh_in_pieces(tree, pieces, (table_lookup, table) if table is not None else None, args.criterion,
+                                mode, described, args.patterns.name if args.patterns else None,
+                                uniform=not args.no_uniform, delaunay=not args.no_delaunay,
+                                write=write if out is not None else None,
+                                path=paths.__getitem__ if paths is not None else None, jobs=args.jobs,
+                                scheduler=args.scheduler, dask_workers=args.dask_workers, progress=progress)
     if out is not None:
         write_pvtu(out.path("mesh.pvtu"), [Path(p) for p in paths])
         write_report(report, out.path("report.json"))

@@ -148,13 +148,17 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: 
 def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: str, mode: str,
                    described: dict, patterns: str | None, uniform: bool = True, delaunay: bool = True,
                    write: Callable | None = None, path: Callable[[int], str] | None = None, jobs: int = 1,
-                   scheduler: str | None = None, dask_workers: int | None = None, catalogue: dict | None = None) -> dict:
+                   scheduler: str | None = None, dask_workers: int | None = None, catalogue: dict | None = None,
+                   progress: Callable[[str, int, int], None] | None = None) -> dict:
     """Mesh ``tree`` in ``pieces`` tasks (each writing ``path(k)`` with ``write``); return the whole mesh's report.
 
     ``lookup``: ``(factory, arguments)`` of the pattern lookup (``None``: every
     configuration tessellated); ``jobs``, ``scheduler``, ``dask_workers``: where the
     tasks run (:func:`~cospherical.execution.backends.completed`); ``catalogue``: the
     element catalogue (default: the shipped one), as in :func:`~cospherical.mesh.assembly.assemble`.
+    ``progress(stage, total, n)``: told as the pieces finish, on whichever backend, ``n`` more of
+    ``total``; stage ``pieces`` (every piece, told with 0 when they start) and ``again`` (the
+    pieces whose leaves are re-tessellated across the seams, a second round).
     """
     catalogue = shipped_catalogue() if catalogue is None else catalogue
     grid, keys = vertex_keys(tree)
@@ -165,8 +169,16 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
         return (Piece(k, tree.box, tree.levels[leaves], tree.positions[leaves], leaves, grid, criterion, mode,
                       delaunay, write, path(k) if path is not None else None, **more),)
 
-    results = dict(completed(mesh_piece, {k: task(k) for k in range(pieces)}, jobs, scheduler, dask_workers,
-                             common=(keys, lookup, catalogue)))
+    def told(stage: str, total: int, finished):
+        if progress is not None:
+            progress(stage, total, 0)
+        for item in finished:
+            if progress is not None:
+                progress(stage, total, 1)
+            yield item
+
+    results = dict(told("pieces", pieces, completed(mesh_piece, {k: task(k) for k in range(pieces)}, jobs, scheduler,
+                                                    dask_workers, common=(keys, lookup, catalogue))))
     leaf_mesh = None
     regions = (0, 0)
     if mode == "global":
@@ -179,8 +191,9 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
             failing = tuple(np.concatenate([f[i] for f in failing]) for i in range(2))
             again, regions = _cells_by_piece(tree, parts, marked, failing, grid, keys, lookup, criterion,
                                                      catalogue)
-            results.update(completed(mesh_piece, {k: task(k, **more) for k, more in again.items()}, jobs,
-                                     scheduler, dask_workers, common=(keys, lookup, catalogue)))
+            results.update(told("again", len(again), completed(
+                mesh_piece, {k: task(k, **more) for k, more in again.items()}, jobs, scheduler, dask_workers,
+                common=(keys, lookup, catalogue))))
     seams = [seam for k in range(pieces) for seam in results[k]["seams"]]
     n = np.int64(grid + 1)
 
