@@ -11,6 +11,7 @@ command -v qdelaunay >/dev/null 2>&1 || packages+=(qhull-bin)   # Qhull's merged
 command -v pdflatex >/dev/null 2>&1 || packages+=(texlive-latex-base texlive-latex-recommended texlive-pictures)  # render --pdf: the LaTeX tables compiled in the tests
 command -v pdftoppm >/dev/null 2>&1 || packages+=(poppler-utils)  # PDF page -> PNG in the tests
 command -v tetgen >/dev/null 2>&1 || packages+=(tetgen)  # bench_outputs.py and mesh --dual: the tetrahedral mesher beside ours
+[ -x /usr/bin/time ] || packages+=(time)  # GNU time: the docs' bench_peers.py example reads a command's peak memory from it
 command -v chromium >/dev/null 2>&1 || packages+=(chromium)  # the docs site's pages opened headless in the tests
 command -v chromedriver >/dev/null 2>&1 || packages+=(chromium-driver)  # selenium drives that chromium through it
 command -v cc >/dev/null 2>&1 || packages+=(gcc)  # the docs' C reader of the pattern-table store, compiled in the tests
