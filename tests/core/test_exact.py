@@ -62,3 +62,22 @@ def test_box_lengths(text):
     else:
         assert length.squared > 0 and float(length) > 0
         assert Length.parse(length.text) == length
+
+
+@fuzz(400)
+@given(st.integers(1, 10**40 - 1), st.integers(0, 140), st.integers(0, 60), st.booleans(),
+       st.sampled_from(["", "2", "3", "7/5", "1/1024", "9" * 39, "1/" + "7" * 39]))
+def test_a_length_is_read_back_from_its_text(numerator, twos, fives, small, radicand):
+    """What files write of a length (its ``text``: the domain of dual.npz, report.json, mesh.vtu) reads back
+    as the same length, or the length is refused when given: 1/2**130 was written as a decimal of 132
+    characters, 9...9*sqrt(2) as the square root of an 80-digit number, both beyond what the reader takes."""
+    from fractions import Fraction
+
+    value = Fraction(numerator, 2**twos * 5**fives) if small else Fraction(2**twos * 5**fives, numerator)
+    text = f"{value}*sqrt({radicand})" if radicand else str(value)
+    try:
+        length = Length.parse(text)
+    except InputError as error:
+        assert "too large or too precise" in str(error) or "too long" in str(error), (text, error)
+        return
+    assert Length.parse(length.text) == length, (text, length.text)

@@ -94,7 +94,10 @@ def rational_text(value: Fraction) -> str:
         scaled = value * 10**digits
         sign = "-" if scaled < 0 else ""
         whole, frac = divmod(abs(scaled.numerator), 10**digits)
-        return f"{sign}{whole}.{frac:0{digits}d}"
+        text = f"{sign}{whole}.{frac:0{digits}d}"
+        # 1/2**130 is a decimal of 132 characters, beyond what parse_rational reads back: a fraction then
+        if len(text) <= _MAX_TEXT:
+            return text
     return f"{value.numerator}/{value.denominator}"
 
 
@@ -137,7 +140,11 @@ class Length:
                 factor = parse_rational(match["factor"], what) if match["factor"] else Fraction(1)
                 if radicand <= 0 or factor <= 0:
                     raise InputError(f"{what} {text!r}: must be > 0")
-                return cls(factor * factor * radicand)
+                length = cls(factor * factor * radicand)
+                # its text (the root, or sqrt of the square) is what files write and read back: within the bounds
+                root = _exact_sqrt(length.squared)
+                bounded(root if root is not None else length.squared, what, text)
+                return length
         value = parse_rational(text, what)
         if value <= 0:
             raise InputError(f"{what} {text!r}: must be > 0")
