@@ -47,6 +47,8 @@ _REGION = "regions:\n  - {name: si, material: Si, boxes: [[0, 0, 0, 1, 1, 1]]}\n
     ("device: d\n" + _REGION + "levels: 99\n", "levels"),
     ("device: d\n" + _REGION + "refine: [{cone: [1, 2]}]\n", "refine"),
     ("x" * (MAX_DEVICE_BYTES + 1), "too large"),
+    ("device: thin\nregions:\n  - {name: a, material: Si, boxes: [[0, 0, 0, 1, 1, '65535/65536']]}\n"
+     "  - {name: b, material: Si, boxes: [[0, 0, '65535/65536', 1, 1, 1]]}\n", "above the bound"),
 ])
 def test_bad_device_files_are_refused_with_one_line(tmp_path, capsys, text, needle):
     path = tmp_path / "device.yaml"

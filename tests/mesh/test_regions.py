@@ -350,3 +350,24 @@ def _circumcentre(p: list[list[int]]) -> list[Fraction]:
 def _det(m: list[list[int]]) -> int:
     return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+_HOLE = """device: cavity
+regions:
+  - name: shell
+    material: Si
+    boxes: [[0, 0, 0, 4, 4, 1], [0, 0, 3, 4, 4, 4], [0, 0, 1, 1, 4, 3], [3, 0, 1, 4, 4, 3], [1, 0, 1, 3, 1, 3],
+            [1, 3, 1, 3, 4, 3]]
+  - {name: core, material: Ox, boxes: [[1, 1, 1, 2, 3, 3]]}
+contacts: [{name: inner, region: shell, box: [3, 1, 1, 3, 3, 3]}]
+levels: 1
+"""
+
+
+def test_a_domain_with_a_box_shaped_hole_passes_the_oracle(tmp_path):
+    """A shell around a cavity half filled by another region: the hole's leaves are dropped, and a contact lies on
+    the cavity's wall (a boundary inside the bounding box)."""
+    path = tmp_path / "cavity.yaml"
+    path.write_text(_HOLE)
+    m = _mesh_and_check(path, tmp_path / "out")
+    assert m.report.volume == "15/16" and m.report.volume_ok  # 64 - 4 (the empty half of the cavity) of 4 x 4 x 4
