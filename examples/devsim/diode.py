@@ -177,10 +177,9 @@ def gmsh_box(fine: float, coarse: float = 0.25, width: float = 0.1):
         gmsh.finalize()
 
 
-def gmsh_currents(devsim, fine: float, biases, step: float = 0.05) -> dict:
-    """The anode current on Gmsh's mesh of the cube (DEVSIM's own geometry: a Gmsh mesh has no exact dual)."""
-    points, tets, triangles, side = gmsh_box(fine)
-    name = f"diode-gmsh-{fine:g}"
+def simplex_currents(devsim, name: str, points, tets, triangles, side, biases, step: float) -> np.ndarray:
+    """The anode current on a tetrahedral mesh of the unit cube with DEVSIM's own geometry (contacts: the
+    triangles of the sides x = 0, ``side`` 0, and x = 1, ``side`` 1)."""
     elements = np.concatenate([np.column_stack([np.full(len(triangles), 2), 1 + side, triangles]).reshape(-1),
                                np.column_stack([np.full(len(tets), 3), np.zeros(len(tets), dtype=np.int64),
                                                 tets]).reshape(-1)])
@@ -192,10 +191,40 @@ def gmsh_currents(devsim, fine: float, biases, step: float = 0.05) -> dict:
     quiet(devsim.finalize_mesh, mesh=name)
     quiet(devsim.create_device, mesh=name, device=name)
     quiet(physics, devsim, name, "domain")
-    result = {"fine": fine, "nodes": len(points), "devsim": sweep(devsim, name, "xmin", biases, step)}
-    devsim.delete_device(device=name)
-    devsim.delete_mesh(mesh=name)
-    return result
+    try:
+        return sweep(devsim, name, "xmin", biases, step)
+    finally:
+        devsim.delete_device(device=name)
+        devsim.delete_mesh(mesh=name)
+
+
+def gmsh_currents(devsim, fine: float, biases, step: float = 0.05) -> dict:
+    """The anode current on Gmsh's mesh of the cube (DEVSIM's own geometry: a Gmsh mesh has no exact dual)."""
+    points, tets, triangles, side = gmsh_box(fine)
+    return {"fine": fine, "nodes": len(points),
+            "devsim": simplex_currents(devsim, f"diode-gmsh-{fine:g}", points, tets, triangles, side, biases, step)}
+
+
+def delaunay_currents(devsim, level: int, biases, step: float = 0.05) -> dict:
+    """The anode current on a tetrahedral Delaunay mesh (TetGen, else Qhull) of the level's octree vertices,
+    with DEVSIM's own geometry: the vertices of this tool's mesh without its co-spherical elements."""
+    from cospherical.core.geometry import six_volumes
+    from cospherical.mesh.dual import external_tetrahedra
+
+    mesh = junction_mesh(level)
+    grid_points = np.asarray(mesh.vertices, dtype=np.int64)
+    tets, tool, _ = external_tetrahedra(grid_points)
+    flip = six_volumes(grid_points[tets]) < 0
+    tets[flip] = tets[flip][:, [0, 2, 1, 3]]
+    faces = np.sort(tets[:, [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]].reshape(-1, 3), axis=1)
+    unique, counts = np.unique(faces, axis=0, return_counts=True)
+    outer = unique[counts == 1]
+    x = grid_points[outer][:, :, 0]
+    side = np.where((x == 0).all(axis=1), 0, np.where((x == mesh.grid).all(axis=1), 1, -1))
+    points = grid_points / mesh.grid
+    current = simplex_currents(devsim, f"diode-{tool}-L{level}", points, tets, outer[side >= 0], side[side >= 0],
+                               biases, step)
+    return {"level": level, "tool": tool, "nodes": len(points), "devsim": current}
 
 
 def main(argv=None) -> int:
@@ -207,6 +236,9 @@ def main(argv=None) -> int:
     parser.add_argument("--gmsh", nargs="*", type=float, default=[], metavar="SIZE",
                         help="also Gmsh meshes of the cube, of these element sizes (um) near the junction (0.25 "
                         "elsewhere), solved with DEVSIM's own geometry")
+    parser.add_argument("--delaunay", nargs="*", type=int, default=[], metavar="LEVEL",
+                        help="also TetGen's (else Qhull's) Delaunay tetrahedra of these levels' vertices, solved "
+                        "with DEVSIM's own geometry")
     parser.add_argument("--plot", metavar="FILE", help="write the curves and errors as a PNG")
     args = parser.parse_args(argv)
     devsim = import_devsim()
@@ -216,6 +248,7 @@ def main(argv=None) -> int:
     exact_current = reference(devsim, biases, step=args.step) * area
     rows = [octree_currents(devsim, level, biases, args.step) for level in args.levels]
     meshed = [gmsh_currents(devsim, size, biases, args.step) for size in args.gmsh]
+    tetrahedral = [delaunay_currents(devsim, level, biases, args.step) for level in args.delaunay]
     print(f"anode current at {biases[-1]:g} V: 1D reference {exact_current[-1]:.6e} A")
     print(f"{'mesh':>14} {'nodes':>6} {'exact dual':>11} {'DEVSIM geometry':>16}")
     for r in rows:
@@ -224,6 +257,9 @@ def main(argv=None) -> int:
     for r in meshed:
         error = (r["devsim"][-1] - exact_current[-1]) / exact_current[-1]
         print(f"{'Gmsh ' + format(r['fine'], 'g'):>14} {r['nodes']:>6} {'-':>11} {error:>+15.2%}")
+    for r in tetrahedral:
+        error = (r["devsim"][-1] - exact_current[-1]) / exact_current[-1]
+        print(f"{r['tool'] + ' L' + str(r['level']):>14} {r['nodes']:>6} {'-':>11} {error:>+15.2%}")
     if args.plot:
         import matplotlib
 
