@@ -388,7 +388,9 @@ def device_octree(layout: DeviceLayout, max_leaves: int | None = None) -> tuple[
     device = layout.device
     shapes = [_shifted(shape, device.origin) for shape in device.refine]
     tree = build_octree(device.box, device.levels, shapes, device.balance, max_leaves, must_split=layout.cuts,
-                        resolve=layout.resolving_level)
+                        resolve=layout.resolving_level,
+                        name=f"device {shown(device.name)} (levels {device.levels}, its boxes resolved at level "
+                             f"{layout.resolving_level})")
     region = leaf_owner(layout, tree.levels, tree.positions)
     keep = region >= 0
     return Octree(tree.box, tree.levels[keep], tree.positions[keep]), region[keep].astype(np.int32)

@@ -358,7 +358,8 @@ def check_leaf_count(count: int, what: str, max_leaves: int | None = None) -> No
 
 def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balance = "vertex",
                  max_leaves: int | None = None,
-                 must_split: Callable[[int, np.ndarray], np.ndarray] | None = None, resolve: int = 0) -> Octree:
+                 must_split: Callable[[int, np.ndarray], np.ndarray] | None = None, resolve: int = 0,
+                 name: str | None = None) -> Octree:
     """Refine every cell whose closed box meets a shape down to ``levels``, then 2:1 balance (coarsest).
 
     ``balance``: ``vertex`` (leaves touching across a face, an edge or a corner
@@ -390,7 +391,8 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balanc
         raise InputError(f"--balance {shown(balance)}: choose vertex or edge")
     if isinstance(levels, bool) or not isinstance(levels, int) or not 0 <= levels <= MAX_LEVEL:
         raise InputError(f"--levels {shown(levels)}: must be an integer from 0 to {MAX_LEVEL}")
-    check_leaf_count(estimate_leaves(box, levels, shapes), f"--levels {levels}: an estimated", max_leaves)
+    name = f"--levels {levels}" if name is None else name
+    check_leaf_count(estimate_leaves(box, levels, shapes), f"{name}: an estimated", max_leaves)
     split: list[np.ndarray] = []
     existing = np.zeros(1, dtype=np.int64)
     deepest = max(levels, resolve)
@@ -407,7 +409,7 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balanc
             hit |= must_split(level, cells)
         split.append(existing[hit])
         # every cell of the next level is or holds a leaf: the estimate's guard, before the children exist
-        check_leaf_count(8 * len(split[-1]), f"--levels {levels}: level {level + 1} has at least", max_leaves)
+        check_leaf_count(8 * len(split[-1]), f"{name}: level {level + 1} has at least", max_leaves)
         existing = _children(level, split[-1])
     offsets = _offsets(balance)
     for level in range(deepest - 1, 0, -1):
@@ -416,7 +418,7 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balanc
         parents = distinct(_keys_of(level - 1, _cells_of(level, need) // 2))
         split[level - 1] = np.union1d(split[level - 1], parents)
     levels_, positions = _leaves_from_splits(split)
-    check_leaf_count(len(levels_), f"--levels {levels}: balanced, the tree has", max_leaves)
+    check_leaf_count(len(levels_), f"{name}: balanced, the tree has", max_leaves)
     return Octree(box, levels_, positions)
 
 
