@@ -65,7 +65,7 @@ def _load_summary(path: Path) -> dict:
 def _refuse_non_finite(data, path: Path) -> None:
     """JSON Schema's numbers admit NaN and infinities (``"share": NaN`` parses); no summary holds one,
     and a table would print ``nan \\%``."""
-    stack = [((), data)]
+    stack: list[tuple[tuple[str, ...], object]] = [((), data)]
     while stack:
         where, item = stack.pop()
         if isinstance(item, float) and not math.isfinite(item):

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Callable, Iterable, Protocol
 
 from ..caches import cached
+from ..choices import FacePointSource
 from ..core.configuration import POINT_POLICIES, Box
 from ..core.shapes import ELEMENTS
 from ..core.tessellation import Tessellation, element_entry
@@ -73,7 +74,7 @@ class _StudyTable(Protocol):
     name: str
     element: str
     box: Box
-    face_points: str
+    face_points: FacePointSource
     criteria: tuple[str, ...]
 
     def rows(self) -> Iterable[tuple[str, bool, Mapping[str, Tessellation], Callable[[Tessellation], Tessellation]]]:

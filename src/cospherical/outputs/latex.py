@@ -117,7 +117,7 @@ def element_png(entry: dict, path: Path, size_px: int = 160) -> None:
 
     screen, edges, visible = _projection(entry, 1.0)
     fig = plt.figure(figsize=(size_px / 100, size_px / 100), dpi=100)
-    ax = fig.add_axes([0.05, 0.05, 0.9, 0.9])
+    ax = fig.add_axes((0.05, 0.05, 0.9, 0.9))
     for a, b in edges:
         (x1, y1), (x2, y2) = screen[a], screen[b]
         if (a, b) in visible:
