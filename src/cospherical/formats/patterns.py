@@ -71,11 +71,18 @@ def pattern_name(study: str, box_texts, face_points: str = "octree", element: st
 class _StudyTable(Protocol):
     """What a pattern table is written from: a study's result (:class:`cospherical.studies.engine.Study`)."""
 
-    name: str
-    element: str
-    box: Box
-    face_points: FacePointSource
-    criteria: tuple[str, ...]
+    # read-only: a study is frozen, and its criteria are a property
+    @property
+    def name(self) -> str: ...
+    @property
+    def element(self) -> str: ...
+    @property
+    def box(self) -> Box: ...
+    @property
+    def face_points(self) -> FacePointSource: ...
+    @property
+    def criteria(self) -> tuple[str, ...]: ...
+
 
     def rows(self) -> Iterable[tuple[str, bool, Mapping[str, Tessellation], Callable[[Tessellation], Tessellation]]]:
         """Per configuration, in code order: its code, ``fvm_adequate``, the tessellations per
