@@ -126,7 +126,8 @@ def test_the_cli_writes_the_tetrahedra_and_gmsh_file_that_write_writes(tmp_path,
     assert main(["mesh", "--device", device, "--gmsh", "4.1", "--gmsh-binary", "--tets", "--no-uniform",
                  "--out", str(tmp_path / "cli")]) == 0
     capsys.readouterr()
-    cospherical.build_mesh(device=device, uniform=False).write(tmp_path / "api", gmsh="4.1", binary=True, tets=True)
+    mesh = cospherical.build_mesh(device=device, uniform=False)
+    mesh.write(tmp_path / "api", gmsh="4.1", binary=True, tets=True)
     cli, api = _digests(tmp_path / "cli"), _digests(tmp_path / "api")
     assert {"mesh.msh", "tets.vtu", ".cospherical-manifest.json"} <= set(cli) and cli == api
     manifest = json.loads((tmp_path / "cli" / ".cospherical-manifest.json").read_text())
@@ -139,6 +140,15 @@ def test_the_cli_writes_the_tetrahedra_and_gmsh_file_that_write_writes(tmp_path,
     finally:
         gmsh.finalize()
     assert names == {(3, "substrate"), (3, "oxide"), (2, "bulk"), (2, "gate"), (2, "substrate|oxide")}
+    import meshio  # tets.vtu read by an independent reader: tetrahedra only, positive, each with its parent and region
+
+    back = meshio.read(tmp_path / "cli" / "tets.vtu")
+    assert [block.type for block in back.cells] == ["tetra"]
+    d = back.points[back.cells[0].data]
+    assert (np.einsum("ij,ij->i", d[:, 1] - d[:, 0], np.cross(d[:, 2] - d[:, 0], d[:, 3] - d[:, 0])) > 0).all()
+    element, region = back.cell_data["element"][0], back.cell_data["region"][0]
+    assert set(np.unique(element)) == set(range(len(mesh.elements)))
+    assert set(np.unique(region)) == {0, 1}
 
 
 @pytest.mark.parametrize("argv, needle", [
