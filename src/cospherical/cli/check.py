@@ -57,16 +57,18 @@ def run(args) -> int:
 
 def _check_dual(path: Path) -> None:
     from ..errors import FormatError
-    from ..formats.dual import read_dual, verify_dual
+    from ..formats.dual import domain_sums, dual_layout, read_dual, verify_dual
 
     dual = read_dual(path)
+    layout = dual_layout(dual, path)  # a device's union of boxes (dual.npz version 4), else the box
+    volume, expected = domain_sums(layout) if layout is not None else (1, (2, 2, 2))
     total = dual.volume_sum()
-    if total != 1:
-        raise FormatError(f"{path}: the control volumes sum to {_cut(total)} of the domain, not 1")
+    if total != volume:
+        raise FormatError(f"{path}: the control volumes sum to {_cut(total)} of the domain's box, not {_cut(volume)}")
     sides = dual.boundary_area_sums()
-    if sides != (2, 2, 2):
+    if sides != expected:
         raise FormatError(f"{path}: the boundary areas sum to {', '.join(map(_cut, sides))} sides normal to x, y, z, "
-                          "not 2 each")
+                          f"not {', '.join(map(_cut, expected))}")
     verify_dual(dual, path)  # a re-signed change that keeps the sums: every value computed again
     negative = dual.negative_coefficients()
     say(f"{path}: ok, dual of {len(dual.vertices)} vertices and {len(dual.edges)} edges, every value equal to "

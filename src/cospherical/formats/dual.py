@@ -42,8 +42,9 @@ same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` element
 A device's dual (``mesh --device ... --dual``) is version 4: the members above plus its
 parts per region and its contacts (manifest: ``region_names``, ``region_materials``,
 ``contact_names``, ``contact_regions`` (region indices), ``contact_boxes`` (exact
-texts, device units), ``origin`` (the bounding box's low corner, where the grid
-starts) and the three part denominators)::
+texts, device units), ``region_boxes`` (per region its boxes: the domain),
+``origin`` (the bounding box's low corner, where the grid starts) and the three part
+denominators)::
 
     element_region                   int e     each element's region
     volume_part_vertex, _region      int p     one row per (vertex, region), sorted
@@ -64,7 +65,8 @@ The parts of a vertex or an edge sum to its total exactly, a region's volume par
 to its volume, a contact's area parts to its rectangle's area.  A one-box mesh (one
 region) writes version 3, byte for byte as before; both versions are read, and
 :func:`verify_dual` computes a version 4 file's parts again from its elements, their
-regions and its contact faces.
+regions and its contact faces, and proves the elements a mesh of the union of boxes
+(the faces met once lie in its boundary, which need not be the bounding box's).
 
 The reader refuses, with one line, a file that is not such a zip, lacks or adds a
 member, has an array of the wrong kind or shape, fails a checksum (a truncated or
@@ -112,7 +114,7 @@ from ..errors import FormatError, InputError, shown
 from ..files.yamlio import atomic_write, machine_memory, parse_json
 from ..mesh.dual import Dual, RegionParts
 
-__all__ = ["DUAL_FORMAT_VERSION", "read_dual", "verify_dual", "write_dual"]
+__all__ = ["DUAL_FORMAT_VERSION", "domain_sums", "dual_layout", "read_dual", "verify_dual", "write_dual"]
 
 DUAL_FORMAT_VERSION = 4
 # Version 3 is version 4 without the region members: a one-box mesh (one region) still writes it,
@@ -198,7 +200,8 @@ def write_dual(dual: Dual, path: str | Path) -> None:
                  "volume_part_denominator": str(parts.volume_denominator),
                  "coupling_part_denominator": str(parts.coupling_denominator),
                  "contact_part_denominator": str(parts.contact_denominator),
-                 "origin": [str(x) for x in parts.origin]}
+                 "origin": [str(x) for x in parts.origin],
+                 "region_boxes": [[list(box) for box in boxes] for boxes in parts.boxes]}
     blobs = {name: _npy(array) for name, array in arrays.items()}
     manifest = {
         "format": "cospherical-dual", "version": DUAL_FORMAT_VERSION if parts is not None else 3, **extra,
@@ -449,6 +452,12 @@ def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n
     if not isinstance(origin, list) or len(origin) != 3 or not all(isinstance(x, str) and _FRACTION.fullmatch(x)
                                                                     for x in origin):
         raise FormatError(f"{path}: manifest: origin is not three exact numbers")
+    region_boxes = manifest.get("region_boxes")
+    if not isinstance(region_boxes, list) or len(region_boxes) != len(names) or not all(
+            isinstance(boxes, list) and 0 < len(boxes) <= 64 and all(
+                isinstance(b, list) and len(b) == 6 and all(isinstance(x, str) and _FRACTION.fullmatch(x) for x in b)
+                for b in boxes) for boxes in region_boxes):
+        raise FormatError(f"{path}: manifest: region_boxes is not, per region, its boxes of six exact numbers")
     parts = RegionParts(
         tuple(names), tuple(materials), arrays["element_region"].astype(np.int32),
         arrays["volume_part_vertex"].astype(np.int64), arrays["volume_part_region"].astype(np.int32),
@@ -459,7 +468,7 @@ def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n
         arrays["contact_face_contact"].astype(np.int32), arrays["contact_part_vertex"].astype(np.int64),
         arrays["contact_part_contact"].astype(np.int32),
         _integers(arrays["contact_part_exact"], "contact_part_exact", path), denominators[2], factor,
-        tuple(origin))
+        tuple(origin), tuple(tuple(tuple(b) for b in boxes) for boxes in region_boxes))
     for name in ("volume_part", "coupling_part", "contact_part"):  # the floats: what the exact values give
         if not np.array_equal(arrays[name], getattr(parts, name)):
             raise FormatError(f"{path}: member {name}: not what the exact values give")
@@ -549,7 +558,7 @@ def _element_shapes(dual: Dual, path: str | Path) -> np.ndarray:
     return shape
 
 
-def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path) -> None:
+def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path, layout=None) -> None:
     """The elements are a mesh of the domain: every face met by exactly two elements, in opposite
     orientations, or by one in the domain's boundary
     (:func:`~cospherical.mesh.checks.pair_faces`, the mesher's own conformity rule).
@@ -568,7 +577,7 @@ def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path) -> None:
                               machine_memory() // 2)
     except InputError as error:
         raise FormatError(f"{path}: member element_nodes: {error}") from None
-    found = pair_faces(faces, dual.grid_vertices, dual.grid, examples=1)
+    found = pair_faces(faces, dual.grid_vertices, dual.grid, examples=1, layout=layout)
     if found["nonconforming_faces"]:
         corners = [[round(x * dual.grid) for x in corner] for corner in found["nonconforming_examples"][0]]
         raise FormatError(f"{path}: member element_nodes: the elements are not a mesh: {found['nonconforming_faces']:,} "
@@ -591,7 +600,7 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
         again = mesh_dual(_Vertices(dual.box, dual.grid, dual.grid_vertices), (dual.element_nodes, dual.element_sizes))
     except InputError as error:  # an element that is flat or not co-spherical has no dual
         raise FormatError(f"{path}: member element_nodes: {error}") from None
-    _check_mesh(dual, shape, path)
+    _check_mesh(dual, shape, path, dual_layout(dual, path))
     if not np.array_equal(again.edges, dual.edges):
         raise FormatError(f"{path}: member edges: not the edges of its elements ({len(dual.edges)} edges, "
                           f"its elements have {len(again.edges)})")
@@ -641,6 +650,47 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
             raise FormatError(f"{path}: member {name}: {what} is not what the exact values give")
     if dual.regions is not None:
         _verify_regions(dual, path)
+
+
+def dual_layout(dual: Dual, path: str | Path):
+    """A version 4 file's device geometry (its regions' boxes and its contacts) checked again and cut into
+    blocks (:class:`~cospherical.mesh.device.DeviceLayout`), or ``None`` for a one-box dual; its bounding box
+    must be the file's domain, its low corner the file's origin."""
+    from ..mesh.device import Contact, Device, Region, device_layout
+
+    parts = dual.regions
+    if parts is None:
+        return None
+    try:
+        regions = tuple(Region(name, material, tuple(tuple(Fraction(x) for x in box) for box in boxes))
+                        for name, material, boxes in zip(parts.names, parts.materials, parts.boxes))
+        contacts = tuple(Contact(name, parts.names[r], tuple(Fraction(x) for x in box))
+                         for name, r, box in zip(parts.contact_names, parts.contact_regions, parts.contact_boxes))
+        device = Device("dual", regions, contacts, (), 0)
+        layout = device_layout(device)
+    except (InputError, ValueError, ZeroDivisionError) as error:
+        raise FormatError(f"{path}: manifest: the device's boxes: {str(error)[:200]}") from None
+    if tuple(str(high - low) for low, high in device.bounds) != tuple(dual.box.texts) or \
+            tuple(device.origin) != tuple(Fraction(x) for x in parts.origin):
+        raise FormatError(f"{path}: manifest: the device's boxes do not span its domain from its origin")
+    return layout
+
+
+def domain_sums(layout) -> tuple[Fraction, tuple[Fraction, Fraction, Fraction]]:
+    """What a device's control volumes and boundary areas sum to: its volume as a fraction of the bounding
+    box's, and per axis the area of its faces in the bounding box's two sides normal to it as a fraction
+    of one side's (the dual's boundary areas are counted in those sides)."""
+    steps = [np.diff(p) for p in layout.planes]
+    inside = layout.owner >= 0
+    volume = Fraction(int((inside * steps[0][:, None, None] * steps[1][None, :, None]
+                           * steps[2][None, None, :]).sum()), layout.steps ** 3)
+    sides = []
+    for axis in range(3):
+        b, c = [a for a in range(3) if a != axis]
+        area = np.outer(steps[b], steps[c])
+        layers = np.moveaxis(inside, axis, 0)
+        sides.append(Fraction(int((layers[0] * area).sum() + (layers[-1] * area).sum()), layout.steps ** 2))
+    return volume, tuple(sides)
 
 
 def _verify_regions(dual: Dual, path: str | Path) -> None:

@@ -260,7 +260,8 @@ class RegionParts:
     (``contact_face_nodes``, -1 padded, ``contact_face_contact``), and the area parts per
     (vertex, contact): ``contact_vertex``, ``contact_contact``, ``contact_exact`` over
     ``contact_denominator``, in device units (a device's lengths are rational).
-    ``origin``: the device's bounding box's low corner (exact texts), where the grid starts.
+    ``origin``: the device's bounding box's low corner (exact texts), where the grid starts;
+    ``boxes``: per region its boxes (six exact texts each, device units): the domain.
     """
 
     names: tuple[str, ...]
@@ -285,6 +286,7 @@ class RegionParts:
     contact_denominator: int
     volume_factor: float
     origin: tuple = ("0", "0", "0")
+    boxes: tuple = ()
 
     @property
     def volume_part(self) -> np.ndarray:

@@ -259,7 +259,7 @@ def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_regio
                  names: tuple[str, ...], materials: tuple[str, ...], contacts: tuple = (),
                  contact_face_nodes: np.ndarray | None = None, contact_face_contact: np.ndarray | None = None,
                  lengths: tuple[Fraction, Fraction, Fraction] | None = None, origin=("0", "0", "0"),
-                 region_duals: list[Dual] | None = None) -> RegionParts:
+                 region_duals: list[Dual] | None = None, boxes: tuple = ()) -> RegionParts:
     """The dual of each region's elements alone (exact), as parts of ``dual`` (see :class:`RegionParts`).
 
     A region's part of a control volume or of a coupling is the dual of its own
@@ -311,7 +311,7 @@ def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_regio
         contact_face_contact.astype(np.int32), np.array([v for v, _ in pairs], dtype=np.int64).reshape(-1),
         np.array([c for _, c in pairs], dtype=np.int32).reshape(-1),
         _narrow([int(shares[p] * contact_denominator) for p in pairs]), contact_denominator, dual.volume_factor,
-        tuple(str(x) for x in origin))
+        tuple(str(x) for x in origin), boxes)
 
 
 def _used(nodes: np.ndarray, count: int) -> np.ndarray:
@@ -387,7 +387,8 @@ def mesh_region_parts(mesh: Mesh, dual: Dual, faces: RegionFaces) -> RegionParts
     duals = [mesh_dual(_region_mesh(mesh, r)) for r in range(len(names))]
     return region_parts(mesh.box, mesh.grid, mesh.vertices, dual, mesh.element_region, mesh.regions.names,
                         mesh.regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths,
-                        device.origin, duals)
+                        device.origin, duals,
+                        tuple(tuple(tuple(str(x) for x in box) for box in r.boxes) for r in device.regions))
 
 
 def _region_mesh(mesh: Mesh, region: int) -> Mesh:
