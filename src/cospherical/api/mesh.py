@@ -35,9 +35,10 @@ from ..files.outputs import OutputFolder
 from ..formats.gmsh import GMSH_VERSIONS
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.dual import Dual
+from ..mesh.device import Device
 from ..mesh.octree import Octree, Shape
 from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode, full_dual, run_pipeline,
-                             tree_from_leaves, tree_from_octree, tree_from_refine)
+                             tree_from_device, tree_from_leaves, tree_from_octree, tree_from_refine)
 from ..mesh.report import MeshReport
 
 __all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "device_cut_axis", "from_treemesh",
@@ -375,7 +376,6 @@ class OctreeMesh:
 
         return to_meshio(self.assembled, self.vertices, self._result.source.leaf_order)
 
-
     def _write_device(self, path: Callable[[str], Path], cut: float | None, point_data: dict,
                       cell_data: dict) -> None:
         """A device's files: ``mesh.vtu`` with cell data ``region`` (names and materials in field data),
@@ -403,7 +403,7 @@ class OctreeMesh:
         write_report(report.to_dict(), path("report.json"))
 
 
-def device_cut_axis(device) -> int:
+def device_cut_axis(device: Device) -> int:
     """The axis ``mesh.png`` cuts a device across: the one its region boxes cut least (y first, then x, then z)."""
     counts = [len({b[a] for r in device.regions for b in r.boxes} | {b[a + 3] for r in device.regions
                                                                      for b in r.boxes}) for a in range(3)]
@@ -414,7 +414,7 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
                refine: Sequence[str | Shape] | str | None = None, *,
                leaves: str | Path | Sequence[Sequence[int]] | np.ndarray | None = None, tree: Octree | None = None,
                patterns: Any = None, criterion: str = "optimal", delaunay: str | None = None,
-               balance: str = "vertex", dual: bool = False, device: Any = None, max_leaves: int | None = None,
+               balance: str = "vertex", dual: bool = False, device: str | Path | Device | None = None, max_leaves: int | None = None,
                check_delaunay: bool = True, uniform: bool = True, progress: Progress | None = None) -> OctreeMesh:
     """Mesh an octree: each leaf's elements, globally Delaunay, checked exactly, reported; the dual on request.
 
@@ -469,21 +469,31 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
                                           ("leaves", leaves), ("tree", tree)) if value is not None]
         if given:
             raise InputError(f"device=: its file gives the domain and the tree, not {given[0]}=")
-        delaunay_mode(criterion, delaunay)
-        clock = time.perf_counter()
-        from ..mesh.device import Device
-        from ..mesh.pipeline import tree_from_device
-
+    else:
+        box = _domain_box(domain, tree)
+    delaunay_mode(criterion, delaunay)  # a contradiction refused before the work
+    clock = time.perf_counter()
+    if device is not None:
         if not isinstance(device, Device):
             from ..formats.device_file import read_device
 
             device = read_device(device)
-        source = tree_from_device(device, max_leaves)
-        timings = {"tree": time.perf_counter() - clock}
-        lookup, name = pattern_lookup(patterns, criterion, source.tree.box)
-        return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,
-                                       check_delaunay=check_delaunay, uniform=uniform, dual=dual, progress=progress,
-                                       timings=timings), device.origin)
+        source, origin = tree_from_device(device, max_leaves), device.origin
+    else:
+        source = tree_source(box, levels, refine, leaves=leaves, tree=tree, balance=balance, max_leaves=max_leaves)
+        origin = (0.0, 0.0, 0.0)
+    timings = {"tree": time.perf_counter() - clock}
+    clock = time.perf_counter()
+    lookup, name = pattern_lookup(patterns, criterion, source.tree.box)
+    if patterns is not None:
+        timings["table"] = time.perf_counter() - clock
+    return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,
+                                   check_delaunay=check_delaunay, uniform=uniform, dual=dual, progress=progress,
+                                   timings=timings), origin)
+
+
+def _domain_box(domain: Sequence[Any] | Box | None, tree: Octree | None) -> Box:
+    """The root cell of ``build_mesh(domain=..., tree=...)``: the domain given, else the tree's; the two must agree."""
     if isinstance(domain, Box):
         box = domain
     elif domain is not None:
@@ -496,17 +506,7 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         raise InputError("domain=: the root cell's three lengths, such as (1, 2, 4)")
     if tree is not None and tree.box != box:
         raise InputError(f"tree=: its domain {' x '.join(tree.box.texts)} is not domain= {' x '.join(box.texts)}")
-    delaunay_mode(criterion, delaunay)  # a contradiction refused before the work
-    clock = time.perf_counter()
-    source = tree_source(box, levels, refine, leaves=leaves, tree=tree, balance=balance, max_leaves=max_leaves)
-    timings = {"tree": time.perf_counter() - clock}
-    clock = time.perf_counter()
-    lookup, name = pattern_lookup(patterns, criterion, box)
-    if patterns is not None:
-        timings["table"] = time.perf_counter() - clock
-    return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,
-                                   check_delaunay=check_delaunay, uniform=uniform, dual=dual, progress=progress,
-                                   timings=timings))
+    return box
 
 
 def from_treemesh(tree_mesh: Any, **options: Any) -> OctreeMesh:

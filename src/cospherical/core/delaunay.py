@@ -20,6 +20,7 @@ from itertools import combinations
 from typing import Sequence
 
 from ..choices import DELAUNAY_BACKENDS, DelaunayBackend
+from ..errors import InputError
 from .geometry import Frame, Sphere, determinant, dot, plane_normal, sub
 
 __all__ = ["Cell", "delaunay_cells", "hull_faces"]
@@ -135,7 +136,7 @@ def delaunay_cells(frame: Frame, backend: DelaunayBackend = "python") -> list[Ce
     asks for ``"compiled"``.
     """
     if backend not in DELAUNAY_BACKENDS:
-        raise ValueError(f"backend {backend!r}: one of {', '.join(DELAUNAY_BACKENDS)}")
+        raise InputError(f"backend {backend!r}: one of {', '.join(DELAUNAY_BACKENDS)}")
     if backend == "compiled":
         cells = _compiled_cells(frame)
         if cells is not None:

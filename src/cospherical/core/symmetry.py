@@ -25,6 +25,7 @@ if TYPE_CHECKING:
 
 from ..caches import cached
 from ..choices import KEY_BACKENDS, ORBIT_BACKENDS, KeyBackend, OrbitBackend
+from ..errors import InputError
 from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, point_suffix
 from .configuration import Box, Configuration
 from .geometry import Rational, cross, determinant, sub, tetra_six_volume
@@ -204,7 +205,7 @@ def orbit_point_keys(
     import numpy as np
 
     if backend not in KEY_BACKENDS:
-        raise ValueError(f"backend {backend!r}: one of {', '.join(KEY_BACKENDS)}")
+        raise InputError(f"backend {backend!r}: one of {', '.join(KEY_BACKENDS)}")
     digits = np.ascontiguousarray(digits).reshape(-1, 12)  # any integer type: millions of rows stay small
     masks = np.zeros(len(digits), dtype=np.int64) if masks is None else np.ascontiguousarray(masks, dtype=np.int64)
     targets = np.array([[target for target, _ in sym.edge_map] for sym in symmetries], dtype=np.int64).reshape(-1, 12)
@@ -265,7 +266,7 @@ def orbit_representatives(codes: Sequence[str], symmetries: Sequence[Symmetry],
     ['000000000008', '000000000008']
     """
     if backend not in ORBIT_BACKENDS:
-        raise ValueError(f"backend {backend!r}: one of {', '.join(ORBIT_BACKENDS)}")
+        raise InputError(f"backend {backend!r}: one of {', '.join(ORBIT_BACKENDS)}")
     if not symmetries:
         raise ValueError("orbit representatives: no symmetries (the identity at least)")
     shape = symmetries[0].shape

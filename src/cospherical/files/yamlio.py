@@ -8,7 +8,7 @@ import os
 import re
 import stat
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import yaml
 
@@ -17,7 +17,7 @@ from ..errors import FormatError
 from .data import data_path
 from .outputs import atomic_open, atomic_path, atomic_write
 
-__all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
+__all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_document", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
 
 _Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 
@@ -205,6 +205,24 @@ def _refuse_size(text: str, name: str):
                       f"per entry); the full YAML parser takes at most {MAX_YAML_PARSE:,}")
 
 
+def load_document(text: str, name: str, loader: type) -> Any:
+    """``text`` read by the YAML ``loader``, whatever goes wrong one :class:`FormatError` line naming ``name`` and the line.
+
+    The one place a YAML parser's errors become a user's message: the reader of the
+    project's own files and the device file's exact reader (its own loader) share it.
+    """
+    try:
+        return yaml.load(text, Loader=loader)
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f" line {mark.line + 1}" if mark else ""
+        problem = getattr(error, "problem", None) or "not valid YAML"
+        raise FormatError(f"{name}:{where}: {problem}") from None
+    except (ValueError, OverflowError, RecursionError) as error:
+        # e.g. an integer of more digits than Python converts (sys.get_int_max_str_digits)
+        raise FormatError(f"{name}: a value cannot be read: {str(error).splitlines()[0][:120]}") from None
+
+
 def parse_yaml(text: str, name: str):
     """Parse YAML text safely: no aliases, no deep nesting, no Python tags; errors as one-line FormatError."""
     json_like = text.lstrip().startswith("{")
@@ -218,16 +236,7 @@ def parse_yaml(text: str, name: str):
             pass  # a YAML flow mapping, or broken: the YAML reader says where
     if len(text) > MAX_YAML_PARSE:
         _refuse_size(text, name)
-    try:
-        data = yaml.load(text, Loader=_Loader)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" line {mark.line + 1}" if mark else ""
-        problem = getattr(error, "problem", None) or "not valid YAML"
-        raise FormatError(f"{name}:{where}: {problem}") from None
-    except (ValueError, OverflowError, RecursionError) as error:
-        # e.g. an integer of more digits than Python converts (sys.get_int_max_str_digits)
-        raise FormatError(f"{name}: a value cannot be read: {str(error).splitlines()[0][:120]}") from None
+    data = load_document(text, name, _Loader)
     _refuse_aliases(data, name)
     return data
 

@@ -33,7 +33,7 @@ import yaml
 
 from ..core.exact import parse_rational
 from ..errors import FormatError, InputError
-from ..files.yamlio import check_nesting, read_text, validate
+from ..files.yamlio import check_nesting, load_document, read_text, validate
 from ..mesh.device import Contact, Device, Region
 from ..mesh.octree import Shape, parse_shape
 
@@ -102,14 +102,7 @@ def parse_device(text: str, name: str = "device file") -> Device:
     if len(text) > MAX_DEVICE_BYTES:
         raise FormatError(f"{name}: {len(text):,} characters, above the {MAX_DEVICE_BYTES:,} a device file may have")
     check_nesting(text, name)
-    try:
-        data = yaml.load(text, Loader=_ExactLoader)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" line {mark.line + 1}" if mark else ""
-        raise FormatError(f"{name}:{where}: {getattr(error, 'problem', None) or 'not valid YAML'}") from None
-    except (ValueError, OverflowError, RecursionError) as error:
-        raise FormatError(f"{name}: a value cannot be read: {str(error).splitlines()[0][:120]}") from None
+    data = load_document(text, name, _ExactLoader)
     if not isinstance(data, dict):
         raise FormatError(f"{name}: a device file is a mapping with 'device' and 'regions'")
     validate(data, "device", name)

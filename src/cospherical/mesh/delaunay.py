@@ -162,7 +162,7 @@ def _global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Eng
                      proposal=None) -> tuple[Mesh, DelaunayCheck | None]:
     """:func:`global_delaunay`, and :func:`check_delaunay` on the result when it ran (a cluster was re-tessellated)."""
     if engine not in ENGINES:
-        raise ValueError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
+        raise InputError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
     if found is None:
         found = check_delaunay(mesh)
     elements = found.not_cells
