@@ -368,8 +368,8 @@ def _cube_points(digits: _Ints, corners: _Ints, starts: _Ints, axes: _Ints, face
 
 @njit(cache=True)
 def cube_batch(codes: _Ints, corners: _Ints, starts: _Ints, axes: _Ints, face_edges: _Ints, face_base: _Ints,
-               tets: _Ints, closed: _Ints, open_: _Ints, polys: _Ints, poly_mask: _Ints, poly_code: _Ints,
-               every_cell: bool = False) -> int:
+               tets: _Ints, closed: NDArray[np.bool_], open_: NDArray[np.bool_], polys: _Ints, poly_mask: _Ints,
+               poly_code: _Ints, every_cell: bool = False) -> int:
     """Tessellate the cube configurations ``codes`` (base-16 numbers, 1/16 positions, octree points).
 
     Per configuration: ``tets`` the number of tetrahedra, ``closed``/``open_``

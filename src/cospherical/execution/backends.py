@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import Any, Callable, Hashable, Iterator
+from typing import Any, Callable, Hashable, Iterator, Mapping, TypeVar
 
 from ..errors import InputError, UsageError
 
 __all__ = ["check_backend", "completed"]
+
+_Key = TypeVar("_Key", bound=Hashable)  # a task's key: what its result comes back with
 
 
 # Local worker processes (--jobs, --dask-workers) at most: each one starts a Python with numpy
@@ -50,8 +52,8 @@ def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, ti
         dask.config.set({"distributed.comm.timeouts.connect": f"{timeout}s"})
 
 
-def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, scheduler: str | None = None,
-              dask_workers: int | None = None, common: tuple = ()) -> Iterator[tuple[Hashable, Any]]:
+def completed(function: Callable, tasks: Mapping[_Key, tuple], jobs: int = 1, scheduler: str | None = None,
+              dask_workers: int | None = None, common: tuple = ()) -> Iterator[tuple[_Key, Any]]:
     """Yield ``(key, function(*args))`` for every task, in the order they finish, on the chosen backend.
 
     Parameters
@@ -94,8 +96,8 @@ def completed(function: Callable, tasks: dict[Hashable, tuple], jobs: int = 1, s
                     yield pending.pop(future), future.result()
 
 
-def _dask_completed(function: Callable, tasks: dict[Hashable, tuple], scheduler: str | None,
-                    dask_workers: int | None, common: tuple = ()) -> Iterator[tuple[Hashable, Any]]:
+def _dask_completed(function: Callable, tasks: Mapping[_Key, tuple], scheduler: str | None,
+                    dask_workers: int | None, common: tuple = ()) -> Iterator[tuple[_Key, Any]]:
     """:func:`completed` on Dask: a running scheduler, or a local cluster whose scratch space
     (its lock files included) is a private temporary folder, removed at the end however the run ends."""
     import logging

@@ -52,7 +52,7 @@ _CELLS_PER_CONFIGURATION = 96  # the compiled walk's room per configuration, tet
 
 
 @cached(maxsize=1)
-def _cube_tables():
+def _cube_tables() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     # The compiled kernel (numba) is imported only where bulk work needs it: the
     # command line starts without it.
     from ...core import compiled
@@ -127,12 +127,13 @@ def element_entries(elements: list[tuple[int, int]],
     :class:`ElementEntry`; and every type met (pieces included), described
     (``of_configuration``: as for :func:`cell_polyhedron`)."""
     squared = (1, 1, 1)
-    entries, types = [], {}
+    entries: list[ElementEntry] = []
+    types: dict[str, TypeInfo] = {}
     for node_mask, code in elements:
         points, poly = cell_polyhedron(node_mask, code, of_configuration)
         etype = classify(poly)[0]
         types.setdefault(etype.id, TypeInfo.of(etype))
-        options = {}
+        options: dict[str, tuple[tuple[str, ...], ...]] = {}
         for criterion in SPLIT_CRITERIA:
             found = split_options(points, squared, poly, criterion)
             for piece in (piece for option in found for piece in option):
@@ -356,12 +357,12 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
         except NotACell as error:
             # a stage-1 checkpoint named it (the tessellation names only cells): that chunk is damaged
             position = {element: k for k, element in enumerate(work)}.get((error.node_mask, error.code))
-            i = None if position is None else int(holder[position]) // chunk
-            if i not in resumed:
+            damaged_chunk = None if position is None else int(holder[position]) // chunk
+            if damaged_chunk not in resumed:
                 raise
-            _notice(notice, [f"{tag}-cells-{i:05d}.npz ({error})"])
-            del stage1[i]
-            resumed.discard(i)
+            _notice(notice, [f"{tag}-cells-{damaged_chunk:05d}.npz ({error})"])
+            del stage1[damaged_chunk]
+            resumed.discard(damaged_chunk)
             tessellate_missing()
     if examples is not None:
         tetrahedron = (sum(1 << n for n in (0, 1, 3, 4)), 0)  # as _tetrahedron() makes it
