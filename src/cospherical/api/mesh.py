@@ -236,8 +236,7 @@ class OctreeMesh:
     @cached_property
     def vertices(self) -> np.ndarray:
         """(n, 3) float64: the vertices' coordinates, ``origin`` added (``mesh.vtu``'s points start at 0)."""
-        mesh = self.assembled
-        points = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+        points = self.assembled.points()
         return points + np.array(self.origin) if any(self.origin) else points
 
     @property

@@ -22,7 +22,9 @@ import json
 import os
 import re
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
+from typing import Sequence
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -32,6 +34,7 @@ from ..errors import FormatError, InputError
 from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
+from ..mesh.regions import RegionFaces
 from .check import EntryCheck
 
 __all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "VtuGrid", "vtu_arrays", "vtu_grid",
@@ -272,7 +275,7 @@ def vtu_arrays(mesh: Mesh) -> dict:
 
 
 def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell_data: dict | None = None,
-              leaves: np.ndarray | None = None, field_data: dict | None = None, origin=None) -> None:
+              leaves: np.ndarray | None = None, field_data: dict | None = None, origin: Sequence[Fraction] | None = None) -> None:
     """Write the mesh as one compressed binary VTU grid, atomically (a complete new file or the old one).
 
     Standard VTK cells (tetra, pyramid, wedge, hexahedron, nodes in VTK order) for
@@ -303,7 +306,7 @@ class VtuGrid:
 
 
 def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None = None,
-             leaves: np.ndarray | None = None, field_data: dict | None = None, origin=None) -> VtuGrid:
+             leaves: np.ndarray | None = None, field_data: dict | None = None, origin: Sequence[Fraction] | None = None) -> VtuGrid:
     """The grid :func:`write_vtu` writes (and the pyvista adapter builds in memory), cells sorted by VTK cell type.
 
     Point data: ``grid_coordinates`` (the exact integer grid point of each vertex),
@@ -353,7 +356,7 @@ def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None 
         if name in fields:
             raise ValueError(f"field data {name!r}: the writer's own")
         fields[name] = values
-    coordinates = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+    coordinates = mesh.points()
     if origin is not None:
         coordinates = coordinates + np.array([float(x) for x in origin])
     return VtuGrid(coordinates, arrays["types"], arrays["connectivity"], arrays["offsets"], arrays["faces"],
@@ -437,7 +440,7 @@ def write_pvtu(path: str | Path, pieces: list[Path]) -> None:
     atomic_write(path, "\n".join(xml) + "\n")
 
 
-def write_faces_vtu(mesh: Mesh, faces, path: str | Path, origin=None) -> None:
+def write_faces_vtu(mesh: Mesh, faces: RegionFaces, path: str | Path, origin: Sequence[Fraction] | None = None) -> None:
     """Write a device's contact and interface faces as one VTU of polygons, atomically.
 
     Cells: every contact face (cell data ``contact``: its index in the field data

@@ -220,6 +220,14 @@ class Mesh:
     def __len__(self) -> int:
         return len(self.element_leaf)
 
+    def points(self) -> np.ndarray:
+        """(n, 3) float64: the vertices in the domain's units, the root box's corner at 0.
+
+        The one conversion from the exact grid (``vertices / grid`` of each side) to
+        floats, so every writer and check places a vertex at the same float.
+        """
+        return self.vertices * (np.array(self.box.to_float()) / self.grid)
+
     @property
     def element_region(self) -> np.ndarray | None:
         """Per element, the index of its region (its leaf's; a cell's first leaf's), or ``None`` without regions."""

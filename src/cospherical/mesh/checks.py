@@ -382,7 +382,7 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
     vertex set when they were kept, so only the other cells are tested (and counted in
     ``delaunay_exact_tests``); ``progress`` is told of the others at once.
     """
-    points = mesh.vertices * (np.array(mesh.box.to_float()) / mesh.grid)
+    points = mesh.points()
     spheres = _spheres(mesh, points)
     if progress and mesh.cells is not None:
         progress(len(mesh) - len(spheres.centers))

@@ -48,10 +48,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-__all__ = ["SIDES", "BoundaryTriangles", "SimplexMesh", "Tetrahedra", "boundary_triangles", "fan_triangles", "real_points",
+if TYPE_CHECKING:
+    from .assembly import Mesh
+    from .regions import RegionFaces
+
+__all__ = ["SIDES", "BoundaryTriangles", "SimplexMesh", "Tetrahedra", "boundary_triangles", "fan_triangles",
            "dual_simplex_mesh", "element_blocks", "simplex_mesh", "split_tetrahedra"]
 
 
@@ -112,7 +117,7 @@ def fan_triangles(face: np.ndarray) -> np.ndarray:
 
 
 def _regions(mesh) -> np.ndarray:
-    region = getattr(mesh, "element_region", None)
+    region = mesh.element_region
     return np.zeros(len(mesh), dtype=np.int32) if region is None else np.asarray(region, dtype=np.int32)
 
 
@@ -223,12 +228,7 @@ class SimplexMesh:
     surfaces: tuple[str, ...]
 
 
-def real_points(mesh) -> np.ndarray:
-    """The mesh's vertices in the domain's units (floats)."""
-    return np.asarray(mesh.vertices, dtype=np.float64) * (np.array(mesh.box.to_float()) / int(mesh.grid))
-
-
-def simplex_mesh(mesh, tetrahedra: Tetrahedra | None = None, faces=None) -> SimplexMesh:
+def simplex_mesh(mesh: Mesh, tetrahedra: Tetrahedra | None = None, faces: RegionFaces | None = None) -> SimplexMesh:
     """The mesh's tetrahedra per region and its named surfaces (see :class:`SimplexMesh`).
 
     A device's mesh (regions from a device file) gives one volume per region, named as
@@ -240,10 +240,10 @@ def simplex_mesh(mesh, tetrahedra: Tetrahedra | None = None, faces=None) -> Simp
     """
     blocks = list(mesh.blocks())
     tets = split_tetrahedra(mesh, blocks) if tetrahedra is None else tetrahedra
-    regions = getattr(mesh, "regions", None)
+    regions = mesh.regions
     if regions is None or regions.layout is None:
         outer = boundary_triangles(mesh, blocks)
-        return SimplexMesh(real_points(mesh), tets.nodes, tets.region, ("domain",), outer.nodes,
+        return SimplexMesh(mesh.points(), tets.nodes, tets.region, ("domain",), outer.nodes,
                            outer.side.astype(np.int32), SIDES)
     from .regions import region_faces
 
@@ -256,7 +256,7 @@ def simplex_mesh(mesh, tetrahedra: Tetrahedra | None = None, faces=None) -> Simp
     triangles = np.concatenate([p[0] for p in parts])
     surface = np.concatenate([p[1] for p in parts]).astype(np.int32)
     order = np.argsort(surface, kind="stable")  # surface by surface, each in its faces' order
-    points = real_points(mesh) + np.array([float(x) for x in device.origin])
+    points = mesh.points() + np.array([float(x) for x in device.origin])
     return SimplexMesh(points, tets.nodes, tets.region, tuple(regions.names), triangles[order], surface[order],
                        surfaces)
 
