@@ -45,7 +45,7 @@ __all__ = ["CRITERIA", "SPLIT_CRITERIA", "subdivisions"]
 class _Element:
     """An element in frame indices, with what the criteria need to know about it."""
 
-    def __init__(self, frame: Frame, poly: Polyhedron, criterion: SplitCriterion):
+    def __init__(self, frame: Frame, poly: Polyhedron, criterion: SplitCriterion) -> None:
         if criterion not in SPLIT_CRITERIA:
             raise ValueError(f"criterion {criterion!r}: choose one of {', '.join(SPLIT_CRITERIA)}")
         self.frame = frame
