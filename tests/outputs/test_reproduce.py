@@ -37,10 +37,10 @@ def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypat
         names._shipped_names.cache_clear()
     tmp_path = root
     for folder in ("catalogue", "patterns", "results"):
-        # results/sweep/, results/intersection/, results/mesh/ and results/benchmarks/ come from other
+        # results/sweep/, results/intersection/, results/mesh/, results/devices/ and results/benchmarks/ come from other
         # commands and the benchmark scripts (CONTRIBUTING.md), not from reproduce
         committed = sorted(p.relative_to(ROOT) for p in (ROOT / folder).rglob("*") if p.is_file()
-                           and not {"sweep", "intersection", "mesh", "benchmarks"} & set(p.relative_to(ROOT).parts))
+                           and not {"sweep", "intersection", "mesh", "devices", "benchmarks"} & set(p.relative_to(ROOT).parts))
         assert committed == sorted(p.relative_to(tmp_path) for p in (tmp_path / folder).rglob("*") if p.is_file())
         for name in committed:
             if name.suffix == ".png":  # pictures depend on the matplotlib build; check they are pictures
