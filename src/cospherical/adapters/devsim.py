@@ -45,6 +45,7 @@ import contextlib
 import io
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
@@ -141,12 +142,13 @@ def _source(mesh) -> _Source:
     if regions is None or regions.layout is None:
         simplices = simplex_mesh(assembled)
         return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area)}, {})
-    from ..mesh.regions import mesh_region_parts, region_faces
+    from ..mesh.pipeline import full_dual
+    from ..mesh.regions import region_faces
 
     faces = region_faces(assembled)
     simplices = simplex_mesh(assembled, faces=faces)
-    parts = dual.regions if dual.regions is not None else mesh_region_parts(assembled, dual, faces)
-    geometry = _region_geometry(dual, parts)
+    dual = full_dual(assembled, faces, dual)  # with its parts per region
+    geometry = _region_geometry(dual, dual.regions)
     device = regions.layout.device
     return _Source(simplices, dual, geometry, {c.name: c.region for c in device.contacts}, tuple(regions.materials))
 
@@ -166,7 +168,7 @@ def _region_geometry(dual: Dual, parts) -> dict:
     return geometry
 
 
-def create_device(mesh, device: str = "device", contacts=None, material: str = "Silicon",
+def create_device(mesh, device: str = "device", contacts: Sequence[str] | None = None, material: str = "Silicon",
                   scale: float = 1.0) -> DevsimDevice:
     """Build DEVSIM's mesh and device from ``mesh``, the exact dual installed as its geometry.
 
