@@ -107,3 +107,28 @@ def test_a_device_gives_a_volume_per_region_and_a_surface_per_contact_and_interf
         assert len(triangles)
         sides = [faces[tuple(sorted(t))] for t in triangles.tolist()]
         assert all(sorted(s) == region_of[name] for s in sides)
+
+
+def test_a_device_of_one_region_gives_its_contacts_and_no_interface(tmp_path):
+    """A device of one region (a box, contacts on two of its sides, no interface): its Gmsh file has the
+    region's volume and the contacts' surfaces, each contact's triangles covering its rectangle (a device
+    without interfaces, such as examples/devices/l-shape.yaml, was a ValueError traceback)."""
+    import meshio
+
+    from cospherical.api.mesh import build_mesh
+    from cospherical.formats.gmsh import write_msh
+    from cospherical.mesh.device import Contact, Device, Region
+    from cospherical.mesh.tetrahedra import simplex_mesh
+
+    F = Fraction
+    device = Device("bar", (Region("si", "Si", ((F(0), F(0), F(0), F(2), F(1), F(1)),)),),
+                    (Contact("left", "si", (F(0), F(0), F(0), F(0), F(1), F(1))),
+                     Contact("top", "si", (F(1), F(0), F(1), F(2), F(1), F(1)))), (), 0)
+    built = build_mesh(device=device, uniform=False)
+    simplices = simplex_mesh(built.assembled)
+    assert simplices.volumes == ("si",) and simplices.surfaces == ("left", "top")
+    for k in range(2):  # 1 x 1 each
+        p = simplices.points[simplices.triangles[simplices.surface == k]]
+        assert np.isclose(0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum(), 1)
+    write_msh(simplices, tmp_path / "mesh.msh")
+    assert sorted(meshio.read(tmp_path / "mesh.msh").field_data) == ["left", "si", "top"]

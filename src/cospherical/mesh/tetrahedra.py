@@ -263,8 +263,10 @@ def simplex_mesh(mesh: Mesh, tetrahedra: Tetrahedra | None = None, faces: Region
 
 def _fanned(polygons: np.ndarray, label: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Triangles of -1 padded polygons (fanned from each one's smallest id) and each triangle's label."""
-    polygons = np.asarray(polygons, dtype=np.int64).reshape(len(label), -1)
     label = np.asarray(label, dtype=np.int64)
+    polygons = np.asarray(polygons, dtype=np.int64)
+    # none (a device of one region has no interface): numpy cannot reshape an empty array to (0, -1)
+    polygons = polygons.reshape(len(label), -1) if polygons.size else np.zeros((len(label), 0), dtype=np.int64)
     sizes = (polygons >= 0).sum(axis=1)
     triangles, labels, rows = [np.zeros((0, 3), dtype=np.int64)], [np.zeros(0, dtype=np.int64)], []
     for k in np.unique(sizes):
