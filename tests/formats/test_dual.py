@@ -365,3 +365,96 @@ def test_a_resigned_dual_whose_elements_overlap_and_leave_a_hole_is_refused(tmp_
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "forged.npz: member element_nodes: the elements are not a mesh" in err, err
     assert main(["check", str(_forged_dual(tmp_path / "good.npz", {}, tetrahedra))]) == 0  # unforged, it passes
+
+
+@pytest.fixture(scope="module")
+def device_dual(tmp_path_factory):
+    """A small device's dual.npz (version 4): two regions, a contact on each."""
+    from fractions import Fraction as F
+
+    from cospherical.api.mesh import build_mesh
+    from cospherical.mesh.device import Contact, Device, Region
+
+    def box(*values):
+        return tuple(F(v) for v in values)
+
+    device = Device("two", (Region("si", "Si", (box(0, 0, 0, 1, 1, "1/2"),)),
+                            Region("ox", "SiO2", (box(0, 0, "1/2", 1, 1, 1),))),
+                    (Contact("bulk", "si", box(0, 0, 0, 1, 1, 0)), Contact("gate", "ox", box(0, 0, 1, 1, 1, 1))), (), 1)
+    path = tmp_path_factory.mktemp("device") / "dual.npz"
+    from cospherical.formats.dual import write_dual
+
+    write_dual(build_mesh(device=device, uniform=False, dual=True).dual, path)
+    return path
+
+
+def _with_contact_faces(good: Path, target: Path, faces: np.ndarray, which: np.ndarray, regions=None) -> None:
+    """The dual at ``good`` with other contact faces (and contact regions), its contact parts computed again
+    from them by the library itself: consistent, so only the check of the faces themselves can refuse it."""
+    from dataclasses import replace
+    from fractions import Fraction
+
+    from cospherical.formats.dual import read_dual, write_dual
+    from cospherical.mesh.regions import region_parts
+
+    dual = read_dual(good)
+    parts = dual.regions
+    regions = regions or parts.contact_regions
+    contacts = tuple((name, region, box, next(a for a in range(3) if Fraction(box[a]) == Fraction(box[a + 3])))
+                     for name, region, box in zip(parts.contact_names, regions, parts.contact_boxes))
+    again = region_parts(dual.box, dual.grid, dual.grid_vertices, dual, parts.element_region, parts.names,
+                         parts.materials, contacts, faces, which, tuple(Fraction(t) for t in dual.box.texts),
+                         parts.origin)
+    write_dual(replace(dual, regions=again), target)
+
+
+@pytest.mark.parametrize("case", ["names with a newline and ESC", "names as paths", "two regions of one name",
+                                  "two contacts of one name", "a region index true", "a part denominator of "
+                                  "1000 digits", "a contact face repeated", "a contact face naming a vertex twice",
+                                  "a million contact faces", "a contact box along another axis",
+                                  "one quad over a whole contact", "a contact on a region it does not touch"])
+def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, capsys, case):
+    # re-signed or consistently recomputed: a v4 file's names, contacts and parts are held to what the mesher
+    # writes (names by the device file's rule; contact faces on elements of their region), never a traceback
+    from cospherical.cli import main
+    from cospherical.formats.dual import read_dual
+
+    parts = read_dual(device_dual).regions
+    faces, which = parts.contact_face_nodes, parts.contact_face_contact
+    target = tmp_path / "forged.npz"
+    manifest = {"names with a newline and ESC": {"region_names": ["si\n", "ox\x1b[2J"]},
+                "names as paths": {"region_materials": ["../../etc/passwd", "<script>"]},
+                "two regions of one name": {"region_names": ["si", "si"]},
+                "two contacts of one name": {"contact_names": ["c", "c"]},
+                "a region index true": {"contact_regions": [True, 1]},
+                "a part denominator of 1000 digits": {"coupling_part_denominator": "9" * 1000},
+                "a contact box along another axis": {"contact_boxes": [["1/7"] * 3 + ["1/7", "1", "1"],
+                                                                       list(parts.contact_boxes[1])]}}
+    repeated = faces.copy()
+    repeated[0, 1] = repeated[0, 0]
+    members = {"a contact face repeated": (np.concatenate([faces[:1], faces]), np.concatenate([which[:1], which])),
+               "a contact face naming a vertex twice": (repeated, which),
+               "a million contact faces": (np.repeat(faces[:1], 10**6, axis=0), np.repeat(which[:1], 10**6))}
+    if case in manifest:
+        _resigned(device_dual, target, lambda m: m.update(manifest[case]))
+    elif case in members:
+        nodes, contact = members[case]
+        _resigned(device_dual, target, members={"contact_face_nodes": nodes,
+                                                "contact_face_contact": contact.astype(np.int32)})
+    elif case == "one quad over a whole contact":
+        grid_vertices = read_dual(device_dual).grid_vertices
+        top = grid_vertices[:, 2].max()
+        corners = [int(np.flatnonzero((grid_vertices == [x, y, 0]).all(axis=1))[0])
+                   for x, y in ((0, 0), (0, top), (top, top), (top, 0))]
+        keep = which != 0
+        quad = np.full((1, faces.shape[1]), -1, dtype=faces.dtype)
+        quad[0, :4] = corners
+        _with_contact_faces(device_dual, target, np.concatenate([quad, faces[keep]]),
+                            np.concatenate([[0], which[keep]]).astype(np.int32))
+    else:  # the bulk contact (z = 0, under si) said to be on ox
+        _with_contact_faces(device_dual, target, faces, which, regions=(1, 0))
+    capsys.readouterr()
+    assert main(["check", str(target)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and err[:-1].isprintable() and len(err) < 400, err
+    assert "\x1b" not in err and ("contact_face_nodes" in err or "manifest" in err), err

@@ -141,6 +141,8 @@ _REGION_MEMBERS = {
     "contact_part_exact": ("iU", None, "r"), "contact_part": ("f", None, "r"),
 }
 _MAX_NAMES = 64
+# a region's, material's or contact's name: the device file's rule (schemas/device.schema.json, $defs.name)
+_NAME = re.compile(r"[A-Za-z0-9_.+-]{1,64}")
 # the most vertices an element may list: a leaf's 26 points, or a cell of the global mode (co-spherical
 # grid points); bounds the exact hull computed per distinct element shape when the dual is verified
 _MAX_ELEMENT_NODES = 64
@@ -395,7 +397,9 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
     squared = tuple(Fraction(x) for x in box.squared)
     if plane_squared != tuple(squared[(k + 1) % 3] * squared[(k + 2) % 3] for k in range(3)):
         raise FormatError(f"{path}: manifest: boundary_factors_squared are not the domain's (b^2 c^2, a^2 c^2, a^2 b^2)")
-    regions = _region_parts(arrays, manifest, len(vertices), len(edges), len(nodes), path, factor) \
+    # a polyhedron of k vertices has at most 2k - 4 faces: the most contact faces the elements can hold
+    regions = _region_parts(arrays, manifest, len(vertices), len(edges), len(nodes), path, factor,
+                            2 * int(sizes.astype(np.int64).sum())) \
         if "element_region" in arrays else None
     return Dual(box=box, grid=grid, grid_vertices=arrays["grid_vertices"].astype(np.int64),
                 vertices=arrays["vertices"], edges=edges.astype(np.int64), length=arrays["length"],
@@ -411,22 +415,23 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
 
 
 def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n_elements: int, path: Path,
-                  factor: float) -> RegionParts:
+                  factor: float, n_face_bound: int) -> RegionParts:
     """A version 4 file's region members, checked: names, indices in range, denominators (before any geometry)."""
     names, materials = manifest.get("region_names"), manifest.get("region_materials")
     contacts, regions_of = manifest.get("contact_names"), manifest.get("contact_regions")
     boxes = manifest.get("contact_boxes")
 
     def texts(value, count=None) -> bool:
+        # the device file's rule for names (they go on to DEVSIM, Gmsh and VTU files as they are)
         return isinstance(value, list) and len(value) <= _MAX_NAMES and (count is None or len(value) == count) and \
-            all(isinstance(x, str) and 0 < len(x) <= 64 for x in value)
+            all(isinstance(x, str) and _NAME.fullmatch(x) for x in value)
 
-    if not texts(names) or not names or not isinstance(materials, list) or len(materials) != len(names) or \
-            not all(isinstance(x, str) and len(x) <= 64 for x in materials):
+    if not texts(names) or not names or not texts(materials, len(names)) or len(set(names)) != len(names):
         raise FormatError(f"{path}: manifest: region_names and region_materials are not lists of up to "
-                          f"{_MAX_NAMES} names")
-    if not texts(contacts) or not isinstance(regions_of, list) or len(regions_of) != len(contacts) or \
-            not all(isinstance(r, int) and 0 <= r < len(names) for r in regions_of) or \
+                          f"{_MAX_NAMES} names (1 to 64 of A-Z a-z 0-9 _ . + -), the region names distinct")
+    if not texts(contacts) or len(set(contacts)) != len(contacts) or not isinstance(regions_of, list) or \
+            len(regions_of) != len(contacts) or \
+            not all(type(r) is int and 0 <= r < len(names) for r in regions_of) or \
             not isinstance(boxes, list) or len(boxes) != len(contacts) or \
             not all(isinstance(b, list) and len(b) == 6 and all(isinstance(x, str) and _FRACTION.fullmatch(x)
                                                                for x in b) for b in boxes):
@@ -446,6 +451,7 @@ def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n
     faces = arrays["contact_face_nodes"]
     if np.any((faces < -1) | (faces >= n_vertices)) or np.any((faces[:, :3] < 0)):
         raise FormatError(f"{path}: member contact_face_nodes: a face that names no vertex")
+    _distinct_faces(faces, n_face_bound, path)
     if len(arrays["element_region"]) != n_elements:
         raise FormatError(f"{path}: member element_region: not one region per element")
     origin = manifest.get("origin")
@@ -470,9 +476,33 @@ def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n
         _integers(arrays["contact_part_exact"], "contact_part_exact", path), denominators[2], factor,
         tuple(origin), tuple(tuple(tuple(b) for b in boxes) for boxes in region_boxes))
     for name in ("volume_part", "coupling_part", "contact_part"):  # the floats: what the exact values give
-        if not np.array_equal(arrays[name], getattr(parts, name)):
+        try:
+            given = getattr(parts, name)
+        except OverflowError:  # a denominator of hundreds of digits: no float
+            raise FormatError(f"{path}: manifest: {name}_denominator is too large for its parts to be floats") from None
+        if not np.array_equal(arrays[name], given):
             raise FormatError(f"{path}: member {name}: not what the exact values give")
     return parts
+
+
+def _distinct_faces(faces: np.ndarray, most: int, path: Path) -> None:
+    """Contact faces: each of distinct vertices, no two of the same vertices, and no more than the elements
+    have faces (``most``), refused in bulk before check walks them one by one (a face repeated three million
+    times deflates to 115 kB and took 48 CPU-s)."""
+    if len(faces) > most:
+        raise FormatError(f"{path}: member contact_face_nodes: {len(faces):,} faces, more than its elements have "
+                          f"({most:,})")
+    width = faces.shape[1]
+    ordered = np.sort(np.where(faces >= 0, faces, -1 - np.arange(width)[None, :]), axis=1)
+    if np.any(ordered[:, 1:] == ordered[:, :-1]):
+        row = int(np.flatnonzero(np.any(ordered[:, 1:] == ordered[:, :-1], axis=1))[0])
+        raise FormatError(f"{path}: member contact_face_nodes: face {row} names a vertex twice")
+    if len(ordered) > 1:
+        order = np.lexsort(ordered.T[::-1])
+        same = np.flatnonzero(np.all(ordered[order[1:]] == ordered[order[:-1]], axis=1))
+        if len(same):
+            first, second = sorted((int(order[same[0]]), int(order[same[0] + 1])))
+            raise FormatError(f"{path}: member contact_face_nodes: faces {first} and {second} have the same vertices")
 
 
 def _elements(nodes: np.ndarray, sizes: np.ndarray, n_vertices: int, path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -712,9 +742,13 @@ def _verify_regions(dual: Dual, path: str | Path) -> None:
         axes.append(flat[0])
     contacts = tuple((name, region, tuple(box), axis) for name, region, box, axis in
                      zip(parts.contact_names, parts.contact_regions, parts.contact_boxes, axes))
-    again = region_parts(dual.box, dual.grid, dual.grid_vertices, dual, parts.element_region, parts.names,
-                         parts.materials, contacts, parts.contact_face_nodes, parts.contact_face_contact, lengths,
-                         parts.origin)
+    try:
+        again = region_parts(dual.box, dual.grid, dual.grid_vertices, dual, parts.element_region, parts.names,
+                             parts.materials, contacts, parts.contact_face_nodes, parts.contact_face_contact, lengths,
+                             parts.origin)
+    except ZeroDivisionError:  # a face whose first three vertices are on one line in its contact's plane
+        raise FormatError(f"{path}: member contact_face_nodes: a contact face is no polygon in its contact's "
+                          "plane") from None
 
     def rows_differ(name: str, ours: tuple, theirs: tuple) -> None:
         (a_index, a_values, a_den), (b_index, b_values, b_den) = ours, theirs
@@ -756,4 +790,26 @@ def _verify_regions(dual: Dual, path: str | Path) -> None:
         if area != (box[b + 3] - box[b]) * (box[d + 3] - box[d]):
             raise FormatError(f"{path}: contact {shown(parts.contact_names[c])}: its faces' area {area} is not its "
                               "rectangle's")
+    _contact_faces_on_elements(dual, path)
+
+
+def _contact_faces_on_elements(dual: Dual, path: str | Path) -> None:
+    """Each contact face lies on an element of its contact's region: its vertices are that element's (in the
+    contact's flat rectangle, checked before, they are the element's face there).  A polygon of the file's own
+    (one quad over a whole contact) or a contact naming a region that does not touch it is refused."""
+    parts = dual.regions
+    nodes = dual.element_nodes.astype(np.int64)
+    owner = np.repeat(np.arange(len(nodes)), nodes.shape[1])  # vertex -> elements, through one sort
+    flat = nodes.reshape(-1)
+    order = np.argsort(flat, kind="stable")
+    keys, owners = flat[order], owner[order]
+    for k, (face, c) in enumerate(zip(parts.contact_face_nodes.tolist(), parts.contact_face_contact.tolist())):
+        ids = [v for v in face if v >= 0]
+        low, high = np.searchsorted(keys, ids[0], "left"), np.searchsorted(keys, ids[0], "right")
+        candidates = owners[low:high]
+        candidates = candidates[parts.element_region[candidates] == parts.contact_regions[c]]
+        if not any(set(ids) <= set(nodes[e].tolist()) for e in candidates.tolist()):
+            raise FormatError(f"{path}: member contact_face_nodes: face {k} of contact "
+                              f"{shown(parts.contact_names[c])} is no face of an element of its region "
+                              f"{shown(parts.names[parts.contact_regions[c]])}")
 
