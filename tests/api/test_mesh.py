@@ -98,6 +98,22 @@ def test_a_leaf_list_in_memory_is_numbered_as_listed():
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], criterion="internal_faces", delaunay="global"),
      "use --delaunay leaf"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], device="d.yaml"), "not domain="),
+    # keywords of a type build_mesh cannot use: one line naming the keyword, never a TypeError from inside
+    (dict(domain=5, levels=1, refine=["point:0,0,0"]), "domain=5"),
+    (dict(domain=iter([1, 1, 1]), levels=1, refine=["point:0,0,0"]), "domain=<list_iterator"),
+    (dict(domain=(1, 1, 1), levels=1, refine=5), "refine=5"),
+    (dict(domain=(1, 1, 1), levels=1, refine={"point:0,0,0"}), "refine={"),  # a set: hash order
+    (dict(domain=(1, 1, 1), tree=5), "tree=5"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], patterns=5), "patterns=5"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], criterion="x"), "criterion='x'"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], criterion=["optimal"]), "criterion=['optimal']"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], delaunay=[]), "delaunay=[]"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], dual="no"), "dual='no'"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], max_leaves="8"), "max_leaves='8'"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], max_leaves=1.5), "max_leaves=1.5"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], progress=5), "progress=5"),
+    (dict(device=5), "device=5"),
+    (dict(device=""), "device=''"),
 ])
 def test_bad_calls_raise_one_input_error(kwargs, needle):
     with pytest.raises(InputError, match=None) as raised:
@@ -166,3 +182,16 @@ def test_gmsh_and_tets_options_refused_with_one_line(tmp_path, capsys, argv, nee
     assert main([*base, *argv]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and needle in err[0] and not (tmp_path / "out").exists()
+
+
+def test_write_refuses_an_empty_folder_and_a_cut_outside_the_domain(tmp_path, monkeypatch):
+    # write("") wrote the files into the current folder; a NaN cut was a ValueError from the picture
+    mesh = cospherical.build_mesh(domain=(1, 1, 1), levels=0, refine=["point:0,0,0"], uniform=False)
+    monkeypatch.chdir(tmp_path)
+    for kwargs, needle in ((dict(folder=""), "folder=''"), (dict(folder=None), "folder=None"),
+                           (dict(folder="out", cut=float("nan")), "cut=nan"), (dict(folder="out", cut=2), "cut=2"),
+                           (dict(folder="out", cut="x"), "cut='x'")):
+        with pytest.raises(InputError) as raised:
+            mesh.write(**kwargs)
+        assert needle in str(raised.value) and "\n" not in str(raised.value)
+    assert list(tmp_path.iterdir()) == []

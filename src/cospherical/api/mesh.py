@@ -23,6 +23,7 @@ from __future__ import annotations
 import re
 import time
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import cached_property
 from pathlib import Path
 from typing import Any, Callable, NamedTuple, Sequence
@@ -30,7 +31,7 @@ from typing import Any, Callable, NamedTuple, Sequence
 import numpy as np
 
 from ..core.configuration import Box
-from ..errors import InputError
+from ..errors import InputError, shown
 from ..files.outputs import OutputFolder
 from ..formats.gmsh import GMSH_VERSIONS
 from ..mesh.assembly import Lookup, Mesh
@@ -284,6 +285,12 @@ class OctreeMesh:
         (:mod:`cospherical.formats.gmsh`); ``tets``: also ``tets.vtu``, the same
         tetrahedra with cell data ``element`` (the parent) and ``region``.
         """
+        if not isinstance(folder, (str, Path)) or not str(folder).strip():
+            # Path("") is the current folder: the files would land wherever the program runs
+            raise InputError(f"folder={shown(folder)}: a folder's path")
+        if cut is not None and (isinstance(cut, bool) or not isinstance(cut, (int, float, Fraction))
+                                or not 0 <= cut <= 1):
+            raise InputError(f"cut={shown(cut)}: the height of mesh.png's cut as a fraction of the domain's, 0..1")
         names = output_names(self.report.dual is not None, self._result.source.device is not None, gmsh is not None,
                              tets)
         with OutputFolder(folder, "mesh", names, writes=mesh_writes) as out:
@@ -463,6 +470,9 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
     >>> m.report.leaves, m.report.volume_ok, m.report.nonconforming_faces, m.report.delaunay_violations
     (64, True, 0, 0)
     """
+    _check_keywords(domain=domain, refine=refine, tree=tree, patterns=patterns, criterion=criterion,
+                    delaunay=delaunay, dual=dual, device=device, max_leaves=max_leaves, check_delaunay=check_delaunay,
+                    uniform=uniform, progress=progress)
     if device is not None:
         given = [name for name, value in (("domain", domain), ("levels", levels), ("refine", refine),
                                           ("leaves", leaves), ("tree", tree)) if value is not None]
@@ -506,6 +516,43 @@ def _domain_box(domain: Sequence[Any] | Box | None, tree: Octree | None) -> Box:
     if tree is not None and tree.box != box:
         raise InputError(f"tree=: its domain {' x '.join(tree.box.texts)} is not domain= {' x '.join(box.texts)}")
     return box
+
+
+def _check_keywords(**given: Any) -> None:
+    """:func:`build_mesh`'s keywords of a type it cannot use, refused with one :class:`InputError` naming the
+    keyword (a value of the right type is checked where it is used)."""
+    from ..choices import CRITERIA
+    from ..formats.patterns import PatternTable
+    from ..mesh.device import Device
+
+    def path_like(value: Any) -> bool:
+        return isinstance(value, (str, Path)) and str(value).strip() != ""
+
+    def flag(value: Any) -> bool:
+        return isinstance(value, (bool, np.bool_))
+
+    rules: dict[str, tuple[Callable[[Any], bool], str]] = {
+        "domain": (lambda v: isinstance(v, Box) or (hasattr(v, "__len__") and not isinstance(v, (str, bytes))),
+                   "three lengths, such as (1, 2, 4), or a Box"),
+        # a set would be taken in hash order: the report's list of shapes would change from run to run
+        "refine": (lambda v: isinstance(v, (str, Shape, list, tuple)),
+                   "a shape or a list of shapes, such as ['sphere:0.5,0.5,0.5,0.3']"),
+        "tree": (lambda v: isinstance(v, Octree), "an Octree (cospherical.mesh.octree)"),
+        "patterns": (lambda v: isinstance(v, PatternTable) or path_like(v),
+                     "a pattern table's path, or a table cospherical.load_patterns read"),
+        "criterion": (lambda v: isinstance(v, str) and v in CRITERIA, f"one of {', '.join(CRITERIA)}"),
+        "delaunay": (lambda v: isinstance(v, str), "global or leaf"),
+        "device": (lambda v: isinstance(v, Device) or path_like(v), "a device file's path, or a Device"),
+        "max_leaves": (lambda v: isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= 1,
+                       "a positive integer"),
+        "progress": (callable, "a callable progress(stage, total, advance)"),
+        "dual": (flag, "True or False"), "check_delaunay": (flag, "True or False"), "uniform": (flag, "True or False"),
+    }
+    for name, value in given.items():
+        fits, wanted = rules[name]
+        if value is not None and not fits(value) or value is None and name in ("criterion", "dual", "check_delaunay",
+                                                                                  "uniform"):
+            raise InputError(f"{name}={shown(value)}: {wanted}")
 
 
 def from_treemesh(tree_mesh: Any, **options: Any) -> OctreeMesh:
