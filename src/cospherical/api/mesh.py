@@ -487,7 +487,8 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
             from ..formats.device_file import read_device
 
             device = read_device(device)
-        source, origin = tree_from_device(device, max_leaves), device.origin
+        source = tree_from_device(device, max_leaves)
+        origin = source.device.device.origin  # the checked device's (exact coordinates)
     else:
         source = tree_source(box, levels, refine, leaves=leaves, tree=tree, balance=balance, max_leaves=max_leaves)
         origin = (0.0, 0.0, 0.0)

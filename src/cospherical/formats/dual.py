@@ -112,6 +112,7 @@ import numpy as np
 from ..core.configuration import Box
 from ..errors import FormatError, InputError, shown
 from ..files.yamlio import atomic_write, machine_memory, parse_json
+from ..mesh.device import NAME
 from ..mesh.dual import Dual, RegionParts
 
 __all__ = ["DUAL_FORMAT_VERSION", "domain_sums", "dual_layout", "read_dual", "verify_dual", "write_dual"]
@@ -141,8 +142,6 @@ _REGION_MEMBERS = {
     "contact_part_exact": ("iU", None, "r"), "contact_part": ("f", None, "r"),
 }
 _MAX_NAMES = 64
-# a region's, material's or contact's name: the device file's rule (schemas/device.schema.json, $defs.name)
-_NAME = re.compile(r"[A-Za-z0-9_.+-]{1,64}")
 # the most vertices an element may list: a leaf's 26 points, or a cell of the global mode (co-spherical
 # grid points); bounds the exact hull computed per distinct element shape when the dual is verified
 _MAX_ELEMENT_NODES = 64
@@ -424,7 +423,7 @@ def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n
     def texts(value, count=None) -> bool:
         # the device file's rule for names (they go on to DEVSIM, Gmsh and VTU files as they are)
         return isinstance(value, list) and len(value) <= _MAX_NAMES and (count is None or len(value) == count) and \
-            all(isinstance(x, str) and _NAME.fullmatch(x) for x in value)
+            all(isinstance(x, str) and NAME.fullmatch(x) for x in value)
 
     if not texts(names) or not names or not texts(materials, len(names)) or len(set(names)) != len(names):
         raise FormatError(f"{path}: manifest: region_names and region_materials are not lists of up to "

@@ -32,6 +32,7 @@ Examples
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -39,10 +40,10 @@ import numpy as np
 
 from ..core.configuration import Box
 from ..errors import InputError, shown
-from .octree import MAX_LEVEL, Octree, Shape, build_octree
+from .octree import MAX_LEVEL, Octree, Shape, build_octree, parse_shape
 
-__all__ = ["AXES", "Contact", "Device", "DeviceLayout", "MAX_BOXES", "MAX_CONTACTS", "MAX_REGIONS", "Region", "Regions",
-           "device_layout", "device_octree"]
+__all__ = ["AXES", "Contact", "Device", "DeviceLayout", "MAX_BOXES", "MAX_CONTACTS", "MAX_REFINE", "MAX_REGIONS", "NAME",
+           "Region", "Regions", "checked_device", "device_layout", "device_octree"]
 
 AXES = "xyz"
 # Bounds of what a device file may describe: the block grid has at most (2 * boxes + 2 * contacts + 2)
@@ -50,7 +51,11 @@ AXES = "xyz"
 MAX_REGIONS = 64
 MAX_BOXES = 64
 MAX_CONTACTS = 64
+MAX_REFINE = 64
 _COORDINATE_NAMES = ("x0", "y0", "z0", "x1", "y1", "z1")
+# A name (device, region, material, contact): the device file's rule (schemas/device.schema.json, $defs.name).
+# Names are data, written into VTU, Gmsh and DEVSIM as they are: no path separator, quote, space or control.
+NAME = re.compile(r"[A-Za-z0-9_.+-]{1,64}")
 
 Coordinates = tuple[Fraction, Fraction, Fraction, Fraction, Fraction, Fraction]
 
@@ -234,6 +239,52 @@ def _dyadic_level(value: Fraction, low: Fraction, length: Fraction) -> int | Non
     return den.bit_length() - 1
 
 
+def checked_device(device: Device) -> Device:
+    """``device`` as the device file would give it, or one :class:`InputError`: names by :data:`NAME`, six
+    exact coordinates per box (integers, fractions or their texts: through
+    :func:`~cospherical.core.exact.parse_rational`, never a float), refinement shapes as
+    :class:`~cospherical.mesh.octree.Shape` (or their texts), counts bounded first.  A ``Device`` built in
+    Python skips the file's schema; this holds it to the same rules."""
+    from ..core.exact import parse_rational
+
+    if not isinstance(device, Device):
+        raise InputError(f"device {shown(device)}: a Device, or a device file's path")
+
+    def sequence(value, what: str, most: int) -> tuple:
+        if not isinstance(value, (tuple, list)) or len(value) > most:
+            raise InputError(f"device {shown(device.name)}: its {what}: a list of at most {most}, not {shown(value)}")
+        return tuple(value)
+
+    def name(value, what: str) -> str:
+        if not isinstance(value, str) or not NAME.fullmatch(value):
+            raise InputError(f"{what} name {shown(value)}: 1 to 64 of A-Z a-z 0-9 _ . + -")
+        return value
+
+    def coordinates(value, what: str) -> tuple:
+        if not isinstance(value, (tuple, list)) or len(value) != 6:
+            raise InputError(f"{what}: six coordinates x0 y0 z0 x1 y1 z1, not {shown(value)}")
+        return tuple(parse_rational(x, what) for x in value)
+
+    name(device.name, "device")
+    regions = []
+    for region in sequence(device.regions, "regions", MAX_REGIONS):
+        if not isinstance(region, Region):
+            raise InputError(f"device {shown(device.name)}: {shown(region)} is not a Region")
+        label = f"region {shown(name(region.name, 'region'))}"
+        boxes = sequence(region.boxes, f"{label}'s boxes", MAX_BOXES)
+        regions.append(Region(region.name, name(region.material, "material"),
+                              tuple(coordinates(box, f"{label} box {k}") for k, box in enumerate(boxes))))
+    contacts = []
+    for contact in sequence(device.contacts, "contacts", MAX_CONTACTS):
+        if not isinstance(contact, Contact):
+            raise InputError(f"device {shown(device.name)}: {shown(contact)} is not a Contact")
+        label = f"contact {shown(name(contact.name, 'contact'))}"
+        contacts.append(Contact(contact.name, name(contact.region, "region"), coordinates(contact.box, label)))
+    refine = tuple(shape if isinstance(shape, Shape) else parse_shape(shape)
+                   for shape in sequence(device.refine, "refine", MAX_REFINE))
+    return Device(device.name, tuple(regions), tuple(contacts), refine, device.levels, device.balance)
+
+
 def device_layout(device: Device) -> DeviceLayout:
     """Check a device's geometry exactly and cut it into blocks (see the module).
 
@@ -245,6 +296,7 @@ def device_layout(device: Device) -> DeviceLayout:
     than one piece (boxes must touch the rest along a face: a disconnected domain is
     refused, each piece is its own device).
     """
+    device = checked_device(device)
     regions = device.regions
     if not regions:
         raise InputError(f"device {shown(device.name)}: no regions")
@@ -261,6 +313,10 @@ def device_layout(device: Device) -> DeviceLayout:
             if name in seen:
                 raise InputError(f"device {shown(device.name)}: two {kind}s named {shown(name)}")
             seen.add(name)
+    # one name space: Gmsh's physical names, meshio's field data and DEVSIM take a name for one thing
+    taken = {r.name for r in regions} & {c.name for c in device.contacts}
+    if taken:
+        raise InputError(f"device {shown(device.name)}: a region and a contact both named {shown(min(taken))}")
 
     def where(r: int, k: int) -> str:
         return f"region {shown(regions[r].name)} box {k}"
@@ -342,6 +398,11 @@ def device_layout(device: Device) -> DeviceLayout:
             raise InputError(f"contact {shown(contact.name)}: not on the boundary of region {shown(contact.region)} "
                              f"(the rectangle {AXES[axis]} = {contact.box[axis]} must have the region on one side "
                              "only, everywhere)")
+        for other, (axis0, value0, (p0, p1), (q0, q1)) in zip(device.contacts, contacts):
+            if axis0 == axis and value0 == value and max(p0, g[b]) < min(p1, g[b + 3]) and \
+                    max(q0, g[c]) < min(q1, g[c + 3]):
+                raise InputError(f"contact {shown(contact.name)} overlaps contact {shown(other.name)}: a face is in "
+                                 "one contact")
         contacts.append((axis, value, (g[b], g[b + 3]), (g[c], g[c + 3])))
     volume_unit = math.prod(lengths) / steps ** 3
     sizes = [np.diff(p) for p in planes]

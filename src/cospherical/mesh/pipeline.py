@@ -97,6 +97,7 @@ def tree_from_device(device: Device, max_leaves: int | None = None) -> TreeSourc
     """The tree of a device (:mod:`cospherical.mesh.device`): checked, refined until its region boundaries and
     contact edges lie on leaf faces, balanced, the leaves outside every region dropped."""
     layout = device_layout(device)
+    device = layout.device  # checked: exact coordinates, shapes parsed
     tree, leaf_region = device_octree(layout, max_leaves)
     described = {"source": "device", "device": device.name, "levels": device.levels,
                  "refine": [s.text for s in device.refine], "balance": device.balance,
