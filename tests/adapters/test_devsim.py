@@ -190,3 +190,27 @@ def test_a_failure_half_way_leaves_no_device_behind(devsim, graded, monkeypatch)
     monkeypatch.undo()
     handed = create_device(graded, device="half")
     drop(devsim, handed.name)
+
+
+def test_a_forged_mesh_folder_never_reaches_devsim(devsim, graded, tmp_path):
+    # a dual.npz whose node volumes were changed and re-signed: read_dual alone took it (NaN node volumes
+    # in DEVSIM); the folder is checked as `cospherical check` checks it
+    sys.path.insert(0, str(ROOT / "tests" / "formats"))
+    from test_dual import _resigned
+
+    from cospherical.errors import FormatError
+
+    dual = mesh_dual(graded)
+    write_dual(dual, tmp_path / "good.npz")
+    (tmp_path / "forged").mkdir()
+    _resigned(tmp_path / "good.npz", tmp_path / "forged" / "dual.npz",
+              members={"control_volume": np.full(len(dual.vertices), np.nan)})
+    with pytest.raises(FormatError, match="control_volume") as caught:
+        create_device(tmp_path / "forged", device="forged")
+    assert "\n" not in str(caught.value) and "forged" not in devsim.get_device_list()
+
+
+@pytest.mark.parametrize("contacts", [5, "xmin", [1]])
+def test_contacts_of_another_type_are_refused(devsim, graded, contacts):
+    with pytest.raises(InputError, match="contacts="):
+        create_device(graded, device="contacts-typed", contacts=contacts)

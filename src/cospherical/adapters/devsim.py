@@ -114,7 +114,7 @@ def _source(mesh) -> _Source:
     from ..mesh.tetrahedra import dual_simplex_mesh, simplex_mesh
 
     if isinstance(mesh, (str, Path)):
-        from ..formats.dual import read_dual
+        from ..formats.dual import read_dual, verify_dual
 
         folder = Path(mesh)
         if not folder.is_dir():
@@ -125,6 +125,8 @@ def _source(mesh) -> _Source:
             raise InputError(f"{shown(str(folder))}: not a mesh folder with dual.npz (write one with cospherical "
                              "mesh --dual --out DIR)")
         dual = read_dual(path)
+        # a file on disk is anyone's: a value changed and its checksum renewed would reach DEVSIM as it is
+        verify_dual(dual, path)
         simplices = dual_simplex_mesh(dual)
         if dual.regions is None:
             return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area)}, {})
@@ -196,6 +198,9 @@ def create_device(mesh, device: str = "device", contacts: Sequence[str] | None =
         raise InputError(f"scale {shown(scale)}: must be a positive number")
     if not isinstance(device, str) or not device.strip() or len(device) > 200 or not device.isprintable():
         raise InputError(f"device name {shown(device)}: must be a non-empty printable name")
+    if contacts is not None and (not isinstance(contacts, (list, tuple)) or not all(isinstance(c, str) for c in contacts)):
+        # a string would be taken letter by letter
+        raise InputError(f"contacts={shown(contacts)}: a list of contact names, such as ['gate']")
     devsim = import_devsim()
     if device in devsim.get_device_list() or device in devsim.get_mesh_list():
         raise InputError(f"device {shown(device)}: DEVSIM already has a device or mesh of that name")
