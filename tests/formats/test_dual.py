@@ -404,7 +404,7 @@ def _with_contact_faces(good: Path, target: Path, faces: np.ndarray, which: np.n
                      for name, region, box in zip(parts.contact_names, regions, parts.contact_boxes))
     again = region_parts(dual.box, dual.grid, dual.grid_vertices, dual, parts.element_region, parts.names,
                          parts.materials, contacts, faces, which, tuple(Fraction(t) for t in dual.box.texts),
-                         parts.origin)
+                         parts.origin, boxes=parts.boxes)
     write_dual(replace(dual, regions=again), target)
 
 
@@ -458,3 +458,6 @@ def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, ca
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err and err[:-1].isprintable() and len(err) < 400, err
     assert "\x1b" not in err and ("contact_face_nodes" in err or "manifest" in err), err
+    assert case != "one quad over a whole contact" or "is no face of an element of its region" in err, err
+    assert case != "a contact on a region it does not touch" or "is no face of an element of its region" in err \
+        or "not on the boundary of region 'ox'" in err, err
