@@ -25,11 +25,12 @@ from urllib.parse import quote
 from mkdocs.exceptions import PluginError
 from mkdocs.structure.files import File
 
+from cospherical.choices import CRITERIA
+
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "results"
 SCHEMAS = ROOT / "src" / "cospherical" / "data" / "schemas"
 MARKER = re.compile(r"<!-- generated: ([a-z-]+)(?::([a-z._-]+))? -->")
-CRITERIA = ("optimal", "internal_faces", "internal_edges_and_faces")
 
 
 # --- files taken into the site from where they live -------------------------------------------

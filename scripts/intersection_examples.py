@@ -21,7 +21,7 @@ from pathlib import Path
 
 from cospherical.files.flowyaml import sequence_line
 from cospherical.files.yamlio import atomic_write
-from cospherical.studies.intersection import INSERTION_ORDERS
+from cospherical.choices import INSERTION_ORDERS
 from cospherical.studies.intersection.run import example_elements, run_intersection
 
 TARGET = Path(__file__).resolve().parents[1] / "src" / "cospherical" / "data" / "intersection-examples.yaml"

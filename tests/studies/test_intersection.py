@@ -12,7 +12,8 @@ from sampling import sampled_table
 
 from cospherical import Box
 from cospherical.studies.engine import bisection_codes
-from cospherical.studies.intersection import INSERTION_ORDERS, intersection_codes, run_intersection, set_patterns
+from cospherical.choices import INSERTION_ORDERS
+from cospherical.studies.intersection import intersection_codes, run_intersection, set_patterns
 from cospherical.studies.summary import study_summary
 
 

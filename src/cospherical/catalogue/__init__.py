@@ -2,8 +2,6 @@
 
 from .build import build_catalogue, intersection_examples
 from .criteria import (
-                       CRITERIA,
-                       SPLIT_CRITERIA,
                        Choice,
                        apply_catalogue_criterion,
                        choose,
@@ -19,7 +17,7 @@ from .criteria import (
 from .names import (SCHEMA_VERSION, catalogue_from_text, catalogue_names, catalogue_path, known_name, load_catalogue,
                     shipped_catalogue, type_name, type_names)
 
-__all__ = ["CRITERIA", "SCHEMA_VERSION", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "build_catalogue",
+__all__ = ["SCHEMA_VERSION", "Choice", "apply_catalogue_criterion", "build_catalogue",
            "catalogue_from_text", "catalogue_names", "intersection_examples",
            "catalogue_path",
            "choose", "choose_kept", "element_options", "kept_split", "known_name", "load_catalogue", "minimal_kept_sets",

@@ -19,7 +19,7 @@ from ..core.delaunay import delaunay_cells
 from ..core.element_types import ElementType
 from ..core.geometry import Frame
 from ..core.polyhedron import polyhedron
-from ..core.split import SPLIT_CRITERIA
+from ..choices import SPLIT_CRITERIA
 from ..core.tessellation import Element
 from ..errors import FormatError
 from ..files.data import data_path

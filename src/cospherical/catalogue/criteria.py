@@ -16,11 +16,11 @@ from typing import Sequence
 
 from ..caches import cached
 from ..core.geometry import Frame
-from ..core.split import CRITERIA, SPLIT_CRITERIA, subdivisions
+from ..core.split import subdivisions
 from ..core.tessellation import Element, Tessellation
 from .names import shipped_catalogue
 
-__all__ = ["CRITERIA", "SPLIT_CRITERIA", "Choice", "apply_catalogue_criterion", "choose", "choose_kept",
+__all__ = ["Choice", "apply_catalogue_criterion", "choose", "choose_kept",
            "element_options", "kept_split", "minimal_kept_sets", "option_types", "split_options", "split_positions", "split_tessellation"]
 
 

@@ -12,14 +12,13 @@ import numpy as np
 
 from ..api.mesh import build_mesh, mesh_writes, output_names, piece_name, tree_source
 from ..formats.gmsh import GMSH_VERSIONS
-from ..catalogue import CRITERIA
+from ..choices import BALANCES, CRITERIA, MODES
 from ..core.configuration import Box
 from ..core.exact import parse_rational
 from ..errors import InputError
 from ..files.outputs import OutputFolder
 from ..formats.mesh import report_json, table_lookup, write_report
-from ..mesh.delaunay import MODES
-from ..mesh.octree import BALANCES, BYTES_PER_LEAF, MAX_LEVEL, parse_shape
+from ..mesh.octree import BYTES_PER_LEAF, MAX_LEVEL, parse_shape
 from ..mesh.pipeline import TreeSource, delaunay_mode
 from .progress import stage_bars
 from .output import path_argument

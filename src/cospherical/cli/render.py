@@ -7,7 +7,8 @@ import sys
 from pathlib import Path
 
 from ..catalogue import build_catalogue, shipped_catalogue
-from ..core.configuration import POINT_POLICIES, Box
+from ..choices import POINT_POLICIES
+from ..core.configuration import Box
 from ..core.shapes import ELEMENTS
 from ..errors import FormatError, InputError, UsageError, one_line
 from ..files.yamlio import load_yaml, validate

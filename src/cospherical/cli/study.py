@@ -7,8 +7,8 @@ import os
 import sys
 
 from ..catalogue import shipped_catalogue
-from ..choices import INSERTION_ORDERS
-from ..core.configuration import POINT_POLICIES, Box
+from ..choices import INSERTION_ORDERS, POINT_POLICIES
+from ..core.configuration import Box
 from ..core.shapes import ELEMENTS
 from ..errors import UsageError, one_line
 from ..files.yamlio import atomic_write

@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..catalogue import CRITERIA, apply_catalogue_criterion
-from ..core.configuration import POINT_POLICIES, Configuration
+from ..choices import CRITERIA, POINT_POLICIES
+from ..catalogue import apply_catalogue_criterion
+from ..core.configuration import Configuration
 from ..core.shapes import ELEMENTS, Shape, standard_shape
 from ..core.tessellation import tessellate
 from ..errors import FormatError, InputError

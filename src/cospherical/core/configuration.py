@@ -23,7 +23,7 @@ from .geometry import Rational
 from .shapes import Box, Point, Shape, standard_shape
 
 # Box: the type of a configuration's box (Configuration.box), public here with the class that takes it
-__all__ = ["Box", "Configuration", "FACE_POINT_SOURCES", "POINT_POLICIES", "steiner_parameters"]
+__all__ = ["Box", "Configuration", "steiner_parameters"]
 
 
 

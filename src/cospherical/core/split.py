@@ -25,7 +25,7 @@ from __future__ import annotations
 from itertools import combinations
 from typing import Sequence
 
-from ..choices import CRITERIA, SPLIT_CRITERIA, SplitCriterion
+from ..choices import SPLIT_CRITERIA, SplitCriterion
 from .delaunay import hull_faces
 from .geometry import Frame, dot, plane_normal, six_volume
 from .polyhedron import Polyhedron, face_kind
@@ -38,7 +38,7 @@ _Piece = tuple[list[_PieceFace], int]
 # The faces a split has left open: point set -> (cycle, normal pointing into the uncovered part).
 _OpenFaces = dict[frozenset[int], tuple[tuple[int, ...], Sequence[int]]]
 
-__all__ = ["CRITERIA", "SPLIT_CRITERIA", "subdivisions"]
+__all__ = ["subdivisions"]
 
 
 

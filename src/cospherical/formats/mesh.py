@@ -29,7 +29,8 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from ..core.configuration import POINT_POLICIES, Box, Configuration
+from ..choices import POINT_POLICIES
+from ..core.configuration import Box, Configuration
 from ..errors import FormatError, InputError
 from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh

@@ -23,8 +23,8 @@ from pathlib import Path
 from typing import Callable, Iterable, Protocol
 
 from ..caches import cached
-from ..choices import FacePointSource
-from ..core.configuration import POINT_POLICIES, Box
+from ..choices import FacePointSource, POINT_POLICIES
+from ..core.configuration import Box
 from ..core.shapes import ELEMENTS
 from ..core.tessellation import Tessellation, element_entry
 from ..errors import FormatError, InputError, shown

@@ -124,7 +124,7 @@ from ..errors import InputError
 from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, distinct, type_info
 from .checks import DelaunayCheck, check_delaunay, grid_weights
 
-__all__ = ["ENGINES", "MODES", "delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
+__all__ = ["delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
 _NO_CLUSTER = -1  # the cluster of a leaf element that is kept, and of a vertex of no cluster
 

@@ -31,7 +31,7 @@ from ..core.exact import parse_rational
 from ..errors import CosphericalWarning, InputError, shown
 from ..files.yamlio import machine_memory
 
-__all__ = ["BALANCES", "BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count", "distinct",
+__all__ = ["BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count", "distinct",
            "estimate_leaves", "leaf_bound", "leaf_list_order", "leaves_octree", "parse_shape"]
 
 MAX_LEVEL = 16  # keys (2**16)**3 and the half-spacing grid (2**17 + 1)**3 stay inside int64

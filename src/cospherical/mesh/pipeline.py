@@ -38,7 +38,8 @@ import numpy as np
 from ..core.configuration import Box
 from ..errors import InputError
 from .assembly import Lookup, Mesh, assemble
-from .delaunay import MODES, delaunay_mesh
+from ..choices import MODES
+from .delaunay import delaunay_mesh
 from .device import Device, DeviceLayout, device_layout, device_octree
 from .dual import Dual, dual_summary, mesh_dual
 from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape

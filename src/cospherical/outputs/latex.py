@@ -19,7 +19,7 @@ import jinja2
 
 from ..core.element_types import face_summary
 from ..core.geometry import cross, plane_normal
-from ..core.split import CRITERIA
+from ..choices import CRITERIA
 from ..errors import InputError
 from ..files.data import data_path
 from ..files.outputs import OutputFolder, atomic_open

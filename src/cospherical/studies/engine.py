@@ -16,8 +16,8 @@ from dataclasses import dataclass, replace
 from functools import partial
 from typing import Callable, Iterator, Sequence
 
-from ..catalogue import CRITERIA, Choice, choose
-from ..choices import FacePointSource
+from ..catalogue import Choice, choose
+from ..choices import CRITERIA, FacePointSource
 from ..core.base_element import base_element
 from ..core.configuration import Box, Configuration
 from ..core.element_types import ElementType

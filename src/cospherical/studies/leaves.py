@@ -20,7 +20,7 @@ from __future__ import annotations
 from itertools import combinations
 from typing import Sequence
 
-from ..catalogue import CRITERIA
+from ..choices import CRITERIA
 from ..core.codes import point_suffix
 from ..core.configuration import Box
 from ..core.shapes import FACE_EDGES

@@ -9,7 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
-from ..core.configuration import POINT_POLICIES, Box
+from ..choices import POINT_POLICIES
+from ..core.configuration import Box
 from .engine import Study, bisection_codes, run_study
 from .leaves import leaf_codes, run_leaves
 

@@ -5,10 +5,10 @@ two checkpointed stages (where the work runs: :mod:`cospherical.execution`), and
 ``statistics`` counts what was found.
 """
 
-from .family import INSERTION_ORDERS, PARALLEL_EDGES, all_configurations, intersection_codes, orbits, set_patterns
+from .family import PARALLEL_EDGES, all_configurations, intersection_codes, orbits, set_patterns
 from .run import cell_polyhedron, element_entries, run_intersection, tessellate_chunk
 from .statistics import ElementEntry, statistics
 
-__all__ = ["INSERTION_ORDERS", "PARALLEL_EDGES", "ElementEntry", "all_configurations", "cell_polyhedron",
+__all__ = ["PARALLEL_EDGES", "ElementEntry", "all_configurations", "cell_polyhedron",
            "element_entries",
            "intersection_codes", "orbits", "run_intersection", "set_patterns", "statistics", "tessellate_chunk"]

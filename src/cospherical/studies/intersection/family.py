@@ -30,7 +30,7 @@ from ...core.symmetry import box_symmetries, orbit_keys
 from ...errors import InputError
 from ...choices import INSERTION_ORDERS, KeyBackend
 
-__all__ = ["INSERTION_ORDERS", "PARALLEL_EDGES", "all_configurations", "intersection_codes", "orbits", "set_patterns"]
+__all__ = ["PARALLEL_EDGES", "all_configurations", "intersection_codes", "orbits", "set_patterns"]
 
 PARALLEL_EDGES = tuple(tuple(k for k in range(12) if edge_axis(k) == axis) for axis in range(3))
 

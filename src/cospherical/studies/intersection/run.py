@@ -33,7 +33,7 @@ from ...core.delaunay import delaunay_cells
 from ...core.element_types import classify
 from ...core.geometry import Frame
 from ...core.polyhedron import polyhedron
-from ...core.split import SPLIT_CRITERIA
+from ...choices import SPLIT_CRITERIA
 from ...core.symmetry import key_code
 from ...execution.backends import completed
 from ...files.yamlio import atomic_write, parse_json

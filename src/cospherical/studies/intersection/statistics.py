@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...catalogue import choose_kept
-from ...core.split import SPLIT_CRITERIA
+from ...choices import SPLIT_CRITERIA
 from ..summary import TypeInfo, frequency_table
 
 __all__ = ["ElementEntry", "statistics"]
