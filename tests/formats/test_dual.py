@@ -369,7 +369,8 @@ def test_a_resigned_dual_whose_elements_overlap_and_leave_a_hole_is_refused(tmp_
 
 @pytest.fixture(scope="module")
 def device_dual(tmp_path_factory):
-    """A small device's dual.npz (version 4): two regions, a contact on each."""
+    """A small device's dual.npz (version 4): two regions, a contact on each, both on the side x = 0 (the
+    elements at x = 1 have no contact face)."""
     from fractions import Fraction as F
 
     from cospherical.api.mesh import build_mesh
@@ -380,7 +381,8 @@ def device_dual(tmp_path_factory):
 
     device = Device("two", (Region("si", "Si", (box(0, 0, 0, 1, 1, "1/2"),)),
                             Region("ox", "SiO2", (box(0, 0, "1/2", 1, 1, 1),))),
-                    (Contact("bulk", "si", box(0, 0, 0, 1, 1, 0)), Contact("gate", "ox", box(0, 0, 1, 1, 1, 1))), (), 1)
+                    (Contact("bulk", "si", box(0, 0, 0, 0, 1, "1/2")), Contact("gate", "ox", box(0, 0, "1/2", 0, 1, 1))),
+                    (), 1)
     path = tmp_path_factory.mktemp("device") / "dual.npz"
     from cospherical.formats.dual import write_dual
 
@@ -388,7 +390,8 @@ def device_dual(tmp_path_factory):
     return path
 
 
-def _with_contact_faces(good: Path, target: Path, faces: np.ndarray, which: np.ndarray, regions=None) -> None:
+def _with_contact_faces(good: Path, target: Path, faces: np.ndarray, which: np.ndarray, regions=None,
+                        element_region=None) -> None:
     """The dual at ``good`` with other contact faces (and contact regions), its contact parts computed again
     from them by the library itself: consistent, so only the check of the faces themselves can refuse it."""
     from dataclasses import replace
@@ -402,7 +405,8 @@ def _with_contact_faces(good: Path, target: Path, faces: np.ndarray, which: np.n
     regions = regions or parts.contact_regions
     contacts = tuple((name, region, box, next(a for a in range(3) if Fraction(box[a]) == Fraction(box[a + 3])))
                      for name, region, box in zip(parts.contact_names, regions, parts.contact_boxes))
-    again = region_parts(dual.box, dual.grid, dual.grid_vertices, dual, parts.element_region, parts.names,
+    element_region = parts.element_region if element_region is None else element_region
+    again = region_parts(dual.box, dual.grid, dual.grid_vertices, dual, element_region, parts.names,
                          parts.materials, contacts, faces, which, tuple(Fraction(t) for t in dual.box.texts),
                          parts.origin, boxes=parts.boxes)
     write_dual(replace(dual, regions=again), target)
@@ -412,7 +416,8 @@ def _with_contact_faces(good: Path, target: Path, faces: np.ndarray, which: np.n
                                   "two contacts of one name", "a region index true", "a part denominator of "
                                   "1000 digits", "a contact face repeated", "a contact face naming a vertex twice",
                                   "a million contact faces", "a contact box along another axis",
-                                  "one quad over a whole contact", "a contact on a region it does not touch"])
+                                  "one quad over a whole contact", "a contact on a region it does not touch",
+                                  "an element given the other region"])
 def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, capsys, case):
     # re-signed or consistently recomputed: a v4 file's names, contacts and parts are held to what the mesher
     # writes (names by the device file's rule; contact faces on elements of their region), never a traceback
@@ -444,20 +449,29 @@ def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, ca
     elif case == "one quad over a whole contact":
         grid_vertices = read_dual(device_dual).grid_vertices
         top = grid_vertices[:, 2].max()
-        corners = [int(np.flatnonzero((grid_vertices == [x, y, 0]).all(axis=1))[0])
-                   for x, y in ((0, 0), (0, top), (top, top), (top, 0))]
+        corners = [int(np.flatnonzero((grid_vertices == [0, y, z]).all(axis=1))[0])  # bulk: x = 0, z 0 .. 1/2
+                   for y, z in ((0, 0), (top, 0), (top, top // 2), (0, top // 2))]
         keep = which != 0
         quad = np.full((1, faces.shape[1]), -1, dtype=faces.dtype)
         quad[0, :4] = corners
         _with_contact_faces(device_dual, target, np.concatenate([quad, faces[keep]]),
                             np.concatenate([[0], which[keep]]).astype(np.int32))
-    else:  # the bulk contact (z = 0, under si) said to be on ox
+    elif case == "an element given the other region":  # an element with no contact face, said to be in the other
+        dual = read_dual(device_dual)
+        touching = [set(face[face >= 0].tolist()) for face in faces]
+        inner = next(e for e, (row, size) in enumerate(zip(dual.element_nodes, dual.element_sizes))
+                     if not any(face <= set(row[:size].tolist()) for face in touching))
+        element_region = dual.regions.element_region.copy()
+        element_region[inner] = 1 - element_region[inner]
+        _with_contact_faces(device_dual, target, faces, which, element_region=element_region)
+    else:  # the bulk contact (on si's side x = 0) said to be on ox
         _with_contact_faces(device_dual, target, faces, which, regions=(1, 0))
     capsys.readouterr()
     assert main(["check", str(target)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err and err[:-1].isprintable() and len(err) < 400, err
-    assert "\x1b" not in err and ("contact_face_nodes" in err or "manifest" in err), err
+    assert "\x1b" not in err and ("contact_face_nodes" in err or "manifest" in err or "element_region" in err), err
     assert case != "one quad over a whole contact" or "is no face of an element of its region" in err, err
+    assert case != "an element given the other region" or "member element_region" in err, err
     assert case != "a contact on a region it does not touch" or "is no face of an element of its region" in err \
         or "not on the boundary of region 'ox'" in err, err

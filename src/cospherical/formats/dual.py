@@ -629,7 +629,10 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
         again = mesh_dual(_Vertices(dual.box, dual.grid, dual.grid_vertices), (dual.element_nodes, dual.element_sizes))
     except InputError as error:  # an element that is flat or not co-spherical has no dual
         raise FormatError(f"{path}: member element_nodes: {error}") from None
-    _check_mesh(dual, shape, path, dual_layout(dual, path))
+    layout = dual_layout(dual, path)
+    _check_mesh(dual, shape, path, layout)
+    if layout is not None:
+        _check_element_regions(dual, layout, path)
     if not np.array_equal(again.edges, dual.edges):
         raise FormatError(f"{path}: member edges: not the edges of its elements ({len(dual.edges)} edges, "
                           f"its elements have {len(again.edges)})")
@@ -679,6 +682,28 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
             raise FormatError(f"{path}: member {name}: {what} is not what the exact values give")
     if dual.regions is not None:
         _verify_regions(dual, path)
+
+
+def _check_element_regions(dual: Dual, layout, path: str | Path) -> None:
+    """Each element's region is the region of the box it lies in: the owner of the block holding its vertex
+    centroid (an interior point; decided in integers, the centroid times the element's size against the block
+    planes).  The parts check recomputes from ``element_region``; this proves ``element_region`` itself."""
+    nodes, sizes = dual.element_nodes.astype(np.int64), dual.element_sizes.astype(np.int64)
+    factor = dual.grid // layout.steps  # grid steps per step of the resolving level
+    sums = np.where((nodes >= 0)[..., None], dual.grid_vertices[np.maximum(nodes, 0)], 0).sum(axis=1)
+    owner = np.empty(len(nodes), dtype=np.int64)
+    for size in np.unique(sizes).tolist():
+        rows = np.flatnonzero(sizes == size)
+        index = tuple(np.clip(np.searchsorted(layout.planes[a] * factor * size, sums[rows, a], "right") - 1, 0,
+                              len(layout.planes[a]) - 2) for a in range(3))
+        owner[rows] = layout.owner[index]
+    wrong = np.flatnonzero(owner != dual.regions.element_region)
+    if len(wrong):
+        e = int(wrong[0])
+        names = dual.regions.names
+        lies = f"in a box of region {shown(names[owner[e]])}" if owner[e] >= 0 else "outside every region's box"
+        raise FormatError(f"{path}: member element_region: element {e} is given region "
+                          f"{shown(names[dual.regions.element_region[e]])} but lies {lies}")
 
 
 def dual_layout(dual: Dual, path: str | Path):
