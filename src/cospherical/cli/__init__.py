@@ -64,7 +64,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
 _interrupted = threading.Event()
 _terminated = threading.Event()
-_redelivery: list[threading.Timer] = []  # signals held back while numba's compiler ran
+_redelivery: list[threading.Timer] = []  # signals held back while numba's compiler or a fork hook ran
 
 
 def _on_signal(signum, frame):
@@ -74,9 +74,11 @@ def _on_signal(signum, frame):
     # compiled code it can come back as that library's own error (numba: SystemError,
     # numpy: ImportError) or be swallowed there, and the run must still end as signalled.
     (_terminated if signum == signal.SIGTERM else _interrupted).set()
-    if _in_compiler(frame):
-        # Unwinding through numba's compiler or cache loader crashes the process (SIGSEGV):
-        # deliver the signal again shortly, until it arrives outside.
+    if _cannot_unwind(frame):
+        # Unwinding through numba's compiler or cache loader crashes the process (SIGSEGV), and
+        # an exception raised in logging's fork hooks (os.fork runs them while a pool starts a
+        # worker) is printed as "Exception ignored" with a traceback, then dropped: deliver the
+        # signal again shortly, until it arrives outside.
         # A daemon, and cancelled when the run ends first: never delivered after main returns.
         timer = threading.Timer(0.1, os.kill, (os.getpid(), signum))
         timer.daemon = True
@@ -88,10 +90,10 @@ def _on_signal(signum, frame):
     raise KeyboardInterrupt
 
 
-def _in_compiler(frame) -> bool:
+def _cannot_unwind(frame) -> bool:
     while frame is not None:
         name = frame.f_globals.get("__name__", "")
-        if name.startswith(("numba.", "llvmlite.")):
+        if name.startswith(("numba.", "llvmlite.")) or name == "logging":
             return True
         frame = frame.f_back
     return False
