@@ -45,6 +45,7 @@ import numpy as np
 
 from ..errors import InputError, shown
 from ..files.outputs import atomic_open
+from ..mesh.tetrahedra import SimplexMesh
 
 __all__ = ["GMSH_VERSIONS", "msh_bytes", "write_msh"]
 
@@ -59,7 +60,7 @@ def _check_name(name: str) -> str:
     return name
 
 
-def _groups(simplices):
+def _groups(simplices: SimplexMesh) -> list[tuple[int, int, str, np.ndarray, int]]:
     """(dimension, tag, name, elements (rows of 1-based node tags), element type) per physical group."""
     groups = []
     volumes, surfaces = list(simplices.volumes), list(simplices.surfaces)
@@ -85,7 +86,7 @@ def _text_rows(rows: np.ndarray, float_columns: int = 0) -> str:
     return buffer.getvalue()
 
 
-def msh_bytes(simplices, version: str = "4.1", binary: bool = False) -> bytes:
+def msh_bytes(simplices: SimplexMesh, version: str = "4.1", binary: bool = False) -> bytes:
     """The Gmsh file of a :class:`~cospherical.mesh.tetrahedra.SimplexMesh` as bytes (see the module docstring)."""
     if version not in GMSH_VERSIONS:
         raise InputError(f"Gmsh version {shown(version)}: write one of {', '.join(GMSH_VERSIONS)}")
@@ -194,7 +195,7 @@ def _write_41(out, points, groups, binary: bool) -> None:
     out.write(b"\n$EndElements\n" if binary else b"$EndElements\n")
 
 
-def write_msh(simplices, path: str | Path, version: str = "4.1", binary: bool = False) -> None:
+def write_msh(simplices: SimplexMesh, path: str | Path, version: str = "4.1", binary: bool = False) -> None:
     """Write a :class:`~cospherical.mesh.tetrahedra.SimplexMesh` as a Gmsh file, atomically."""
     data = msh_bytes(simplices, version, binary)
     with atomic_open(path, binary=True) as handle:

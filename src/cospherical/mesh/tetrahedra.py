@@ -54,6 +54,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from .assembly import Mesh
+    from .dual import Dual
     from .regions import RegionFaces
 
 __all__ = ["SIDES", "BoundaryTriangles", "SimplexMesh", "Tetrahedra", "boundary_triangles", "fan_triangles",
@@ -279,7 +280,7 @@ def _fanned(polygons: np.ndarray, label: np.ndarray) -> tuple[np.ndarray, np.nda
     return np.concatenate(triangles)[order], np.concatenate(labels)[order]
 
 
-def dual_simplex_mesh(dual) -> SimplexMesh:
+def dual_simplex_mesh(dual: Dual) -> SimplexMesh:
     """:func:`simplex_mesh` of the elements a :class:`~cospherical.mesh.dual.Dual` holds (a ``dual.npz``).
 
     With a device's parts (``dual.regions``): a volume per region, a surface per contact
