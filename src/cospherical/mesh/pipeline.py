@@ -163,7 +163,8 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     Parameters
     ----------
     source
-        The tree (:func:`tree_from_refine`, :func:`tree_from_leaves`, :func:`tree_from_octree`).
+        The tree (:func:`tree_from_refine`, :func:`tree_from_leaves`, :func:`tree_from_octree`,
+        :func:`tree_from_device`: a device's tree, meshed region by region with its contacts).
     lookup
         A pattern table's elements per configuration
         (:func:`cospherical.formats.mesh.table_lookup`); ``None``: every configuration tessellated.
@@ -216,7 +217,7 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         faces = region_faces(mesh)
         if found is not None:
             found = full_dual(mesh, faces, found)
-        report["device"] = device_report(mesh, faces, found.regions if found is not None else None, found)
+        report["device"] = device_report(mesh, faces, found)
     clock.stage(None)
     return PipelineResult(source, mesh, MeshReport.from_dict(report, timings), found,
                           checked_report.delaunay.violating_elements if checked_report.delaunay is not None else None,

@@ -428,11 +428,10 @@ def region_volumes(mesh: Mesh) -> list[Fraction]:
     return volumes
 
 
-def device_report(mesh: Mesh, faces: RegionFaces, parts: RegionParts | None = None,
-                  dual: Dual | None = None) -> dict:
-    """The report's ``device`` section: per region its elements, nodes, volume (exact) and, with the dual,
-    its negative coefficients (interior: off the domain's boundary); per contact its faces, nodes, area;
-    per interface its faces and nodes."""
+def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> dict:
+    """The report's ``device`` section: per region its elements, nodes, volume (exact) and, with the dual
+    (its parts per region computed), its negative coefficients (interior: off the domain's boundary) and
+    control volume sum; per contact its faces, nodes, area; per interface its faces and nodes."""
     layout = mesh.regions.layout
     device = layout.device
     lengths = [high - low for low, high in device.bounds]
@@ -441,6 +440,7 @@ def device_report(mesh: Mesh, faces: RegionFaces, parts: RegionParts | None = No
     conn, _ = mesh.connectivity()
     volumes = region_volumes(mesh)
     negative = None
+    parts = dual.regions if dual is not None else None
     if parts is not None:
         keys = dual.edges[parts.coupling_edge, 0].astype(np.int64) * len(mesh.vertices) + \
             dual.edges[parts.coupling_edge, 1]
