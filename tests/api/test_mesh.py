@@ -114,6 +114,7 @@ def test_a_leaf_list_in_memory_is_numbered_as_listed():
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], progress=5), "progress=5"),
     (dict(device=5), "device=5"),
     (dict(device=""), "device=''"),
+    (dict(device="d.yaml", balance="edge"), "not balance="),  # the file says its balance: was ignored
 ])
 def test_bad_calls_raise_one_input_error(kwargs, needle):
     with pytest.raises(InputError, match=None) as raised:

@@ -45,6 +45,7 @@ UNBALANCED = [(1, i, j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1) if (i
     (["--levels", "x", "--refine", "point:0,0,0"], "--levels 'x'"),
     (["--refine", "point:0,0,0"], "needs --levels"),
     (["--levels", "2", "--refine", "point:0,0,0", "--balance", "face"], "invalid choice: 'face'"),
+    (["--leaves", "leaves.txt", "--balance", "edge"], "--balance goes with --refine"),  # was ignored
     (["--leaves", "{tmp}/overlap.txt"], "leaf 1 repeats leaf 0"),
     (["--leaves", "{tmp}/gap.txt"], "no leaf covers the cell at level 1, position 1 1 1"),
     (["--leaves", "{tmp}/unbalanced.txt"], "leaf 0 (level 1, position 0 0 1) touches leaves of level 3"),

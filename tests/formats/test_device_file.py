@@ -63,6 +63,9 @@ def test_bad_device_files_are_refused_with_one_line(tmp_path, capsys, text, need
 def test_a_device_does_not_take_a_tree_of_its_own(tmp_path, capsys):
     assert main(["mesh", "--device", str(EXAMPLES / "pn-diode.yaml"), "--refine", "point:0,0,0", "--levels", "1"]) == 2
     assert "--refine" in capsys.readouterr().err
+    # the file says its balance: --balance was ignored without a word
+    assert main(["mesh", "--device", str(EXAMPLES / "pn-diode.yaml"), "--balance", "edge"]) == 2
+    assert "--balance" in capsys.readouterr().err
 
 
 def test_numbers_stay_exact_and_names_are_data():

@@ -420,7 +420,7 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
                refine: Sequence[str | Shape] | str | None = None, *,
                leaves: str | Path | Sequence[Sequence[int]] | np.ndarray | None = None, tree: Octree | None = None,
                patterns: Any = None, criterion: str = "optimal", delaunay: str | None = None,
-               balance: str = "vertex", dual: bool = False, device: str | Path | Device | None = None, max_leaves: int | None = None,
+               balance: str | None = None, dual: bool = False, device: str | Path | Device | None = None, max_leaves: int | None = None,
                check_delaunay: bool = True, uniform: bool = True, progress: Progress | None = None) -> OctreeMesh:
     """Mesh an octree: each leaf's elements, globally Delaunay, checked exactly, reported; the dual on request.
 
@@ -433,8 +433,8 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
     levels, refine
         Split every cell whose closed box meets a shape down to ``levels``:
         ``sphere:X,Y,Z,R`` (its surface), ``plane:NX,NY,NZ,D``, ``point:X,Y,Z``,
-        ``box:X0,Y0,Z0,X1,Y1,Z1`` in domain units; then 2:1 ``balance`` (``vertex``
-        across faces, edges and corners, or ``edge``).
+        ``box:X0,Y0,Z0,X1,Y1,Z1`` in domain units; then 2:1 ``balance`` (``vertex``,
+        the default: across faces, edges and corners, or ``edge``; a device file gives its own).
     leaves
         Instead: a leaf list file, or its rows ``(level, i, j, k)``; checked to tile
         the domain and be 1-irregular.  The mesh numbers the leaves as listed.
@@ -475,7 +475,8 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
                     uniform=uniform, progress=progress)
     if device is not None:
         given = [name for name, value in (("domain", domain), ("levels", levels), ("refine", refine),
-                                          ("leaves", leaves), ("tree", tree)) if value is not None]
+                                          ("leaves", leaves), ("tree", tree), ("balance", balance))
+                 if value is not None]
         if given:
             raise InputError(f"device=: its file gives the domain and the tree, not {given[0]}=")
     else:
@@ -490,7 +491,8 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         source = tree_from_device(device, max_leaves)
         origin = source.device.device.origin  # the checked device's (exact coordinates)
     else:
-        source = tree_source(box, levels, refine, leaves=leaves, tree=tree, balance=balance, max_leaves=max_leaves)
+        source = tree_source(box, levels, refine, leaves=leaves, tree=tree, balance=balance or "vertex",
+                             max_leaves=max_leaves)
         origin = (0.0, 0.0, 0.0)
     timings = {"tree": time.perf_counter() - clock}
     clock = time.perf_counter()

@@ -55,7 +55,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--max-leaves", metavar="N",
                         help="refuse a tree of more leaves than N, estimated before it is built (default: what half "
                         f"of this machine's memory holds at {BYTES_PER_LEAF} bytes a leaf)")
-    parser.add_argument("--balance", choices=BALANCES, default="vertex",
+    parser.add_argument("--balance", choices=BALANCES,
                         help="2:1 balance across faces, edges and corners (vertex, default) or faces and edges "
                         "(edge); across faces alone is not offered: it is not 1-irregular")
     parser.add_argument("--patterns", type=path_argument, metavar="FILE",
@@ -168,7 +168,7 @@ def run(args) -> int:
         from ..formats.device_file import read_device
 
         for option, value in (("--refine", args.refine), ("--leaves", args.leaves), ("--levels", args.levels),
-                              ("--partitions", args.partitions)):
+                              ("--balance", args.balance), ("--partitions", args.partitions)):
             if value is not None:
                 raise InputError(f"{option}: a device file gives its own tree (refine and levels): not with --device")
         args.device = read_device(args.device)  # before the output folder: a bad file writes nothing
@@ -218,10 +218,12 @@ def _run(args, out: OutputFolder | None) -> int:
     elif args.leaves is not None:
         if args.levels is not None:
             raise InputError("--levels goes with --refine, not with --leaves")
+        if args.balance is not None:  # a leaf list is the tree as given: checked 1-irregular, never balanced
+            raise InputError("--balance goes with --refine, not with --leaves")
         given = {"leaves": args.leaves}
     else:
         shapes = [parse_shape(text) for text in args.refine]
-        given = {"levels": _levels(args.levels), "refine": shapes, "balance": args.balance}
+        given = {"levels": _levels(args.levels), "refine": shapes, "balance": args.balance or "vertex"}
     box = Box.parse(args.domain) if args.device is None else None
     if args.partitions is not None:
         return _in_pieces(args, tree_source(box, **given, max_leaves=max_leaves), out)
