@@ -11,8 +11,9 @@ from cospherical.core.configuration import Box
 from cospherical.errors import InputError
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.octree import build_octree, parse_shape
-from cospherical.mesh.pipeline import (delaunay_mode, run_pipeline, tree_from_leaves, tree_from_octree,
-                                       tree_from_refine)
+from cospherical.formats.device_file import parse_device
+from cospherical.mesh.pipeline import (delaunay_mode, run_pipeline, tree_from_device, tree_from_leaves,
+                                       tree_from_octree, tree_from_refine)
 from cospherical.mesh.report import MeshReport, mesh_report
 
 BOX = Box.parse([1, 2, 4])
@@ -33,6 +34,19 @@ def test_progress_adds_up_to_each_stage_total_and_timings_follow_the_stages():
                                            "delaunay", "statistics", "dual"]
     assert all(seconds >= 0 for seconds in result.report.timings.values())
     assert result.dual is not None and result.report.dual["edges"] == len(result.dual.edges)
+
+
+def test_a_device_tells_the_same_stages_with_their_own_totals():
+    """A device's mesh is told as the one-box mesh is (assembly through the leaves, the leaf mesh's check through
+    its elements), so the command line draws the same bars for it."""
+    device = parse_device("device: cube\nregions:\n  - {name: si, material: Si, boxes: [[0, 0, 0, 1, 1, 1]]}\n"
+                          "refine:\n  - point: [0.1, 0.2, 0.3]\nlevels: 3\n")
+    told = defaultdict(list)
+    source = tree_from_device(device)
+    result = run_pipeline(source, uniform=False, progress=lambda stage, total, n: told[stage].append((total, n)))
+    assert set(told) == {"assembly", "regions"}
+    assert told["assembly"][0][0] == len(source.tree) == sum(n for _, n in told["assembly"])
+    assert told["regions"][0][0] == result.report.leaf_mesh["elements"] == sum(n for _, n in told["regions"])
 
 
 def test_the_pipeline_in_leaf_mode_is_the_steps_by_hand():

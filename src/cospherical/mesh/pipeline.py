@@ -198,7 +198,7 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     clock.stage("assembly")
     if source.device is not None:
         mesh, leaf_mesh, checked = device_mesh(source.device, tree, source.leaf_region, lookup, criterion, mode,
-                                               progress=told("regions", len(tree)))
+                                               progress=progress)
     else:
         mesh = assemble(tree, lookup, progress=told("assembly", len(tree)), criterion=criterion)
         clock.stage("global Delaunay" if mode == "global" else None)

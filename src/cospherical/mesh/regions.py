@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Callable
 
 import numpy as np
 
@@ -45,23 +46,29 @@ __all__ = ["RegionFaces", "contact_areas", "device_mesh", "device_report", "mesh
 
 
 def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, lookup: Lookup | None = None,
-                criterion: str = "optimal", mode: str = "global", progress=None,
-                cache: dict | None = None) -> tuple[Mesh, dict | None, dict | None]:
+                criterion: str = "optimal", mode: str = "global",
+                progress: Callable[[str, int | None, int], None] | None = None,
+                cache: dict | None = None) -> tuple[Mesh, dict | None, DelaunayCheck | None]:
     """Mesh a device's tree: the leaf mesh, then in ``global`` mode the exact Delaunay subdivision box by box.
 
     Returns what :func:`~cospherical.mesh.delaunay.delaunay_mesh` returns: the mesh,
     what the check found on the leaf mesh (summed over the boxes), and the check of
     the result (the boxes' checks summed; each against its own box's vertices).
+    ``progress(stage, total, advance)``: told of the stages as the one-box pipeline
+    tells them (``assembly`` through the leaves, ``regions`` through the leaf mesh's
+    elements), so a device's mesh shows the same bars.
     """
     device = layout.device
     regions = Regions(tuple(r.name for r in device.regions), tuple(r.material for r in device.regions),
                       leaf_region, layout)
     cache = {} if cache is None else cache
-    mesh = assemble(tree, lookup, criterion=criterion, cache=cache)
+    mesh = assemble(tree, lookup, criterion=criterion, cache=cache,
+                    progress=None if progress is None else (lambda n: progress("assembly", len(tree), n)))
     mesh.regions = regions
     boxes = sum(len(r.boxes) for r in device.regions)
     if mode != "global" or boxes == 1:
-        return delaunay_mesh(mesh, mode, progress=progress)
+        return delaunay_mesh(mesh, mode,
+                             progress=None if progress is None else (lambda n: progress("regions", len(mesh), n)))
     leaf_box = leaf_owner(layout, tree.levels, tree.positions, boxes=True)
     grid, keys = vertex_keys(tree)
     n = np.int64(grid + 1)
