@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import discretize
 import numpy as np
 import pytest
@@ -48,3 +50,11 @@ def test_what_it_cannot_mesh_is_one_error():
         cospherical.from_treemesh(object())
     with pytest.raises(InputError, match="domain= is the TreeMesh's own"):
         cospherical.from_treemesh(discretize.TreeMesh([[(1, 4)]] * 3, diagonal_balance=True), domain=(1, 1, 1))
+    with pytest.raises(InputError, match="device= is the TreeMesh's own"):  # it said "not domain=", not given
+        cospherical.from_treemesh(discretize.TreeMesh([[(1, 4)]] * 3, diagonal_balance=True), device="d.yaml")
+    nan_origin = discretize.TreeMesh([[(1 / 4, 4)]] * 3, diagonal_balance=True, origin=[float("nan"), 0, 0])
+    nan_origin.refine_points([[0.3, 0.6, 0.7]], level=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's "invalid value encountered in cast" was printed, then a leaf -2**63
+        with pytest.raises(InputError, match="must be finite numbers"):
+            cospherical.from_treemesh(nan_origin)

@@ -49,6 +49,9 @@ def treemesh_leaves(tree_mesh) -> TreeMeshLeaves:
         raise InputError(f"from_treemesh: a discretize.TreeMesh, not {type(tree_mesh).__name__} ({error})") from None
     if len(widths) != 3:
         raise InputError(f"from_treemesh: a 3-D TreeMesh, not {len(widths)}-D")
+    if not all(np.isfinite(x) for x in origin) or not all(np.isfinite(h).all() and (h > 0).all() for h in widths):
+        # a NaN origin gave every leaf the position -2**63 (numpy's cast of NaN), named as "outside the domain"
+        raise InputError(f"from_treemesh: its origin {origin} and cell widths must be finite numbers, the widths > 0")
     if len(set(shape)) != 1:
         raise InputError(f"from_treemesh: {' x '.join(map(str, shape))} base cells: the root cell must be split "
                          "alike along the three axes (the same power of two a side)")

@@ -578,7 +578,7 @@ def from_treemesh(tree_mesh: Any, **options: Any) -> OctreeMesh:
     """
     from ..adapters.discretize import treemesh_leaves
 
-    for taken in ("domain", "levels", "refine", "leaves", "tree"):
+    for taken in ("domain", "levels", "refine", "leaves", "tree", "device", "balance"):
         if taken in options:
             raise InputError(f"from_treemesh: {taken}= is the TreeMesh's own")
     leaves = treemesh_leaves(tree_mesh)
