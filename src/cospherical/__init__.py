@@ -8,7 +8,7 @@ first use, so ``import cospherical`` stays cheap for the command line.
   (the cuboid, a prism, pyramid, tetrahedron or any convex shape): ``Shape``, ``standard_shape``.
 - The element catalogue: ``shipped_catalogue``, ``load_catalogue``, ``type_name``.
 - Pattern tables: ``load_patterns``, ``PatternTable``.
-- A mesh of an octree in one call: ``build_mesh`` (refine shapes, a leaf list or a tree in,
+- A mesh of an octree in one call: ``build_mesh`` (refine shapes, a leaf list, a tree or a device in,
   an ``OctreeMesh`` out: vertices, elements, the exact report ``MeshReport``, the dual, its
   files, ``to_pyvista``, ``to_meshio``) and ``from_treemesh`` (a ``discretize.TreeMesh`` in).
 - Errors: ``CosphericalError`` and its kinds ``InputError``, ``FormatError``, ``UsageError``;
@@ -20,8 +20,9 @@ The mesher's steps are in its package, :mod:`cospherical.mesh` (``pipeline.run_p
 ``__all__`` says what it makes public; a name with a leading underscore is internal.
 
 The layers, top to bottom, each importing only from those below it: ``cli``, ``api``, ``outputs``,
-``adapters``, ``formats``, ``mesh``, ``studies``, ``catalogue``, ``paper``, ``core`` and ``files``, then
-``errors``, ``version`` and ``caches`` (pyproject.toml's import-linter contracts).
+``adapters``, ``formats``, ``mesh``, ``studies``, ``catalogue``, ``paper``, ``core``, ``files`` and
+``execution``, then ``errors``, ``version``, ``caches`` and ``choices`` (pyproject.toml's import-linter
+contracts).
 
 Examples
 --------
