@@ -491,17 +491,23 @@ def _distinct_faces(faces: np.ndarray, most: int, path: Path) -> None:
     if len(faces) > most:
         raise FormatError(f"{path}: member contact_face_nodes: {len(faces):,} faces, more than its elements have "
                           f"({most:,})")
-    width = faces.shape[1]
-    ordered = np.sort(np.where(faces >= 0, faces, -1 - np.arange(width)[None, :]), axis=1)
-    if np.any(ordered[:, 1:] == ordered[:, :-1]):
-        row = int(np.flatnonzero(np.any(ordered[:, 1:] == ordered[:, :-1], axis=1))[0])
-        raise FormatError(f"{path}: member contact_face_nodes: face {row} names a vertex twice")
+    _distinct_rows(faces, faces >= 0, path, "contact_face_nodes", "face")
+
+
+def _distinct_rows(nodes: np.ndarray, used: np.ndarray, path: Path, member: str, row: str) -> None:
+    """Refuse a row of ``nodes`` (its ``used`` entries; the rest padding) naming a vertex twice, or two rows
+    of the same vertices: in bulk, with the first offending row named, before any geometry."""
+    width = nodes.shape[1]
+    ordered = np.sort(np.where(used, nodes, -1 - np.arange(width)[None, :]), axis=1)
+    twice = np.any(ordered[:, 1:] == ordered[:, :-1], axis=1)
+    if twice.any():
+        raise FormatError(f"{path}: member {member}: {row} {int(np.flatnonzero(twice)[0])} names a vertex twice")
     if len(ordered) > 1:
         order = np.lexsort(ordered.T[::-1])
         same = np.flatnonzero(np.all(ordered[order[1:]] == ordered[order[:-1]], axis=1))
         if len(same):
             first, second = sorted((int(order[same[0]]), int(order[same[0] + 1])))
-            raise FormatError(f"{path}: member contact_face_nodes: faces {first} and {second} have the same vertices")
+            raise FormatError(f"{path}: member {member}: {row}s {first} and {second} have the same vertices")
 
 
 def _elements(nodes: np.ndarray, sizes: np.ndarray, n_vertices: int, path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -514,19 +520,10 @@ def _elements(nodes: np.ndarray, sizes: np.ndarray, n_vertices: int, path: Path)
     used = np.arange(width)[None, :] < sizes[:, None]
     if np.any(nodes[~used] != -1) or np.any(nodes[used] < 0) or np.any(nodes[used] >= n_vertices):
         raise FormatError(f"{path}: member element_nodes: an element names no vertex, or its padding is not -1")
-    ordered = np.sort(np.where(used, nodes, -1 - np.arange(width)[None, :]), axis=1)
-    if np.any(ordered[:, 1:] == ordered[:, :-1]):
-        row = int(np.flatnonzero(np.any(ordered[:, 1:] == ordered[:, :-1], axis=1))[0])
-        raise FormatError(f"{path}: member element_nodes: element {row} names a vertex twice")
     # Two elements of the same vertices: refused here, in bulk, because check's recomputation walks the
     # elements one by one in Python: ten million copies of one element deflate to a file of 225 kB
     # and took minutes before the edge comparison found them.
-    if len(ordered) > 1:
-        order = np.lexsort(ordered.T[::-1])
-        same = np.flatnonzero(np.all(ordered[order[1:]] == ordered[order[:-1]], axis=1))
-        if len(same):
-            first, second = sorted((int(order[same[0]]), int(order[same[0] + 1])))
-            raise FormatError(f"{path}: member element_nodes: elements {first} and {second} have the same vertices")
+    _distinct_rows(nodes, used, path, "element_nodes", "element")
     return nodes.astype(np.int32), sizes.astype(np.int8)
 
 
