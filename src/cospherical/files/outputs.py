@@ -37,7 +37,7 @@ import re
 import shutil
 import stat
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -249,7 +249,8 @@ class OutputFolder:
     ['.cospherical-manifest.json', 'a.txt']
     """
 
-    def __init__(self, folder: str | Path, writer: str, names=(), writes: Callable[[str], object] | None = None):
+    def __init__(self, folder: str | Path, writer: str, names: Iterable[str] = (),
+                 writes: Callable[[str], object] | None = None) -> None:
         self.folder = Path(folder)
         self.writer = writer
         self._writes = writes
