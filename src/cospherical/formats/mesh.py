@@ -344,18 +344,18 @@ def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None 
              "leaf": (mesh.element_leaf if leaves is None else leaves[mesh.element_leaf])[order].astype(np.int32), "fvm": mesh.element_fvm()[order].astype(np.uint8)}
     for name, values in (cell_data or {}).items():
         if name in cells:
-            raise ValueError(f"cell data {name!r}: the writer's own")
+            raise InputError(f"cell data {name!r}: the writer's own")
         if len(values) != len(mesh):
-            raise ValueError(f"cell data {name!r}: {len(values)} rows for {len(mesh)} elements")
+            raise InputError(f"cell data {name!r}: {len(values)} rows for {len(mesh)} elements")
         cells[name] = np.asarray(values)[order]
     points = {"grid_coordinates": narrow(mesh.vertices)}
     for name, values in (point_data or {}).items():
         if name in points:
-            raise ValueError(f"point data {name!r}: the writer's own")
+            raise InputError(f"point data {name!r}: the writer's own")
         points[name] = values
     for name, values in (field_data or {}).items():
         if name in fields:
-            raise ValueError(f"field data {name!r}: the writer's own")
+            raise InputError(f"field data {name!r}: the writer's own")
         fields[name] = values
     coordinates = mesh.points()
     if origin is not None:
@@ -423,7 +423,7 @@ def write_pvtu(path: str | Path, pieces: list[Path]) -> None:
         if declared is None:
             declared = mine
         elif mine != declared:
-            raise ValueError(f"{piece}: its arrays are not the first piece's")
+            raise FormatError(f"{piece}: its arrays are not the first piece's")
 
     def arrays(section: str) -> list[str]:
         return [f'<PDataArray type="{kind}"' + (f" Name={name}" if section != "Points" else "")

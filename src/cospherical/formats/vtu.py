@@ -24,6 +24,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..core.tessellation import Tessellation
+from ..errors import InputError
 from ..files.yamlio import atomic_open
 
 __all__ = ["VTK_CELL", "narrow", "text_array", "write_grid", "write_vtu"]
@@ -55,7 +56,7 @@ def _array(name: str, data: np.ndarray) -> tuple[str, np.ndarray, int]:
     if data.dtype == bool:
         data = data.astype(np.uint8)
     if data.dtype.newbyteorder("=") not in _VTK_TYPE:
-        raise ValueError(f"{name}: no VTK array type for {data.dtype}")
+        raise InputError(f"{name}: no VTK array type for {data.dtype}")
     data = data.astype(data.dtype.newbyteorder("<"), copy=False)
     return name, data, 1 if data.ndim == 1 else int(np.prod(data.shape[1:]))
 
@@ -85,7 +86,7 @@ def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, con
     Data arrays have one row per point, per cell, or any length (field data).
     """
     if (faces is None) != (faceoffsets is None):
-        raise ValueError("write_grid: faces and faceoffsets go together")
+        raise InputError("write_grid: faces and faceoffsets go together")
     arrays: list[tuple[str, list[tuple[str, np.ndarray, int]]]] = [
         ("FieldData", [_array(k, v) for k, v in (field_data or {}).items()]),
         ("PointData", [_array(k, v) for k, v in (point_data or {}).items()]),
@@ -100,7 +101,7 @@ def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, con
     for section, items in arrays[1:3]:
         for name, data, _ in items:
             if len(data) != (n_points if section == "PointData" else n_cells):
-                raise ValueError(f"{section} {name}: {len(data)} rows for {n_points} points and {n_cells} cells")
+                raise InputError(f"{section} {name}: {len(data)} rows for {n_points} points and {n_cells} cells")
     xml, blobs, offset = [], [], 0
 
     def data_array(name: str, data: np.ndarray, components: int, tuples: bool) -> str:
