@@ -26,6 +26,7 @@ from itertools import combinations
 from typing import Sequence
 
 from ..choices import SPLIT_CRITERIA, SplitCriterion
+from ..errors import InputError
 from .delaunay import hull_faces
 from .geometry import Frame, dot, plane_normal, six_volume
 from .polyhedron import Polyhedron, face_kind
@@ -47,7 +48,7 @@ class _Element:
 
     def __init__(self, frame: Frame, poly: Polyhedron, criterion: SplitCriterion) -> None:
         if criterion not in SPLIT_CRITERIA:
-            raise ValueError(f"criterion {criterion!r}: choose one of {', '.join(SPLIT_CRITERIA)}")
+            raise InputError(f"criterion {criterion!r}: choose one of {', '.join(SPLIT_CRITERIA)}")
         self.frame = frame
         self.poly = poly
         self.criterion = criterion

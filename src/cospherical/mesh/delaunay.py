@@ -169,7 +169,7 @@ def _global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Eng
     if not len(elements):
         return mesh, None
     if mesh.cells is not None:
-        raise ValueError("the mesh already holds re-tessellated cells")
+        raise InputError("global_delaunay: the mesh already holds re-tessellated cells")
     types = dict(mesh.types)
     cells, checked = retessellate(mesh, elements, types, engine, proposal)
     return with_cells(mesh, _leaves_of(mesh, elements), cells, types), checked
