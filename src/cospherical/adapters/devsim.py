@@ -45,6 +45,7 @@ import contextlib
 import io
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
 from typing import Sequence
 
 import numpy as np
@@ -60,7 +61,7 @@ EXACT_EDGE_COUPLE = "ExactEdgeCouple"
 CONTACT_MATERIAL = "metal"
 
 
-def import_devsim():
+def import_devsim() -> ModuleType:
     """DEVSIM's module, its BLAS configured first (``devsim_openblas``), or one clear error when it is missing."""
     import sys
 

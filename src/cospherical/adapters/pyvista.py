@@ -10,6 +10,8 @@ cells sorted by VTK cell type, cell data ``element`` (the element each cell is),
 
 from __future__ import annotations
 
+from types import ModuleType
+
 import numpy as np
 
 from ..errors import InputError
@@ -19,7 +21,7 @@ from ..formats.vtu import VTK_CELL
 __all__ = ["import_pyvista", "legacy_cells", "to_pyvista"]
 
 
-def import_pyvista():
+def import_pyvista() -> ModuleType:
     """The pyvista module, or one clear error when it is missing."""
     try:
         import pyvista
