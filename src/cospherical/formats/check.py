@@ -17,6 +17,7 @@ from collections import Counter
 from dataclasses import dataclass
 from fractions import Fraction
 from math import lcm
+from pathlib import Path
 from typing import Any
 
 from ..caches import cached
@@ -323,7 +324,7 @@ def read_document(text: str, name: str):
     return kind, (data if kind == "catalogue" else table_from_data(data, name))
 
 
-def read_document_file(path) -> tuple[str, Any]:
+def read_document_file(path: str | Path) -> tuple[str, Any]:
     """:func:`read_document` on a file: a catalogue, a pattern table, or a pattern table's indexed store."""
     if is_store(path):
         return "patterns", load(path)
