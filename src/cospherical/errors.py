@@ -37,7 +37,7 @@ class CosphericalWarning(UserWarning):
     domain): the library warns with :func:`warnings.warn`, the CLI prints one line on stderr."""
 
 
-def shown(value, most: int = 40) -> str:
+def shown(value: object, most: int = 40) -> str:
     """A value as an error line names it: its repr, cut after ``most`` characters (a hostile input of
     megabytes is named, not echoed).
 
@@ -47,6 +47,8 @@ def shown(value, most: int = 40) -> str:
     try:
         text = repr(value)
     except ValueError:  # an int past Python's 4,300-digit limit of int-to-text conversion
+        if not isinstance(value, int):
+            raise
         return f"an integer of {value.bit_length():,} bits"
     return text if len(text) <= most else text[:most] + "..."
 
