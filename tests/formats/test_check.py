@@ -173,12 +173,17 @@ BROKEN = {
 }
 
 
+def broken_table(path: Path, code: str, broken) -> Path:
+    """A leaf table of the empty cube's and one edge point's entries, the entry of ``code`` passed through ``broken``."""
+    entries = leaf_entries("000000000000+f", "800000000000+f")
+    entries[code] = broken(entries[code])
+    return leaf_table(path, entries)
+
+
 @pytest.mark.parametrize("case", BROKEN)
 def test_a_broken_leaf_table_is_refused_naming_the_configuration(tmp_path, capsys, case):
     code, broken, needle = BROKEN[case]
-    entries = leaf_entries("000000000000+f", "800000000000+f")
-    entries[code] = broken(entries[code])
-    path = leaf_table(tmp_path / "broken.yaml", entries)
+    path = broken_table(tmp_path / "broken.yaml", code, broken)
     assert main(["check", str(path)]) == 2
     line = capsys.readouterr().err.strip()
     assert len(line.splitlines()) == 1 and needle in line and f"broken.yaml: configurations/{code}" in line, line

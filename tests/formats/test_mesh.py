@@ -22,7 +22,7 @@ from cospherical.formats.mesh import read_leaves, table_lookup, write_vtu
 from cospherical.formats.patterns import load
 from cospherical.mesh.assembly import assemble
 from cospherical.mesh.octree import build_octree, parse_shape
-from tests.formats.test_check import BROKEN, leaf_entries, leaf_table
+from tests.formats.test_check import BROKEN, broken_table, leaf_entries, leaf_table
 from tests.mesh.test_assembly import OCTANT
 
 CUBE = Box.parse(["1", "1", "1"])
@@ -272,9 +272,7 @@ BROKEN_FOR_THE_MESHER = {**BROKEN, "5,000 copies of the cube": (
 def test_the_mesher_refuses_a_broken_table_entry_with_checks_line(tmp_path, capsys, case):
     """A table entry the mesh would use is held to check's rules: the same one line, exit 2, and no mesh."""
     code, broken, needle = BROKEN_FOR_THE_MESHER[case]
-    entries = leaf_entries("000000000000+f", "800000000000+f")
-    entries[code] = broken(entries[code])
-    path = leaf_table(tmp_path / "broken.yaml", entries)
+    path = broken_table(tmp_path / "broken.yaml", code, broken)
     assert main(["check", str(path)]) == 2
     line = capsys.readouterr().err
     assert needle in line and f"configurations/{code}" in line
