@@ -1,36 +1,56 @@
-"""Local process pools: a pool left by an error, or stopped by the command, ends its running calls at once."""
+"""Local process pools: a pool left by an error, or stopped by the command, ends its running calls at once.
+
+Each case runs in a fresh interpreter, as a command would: the pool registry and the signal
+handlers that other tests leave in a test worker's process are not the command's, and a
+pool's workers are killed there, never beside the test runner's own state.
+"""
 
 from __future__ import annotations
 
-import os
-import time
+import subprocess
+import sys
+import textwrap
+
+_GONE = """
+import os, time
 
 import pytest
 
 from cospherical.execution.pool import process_pool, stop_all
 
 
-def _gone(pid: int) -> bool:
+def gone(pid):
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return True
     return False
+"""
+
+
+def _run(body: str) -> None:
+    result = subprocess.run([sys.executable, "-c", _GONE + textwrap.dedent(body)], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 0, result.stderr
 
 
 def test_a_pool_left_by_an_error_kills_its_running_calls_at_once():
-    start = time.monotonic()
-    with pytest.raises(RuntimeError), process_pool(1) as pool:
-        worker = pool.submit(os.getpid).result()
-        running = pool.submit(time.sleep, 120)  # a chunk of minutes: shutdown() alone would wait for it
-        raise RuntimeError("the command failed meanwhile")
-    assert time.monotonic() - start < 30 and _gone(worker) and running.done()
+    _run("""
+        start = time.monotonic()
+        with pytest.raises(RuntimeError), process_pool(1) as pool:
+            worker = pool.submit(os.getpid).result()
+            running = pool.submit(time.sleep, 120)  # a chunk of minutes: shutdown() alone would wait for it
+            raise RuntimeError("the command failed meanwhile")
+        assert time.monotonic() - start < 30 and gone(worker) and running.done()
+        """)
 
 
 def test_stop_all_stops_every_running_pool():
-    with process_pool(1) as pool:
-        worker = pool.submit(os.getpid).result()
-        pool.submit(time.sleep, 120)
-        start = time.monotonic()
-        stop_all()  # what Ctrl-C and SIGTERM call, wherever the command is
-        assert time.monotonic() - start < 30 and _gone(worker)
+    _run("""
+        with process_pool(1) as pool:
+            worker = pool.submit(os.getpid).result()
+            pool.submit(time.sleep, 120)
+            start = time.monotonic()
+            stop_all()  # what Ctrl-C and SIGTERM call, wherever the command is
+            assert time.monotonic() - start < 30 and gone(worker)
+        """)
