@@ -292,16 +292,36 @@ levels: 4
 """
 
 
-@pytest.mark.parametrize("source", ["stack", "fin"])
-def test_within_each_box_every_element_is_an_empty_sphere_of_the_box_vertices(source, tmp_path):
-    """What the devices page promises, decided here with Fractions: each element's nodes lie on one sphere that
-    holds no vertex of the element's own box strictly inside, nor on it but the element's nodes.  The 1 x 2 x 4
-    stack has leaves that are not cubes (its leaf mesh is not Delaunay: cells are re-tessellated per box)."""
+# One region of four boxes, not convex, in a 3 x 1 x 4 bounding box (leaves that are not cubes): near its notch a
+# cell of the Delaunay subdivision of the region's vertices leaves the region, so one cluster keeps its leaf elements.
+_NOTCH = """device: notch
+regions:
+  - name: a
+    material: Si
+    boxes: [[0, 0, 0, 1.5, 0.5, 2], [0, 0, 2, 1.5, 0.5, 4], [1.5, 0, 0, 3, 0.5, 2], [1.5, 0.5, 0, 3, 1, 2]]
+refine: [{point: [0.739, 0.081, 1.123]}]
+levels: 4
+"""
+
+
+@pytest.mark.parametrize("source", ["stack", "fin", "notch"])
+def test_within_each_region_every_element_is_an_empty_sphere_of_the_region_vertices(source, tmp_path):
+    """What the devices page promises, decided here with Fractions: each element's nodes lie on one sphere; an
+    element the mesh does not name as violating holds no vertex of its region's closed boxes strictly inside (nor,
+    where no cluster kept its leaf elements, on it but its own nodes); one it names holds one.  The 1 x 2 x 4 stack
+    has leaves that are not cubes (its leaf mesh is not Delaunay: cells are re-tessellated per region, across the
+    face between region b's two boxes); the notch keeps the leaf elements of a cluster."""
     path = tmp_path / "device.yaml"
-    path.write_text(_STACK if source == "stack" else (EXAMPLES[0].parent / "fin.yaml").read_text())
-    m = build_mesh(device=path, uniform=False)
+    path.write_text({"stack": _STACK, "notch": _NOTCH}.get(source) or (EXAMPLES[0].parent / "fin.yaml").read_text())
+    m = build_mesh(device=path, uniform=False, dual=source == "notch")
+    report = m.report
+    assert report.volume_ok and report.nonconforming_faces == 0
+    violating = set(m.violating.tolist())
+    assert len(violating) == report.delaunay_violations
     if source == "stack":
-        assert m.report.regions_retessellated >= 1
+        assert report.regions_retessellated >= 1 and not violating
+    if source == "notch":
+        assert violating and report.regions_retessellated >= 1
     regions, _, low, length = _device_boxes(yaml.safe_load(path.read_text()))
     mesh = m.assembled
     grid = mesh.grid
@@ -312,29 +332,57 @@ def test_within_each_box_every_element_is_an_empty_sphere_of_the_box_vertices(so
         common = common * s.denominator // np.gcd(common, s.denominator)
     factor = [int(s * common) for s in scale]
     points = [[int(g) * f for g, f in zip(row, factor)] for row in mesh.vertices.tolist()]
-    boxes = [[int((b[i] - low[i % 3]) / length[i % 3] * grid) for i in range(6)] for r in regions for b in r]
-    members = [np.flatnonzero(np.all((mesh.vertices >= b[:3]) & (mesh.vertices <= b[3:]), axis=1)) for b in boxes]
+    members = []
+    for boxes in regions:
+        on = np.zeros(len(mesh.vertices), dtype=bool)
+        for b in boxes:
+            g = [int((b[i] - low[i % 3]) / length[i % 3] * grid) for i in range(6)]
+            on |= np.all((mesh.vertices >= g[:3]) & (mesh.vertices <= g[3:]), axis=1)
+        members.append(np.flatnonzero(on))
     real = np.array(points, dtype=np.float64)
     conn, sizes = mesh.connectivity()
-    checked = 0
-    for nodes in conn.tolist():
+    element_region = mesh.element_region
+    crossing = 0  # elements with nodes strictly on both sides of a face between two boxes of their region
+    for e, nodes in enumerate(conn.tolist()):
         nodes = [v for v in nodes if v >= 0]
-        quad = [sum(mesh.vertices[v][a] for v in nodes) for a in range(3)]
-        box = next(k for k, b in enumerate(boxes) if all(b[a] * len(nodes) <= quad[a] <= b[a + 3] * len(nodes)
-                                                         for a in range(3)))
+        region = int(element_region[e])
         p = [points[v] for v in nodes]
         centre = _circumcentre(p)
         radius = sum((x - c) ** 2 for x, c in zip(p[0], centre))
         assert all(sum((x - c) ** 2 for x, c in zip(q, centre)) == radius for q in p)
         own = set(nodes)
         # floats only narrow the vertices down (a wide margin); each one near the sphere is decided exactly
-        near = members[box][((real[members[box]] - [float(c) for c in centre]) ** 2).sum(axis=1)
-                            <= float(radius) * (1 + 1e-6) + 1e-9]
-        for v in near.tolist():
-            if v not in own:
-                assert sum((x - c) ** 2 for x, c in zip(points[v], centre)) > radius
-        checked += 1
-    assert checked == len(mesh)
+        near = members[region][((real[members[region]] - [float(c) for c in centre]) ** 2).sum(axis=1)
+                               <= float(radius) * (1 + 1e-6) + 1e-9]
+        sides = [sum((x - c) ** 2 for x, c in zip(points[v], centre)) - radius for v in near.tolist() if v not in own]
+        assert (e in violating) == any(side < 0 for side in sides)
+        if source != "notch":
+            assert all(side > 0 for side in sides)
+        face = 3 * grid // 4  # region b's two boxes meet at z = 3
+        crossing += source == "stack" and {np.sign(mesh.vertices[v][2] - face) for v in nodes} >= {-1, 1}
+    if source == "stack":
+        assert crossing  # cells cross the face between region b's two boxes
+    if source == "notch":
+        _negatives_per_region_are_the_duals(m)
+
+
+def _negatives_per_region_are_the_duals(m) -> None:
+    """A one-region device: the report's interior negative coefficients are the dual's negative coefficients on
+    edges of no face met once (the domain's boundary), counted here from the element faces."""
+    mesh, dual = m.assembled, m.dual
+    single: dict[tuple[int, ...], int] = {}
+    for _, nodes, faces, _ in mesh.blocks():
+        for cycle in faces:
+            for row in nodes[:, list(cycle)].tolist():
+                key = tuple(sorted(row))
+                single[key] = single.get(key, 0) + 1
+    boundary = set()
+    for key, count in single.items():
+        if count == 1:
+            boundary |= {(a, b) for a in key for b in key if a < b}
+    negative = [tuple(edge) for edge, c in zip(dual.edges.tolist(), dual.coefficient_exact.tolist()) if c < 0]
+    interior = sum(1 for a, b in negative if (min(a, b), max(a, b)) not in boundary)
+    assert m.report.device["regions"][0]["negative_coefficients"]["interior"] == interior
 
 
 def _circumcentre(p: list[list[int]]) -> list[Fraction]:

@@ -108,6 +108,25 @@ missing tetrahedra, nor overlaps.  What proves the cells, whatever proposed them
    proving costs the volume sums, no second empty-sphere pass.
 Cube octrees, whose leaf mesh is already
 globally Delaunay, have no cluster: the mesh is returned as it is.
+
+A domain that is not convex (a device's region: a union of boxes with a notch, a step
+or a hole) is handled by the same steps, with V the vertices on the closed domain and
+D their Delaunay subdivision, which tiles the convex hull of V and may have cells that
+leave the domain.  Step 1 holds as it is (a cell's definition does not involve the
+domain).  Steps 2-4 hold for a cluster U_r exactly when every cell of D that meets the
+interior of U_r lies in the domain: such a cell has its interior disjoint from the kept
+elements (cells of D), hence lies in U (the union of the closed clusters, which are
+disjoint) and, being connected, in U_r; so U_r is tiled by cells of D and the rest of
+the proof follows word for word.  Otherwise no set of cells of D tiles U_r, and the
+checks of 5 fail with any proposal, the exact engine's included:
+
+8. With ``convex=False``, a cluster whose exact engine's cells still fail the checks of 5
+   keeps its leaf elements (each leaf's own exact Delaunay subdivision), listed as
+   cells as they are, not proven: it is a cluster where a cell of D leaves the domain.
+   The clusters are disjoint closed sets, so its leaf elements meet only kept leaf
+   elements, face to face as in the leaf mesh.  Every element is then a cell of D or
+   an element of such a cluster, and :func:`~cospherical.mesh.checks.check_delaunay`
+   finds the latter whose sphere holds a vertex strictly inside as violations.
 """
 
 from __future__ import annotations
@@ -137,13 +156,16 @@ class NotOneCell(Exception):
     """
 
 
-def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull", proposal=None) -> Mesh:
+def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull", proposal=None,
+                    convex: bool = True) -> Mesh:
     """The exact Delaunay subdivision of ``mesh``'s vertices, as a :class:`Mesh` (see the module's proof).
 
     ``found``: the result of :func:`check_delaunay` on ``mesh`` when the caller has it.
     ``engine``: how clusters are tetrahedralised, ``qhull`` (floats propose, integers
     check, the exact engine where either fails) or ``exact`` (the exact engine alone).
     ``proposal``: what proposes a cluster's tetrahedra in place of Qhull (see :func:`retessellate`).
+    ``convex``: whether the mesh's leaves tile a convex domain; ``False``: a cluster where
+    a Delaunay cell leaves the domain keeps its leaf elements (the module's step 8).
 
     Examples
     --------
@@ -155,11 +177,11 @@ def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engi
     >>> [check_delaunay(m).violations for m in (leaf, whole)], whole.cells.clusters
     ([5, 0], 1)
     """
-    return _global_delaunay(mesh, found, engine, proposal)[0]
+    return _global_delaunay(mesh, found, engine, proposal, convex)[0]
 
 
 def _global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull",
-                     proposal=None) -> tuple[Mesh, DelaunayCheck | None]:
+                     proposal=None, convex: bool = True) -> tuple[Mesh, DelaunayCheck | None]:
     """:func:`global_delaunay`, and :func:`check_delaunay` on the result when it ran (a cluster was re-tessellated)."""
     if engine not in ENGINES:
         raise InputError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
@@ -171,7 +193,7 @@ def _global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Eng
     if mesh.cells is not None:
         raise InputError("global_delaunay: the mesh already holds re-tessellated cells")
     types = dict(mesh.types)
-    cells, checked = retessellate(mesh, elements, types, engine, proposal)
+    cells, checked = retessellate(mesh, elements, types, engine, proposal, convex)
     return with_cells(mesh, _leaves_of(mesh, elements), cells, types), checked
 
 
@@ -183,7 +205,7 @@ def _leaves_of(mesh: Mesh, elements: np.ndarray) -> np.ndarray:
 
 
 def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: Engine = "qhull",
-                 proposal=None) -> tuple[Cells, DelaunayCheck]:
+                 proposal=None, convex: bool = True) -> tuple[Cells, DelaunayCheck]:
     """The cells of the Delaunay subdivision of ``mesh``'s vertices that replace the leaves holding ``elements``.
 
     ``elements``: the leaf elements that are not cells of it (see the module's proof).
@@ -195,6 +217,8 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: Engine =
     proposes a cluster's tetrahedra in place of Qhull (rows of point indices; a seam
     for tests).  The cells are proven before they are returned (the module's last
     part): a cluster whose cells fail is tetrahedralised again by the exact engine.
+    ``convex=False``: a cluster whose exact engine's cells fail keeps its leaf elements
+    (the module's step 8) instead of raising.
     Returns the cells and :func:`check_delaunay` on the mesh with the cells (which proved them).
     """
     nodes = mesh.element_nodes(elements)
@@ -221,28 +245,43 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: Engine =
     wanted = _cluster_volumes(mesh, elements, part, clusters)
     tets = [_cluster_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine, proposal) for r in range(clusters)]
     exact = set(range(clusters)) if engine == "exact" else set()
+    fallen: set[int] = set()  # clusters that keep their leaf elements (step 8)
     while True:
         tet_cluster = np.concatenate([np.full(len(t), r, dtype=np.int64) for r, t in enumerate(tets)])
         every = np.concatenate(tets)
         every = every[_inside(mesh, every, tet_cluster, cluster, located)]
         try:
-            cells = _cells(mesh, _members(_same_sphere(mesh, every, grid_weights(mesh)), every, len(mesh.vertices)),
-                           proven, located, types)
+            merged = _members(_same_sphere(mesh, every, grid_weights(mesh)), every, len(mesh.vertices)) \
+                if len(every) else np.zeros((0, 1), dtype=np.int64)
+            if fallen:
+                merged = _stacked(merged, mesh.element_nodes(elements[np.isin(part, sorted(fallen))]))
+            cells = _cells(mesh, merged, proven, located, types)
         except NotOneCell:  # no cell to name a cluster by: no proof per cluster
-            failing = set(range(clusters))
+            failing = set(range(clusters)) - fallen
         else:
             cells = Cells(cells.shapes, cells.shape, cells.anchor, cells.nodes, cells.leaf, cells.spanning,
                           cells.proven, clusters=int(clusters), largest_cluster=int(np.diff(bounds).max()))
             trial = with_cells(mesh, bad, cells, types)
             found = check_delaunay(trial)
-            failing = _failing_clusters(trial, found, vertex_cluster, wanted)
+            failing = _failing_clusters(trial, found, vertex_cluster, wanted) - fallen
             if not failing:
                 return cells, found
-        if failing <= exact:  # the exact engine's cells are Delaunay by construction: a bug, not rounding
-            raise RuntimeError(f"the exact engine's cells of clusters {sorted(failing)[:5]} fail the exact checks")
+        if failing & exact and convex:  # the exact engine's cells are Delaunay by construction: a bug, not rounding
+            raise RuntimeError(f"the exact engine's cells of clusters {sorted(failing & exact)[:5]} fail the "
+                               "exact checks")
+        for r in failing & exact:  # a Delaunay cell leaves the (non-convex) domain here: the leaf elements stay
+            tets[r] = tets[r][:0]
+        fallen |= failing & exact
         for r in failing - exact:
             tets[r] = _cluster_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], "exact")
         exact |= failing
+
+
+def _stacked(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Two tables of vertex ids (-1 padded) as one, padded to the wider."""
+    width = max(first.shape[1], second.shape[1])
+    return np.concatenate([np.pad(t, ((0, 0), (0, width - t.shape[1])), constant_values=-1)
+                           for t in (first, second)])
 
 
 def _cluster_volumes(mesh: Mesh, elements: np.ndarray, part: np.ndarray, clusters: int) -> list[Fraction]:
@@ -578,7 +617,7 @@ def _scaled(shape: CellShape, g: int) -> CellShape:
                      shape.grid_volume * g ** 3, shape.sphere.scaled(g), tuple(g * c for c in shape.center))
 
 
-def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress=None
+def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress=None, convex: bool = True
                   ) -> tuple[Mesh, dict[str, int] | None, DelaunayCheck | None]:
     """The mesh a user asked for: ``leaf`` (the leaf mesh as assembled) or ``global`` (its exact Delaunay subdivision).
 
@@ -588,6 +627,7 @@ def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress=None
     (on the leaf mesh when nothing was replaced: a cube octree; else the one that
     proved the cells), so that it need not run twice, else ``None``.
     ``progress(n)`` is told as the check goes through the leaf mesh's elements.
+    ``convex``: whether the leaves tile a convex domain (see :func:`global_delaunay`).
     """
     if mode not in MODES:
         raise InputError(f"--delaunay {mode!r}: write global or leaf")
@@ -595,5 +635,5 @@ def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress=None
         return mesh, None, None
     found = check_delaunay(mesh, progress=progress)
     leaf = found.leaf_mesh(len(mesh))
-    result, checked = _global_delaunay(mesh, found)
+    result, checked = _global_delaunay(mesh, found, convex=convex)
     return result, leaf, (found if result is mesh else checked)

@@ -122,8 +122,7 @@ class DeviceLayout:
     ``resolving_level``: the level ``R`` whose faces hold every box and contact
     coordinate; ``planes[a]``: the distinct coordinates along axis ``a`` in steps of
     ``2**-R`` of the bounding box (``0`` .. ``2**R``); ``owner[i, j, k]``: the region of
-    block ``(i, j, k)`` (-1: outside every region); ``owner_box``: which box (index in
-    file order over all regions) it belongs to; ``contacts``: per contact
+    block ``(i, j, k)`` (-1: outside every region); ``contacts``: per contact
     ``(axis, value, low, high)`` in grid steps (``low``/``high`` its two other axes'
     ranges); ``region_volumes``: each region's exact volume in device units.
     """
@@ -132,7 +131,6 @@ class DeviceLayout:
     resolving_level: int
     planes: tuple[np.ndarray, np.ndarray, np.ndarray]
     owner: np.ndarray
-    owner_box: np.ndarray
     contacts: tuple[tuple[int, int, tuple[int, int], tuple[int, int]], ...]
     region_volumes: tuple[Fraction, ...]
 
@@ -143,8 +141,8 @@ class DeviceLayout:
     def cuts(self, level: int, cells: np.ndarray) -> np.ndarray:
         """Which cells (n x 3 at ``level``) a region boundary cuts, or whose face a boundary or a contact's edge crosses.
 
-        A cell is cut when blocks of different owners (boxes of the device file: each
-        leaf lies in one box, hence one region) meet inside it: across some
+        A cell is cut when blocks of different owners (regions, or outside every region:
+        each leaf lies in one region) meet inside it: across some
         plane strictly inside the cell, in the cell's open span of the other two axes
         (counted with a prefix sum per plane).  It is also split when the blocks just
         beyond one of its faces, over the face's open rectangle, are not all of one
@@ -162,8 +160,7 @@ class DeviceLayout:
         cut = np.zeros(len(cells), dtype=bool)
         for axis in range(3):
             b, c = (axis + 1) % 3, (axis + 2) % 3
-            # boxes, not only regions: each leaf must lie in one box (the global Delaunay mode works box by box)
-            owner = np.moveaxis(self.owner_box, axis, 0)  # (blocks along axis, b, c)
+            owner = np.moveaxis(self.owner, axis, 0)  # (blocks along axis, b, c)
             if b > c:
                 owner = owner.transpose(0, 2, 1)
             # open spans of the cells along b and c, as block ranges
@@ -198,6 +195,12 @@ class DeviceLayout:
             cut |= touching & meets & ~inside
         return cut
 
+    def convex(self, region: int) -> bool:
+        """Whether a region is convex: a union of boxes is convex exactly when it fills its bounding box."""
+        blocks = np.argwhere(self.owner == region)
+        low, high = blocks.min(axis=0), blocks.max(axis=0) + 1
+        return bool(np.all(self.owner[low[0]:high[0], low[1]:high[1], low[2]:high[2]] == region))
+
     def blocks_of(self, low: np.ndarray) -> tuple[np.ndarray, ...]:
         """The block holding each grid point ``low`` (n x 3, in steps of the resolving level), as index arrays."""
         return tuple(np.minimum(np.searchsorted(self.planes[a], low[:, a], "right") - 1, len(self.planes[a]) - 2)
@@ -211,7 +214,7 @@ class Regions:
     ``leaf_region`` (int32, one per leaf of the tree, in its order) indexes ``names``
     and ``materials``; ``layout`` is the device's (``None`` for a one-box domain, one
     region named ``domain``).  An element lies in its leaf's region: a cell of the
-    global Delaunay mode never leaves its box (:mod:`cospherical.mesh.regions`).
+    global Delaunay mode never leaves its region (:mod:`cospherical.mesh.regions`).
     """
 
     names: tuple[str, ...]
@@ -408,7 +411,7 @@ def device_layout(device: Device) -> DeviceLayout:
     sizes = [np.diff(p) for p in planes]
     block_volume = sizes[0][:, None, None] * sizes[1][None, :, None] * sizes[2][None, None, :]
     volumes = tuple(int(block_volume[owner == r].sum()) * volume_unit for r in range(len(regions)))
-    return DeviceLayout(device, resolving, planes, owner, owner_box, tuple(contacts), volumes)
+    return DeviceLayout(device, resolving, planes, owner, tuple(contacts), volumes)
 
 
 def _check_connected(owner_box: np.ndarray, boxes: list, where) -> None:
@@ -457,8 +460,8 @@ def device_octree(layout: DeviceLayout, max_leaves: int | None = None) -> tuple[
     return Octree(tree.box, tree.levels[keep], tree.positions[keep]), region[keep].astype(np.int32)
 
 
-def leaf_owner(layout: DeviceLayout, levels: np.ndarray, positions: np.ndarray, boxes: bool = False) -> np.ndarray:
-    """The region (or with ``boxes`` the box) of each leaf: the owner of the block holding its low corner.
+def leaf_owner(layout: DeviceLayout, levels: np.ndarray, positions: np.ndarray) -> np.ndarray:
+    """The region of each leaf: the owner of the block holding its low corner.
 
     A leaf at or above the resolving level lies in one block's owner (the tree split
     every cell a boundary cuts); a deeper one lies in one block of that level's grid.
@@ -467,7 +470,7 @@ def leaf_owner(layout: DeviceLayout, levels: np.ndarray, positions: np.ndarray, 
     resolving = layout.resolving_level
     low = np.where((levels <= resolving)[:, None], positions.astype(np.int64) << np.maximum(resolving - levels, 0)[:, None],
                    positions.astype(np.int64) >> np.maximum(levels - resolving, 0)[:, None])
-    return (layout.owner_box if boxes else layout.owner)[layout.blocks_of(low)].astype(np.int64)
+    return layout.owner[layout.blocks_of(low)].astype(np.int64)
 
 
 def _shifted(shape: Shape, origin) -> Shape:

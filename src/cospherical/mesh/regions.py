@@ -1,28 +1,31 @@
-"""A device's mesh: elements in regions, the exact Delaunay subdivision box by box, contacts and interfaces.
+"""A device's mesh: elements in regions, the exact Delaunay subdivision region by region, contacts and interfaces.
 
-Each leaf of a device's tree lies in one box of one region
-(:mod:`cospherical.mesh.device`), so each leaf element does.  In the global
-Delaunay mode the elements of each **box of the device file** are the exact Delaunay
-subdivision of the vertices on that closed box (the largest co-spherical cells),
-built as the whole-domain mode builds it (:mod:`cospherical.mesh.delaunay`, whose
-proof holds word for word with the box as the domain: the box is convex, tiled by
-its leaves, and its vertices are the corners of its leaves).  So:
+Each leaf of a device's tree lies in one region (:mod:`cospherical.mesh.device`), so
+each leaf element does.  In the global Delaunay mode the elements of each **region**
+are built from the exact Delaunay subdivision D_R of the vertices on the closed region
+(the union of its boxes), as the whole-domain mode builds it
+(:mod:`cospherical.mesh.delaunay`, with the region as the domain: it is tiled by its
+leaves, and its vertices are the corners of its leaves).  So:
 
-- every element lies in one box, hence in one region, and a cell never crosses an
-  interface, the domain's boundary, or a face between two boxes of one region;
-- within a box the elements are exactly the Delaunay subdivision of the box's
-  vertices: each element's circumsphere holds no vertex of the box strictly inside,
-  and none on it but the element's own nodes.  A vertex *outside* the box may lie
-  inside an element's sphere (behind an interface, across a notch of a non-convex
-  domain): the box method's coefficients of such elements can be negative, and the
-  report counts the negative interior coefficients per region;
-- across a face between two boxes both sides are cut by the Delaunay subdivision of
-  the points on the face; the report's exact conformity check says whether they
-  match (``nonconforming_faces``).  Where they do not, the mesh falls back to the
-  leaf elements in the boxes concerned (each leaf's exact Delaunay subdivision,
-  conforming by construction) and says so (``delaunay_mode``).
+- every element lies in one region; a cell never crosses an interface or the domain's
+  boundary, but may cross a face between two boxes of one region;
+- a convex region gets exactly D_R: each element's circumsphere holds no vertex of the
+  region strictly inside, and none on it but the element's own nodes;
+- in a region that is not convex, a cluster of leaf elements where a cell of D_R
+  leaves the region keeps its leaf elements (the module's step 8); every other
+  element is a cell of D_R.  The check finds those of the first kind whose sphere
+  holds a vertex as violations.  A vertex *outside* the region may lie inside an
+  element's sphere (behind an interface, across a notch): the box method's
+  coefficients of such elements can be negative, and the report counts the negative
+  interior coefficients per region;
+- across an interface both sides are cut by the Delaunay subdivision of the points
+  on the face; the report's exact conformity check says whether they match
+  (``nonconforming_faces``).  Where they do not, the mesh falls back to the leaf
+  elements (each leaf's exact Delaunay subdivision, conforming by construction) and
+  says so (``delaunay_mode``).
 
-A device of one box is meshed exactly as a one-box domain.
+A device of one region is meshed as the region alone, one of one box exactly as a
+one-box domain.
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ from .assembly import Cells, Lookup, Mesh, assemble, vertex_keys
 from .checks import DelaunayCheck, check_conformity
 from .delaunay import delaunay_mesh, with_cells
 from .dual import Dual, RegionParts, mesh_dual
-from .device import DeviceLayout, Regions, leaf_owner
+from .device import DeviceLayout, Regions
 from .octree import Octree
 
 __all__ = ["RegionFaces", "contact_areas", "device_mesh", "device_report", "mesh_region_parts", "region_faces", "region_parts",
@@ -49,11 +52,12 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
                 criterion: str = "optimal", mode: str = "global",
                 progress: Callable[[str, int | None, int], None] | None = None,
                 cache: dict | None = None) -> tuple[Mesh, dict | None, DelaunayCheck | None]:
-    """Mesh a device's tree: the leaf mesh, then in ``global`` mode the exact Delaunay subdivision box by box.
+    """Mesh a device's tree: the leaf mesh, then in ``global`` mode the exact Delaunay subdivision region by region.
 
     Returns what :func:`~cospherical.mesh.delaunay.delaunay_mesh` returns: the mesh,
-    what the check found on the leaf mesh (summed over the boxes), and the check of
-    the result (the boxes' checks summed; each against its own box's vertices).
+    what the check found on the leaf mesh (summed over the regions), and the check of
+    the result (the regions' checks summed, each against its own region's vertices; its
+    elements numbered as the mesh returned numbers them).
     ``progress(stage, total, advance)``: told of the stages as the one-box pipeline
     tells them (``assembly`` through the leaves, ``regions`` through the leaf mesh's
     elements), so a device's mesh shows the same bars.
@@ -65,27 +69,31 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
     mesh = assemble(tree, lookup, criterion=criterion, cache=cache,
                     progress=None if progress is None else (lambda n: progress("assembly", len(tree), n)))
     mesh.regions = regions
-    boxes = sum(len(r.boxes) for r in device.regions)
-    if mode != "global" or boxes == 1:
-        return delaunay_mesh(mesh, mode,
+    count = len(device.regions)
+    if mode != "global" or count == 1:  # one region: its vertices are the mesh's
+        return delaunay_mesh(mesh, mode, convex=layout.convex(0),
                              progress=None if progress is None else (lambda n: progress("regions", len(mesh), n)))
-    leaf_box = leaf_owner(layout, tree.levels, tree.positions, boxes=True)
     grid, keys = vertex_keys(tree)
     n = np.int64(grid + 1)
     points = np.stack([keys // (n * n), (keys // n) % n, keys % n], axis=1)
     factor = grid // layout.steps
     bounds = _box_bounds(layout) * factor
-    parts, found, checks, types = [], [], [], dict(mesh.types)
+    first_box = np.cumsum([0] + [len(r.boxes) for r in device.regions])
+    done: list[tuple[np.ndarray, Mesh, DelaunayCheck | None]] = []
+    parts, found, types = [], [], dict(mesh.types)
     bad = np.zeros(len(tree), dtype=bool)
-    for b in range(boxes):
-        leaves = np.flatnonzero(leaf_box == b)
-        low, high = bounds[b, :3], bounds[b, 3:]
-        ids = np.flatnonzero(np.all((points >= low) & (points <= high), axis=1))
+    for r in range(count):
+        leaves = np.flatnonzero(leaf_region == r)
+        # the vertices on the closed region: on one of its closed boxes
+        on = np.zeros(len(points), dtype=bool)
+        for low_high in bounds[first_box[r]:first_box[r + 1]]:
+            on |= np.all((points >= low_high[:3]) & (points <= low_high[3:]), axis=1)
+        ids = np.flatnonzero(on)
         sub = assemble(Octree(tree.box, tree.levels[leaves], tree.positions[leaves]), lookup, cache=cache,
                        criterion=criterion, vertices=(grid, keys[ids]), catalogue=mesh.catalogue)
-        result, leaf, checked = delaunay_mesh(sub, "global")
+        result, leaf, checked = delaunay_mesh(sub, "global", convex=layout.convex(r))
         found.append(leaf)
-        checks.append(checked)
+        done.append((leaves, result, checked))
         if result.cells is None:
             continue
         types.update(result.types)
@@ -95,20 +103,44 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
         parts.append(Cells(cells.shapes, cells.shape, cells.anchor, nodes, leaves[cells.leaf], cells.spanning,
                            cells.proven, cells.clusters, cells.largest_cluster))
     leaf = {key: sum(f[key] for f in found) for key in found[0]}
-    # the boxes' counts add up; their element indices are the boxes' own, so none is kept
-    none = np.zeros(0, dtype=np.int64)
-    checked = DelaunayCheck(*(sum(getattr(c, name) for c in checks)
-                              for name in ("violations", "violating_pairs", "violating_leaves", "ties", "exact_tests")),
-                            none, none, none)
-    if not parts:
-        return mesh, leaf, checked
-    merged = _merged(parts)
-    result = with_cells(mesh, bad, merged, types)
-    if check_conformity(result, examples=0)["nonconforming_faces"]:
-        # the boxes' subdivisions do not meet face to face: the leaf mesh, conforming by construction
-        return mesh, dict(leaf, fallback="leaf elements: the boxes' Delaunay subdivisions do not meet face to face"), \
+    result = with_cells(mesh, bad, _merged(parts), types) if parts else mesh
+    if parts and check_conformity(result, examples=0)["nonconforming_faces"]:
+        # the regions' subdivisions do not meet face to face: the leaf mesh, conforming by construction
+        return mesh, dict(leaf, fallback="leaf elements: the regions' Delaunay subdivisions do not meet face to face"), \
             None
-    return result, leaf, checked
+    return result, leaf, _summed_checks(result, done)
+
+
+def _summed_checks(whole: Mesh, done: list[tuple[np.ndarray, Mesh, DelaunayCheck | None]]) -> DelaunayCheck | None:
+    """The regions' Delaunay checks as one, their leaves and elements numbered as in ``whole`` (the merged mesh).
+
+    ``done``: per region its leaves (indices into the whole tree), its mesh and its check
+    (``None``: not checked, then neither is the whole).  A region's leaf element keeps its
+    leaf and place in it; its cells follow the earlier regions' cells.
+    """
+    if any(checked is None for _, _, checked in done):
+        return None
+    counts = {name: sum(getattr(c, name) for _, _, c in done if c is not None)
+              for name in ("violations", "violating_pairs", "violating_leaves", "ties", "exact_tests")}
+    leaf_ids, elements, not_cells = [], [], []
+    first_cell = whole.leaf_elements
+    for leaves, sub, checked in done:
+        assert checked is not None
+
+        def numbered(local: np.ndarray, sub: Mesh = sub, leaves: np.ndarray = leaves,
+                     first_cell: int = first_cell) -> np.ndarray:
+            is_cell = local >= sub.leaf_elements
+            leaf = leaves[sub.element_leaf[local]]
+            return np.where(is_cell, first_cell + local - sub.leaf_elements,
+                            whole.element_offsets[leaf] + sub.element_local[local])
+
+        leaf_ids.append(leaves[checked.violating_leaf_ids])
+        elements.append(numbered(checked.violating_elements))
+        not_cells.append(numbered(checked.not_cells))
+        first_cell += len(sub.cells) if sub.cells is not None else 0
+    return DelaunayCheck(counts["violations"], counts["violating_pairs"], counts["violating_leaves"], counts["ties"],
+                         counts["exact_tests"], *(np.sort(np.concatenate(a)).astype(np.int64)
+                                                  for a in (leaf_ids, elements, not_cells)))
 
 
 def _box_bounds(layout: DeviceLayout) -> np.ndarray:
@@ -124,7 +156,7 @@ def _box_bounds(layout: DeviceLayout) -> np.ndarray:
 
 
 def _merged(parts: list[Cells]) -> Cells:
-    """The cells of several boxes as one :class:`Cells` (shape indices shifted past the earlier boxes' shapes)."""
+    """The cells of several regions as one :class:`Cells` (shape indices shifted past the earlier regions' shapes)."""
     shapes, shape, offset = [], [], 0
     for cells in parts:
         shapes.extend(cells.shapes)
