@@ -395,22 +395,23 @@ def dual_table(up: str) -> str:
 def gallery(up: str) -> str:
     from cospherical import shipped_catalogue
 
-    types = {entry["id"]: entry for entry in shipped_catalogue()["types"]}
+    catalogue = shipped_catalogue()
+
     def order(path):
-        entry = types.get(path.stem, {})
-        return entry.get("vertices", 99), entry.get("faces", 99), path.stem
+        entry = catalogue.get(path.stem)
+        return (entry.vertices, entry.faces, path.stem) if entry else (99, 99, path.stem)
 
     pictures = sorted((RESULTS / "elements").glob("*.png"), key=order)
     out = [f"{len(pictures)} pictures, one per element type of the shipped catalogue "
-           f"({len(types)} types), by number of vertices, then faces.", ""]
+           f"({len(catalogue)} types), by number of vertices, then faces.", ""]
     for path in pictures:
-        entry = types.get(path.stem, {})
-        name = _text(entry.get("name", "(not in the catalogue)"))
-        faces = ", ".join(f"{_n(n)} {_text(kind)}" for kind, n in sorted(entry.get("face_kinds", {}).items()))
+        entry = catalogue.get(path.stem)
+        name = _text(entry.name if entry else "(not in the catalogue)")
+        faces = ", ".join(f"{_n(n)} {_text(kind)}" for kind, n in sorted(entry.face_kinds.items() if entry else ()))
         out += ['<figure class="element" markdown>', "",
                 f'![{name}]({up}figures/elements/{_url(path.name)}){{ width="160" }}', "",
-                f"<figcaption><b>{name}</b><br><code>{_text(path.stem)}</code> V {_n(entry.get('vertices'))}, "
-                f"E {_n(entry.get('edges'))}, F {_n(entry.get('faces'))}: {faces}</figcaption>", "</figure>", ""]
+                f"<figcaption><b>{name}</b><br><code>{_text(path.stem)}</code> V {_n(entry and entry.vertices)}, "
+                f"E {_n(entry and entry.edges)}, F {_n(entry and entry.faces)}: {faces}</figcaption>", "</figure>", ""]
     return '<div class="gallery" markdown>\n\n' + "\n".join(out) + "\n</div>"
 
 

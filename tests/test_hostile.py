@@ -285,7 +285,7 @@ def small_tables(tmp_path_factory):
 
     path = tmp_path_factory.mktemp("tables") / "small.yaml"
     study = run_study("bisection", Box.parse(("1", "2", "4")), list(SMALL_CODES))
-    write_patterns(study, path, shipped_catalogue()["version"])
+    write_patterns(study, path, shipped_catalogue().version)
     import yaml
 
     return yaml.load(path.read_text(), Loader=yaml.CSafeLoader)

@@ -6,7 +6,8 @@ first use, so ``import cospherical`` stays cheap for the command line.
 - Configurations and tessellations: ``Box``, ``Configuration``, ``Length`` (an exact
   length), ``tessellate``, ``Tessellation``, ``Element``, ``ElementType``; the base elements
   (the cuboid, a prism, pyramid, tetrahedron or any convex shape): ``Shape``, ``standard_shape``.
-- The element catalogue: ``shipped_catalogue``, ``load_catalogue``, ``type_name``.
+- The element catalogue: ``Catalogue`` (its types by id or code, kept sets), ``shipped_catalogue``,
+  ``load_catalogue``, ``type_name``.
 - Pattern tables: ``load_patterns``, ``PatternTable``.
 - A mesh of an octree in one call: ``build_mesh`` (refine shapes, a leaf list, a tree or a device in,
   an ``OctreeMesh`` out: vertices, elements, the exact report ``MeshReport``, the dual, its
@@ -50,6 +51,7 @@ _API: dict[str, str | tuple[str, str]] = {
     "standard_shape": "cospherical.core.shapes",
     "Tessellation": "cospherical.core.tessellation",
     "tessellate": "cospherical.core.tessellation",
+    "Catalogue": "cospherical.catalogue",
     "load_catalogue": "cospherical.catalogue",
     "shipped_catalogue": "cospherical.catalogue",
     "type_name": "cospherical.catalogue",

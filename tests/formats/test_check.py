@@ -34,7 +34,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def test_leaf_tables_with_bad_codes_fail_check_in_one_line(tmp_path, capsys, key, needle):
     path = tmp_path / "leaves.yaml"
     write_patterns(run_study("leaves", Box.parse(CUBE), ["888800000000+f4", "000000000000+f"], "explicit"), path,
-                   shipped_catalogue()["version"])
+                   shipped_catalogue().version)
     data = load_yaml(path)
     data["configurations"][key] = data["configurations"].pop("888800000000+f4")
     dump_yaml(data, path)
@@ -49,7 +49,7 @@ def small_table(tmp_path_factory):
     path = tmp_path_factory.mktemp("small") / "small.yaml"
     codes = ["000000000000", "800000000000", "880000000000", "888888888888"]
     study = run_study("bisection", Box.parse(("1", "2", "4")), codes)
-    write_patterns(study, path, load_catalogue(catalogue_path())["version"])
+    write_patterns(study, path, load_catalogue(catalogue_path()).version)
     return load_yaml(path)
 
 
@@ -245,7 +245,7 @@ def test_the_node_orders_check_accepts_are_those_vtk_finds_valid():
     from cospherical.formats.patterns import load
 
     check = EntryCheck(load(LEAVES).header, shipped_catalogue(), "leaves")
-    types = {t["id"]: t for t in shipped_catalogue()["types"]}
+    catalogue = shipped_catalogue()
     vtk_type = {"tetra": 10, "wedge": 13, "hexahedron": 12, "pyramid": 14}
     cases = [("000000000000+f", _optimal([_element(TETRAHEDRON, t) for t in KUHN])),
              ("800000000000+f", leaf_entries("800000000000+f")["800000000000+f"]),
@@ -254,7 +254,7 @@ def test_the_node_orders_check_accepts_are_those_vtk_finds_valid():
     points, cells, accepted, turns = [], [], [], 0
     for code, entry in cases:
         first = entry["optimal"][0]
-        graph = nx.Graph((f[k], f[k - 1]) for face in types[first["type"]]["reference_faces"] for f in [face["nodes"]]
+        graph = nx.Graph((f[k], f[k - 1]) for face in catalogue[first["type"]].reference_faces for f in [face.nodes]
                          for k in range(len(f)))
         symmetries = [tuple(m[i] for i in range(len(graph)))
                       for m in nx.algorithms.isomorphism.GraphMatcher(graph, graph).isomorphisms_iter()]
@@ -273,7 +273,7 @@ def test_the_node_orders_check_accepts_are_those_vtk_finds_valid():
             except FormatError as error:
                 assert "reference order" in str(error), error  # the same element: only its order is wrong
                 accepted.append(False)
-            cells.append((vtk_type[types[first["type"]]["vtk"]], [len(points) + ids.index(n) for n in element]))
+            cells.append((vtk_type[catalogue[first["type"]].vtk], [len(points) + ids.index(n) for n in element]))
         points += [tuple(map(float, nodes[n])) for n in ids]
     assert accepted == _vtk_valid(points, cells)
     assert sum(accepted) == turns

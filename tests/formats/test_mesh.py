@@ -202,7 +202,7 @@ def representatives_store(tmp_path_factory):
     from cospherical.studies.intersection import run_intersection
 
     path = tmp_path_factory.mktemp("store") / "intersection-r2.sqlite"
-    write_pattern_table(TableRun(run_intersection(2, jobs=1), jobs=1), shipped_catalogue()["version"], store=path)
+    write_pattern_table(TableRun(run_intersection(2, jobs=1), jobs=1), shipped_catalogue().version, store=path)
     return path
 
 

@@ -41,11 +41,11 @@ def committed_tables():
 def test_committed_catalogue_and_patterns_validate(committed_tables, full, tmp_path):
     catalogue = load_catalogue(catalogue_path())
     check_catalogue(catalogue, "catalogue")
-    ids = [t["id"] for t in catalogue["types"]]
-    names = {t["name"] for t in catalogue["types"]}
+    ids = [t.id for t in catalogue]
+    names = {t.name for t in catalogue}
     assert {"Tetrahedron", "Cuboid", "Rectangular Pyramid", "Tetrahedron Complement", "Generic #8"} <= names
     for stem, table in committed_tables.items():
-        assert table.header["catalogue_version"] == catalogue["version"]
+        assert table.header["catalogue_version"] == catalogue.version
         assert len(table.configurations) == 4096
         known = set(ids)
         assert all(e["type"] in known for entry in table.configurations.values() for e in entry["optimal"])
@@ -108,7 +108,7 @@ def test_a_standard_yaml_reader_reads_the_committed_files_alike(committed_tables
         assert len(sample["configurations"]) == 64
         for code, entry in sample["configurations"].items():
             assert entry == table.configurations[code]
-    assert yaml.safe_load(catalogue_path().read_text()) == load_catalogue(catalogue_path())
+    assert yaml.safe_load(catalogue_path().read_text()) == load_catalogue(catalogue_path()).to_dict()
 
 
 @pytest.mark.parametrize("edit, needle", [
@@ -173,7 +173,7 @@ def test_leaf_tables_pass_check_and_look_up_by_whole_point_set_code(tmp_path):
     for box in (CUBE, ("1", "2", "4")):
         study = run_study("leaves", Box.parse(box), sample, "explicit")
         paths.append(tmp_path / f"{pattern_name('leaves', box, 'explicit')}.yaml")
-        write_patterns(study, paths[-1], shipped_catalogue()["version"])
+        write_patterns(study, paths[-1], shipped_catalogue().version)
     result = cospherical("check", str(catalogue_path()), *map(str, paths))
     assert result.returncode == 0, result.stderr
     assert result.stdout.count(f"{len(sample)} configurations") == 2

@@ -28,7 +28,7 @@ def small_store(tmp_path_factory):
     from cospherical.studies.intersection.table import TableRun
 
     path = tmp_path_factory.mktemp("r2") / "r2.sqlite"
-    write_pattern_table(TableRun(run_intersection(2, jobs=1)), shipped_catalogue()["version"], store=path)
+    write_pattern_table(TableRun(run_intersection(2, jobs=1)), shipped_catalogue().version, store=path)
     return path
 
 

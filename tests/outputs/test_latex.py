@@ -49,10 +49,10 @@ def test_rendered_tex_is_byte_identical_across_runs(tmp_path):
 
 def test_names_are_escaped_and_pictures_drawn():
     catalogue = load_catalogue(catalogue_path())
-    generic = next(t for t in catalogue["types"] if t["name"].startswith("Generic #"))
+    generic = next(t for t in catalogue if t.name.startswith("Generic #"))
     picture = tikz_picture(generic)
-    assert picture.count(r"\draw[thick]") + picture.count(r"\draw[densely dashed, gray]") == generic["edges"]
-    assert r"\draw[densely dashed, gray]" in picture or generic["vertices"] == 4
+    assert picture.count(r"\draw[thick]") + picture.count(r"\draw[densely dashed, gray]") == generic.edges
+    assert r"\draw[densely dashed, gray]" in picture or generic.vertices == 4
     elements = (ROOT / "results" / "latex" / "elements.tex").read_text()
     assert r"Generic \#" in elements and "Generic #" not in elements.replace(r"Generic \#", "")
 

@@ -21,7 +21,6 @@ def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypat
     corrupt.write_text("types: [unclosed\n")
     monkeypatch.setattr(names, "catalogue_path", lambda: corrupt)
     names.shipped_catalogue.cache_clear()
-    names._shipped_names.cache_clear()
     root = tmp_path / "root"
     (root / "catalogue").mkdir(parents=True)
     (root / "catalogue" / "catalogue.yaml").write_text("types: [unclosed\n")
@@ -34,7 +33,6 @@ def test_reproduce_regenerates_committed_files_byte_for_byte(tmp_path, monkeypat
         assert main(["reproduce", "--root", str(root)]) == 0, capsys.readouterr().err
     finally:
         names.shipped_catalogue.cache_clear()
-        names._shipped_names.cache_clear()
     tmp_path = root
     for folder in ("catalogue", "patterns", "results"):
         # results/sweep/, results/intersection/, results/mesh/, results/devices/ and results/benchmarks/ come from other

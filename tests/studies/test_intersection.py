@@ -153,7 +153,7 @@ def test_pattern_table_of_the_representatives(tmp_path):
 
     summary = run_intersection(2, jobs=1)
     path, store = tmp_path / "patterns.yaml", tmp_path / "patterns.sqlite"
-    write_pattern_table(TableRun(summary, jobs=2, chunk=40), shipped_catalogue()["version"], yaml_path=path, store=store)
+    write_pattern_table(TableRun(summary, jobs=2, chunk=40), shipped_catalogue().version, yaml_path=path, store=store)
     table = load(path)
     reps, _, _ = orbits(2)
     assert sorted(table.configurations) == [key_code(k) for k in reps.tolist()]
@@ -167,7 +167,7 @@ def test_pattern_table_of_the_representatives(tmp_path):
     # the same bytes, however the work was cut and run
     again = tmp_path / "again"
     again.mkdir()
-    write_pattern_table(TableRun(summary, jobs=1, chunk=1000), shipped_catalogue()["version"],
+    write_pattern_table(TableRun(summary, jobs=1, chunk=1000), shipped_catalogue().version,
                         yaml_path=again / path.name, store=again / store.name)
     assert (again / path.name).read_bytes() == path.read_bytes()
     assert (again / store.name).read_bytes() == store.read_bytes()
@@ -214,7 +214,7 @@ def test_the_catalogue_holds_every_type_of_the_intersection_studies():
     from cospherical.catalogue import shipped_catalogue
     from cospherical.formats.catalogue_file import intersection_examples
 
-    known = {t["id"] for t in shipped_catalogue()["types"]}
+    known = {t.id for t in shipped_catalogue()}
     examples = {e["element"].type.id for e in intersection_examples()}
     assert examples <= known
     results = Path(__file__).resolve().parents[2] / "results" / "intersection"
@@ -231,7 +231,7 @@ def r4_table(pool_run, tmp_path_factory):
     from cospherical.studies.intersection.table import TableRun
 
     folder = tmp_path_factory.mktemp("r4")
-    write_pattern_table(TableRun(pool_run, jobs=2), shipped_catalogue()["version"], yaml_path=folder / "r4.yaml",
+    write_pattern_table(TableRun(pool_run, jobs=2), shipped_catalogue().version, yaml_path=folder / "r4.yaml",
                         store=folder / "r4.sqlite")
     return folder / "r4.yaml", folder / "r4.sqlite"
 

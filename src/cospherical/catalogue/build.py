@@ -26,6 +26,7 @@ from ..files.data import data_path
 from ..files.flowyaml import decode_entry, split_section
 from ..files.yamlio import read_text
 from ..version import __version__
+from .model import Catalogue
 from .criteria import option_types, split_options, split_positions
 from .names import SCHEMA_VERSION, type_names
 
@@ -82,8 +83,9 @@ def intersection_examples(path: str | Path | None = None) -> list[dict]:
     return found
 
 
-def build_catalogue(studies, extra: Sequence[dict] = ()) -> dict:
-    """The catalogue of every element type met in the studies, as YAML-ready data.
+def build_catalogue(studies, extra: Sequence[dict] = ()) -> Catalogue:
+    """The catalogue of every element type met in the studies (written by
+    :func:`cospherical.formats.catalogue_file.write_catalogue`).
 
     ``extra``: examples of further types (:func:`intersection_examples`), after the studies'.
     """
@@ -170,10 +172,10 @@ def build_catalogue(studies, extra: Sequence[dict] = ()) -> dict:
             }
         )
     digest = hashlib.sha256(json.dumps([entries, sorted(kept.items())], sort_keys=True, default=sorted).encode()).hexdigest()[:12]
-    return {
+    return Catalogue.from_dict({
         "schema_version": SCHEMA_VERSION,
         "version": digest,
         "generator": f"cospherical {__version__}",
         "criteria": {criterion: {"kept": sorted(ids)} for criterion, ids in sorted(kept.items())},
         "types": entries,
-    }
+    })

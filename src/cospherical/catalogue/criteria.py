@@ -18,6 +18,7 @@ from ..caches import cached
 from ..core.geometry import Frame
 from ..core.split import subdivisions
 from ..core.tessellation import Element, Tessellation
+from .model import Catalogue
 from .names import shipped_catalogue
 
 __all__ = ["Choice", "apply_catalogue_criterion", "choose", "choose_kept",
@@ -206,7 +207,7 @@ def split_positions(element: Element, pieces) -> tuple[tuple[str, tuple[int, ...
     return tuple(sorted((p.type.id, tuple(position[n] for n in p.nodes)) for p in pieces))
 
 
-def apply_catalogue_criterion(tess: Tessellation, criterion: str, catalogue: dict | None = None) -> Tessellation:
+def apply_catalogue_criterion(tess: Tessellation, criterion: str, catalogue: Catalogue | None = None) -> Tessellation:
     """Split a tessellation's elements by the catalogue's (default: the shipped one's) kept types for a criterion.
 
     The catalogue keeps, per criterion, the union of its studies' kept sets. An
@@ -216,5 +217,4 @@ def apply_catalogue_criterion(tess: Tessellation, criterion: str, catalogue: dic
     if criterion == "optimal":
         return tess
     catalogue = shipped_catalogue() if catalogue is None else catalogue
-    kept = frozenset(catalogue.get("criteria", {}).get(criterion, {}).get("kept", []))
-    return split_tessellation(tess, kept, criterion, strict=False)[0]
+    return split_tessellation(tess, catalogue.kept(criterion), criterion, strict=False)[0]

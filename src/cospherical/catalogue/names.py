@@ -21,8 +21,9 @@ from ..files.data import data_path
 from ..files.flowyaml import decode_entry, split_section
 from ..files.yamlio import parse_yaml, read_text, validate
 from ..paper import paper_class
+from .model import Catalogue
 
-__all__ = ["SCHEMA_VERSION", "catalogue_from_text", "catalogue_names", "catalogue_path", "known_name", "load_catalogue",
+__all__ = ["SCHEMA_VERSION", "catalogue_from_text", "catalogue_path", "known_name", "load_catalogue",
            "shipped_catalogue", "type_name", "type_names"]
 
 SCHEMA_VERSION = 1
@@ -34,7 +35,7 @@ def catalogue_path() -> Path:
 
 
 @cached(maxsize=1)  # the shipped file does not change while a process runs
-def shipped_catalogue() -> dict:
+def shipped_catalogue() -> Catalogue:
     """The shipped catalogue, read and validated once per process (empty if there is none).
 
     Whatever works with another catalogue (``reproduce`` builds one from
@@ -42,31 +43,21 @@ def shipped_catalogue() -> dict:
 
     Examples
     --------
-    >>> shipped_catalogue()["schema_version"]
+    >>> shipped_catalogue().schema_version
     1
     """
     path = catalogue_path()
     if not path.exists():
-        return {"schema_version": SCHEMA_VERSION, "version": "none", "types": []}
+        return Catalogue.empty(SCHEMA_VERSION)
     return load_catalogue(path)
 
 
-@cached(maxsize=1)
-def _shipped_names() -> dict[str, str]:
-    return catalogue_names(shipped_catalogue())
-
-
-def catalogue_names(catalogue: dict) -> dict[str, str]:
-    """Canonical code -> the catalogue's name of that type."""
-    return {entry["code"]: entry["name"] for entry in catalogue["types"]}
-
-
-def known_name(code: str, catalogue: dict | None = None) -> str | None:
+def known_name(code: str, catalogue: Catalogue | None = None) -> str | None:
     """The name of a canonical code in ``catalogue`` (default: the shipped one), if it has it."""
-    return (_shipped_names() if catalogue is None else catalogue_names(catalogue)).get(code)
+    return (shipped_catalogue() if catalogue is None else catalogue).name_of(code)
 
 
-def type_name(etype: ElementType, catalogue: dict | None = None) -> str:
+def type_name(etype: ElementType, catalogue: Catalogue | None = None) -> str:
     """The name of an element type: the catalogue's (default: the shipped one), else its structural
     or systematic name.
 
@@ -101,7 +92,7 @@ def type_names(types: Iterable[ElementType]) -> dict[str, tuple[str, list[str]]]
     return names
 
 
-def load_catalogue(path: str | Path) -> dict:
+def load_catalogue(path: str | Path) -> Catalogue:
     """Read a catalogue file and validate it against its JSON Schema.
 
     Parameters
@@ -111,9 +102,10 @@ def load_catalogue(path: str | Path) -> dict:
 
     Returns
     -------
-    dict
-        ``schema_version``, ``version``, ``criteria`` (kept type ids per criterion)
-        and ``types`` (one entry per element type: id, name, code, faces, splits...).
+    Catalogue
+        Its ``version``, its types (one :class:`~cospherical.catalogue.model.CatalogueType`
+        each: id, name, code, faces, splits...) by id and by code, and the kept type ids
+        per criterion.
 
     Raises
     ------
@@ -124,14 +116,14 @@ def load_catalogue(path: str | Path) -> dict:
     Examples
     --------
     >>> catalogue = load_catalogue(catalogue_path())
-    >>> next(t["name"] for t in catalogue["types"] if t["vertices"] == 4)
+    >>> next(t.name for t in catalogue.types if t.vertices == 4)
     'Tetrahedron'
     """
     return catalogue_from_text(read_text(path), str(path))
 
 
-def catalogue_from_text(text: str, name: str) -> dict:
-    """A catalogue's text as validated data; a bad catalogue raises :class:`FormatError`.
+def catalogue_from_text(text: str, name: str) -> Catalogue:
+    """A catalogue's text, validated; a bad catalogue raises :class:`FormatError`.
 
     A catalogue as this package writes it (one type per line, JSON flow style)
     has its types decoded as JSON and only its header parsed as YAML; any other
@@ -148,4 +140,4 @@ def catalogue_from_text(text: str, name: str) -> dict:
     if data is None:
         data = parse_yaml(text, name)
     validate(data, "catalogue", name)
-    return data
+    return Catalogue.from_dict(data)

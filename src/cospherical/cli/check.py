@@ -44,7 +44,7 @@ def run(args) -> int:
         kind, document = read_document_file(path)
         if kind == "catalogue":
             check_catalogue(document, str(path))
-            say(f"{path}: ok, catalogue of {len(document['types'])} element types")
+            say(f"{path}: ok, catalogue of {len(document)} element types")
             continue
         if catalogue is None:
             catalogue_file = args.catalogue or catalogue_path()

@@ -88,7 +88,7 @@ def run(args) -> int:
             study = run_study(args.study, Box.parse(args.box), codes, args.face_points or "octree",
                               progress=advance, element=element)
         catalogue = build_catalogue([study])
-        names = {t["id"]: (t["name"], t["aliases"]) for t in catalogue["types"]}
+        names = catalogue.names()
         summaries = [study_summary(study, names)]
     else:
         given = [flag for flag, value in (("--box", args.box), ("--element", args.element),

@@ -145,7 +145,7 @@ def run(args) -> int:
 
         stem = pattern_name(study.name, box.texts, study.face_points, study.element)
         atomic_write(args.out / f"{stem}.json", dump(summary, "json"))
-        write_patterns(study, args.out / f"{stem}.yaml", shipped_catalogue()["version"])
+        write_patterns(study, args.out / f"{stem}.yaml", shipped_catalogue().version)
     return _report(summary, args, study)
 
 
@@ -209,7 +209,7 @@ def _intersection(args) -> int:
                              "entries": (summary["orbits"], "pattern table: entries", "cfg")}) as advance:
                 run = TableRun(summary, jobs=args.jobs, progress=advance, scheduler=args.scheduler,
                                dask_workers=args.dask_workers)
-                write_pattern_table(run, shipped_catalogue()["version"],
+                write_pattern_table(run, shipped_catalogue().version,
                                     yaml_path=args.out / f"{stem}-patterns.yaml" if form != "store" else None,
                                     store=args.out / f"{stem}-patterns.sqlite" if form != "yaml" else None)
     return _report(summary, args)

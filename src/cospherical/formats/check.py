@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..caches import cached
-from ..catalogue import catalogue_from_text
+from ..catalogue import Catalogue, CatalogueType, catalogue_from_text
 from ..core.base_element import base_element
 from ..core.configuration import Box
 from ..core.element_types import classify_faces
@@ -39,38 +39,37 @@ __all__ = ["EntryCheck", "check_catalogue", "check_patterns", "document_data", "
            "validated"]
 
 
-def check_catalogue(data: dict, name: str) -> None:
+def check_catalogue(catalogue: Catalogue, name: str) -> None:
     """Ids, codes and names unique; faces consistent with V/E/F; splits name known types."""
-    ids = Counter(t["id"] for t in data["types"])
-    _check_unique(data, name)
-    for i, t in enumerate(data["types"]):
-        where = f"{name}: types/{i} ({t['id']})"
-        faces = [f["nodes"] for f in t["reference_faces"]]
-        if len(faces) != t["faces"] or any(not 0 <= v < t["vertices"] for f in faces for v in f):
-            raise FormatError(f"{where}: reference_faces do not match {t['vertices']} vertices and {t['faces']} faces")
+    _check_unique(catalogue, name)
+    for i, t in enumerate(catalogue.types):
+        where = f"{name}: types/{i} ({t.id})"
+        faces = [f.nodes for f in t.reference_faces]
+        if len(faces) != t.faces or any(not 0 <= v < t.vertices for f in faces for v in f):
+            raise FormatError(f"{where}: reference_faces do not match {t.vertices} vertices and {t.faces} faces")
         edges = {frozenset((f[k], f[(k + 1) % len(f)])) for f in faces for k in range(len(f))}
-        if len(edges) != t["edges"] or t["vertices"] - t["edges"] + t["faces"] != 2:
-            raise FormatError(f"{where}: V/E/F {t['vertices']}/{t['edges']}/{t['faces']} do not fit its faces")
-        for criterion, splits in t.get("splits", {}).items():
+        if len(edges) != t.edges or t.vertices - t.edges + t.faces != 2:
+            raise FormatError(f"{where}: V/E/F {t.vertices}/{t.edges}/{t.faces} do not fit its faces")
+        for criterion, splits in t.splits.items():
             for split in splits:
                 for piece in split:
-                    if piece["type"] not in ids:
-                        raise FormatError(f"{where}: splits/{criterion}: unknown type {piece['type']!r}")
-    for criterion, entry in data.get("criteria", {}).items():
-        unknown = [k for k in entry.get("kept", []) if k not in ids]
+                    if piece.type not in catalogue:
+                        raise FormatError(f"{where}: splits/{criterion}: unknown type {piece.type!r}")
+    for criterion, kept in catalogue.criteria.items():
+        unknown = sorted(k for k in kept if k not in catalogue)
         if unknown:
             raise FormatError(f"{name}: criteria/{criterion}/kept: unknown type {unknown[0]!r}")
 
 
-def _check_unique(data: dict, name: str) -> None:
+def _check_unique(catalogue: Catalogue, name: str) -> None:
     """Every type once: the same id, canonical code or name twice makes a catalogue ambiguous."""
     for field in ("id", "code", "name"):
-        repeated = [k for k, n in Counter(t[field] for t in data["types"]).items() if n > 1]
+        repeated = [k for k, n in Counter(getattr(t, field) for t in catalogue.types).items() if n > 1]
         if repeated:
             raise FormatError(f"{name}: types: {field} {repeated[0]!r} appears more than once")
 
 
-def check_patterns(table, catalogue: dict | None, name: str, tiling: bool = True, measured: dict | None = None) -> None:
+def check_patterns(table, catalogue: Catalogue | None, name: str, tiling: bool = True, measured: dict | None = None) -> None:
     """Check a loaded :class:`~cospherical.formats.patterns.PatternTable` against the catalogue and geometry.
 
     ``measured``: a dict the checks of several tables share (against one catalogue), so that an
@@ -102,9 +101,9 @@ class EntryCheck:
     for the checks of several tables against the same catalogue).
     """
 
-    def __init__(self, header: dict, catalogue: dict | None, name: str, geometry: bool = True,
+    def __init__(self, header: dict, catalogue: Catalogue | None, name: str, geometry: bool = True,
                  measured: dict | None = None):
-        self._types = {t["id"]: t for t in catalogue["types"]} if catalogue else None
+        self._types = catalogue if catalogue is not None and len(catalogue) else None
         self._name = name
         self._geometry = geometry and bool(self._types)
         try:
@@ -236,7 +235,7 @@ class _Placed:
         return cls(found.volume, found.real_center, shape.contains(found.center), faces, across)
 
 
-def _measure_element(type_id: str, mirror: bool, points: tuple, squared, catalogued: dict, scale,
+def _measure_element(type_id: str, mirror: bool, points: tuple, squared, catalogued: CatalogueType, scale,
                      shape: Shape) -> _Measured | str:
     """An element of type ``type_id`` (``catalogued``, its catalogue entry) listed by ``points``
     (integer pairs of unit coordinates) in the base element ``shape`` of squared lengths ``squared``
@@ -254,7 +253,7 @@ def _measure_element(type_id: str, mirror: bool, points: tuple, squared, catalog
         return f"mirror is {mirror}, recomputed {mirrored}"
     # The type's faces through the node list, turned back for a mirror image, must be the hull's
     # as they run: the node order gives a positively oriented cell (VTK's order for its cells).
-    reference = {_turned(face["nodes"][::-1] if mirror else face["nodes"]) for face in catalogued["reference_faces"]}
+    reference = {_turned(face.nodes[::-1] if mirror else face.nodes) for face in catalogued.reference_faces}
     if reference != {_turned(cycle) for cycle in cycles}:
         return (f"the nodes are not in the reference order of type {type_id}: its faces do not run "
                 "counter-clockwise seen from outside (a mirrored, upside-down or reordered element)")
@@ -304,7 +303,7 @@ def _shape_name(shape: Shape) -> str:
 
 
 def read_document(text: str, name: str):
-    """A catalogue's or pattern table's text: ``("catalogue", data)`` or ``("patterns", PatternTable)``, validated.
+    """A catalogue's or pattern table's text: ``("catalogue", Catalogue)`` or ``("patterns", PatternTable)``, validated.
 
     Files as this package writes them take the fast path of each reader (one
     JSON entry per line, see :mod:`cospherical.files.flowyaml`); anything else is
@@ -321,7 +320,7 @@ def read_document(text: str, name: str):
         _check_unique(catalogue, name)
         return "catalogue", catalogue
     kind, data = validated(parse_yaml(text, name), name)
-    return kind, (data if kind == "catalogue" else table_from_data(data, name))
+    return kind, (Catalogue.from_dict(data) if kind == "catalogue" else table_from_data(data, name))
 
 
 def read_document_file(path: str | Path) -> tuple[str, Any]:
@@ -333,8 +332,8 @@ def read_document_file(path: str | Path) -> tuple[str, Any]:
 
 def document_data(document) -> dict:
     """A read document as one mapping (a pattern table's header with its configurations), as diff compares them."""
-    if isinstance(document, dict):
-        return document
+    if isinstance(document, Catalogue):
+        return document.to_dict()
     return {**document.header, "configurations": document.configurations}
 
 
@@ -344,5 +343,5 @@ def validated(data, name: str) -> tuple[str, dict]:
     kind = document_kind(data, name)
     validate(data, kind, name)
     if kind == "catalogue":
-        _check_unique(data, name)
+        _check_unique(Catalogue.from_dict(data), name)
     return kind, data

@@ -29,6 +29,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ..catalogue import Catalogue
 from ..choices import POINT_POLICIES
 from ..core.configuration import Box, Configuration
 from ..errors import FormatError, InputError
@@ -118,7 +119,8 @@ def read_leaves(path: str | Path, max_leaves: int | None = None) -> tuple[np.nda
     return array[:, 0], array[:, 1:]
 
 
-def table_lookup(table, criterion: str, box: Box, name: str = "pattern table", catalogue: dict | None = None) -> Lookup:
+def table_lookup(table, criterion: str, box: Box, name: str = "pattern table",
+                 catalogue: Catalogue | None = None) -> Lookup:
     """A lookup for :func:`cospherical.mesh.assembly.assemble` reading a pattern table.
 
     The table is asked for the leaf's whole-point-set code (``800000000000+f``), and
@@ -186,7 +188,7 @@ _MIRRORED_VTK = {"tetra": (0, 2, 1, 3), "pyramid": (0, 3, 2, 1, 4), "wedge": (0,
                  "hexahedron": (0, 3, 2, 1, 4, 7, 6, 5)}
 
 
-def orbit_lookup(lookup: Lookup, box: Box, catalogue: dict) -> Lookup:
+def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
     """``lookup``, and for a configuration it lacks, its orbit representative's elements carried back.
 
     A table of orbit representatives (the intersection store) holds one
@@ -202,7 +204,7 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: dict) -> Lookup:
     from ..core.symmetry import box_symmetries, orbit_representatives
 
     symmetries = box_symmetries(box)
-    vtk = {entry["id"]: entry.get("vtk") for entry in catalogue.get("types", [])}
+    vtk = {entry.id: entry.vtk for entry in catalogue}
 
     def mapped(configuration: Configuration):
         found = lookup(configuration)

@@ -24,7 +24,7 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from ..catalogue import apply_catalogue_criterion, shipped_catalogue
+from ..catalogue import Catalogue, apply_catalogue_criterion, shipped_catalogue
 from ..core.codes import mask_code, point_suffix
 from ..core.configuration import Box, Configuration
 from ..core.element_types import ElementType
@@ -209,7 +209,7 @@ class Mesh:
     types: dict[str, dict] = field(default_factory=dict)
     replaced: np.ndarray | None = None
     cells: Cells | None = None
-    catalogue: dict | None = field(default=None, repr=False, compare=False)  # names the types; from assemble
+    catalogue: Catalogue | None = field(default=None, repr=False, compare=False)  # names the types; from assemble
     regions: Regions | None = field(default=None, repr=False, compare=False)  # a device's regions
     _groups: list | None = field(default=None, repr=False, compare=False)
 
@@ -363,12 +363,12 @@ class Mesh:
         low = self.tree.positions[self.cells.leaf].astype(num.dtype) * size[:, None]
         return in_closed_box(num, den[:, None], low, low + size[:, None]).astype(bool)
 
-def type_info(type_id: str, etype: ElementType | None, catalogue: dict) -> dict:
+def type_info(type_id: str, etype: ElementType | None, catalogue: Catalogue) -> dict:
     """Name, paper class, VTK cell and size of a type: from the catalogue, else from the type itself."""
-    for entry in catalogue["types"]:
-        if entry["id"] == type_id:
-            return {"name": entry["name"], "paper_class": (entry.get("aliases") or [None])[0],
-                    "vtk": entry.get("vtk"), "vertices": entry["vertices"], "faces": entry["faces"]}
+    entry = catalogue.get(type_id)
+    if entry is not None:
+        return {"name": entry.name, "paper_class": entry.paper_class,
+                "vtk": entry.vtk, "vertices": entry.vertices, "faces": entry.faces}
     if etype is not None:
         cls = paper_class(etype)
         return {"name": etype.name, "paper_class": cls["name"] if cls else None, "vtk": etype.vtk,
@@ -412,7 +412,7 @@ def _node_keys(origin: np.ndarray, half: np.ndarray, grid: int, part: slice, nod
 
 def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int], None] | None = None,
              cache: dict | None = None, criterion: str = "optimal",
-             vertices: tuple[int, np.ndarray] | None = None, catalogue: dict | None = None) -> Mesh:
+             vertices: tuple[int, np.ndarray] | None = None, catalogue: Catalogue | None = None) -> Mesh:
     """Mesh an octree: configurations from the vertex set, elements from ``lookup`` (else tessellated).
 
     ``lookup(configuration)`` returns the pattern table's elements of that point set
@@ -484,7 +484,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
 
 
 def _leaf_tessellation(configuration: Configuration, lookup: Lookup | None, types: dict, criterion: str,
-                       catalogue: dict) -> LocalTessellation:
+                       catalogue: Catalogue) -> LocalTessellation:
     elements = lookup(configuration) if lookup is not None else None
     if elements is not None:
         return local_tessellation(configuration, [(e["type"], e["nodes"]) for e in elements],

@@ -135,6 +135,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..catalogue import Catalogue
 from ..choices import ENGINES, MODES, DelaunayMode, Engine
 from ..core.geometry import Frame, area_vector, circumcenters, six_volumes, sphere_sides
 from ..core.incremental_delaunay import delaunay_tetrahedra
@@ -584,7 +585,8 @@ def _row_classes(rows: np.ndarray) -> np.ndarray:
     return classes
 
 
-def _shape(offsets: list[tuple[int, int, int]], squared, types: dict, catalogue: dict) -> tuple[CellShape, list[int]]:
+def _shape(offsets: list[tuple[int, int, int]], squared, types: dict,
+           catalogue: Catalogue) -> tuple[CellShape, list[int]]:
     """Classify and measure one cell shape (vertex offsets from the anchor, grid units), exactly.
 
     Returns the shape and the order of ``offsets`` that is the type's reference order.

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..catalogue import shipped_catalogue
+from ..catalogue import Catalogue, shipped_catalogue
 from ..core.configuration import Box
 from ..core.morton import morton_codes
 from ..errors import InputError
@@ -107,7 +107,7 @@ class Piece:
     types: dict | None = None
 
 
-def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: dict) -> dict:
+def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: Catalogue) -> dict:
     """Mesh, check and write one piece (run in a worker); see the module for why it equals its part of the whole.
 
     ``keys``: the whole tree's vertex keys; ``lookup``: ``(factory, arguments)`` that make
@@ -148,7 +148,7 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: 
 def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: str, mode: str,
                    described: dict, patterns: str | None, uniform: bool = True, delaunay: bool = True,
                    write: Callable | None = None, path: Callable[[int], str] | None = None, jobs: int = 1,
-                   scheduler: str | None = None, dask_workers: int | None = None, catalogue: dict | None = None,
+                   scheduler: str | None = None, dask_workers: int | None = None, catalogue: Catalogue | None = None,
                    progress: Callable[[str, int, int], None] | None = None) -> dict:
     """Mesh ``tree`` in ``pieces`` tasks (each writing ``path(k)`` with ``write``); return the whole mesh's report.
 
@@ -206,7 +206,7 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
 
 def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, failing: tuple, grid: int,
                     keys: np.ndarray, lookup: tuple | None, criterion: str,
-                    catalogue: dict) -> tuple[dict[int, dict], tuple[int, int]]:
+                    catalogue: Catalogue) -> tuple[dict[int, dict], tuple[int, int]]:
     """Re-tessellate the marked leaves (whole-tree indices) and give each cell to the piece of its first leaf.
 
     ``failing``: the elements that are not Delaunay cells, as (whole-tree leaf, index in the leaf).

@@ -16,6 +16,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from ..catalogue import Catalogue
 from ..version import __version__
 from .assembly import Mesh
 from .checks import DelaunayCheck, check_circumcenters, check_conformity, check_delaunay, check_volume, match_seams
@@ -39,7 +40,7 @@ def outside_catalogue(mesh: Mesh) -> list[dict]:
     The example is one element's vertices in domain units (exact fractions of the
     domain's sides, as text).  Nothing is added to the catalogue.
     """
-    known = {entry["id"] for entry in mesh.catalogue["types"]}
+    known = mesh.catalogue if mesh.catalogue is not None else ()
     found: dict[str, dict] = {}
     for rows, nodes, _, type_id in mesh.blocks():
         if type_id in known or not len(rows):
@@ -96,7 +97,7 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
 def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dict, patterns: str | None,
                   criterion: str = "optimal", uniform: bool = True, delaunay: bool = True,
                   leaf_mesh: dict | None = None, cells: tuple[int, int] = (0, 0), seams: list | None = None,
-                  vertex_points: Callable | None = None, grid: int = 1, *, catalogue: dict,
+                  vertex_points: Callable | None = None, grid: int = 1, *, catalogue: Catalogue,
                   domain_share: Fraction = Fraction(1)) -> dict:
     """The report of a mesh from the :func:`mesh_figures` of its pieces (one piece: the whole mesh).
 

@@ -13,6 +13,7 @@ from collections import Counter
 
 import numpy as np
 
+from ..catalogue import Catalogue
 from ..core.configuration import Box, Configuration
 from ..studies.engine import bisection_codes, run_study
 from .assembly import PAPER_FINAL, Mesh, type_info
@@ -22,7 +23,7 @@ __all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrence
 _BISECTION_CONFIGURATIONS = 4096
 
 
-def uniform_study(box: Box, catalogue: dict) -> dict:
+def uniform_study(box: Box, catalogue: Catalogue) -> dict:
     """Element counts per type of the uniform-weight bisection study of ``box`` (octree policy, optimal),
     the types named by ``catalogue``."""
     study = run_study("bisection", box, bisection_codes(), "octree", criteria=("optimal",))
@@ -81,7 +82,7 @@ def occurrences(mesh: Mesh) -> tuple[Counter, dict[str, dict]]:
 
 
 def statistics(type_counts: Counter, configurations: dict[str, dict], total_leaves: int, types: dict,
-               catalogue: dict, uniform: dict | None = None) -> dict:
+               catalogue: Catalogue, uniform: dict | None = None) -> dict:
     """:func:`mesh_statistics` from the :func:`occurrences` of a mesh (or of all its pieces, added up);
     ``catalogue`` names the types met nowhere else."""
     configurations = sorted(({

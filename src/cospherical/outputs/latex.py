@@ -17,8 +17,9 @@ from pathlib import Path
 
 import jinja2
 
+from ..catalogue import Catalogue, CatalogueType
 from ..core.element_types import face_summary
-from ..core.geometry import cross, plane_normal
+from ..core.geometry import cross
 from ..choices import CRITERIA
 from ..errors import InputError
 from ..files.data import data_path
@@ -66,22 +67,30 @@ def _normalise(v):
     return tuple(x / n for x in v)
 
 
-def _projection(entry: dict, size: float):
+def _drawn_normal(p: tuple[float, ...], q: tuple[float, ...], r: tuple[float, ...]) -> tuple[float, float, float]:
+    """(q - p) x (r - p) in floats, as :func:`~cospherical.core.geometry.plane_normal` writes it out: a
+    picture's coordinates are the catalogue's float example, not exact values."""
+    (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = p, q, r
+    ux, uy, uz, vx, vy, vz = x1 - x0, y1 - y0, z1 - z0, x2 - x0, y2 - y0, z2 - z0
+    return (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
+
+
+def _projection(entry: CatalogueType, size: float):
     """Screen coordinates of the example's vertices and each edge's visibility."""
     d = _normalise(_TOWARD_VIEWER)
     right = _normalise(cross((0, 0, 1), d))
     up = cross(d, right)
-    points = entry["example"]["coordinates"]
+    points = entry.example.coordinates
     screen = [(sum(a * b for a, b in zip(p, right)), sum(a * b for a, b in zip(p, up))) for p in points]
     xs, ys = [s[0] for s in screen], [s[1] for s in screen]
     scale = size / max(max(xs) - min(xs), max(ys) - min(ys))
     cx, cy = (max(xs) + min(xs)) / 2, (max(ys) + min(ys)) / 2
     screen = [((x - cx) * scale, (y - cy) * scale) for x, y in screen]
     visible_edges, edges = set(), set()
-    for face in entry["reference_faces"]:
-        nodes = face["nodes"]
+    for face in entry.reference_faces:
+        nodes = face.nodes
         p0, p1, p2 = (points[i] for i in nodes[:3])
-        normal = plane_normal(p0, p1, p2)
+        normal = _drawn_normal(p0, p1, p2)
         front = sum(a * b for a, b in zip(normal, d)) > 0
         for i, v in enumerate(nodes):
             edge = tuple(sorted((v, nodes[(i + 1) % len(nodes)])))
@@ -91,7 +100,7 @@ def _projection(entry: dict, size: float):
     return screen, sorted(edges), visible_edges
 
 
-def tikz_picture(entry: dict, size: float = 1.6) -> str:
+def tikz_picture(entry: CatalogueType, size: float = 1.6) -> str:
     """A TikZ drawing of a catalogue entry's example (size in cm)."""
     screen, edges, visible = _projection(entry, size)
     lines = [r"\begin{tikzpicture}[line join=round]"]
@@ -108,7 +117,7 @@ def tikz_picture(entry: dict, size: float = 1.6) -> str:
     return "\n".join(lines)
 
 
-def element_png(entry: dict, path: Path, size_px: int = 160) -> None:
+def element_png(entry: CatalogueType, path: Path, size_px: int = 160) -> None:
     """A PNG picture of a catalogue entry's example (matplotlib, deterministic metadata)."""
     import matplotlib
 
@@ -143,8 +152,7 @@ def save_png(fig, path: Path, dpi: int = 100) -> None:
         plt.close(fig)
 
 
-def _type_rows(summaries: list[dict], catalogue: dict) -> list[dict]:
-    entries = {t["id"]: t for t in catalogue["types"]}
+def _type_rows(summaries: list[dict], catalogue: Catalogue) -> list[dict]:
     seen: dict[str, dict] = {}
     for summary in summaries:
         for data in summary["criteria"].values():
@@ -153,8 +161,8 @@ def _type_rows(summaries: list[dict], catalogue: dict) -> list[dict]:
     rows = []
     for type_id in sorted(seen, key=lambda i: (seen[i]["vertices"], seen[i]["faces"], i)):
         t = seen[type_id]
-        entry = entries.get(type_id)
-        rows.append({**t, "face_summary": face_summary(entry["face_kinds"]) if entry else "--",
+        entry = catalogue.get(type_id)
+        rows.append({**t, "face_summary": face_summary(dict(entry.face_kinds)) if entry else "--",
                      "picture": tikz_picture(entry) if entry else None})
     return rows
 
@@ -175,7 +183,7 @@ def _readable(name: str) -> str:
     return name.replace("_", " ")
 
 
-def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str, pdf: bool = False) -> list[Path]:
+def render_tables(summaries: list[dict], catalogue: Catalogue, out: Path, title: str, pdf: bool = False) -> list[Path]:
     """Write every table of the studies' summaries, and ``document.tex`` including them all
     (and, with ``pdf``, ``document.pdf`` compiled from it, with its log).
 
@@ -193,7 +201,7 @@ def render_tables(summaries: list[dict], catalogue: dict, out: Path, title: str,
     return [out / name for name in names]
 
 
-def _write_tables(summaries: list[dict], catalogue: dict, folder: OutputFolder, title: str) -> list[str]:
+def _write_tables(summaries: list[dict], catalogue: Catalogue, folder: OutputFolder, title: str) -> list[str]:
     env = environment()
     written: list[str] = []
 

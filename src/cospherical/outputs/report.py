@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from ..catalogue import element_options, type_name
+from ..catalogue import Catalogue, element_options, type_name
 from ..paper import comparison_notes, paper_class, paper_comparison, paper_notes, paper_studies, paper_study_key
 from ..studies.engine import Study
 
 __all__ = ["comparison_lines", "paper_set_gaps", "study_comparison_lines", "text_report"]
 
 
-def paper_set_gaps(study: Study, key: str, criterion: str, catalogue: dict | None = None) -> list[dict]:
+def paper_set_gaps(study: Study, key: str, criterion: str, catalogue: Catalogue | None = None) -> list[dict]:
     """Element types of the study that cannot be split into the paper's kept classes.
 
     The paper's table for a criterion names the classes it keeps; an element whose
@@ -107,7 +107,7 @@ def study_comparison_lines(summary: dict) -> list[str]:
     return lines
 
 
-def comparison_lines(summary: dict, study: Study | None = None, catalogue: dict | None = None) -> list[str]:
+def comparison_lines(summary: dict, study: Study | None = None, catalogue: Catalogue | None = None) -> list[str]:
     """The paper's figures beside ours; with the ``study``, also the elements the paper's kept
     classes cannot tessellate, named by ``catalogue`` (default: the shipped one)."""
     key, _ = paper_study_key(summary)

@@ -40,7 +40,7 @@ def reproduce(root: str | Path = ".", progress: Callable[[int], None] | None = N
 
 def _write(root: Path, studies, leaves, shapes) -> str:
     catalogue = build_catalogue(studies + leaves + shapes, intersection_examples())
-    names = {t["id"]: (t["name"], t["aliases"]) for t in catalogue["types"]}
+    names = catalogue.names()
     write_catalogue(catalogue, root / "catalogue" / "catalogue.yaml")
 
     report = ["# Results: the paper's bisection studies, reproduced", "",
@@ -58,21 +58,21 @@ def _write(root: Path, studies, leaves, shapes) -> str:
             octree_summaries[study.box] = summary
         atomic_write(root / "results" / f"{stem}.json", dump(summary, "json"))
         if study.face_points == "octree":
-            write_patterns(study, root / "patterns" / f"{stem}.yaml", catalogue["version"])
+            write_patterns(study, root / "patterns" / f"{stem}.yaml", catalogue.version)
         report += [f"## {stem}", "", "```", text_report(summary).rstrip("\n"), "",
                    *comparison_lines(summary, study, catalogue), "```", ""]
     for study in leaves:
         stem = pattern_name(study.name, study.box.texts, study.face_points)
         summary = compared_with(study_summary(study, names), octree_summaries[study.box])
         atomic_write(root / "results" / f"{stem}.json", dump(summary, "json"))
-        write_patterns(study, root / "patterns" / f"{stem}.yaml", catalogue["version"])
+        write_patterns(study, root / "patterns" / f"{stem}.yaml", catalogue.version)
         report += [f"## {stem}", "", "```", text_report(summary).rstrip("\n"), "```", ""]
     shape_summaries = []
     for study in shapes:
         stem = pattern_name(study.name, study.box.texts, study.face_points, study.element)
         shape_summaries.append(study_summary(study, names))
         atomic_write(root / "results" / f"{stem}.json", dump(shape_summaries[-1], "json"))
-        write_patterns(study, root / "patterns" / f"{stem}.yaml", catalogue["version"])
+        write_patterns(study, root / "patterns" / f"{stem}.yaml", catalogue.version)
         report += [f"## {stem}", "", "```", text_report(shape_summaries[-1]).rstrip("\n"), "```", ""]
     atomic_write(root / "results" / "summary.md", "\n".join(report))
     paper_boxes = [s for s in summaries if s["face_points"] == "octree"]
@@ -80,9 +80,9 @@ def _write(root: Path, studies, leaves, shapes) -> str:
                   "Delaunay tessellations of 1-irregular cuboids: the paper's bisection studies")
     render_tables(shape_summaries, catalogue, root / "results" / "latex-shapes",
                   "Delaunay tessellations of 1-irregular prisms, pyramids and tetrahedra: bisection studies")
-    for entry in catalogue["types"]:
-        element_png(entry, root / "results" / "elements" / f"{entry['id']}.png")
+    for entry in catalogue:
+        element_png(entry, root / "results" / "elements" / f"{entry.id}.png")
     tables = sum(s.face_points == "octree" for s in studies) + len(leaves) + len(shapes)
-    return (f"wrote {root / 'catalogue' / 'catalogue.yaml'} ({len(catalogue['types'])} element types, "
-            f"version {catalogue['version']}), {tables} pattern tables "
+    return (f"wrote {root / 'catalogue' / 'catalogue.yaml'} ({len(catalogue)} element types, "
+            f"version {catalogue.version}), {tables} pattern tables "
             f"in {root / 'patterns'}, summaries, LaTeX tables and element pictures in {root / 'results'}")
