@@ -423,3 +423,23 @@ def test_a_domain_with_a_box_shaped_hole_passes_the_oracle(tmp_path):
     path.write_text(_HOLE)
     m = _mesh_and_check(path, tmp_path / "out")
     assert m.report.volume == "15/16" and m.report.volume_ok  # 64 - 4 (the empty half of the cavity) of 4 x 4 x 4
+
+
+@pytest.mark.parametrize("regions", [1, 2])
+def test_contacts_vtu_is_written_when_the_device_has_named_faces_and_meshio_reads_it(regions, tmp_path):
+    """A device of one region and no contact has no named face: no contacts.vtu (meshio cannot read a VTU of no
+    cells), and the folder's manifest does not list it; with two regions and no contact, its interface faces are
+    there and meshio reads them, none a contact."""
+    text = "device: plain\nregions:\n  - {name: a, material: Si, boxes: [[0, 0, 0, 1, 1, 0.5]]}\n"
+    if regions == 2:
+        text += "  - {name: b, material: Ox, boxes: [[0, 0, 0.5, 1, 1, 1]]}\n"
+    path = tmp_path / "device.yaml"
+    path.write_text(text + "levels: 1\n")
+    build_mesh(device=path, uniform=False).write(tmp_path / "out")
+    written = tmp_path / "out" / "contacts.vtu"
+    manifest = (tmp_path / "out" / ".cospherical-manifest.json").read_text()
+    assert written.exists() == (regions == 2) and ("contacts.vtu" in manifest) == (regions == 2)
+    if regions == 2:
+        read = meshio.read(written)
+        assert (read.cell_data_dict["contact"]["polygon"] == -1).all()
+        assert (read.cell_data_dict["interface"]["polygon"] == 0).all() and len(read.cells_dict["polygon"]) == 4

@@ -50,6 +50,9 @@ __all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut
 def output_names(dual: bool, device: bool = False, gmsh: bool = False, tets: bool = False) -> tuple[str, ...]:
     """The files a mesh writes into its folder (``mesh --out``, :meth:`OctreeMesh.write`), known before the work.
 
+    ``device``: a device with named faces (:attr:`~cospherical.mesh.device.Device.has_faces`), whose
+    contacts and interfaces go to ``contacts.vtu`` (a VTU of no cells, valid VTK, is one meshio cannot read).
+
     The output folder is locked and these names checked before the mesh is made,
     and its manifest lists them afterwards (a later run removes a file of this one
     that it did not write again).
@@ -291,8 +294,9 @@ class OctreeMesh:
         if cut is not None and (isinstance(cut, bool) or not isinstance(cut, (int, float, Fraction))
                                 or not 0 <= cut <= 1):
             raise InputError(f"cut={shown(cut)}: the height of mesh.png's cut as a fraction of the domain's, 0..1")
-        names = output_names(self.report.dual is not None, self._result.source.device is not None, gmsh is not None,
-                             tets)
+        layout = self._result.source.device
+        names = output_names(self.report.dual is not None, layout is not None and layout.device.has_faces,
+                             gmsh is not None, tets)
         with OutputFolder(folder, "mesh", names, writes=mesh_writes) as out:
             self.write_files(out.path, cut, gmsh, binary, tets)
 
@@ -385,7 +389,7 @@ class OctreeMesh:
     def _write_device(self, path: Callable[[str], Path], cut: float | None, point_data: dict,
                       cell_data: dict) -> None:
         """A device's files: ``mesh.vtu`` with cell data ``region`` (names and materials in field data),
-        ``contacts.vtu`` (its contact and interface faces), ``mesh.png`` coloured by region, ``report.json``."""
+        ``contacts.vtu`` (its contact and interface faces, when it has any), ``mesh.png`` coloured by region, ``report.json``."""
         from ..formats.mesh import write_faces_vtu, write_report, write_vtu
         from ..formats.vtu import text_array
         from ..outputs.mesh_picture import cut_png
@@ -399,7 +403,8 @@ class OctreeMesh:
         write_vtu(mesh, path("mesh.vtu"), point_data=point_data,
                   cell_data={"region": mesh.element_region.astype(np.int32), **cell_data}, field_data=fields,
                   origin=device.origin)
-        write_faces_vtu(mesh, self._result.faces, path("contacts.vtu"), origin=device.origin)
+        if device.has_faces:
+            write_faces_vtu(mesh, self._result.faces, path("contacts.vtu"), origin=device.origin)
         axis = device_cut_axis(device)
         at = 0.5 if cut is None else cut
         low, high = device.bounds[axis]

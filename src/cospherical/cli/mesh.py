@@ -185,7 +185,8 @@ def run(args) -> int:
     if pieces is not None:
         names = ("mesh.pvtu", "report.json", *(piece_name(k) for k in range(pieces)))
     else:
-        names = output_names(args.dual, args.device is not None, args.gmsh is not None, args.tets)
+        names = output_names(args.dual, args.device is not None and args.device.has_faces, args.gmsh is not None,
+                             args.tets)
     with OutputFolder(args.out, "mesh", names, writes=mesh_writes) as out:  # locked from the start; every file or none
         return _run(args, out)
 

@@ -110,6 +110,12 @@ class Device:
         return tuple(low for low, _ in self.bounds)
 
     @property
+    def has_faces(self) -> bool:
+        """Whether the device has named faces (``contacts.vtu``): a contact, or two regions, which touch along an
+        interface (the domain is one piece through faces)."""
+        return bool(self.contacts) or len(self.regions) > 1
+
+    @property
     def box(self) -> Box:
         """The bounding box's lengths (the octree's root)."""
         return Box.parse([str(high - low) for low, high in self.bounds])
