@@ -10,7 +10,7 @@ configuration's pieces, and a second one that finds them remembered), the
 Laplacian's assembly, and the process's peak resident memory (after the duals, and
 after the Laplacian).  Target: the dual within 10 s CPU on top of the assembly, peak
 within 4 GB.  ``--baseline REV`` first runs the same in a process of its own with
-``mesh_dual`` as git revision ``REV`` had it (``src/cospherical/mesh/dual.py``), so that
+``mesh_dual`` as git revision ``REV`` had it (its ``mesh/dual.py``, or its package ``mesh/dual/``), so that
 before and after are measured in one run, under one load.
 
 ``--poisson``: examples/poisson.py's table on larger trees (needs the ``compare``
@@ -34,24 +34,12 @@ from cospherical.mesh.assembly import assemble
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def dual_function(module: str | None):
-    """``mesh_dual``: ours, or the one of the file ``module`` (a baseline's ``dual.py``)."""
-    if module is None:
-        from cospherical.mesh.dual import mesh_dual
-
-        return mesh_dual
-    spec = importlib.util.spec_from_file_location("cospherical.mesh._baseline_dual", module)
-    baseline = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = baseline  # its dataclasses look their module up
-    spec.loader.exec_module(baseline)
-    return baseline.mesh_dual
-
-
 def measure(args) -> dict:
     """The tree, its assembly, the two duals and the Laplacian, timed; printed, and returned for the record."""
     from bench_mesh import sphere_tree, timer
 
-    mesh_dual = dual_function(args.dual_module)
+    from cospherical.mesh.dual import mesh_dual
+
     clock: dict = {}
     stage = timer(clock)
     lookup, tree = sphere_tree(args, stage)
@@ -74,18 +62,41 @@ def measure(args) -> dict:
 
 
 def baseline(args) -> dict:
-    """:func:`measure` in a process of its own, with ``mesh_dual`` as revision ``args.baseline`` had it."""
-    source = subprocess.run(["git", "show", f"{args.baseline}:src/cospherical/mesh/dual.py"], cwd=ROOT,
-                            check=True, capture_output=True, text=True).stdout
+    """:func:`measure` in a process of its own, with ``mesh_dual`` as revision ``args.baseline`` had it (its
+    ``mesh/dual.py``, or its package ``mesh/dual/``), loaded in place of ours."""
+    listed = subprocess.run(["git", "ls-tree", "-r", "--name-only", args.baseline, "src/cospherical/mesh/dual.py",
+                             "src/cospherical/mesh/dual"], cwd=ROOT, check=True, capture_output=True,
+                            text=True).stdout.split()
     with tempfile.TemporaryDirectory() as folder:
-        module, out = Path(folder) / "dual.py", Path(folder) / "figures.json"
-        module.write_text(source)
+        out = Path(folder) / "figures.json"
+        for name in listed:
+            target = Path(folder) / Path(name).relative_to("src/cospherical/mesh")
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(subprocess.run(["git", "show", f"{args.baseline}:{name}"], cwd=ROOT, check=True,
+                                              capture_output=True).stdout)
+        module = Path(folder) / ("dual.py" if (Path(folder) / "dual.py").exists() else "dual")
         run = subprocess.run([sys.executable, __file__, "--domain", *args.domain, "--levels", str(args.levels),
                               "--radius", args.radius, "--patterns", args.patterns, "--dual-module", str(module),
-                              "--figures", str(out)], check=True, capture_output=True, text=True)
+                              "--figures", str(out)], capture_output=True, text=True)
+        if run.returncode:
+            raise SystemExit(f"baseline {args.baseline}: its process failed:\n{run.stderr}")
         print(f"baseline: mesh_dual of {args.baseline}, in a process of its own")
         print(run.stdout, end="")
         return json.loads(out.read_text())
+
+
+def load_baseline(module: str) -> None:
+    """Load a baseline's ``dual.py`` (or ``dual/`` package) as ``cospherical.mesh.dual``, before anything imports
+    ours: every caller then uses it."""
+    path = Path(module)
+    if path.is_dir():
+        spec = importlib.util.spec_from_file_location("cospherical.mesh.dual", path / "__init__.py",
+                                                      submodule_search_locations=[str(path)])
+    else:
+        spec = importlib.util.spec_from_file_location("cospherical.mesh.dual", path)
+    baseline = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = baseline
+    spec.loader.exec_module(baseline)
 
 
 def big(args, record) -> None:
@@ -110,7 +121,7 @@ def main() -> None:
     tree_arguments(parser)
     parser.add_argument("--poisson", action="store_true", help="the Poisson comparison instead")
     parser.add_argument("--baseline", metavar="REV", help="first time the dual of this git revision, the same way")
-    parser.add_argument("--dual-module", help=argparse.SUPPRESS)  # a baseline's dual.py, in its own process
+    parser.add_argument("--dual-module", help=argparse.SUPPRESS)  # a baseline's dual.py or dual/, in its own process
     parser.add_argument("--figures", help=argparse.SUPPRESS)  # where that process leaves its figures
     parser.add_argument("--uniform", type=int, nargs="*", default=[2, 3, 4, 5, 6])
     parser.add_argument("--graded", type=int, nargs="*", default=[4, 5, 6, 7])
@@ -118,6 +129,7 @@ def main() -> None:
     from record import recorded
 
     if args.dual_module:
+        load_baseline(args.dual_module)
         Path(args.figures).write_text(json.dumps(measure(args)))
         return
     if not args.poisson:

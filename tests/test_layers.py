@@ -41,9 +41,13 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     # The intersection study's statistics importing its run: the circle its layers broke.
     statistics = tmp_path / "cospherical" / "studies" / "intersection" / "statistics.py"
     statistics.write_text(statistics.read_text() + "\nfrom .run import run_intersection  # wrong on purpose\n")
+    # One element's pieces know nothing of the mesh's sums built on them.
+    pieces = tmp_path / "cospherical" / "mesh" / "dual" / "pieces.py"
+    pieces.write_text(pieces.read_text() + "\nfrom .sums import mesh_dual  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
-    assert "Contracts: 0 kept, 5 broken." in result.stdout
+    assert "Contracts: 0 kept, 6 broken." in result.stdout
+    assert "cospherical.mesh.dual.pieces -> cospherical.mesh.dual.sums" in result.stdout
     assert "cospherical.studies.intersection.statistics is not allowed to import" in result.stdout
     assert "cospherical.formats.diff -> cospherical.studies.engine" in result.stdout
     assert "cospherical.core.configuration -> cospherical.core.delaunay" in result.stdout

@@ -282,7 +282,7 @@ def test_elements_whose_exact_hulls_are_too_much_work_are_refused_before_any_geo
     for hours; the work is bounded from the elements alone, before any hull is computed."""
     from cospherical.cli import main
     from cospherical.formats.dual import read_dual
-    from cospherical.mesh import dual as mesh_dual_module
+    from cospherical.mesh.dual import shapes as mesh_dual_module
 
     good = dual_run / "a" / "dual.npz"
     dual = read_dual(good)

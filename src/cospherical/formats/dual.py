@@ -618,7 +618,7 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
     Raises :class:`FormatError` (one line) at the first difference: an edge, a vertex, or a
     float member that is not what its exact value gives.
     """
-    from ..mesh.dual import _scaled, boundary_areas, mesh_dual
+    from ..mesh.dual import as_floats, boundary_areas, mesh_dual
 
     _distinct_vertices(dual.grid_vertices, path)
     shape = _element_shapes(dual, path)
@@ -664,9 +664,9 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
     real = g * (lengths / dual.grid)
     edge_vectors = real[dual.edges[:, 1]] - real[dual.edges[:, 0]]
     length = np.sqrt((edge_vectors ** 2).sum(axis=1))
-    coefficient = _scaled(dual.coefficient_exact, dual.coefficient_denominator, dual.volume_factor)
+    coefficient = as_floats(dual.coefficient_exact, dual.coefficient_denominator, dual.volume_factor)
     expected = {"vertices": real, "length": length, "coefficient": coefficient, "area": coefficient * length,
-                "control_volume": _scaled(dual.volume_exact, dual.volume_denominator, dual.volume_factor),
+                "control_volume": as_floats(dual.volume_exact, dual.volume_denominator, dual.volume_factor),
                 "boundary": again.boundary,
                 "boundary_area": boundary_areas(dual.boundary_area_exact, dual.boundary_area_denominator,
                                                 dual.boundary_factors_squared)}

@@ -1,0 +1,177 @@
+"""The pieces of a mesh, grouped: once per configuration (or element shape), with the members that share them.
+
+The pieces of a leaf's configuration scale with the leaf's size (coefficients as
+``h``, areas as ``h^2``, volumes as ``h^3``), so they are computed once per
+configuration (and remembered across meshes), once per shape of the cells that
+replace leaves, or, for an element list given as such, once per distinct element
+shape up to translation and powers of two.  Each :class:`Group` holds its pieces
+(:class:`ShapePieces`, keyed by local node ids) and the rows of global vertex ids of
+its members with their sizes: what :mod:`~cospherical.mesh.dual.sums` scatters.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from typing import TYPE_CHECKING, NamedTuple, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...core.configuration import Box
+from ...core.geometry import Frame, Rational
+from ...core.polyhedron import measure
+from ...errors import InputError
+from .pieces import ElementPieces, Point, element_pieces
+
+if TYPE_CHECKING:
+    from ..assembly import LocalTessellation, Mesh
+
+__all__ = ["Group", "ShapePieces", "cell_groups", "element_groups", "leaf_groups"]
+
+Squared = tuple[Fraction, Fraction, Fraction]
+
+
+class ShapePieces:
+    """The pieces of one element shape (or one configuration: its elements' pieces summed), keyed by local node ids.
+
+    ``edges`` (k x 2, ``u < v``, sorted) with ``edge_q`` their shares of ``area / length``
+    over ``a*b*c``; ``volume_nodes`` with ``volume_q`` their control-volume shares over
+    ``a*b*c``; ``boundary``: sorted ``((axis, plane value, node), share)`` of the faces
+    that lie in a coordinate plane (see :class:`~cospherical.mesh.dual.pieces.ElementPieces`).
+    """
+
+    __slots__ = ("edges", "edge_q", "volume_nodes", "volume_q", "boundary")
+
+    def __init__(self, pieces_list: Sequence[ElementPieces]) -> None:
+        edges: dict[tuple[int, int], Fraction] = {}
+        volumes: dict[int, Fraction] = {}
+        boundary: dict[tuple[int, Fraction, int], Fraction] = {}
+        for pieces in pieces_list:
+            for key, q in pieces.edges.items():
+                edges[key] = edges.get(key, Fraction(0)) + q
+            for node, q in pieces.volumes.items():
+                volumes[node] = volumes.get(node, Fraction(0)) + q
+            for (axis, value), shares in pieces.boundary.items():
+                for node, q in shares.items():
+                    boundary[axis, value, node] = boundary.get((axis, value, node), Fraction(0)) + q
+        keys = sorted(edges)
+        self.edges: NDArray[np.int64] = np.array(keys, dtype=np.int64).reshape(-1, 2)
+        self.edge_q: list[Fraction] = [edges[k] for k in keys]
+        nodes = sorted(volumes)
+        self.volume_nodes: NDArray[np.int64] = np.array(nodes, dtype=np.int64)
+        self.volume_q: list[Fraction] = [volumes[n] for n in nodes]
+        self.boundary: list[tuple[tuple[int, Fraction, int], Fraction]] = sorted(boundary.items())
+
+
+class Group(NamedTuple):
+    """Members sharing one :class:`ShapePieces`: member ``i``'s node ``n`` is global vertex
+    ``source[rows[i], n]``, and its pieces are scaled by ``sizes[i]`` (a power of two, grid units)."""
+
+    pieces: ShapePieces
+    source: NDArray[np.integer]
+    rows: NDArray[np.int64]
+    sizes: NDArray[np.int64]
+
+
+def _real_centers(low: NDArray[np.int64], center: Sequence[Rational], size: NDArray[np.int64], lengths: NDArray[np.float64],
+                  grid: int) -> NDArray[np.float64]:
+    """Circumcenters as real coordinates: ``low`` corners (grid units) plus ``center`` (unit offsets) times ``size``."""
+    result: NDArray[np.float64] = (low + np.array([float(x) for x in center]) * size) * (lengths / grid)
+    return result
+
+
+def leaf_groups(mesh: Mesh, squared: Squared) -> tuple[list[Group], NDArray[np.float64]]:
+    """Per configuration: its pieces, the slots and its leaves (their rows of global vertex ids), their sizes;
+    and the real circumcenter of every element (the cells' rows are left for :func:`cell_groups`)."""
+    sizes = mesh.leaf_size()
+    lengths = np.array(mesh.box.to_float())
+    origin = mesh.tree.positions.astype(np.int64) * sizes[:, None]
+    centers = np.zeros((len(mesh), 3))
+    groups = []
+    for _, tessellation, leaves in mesh.groups():
+        first, low, size = mesh.element_offsets[leaves], origin[leaves], sizes[leaves, None]
+        for j, element in enumerate(tessellation.elements):
+            if element.center is None:
+                raise InputError(f"configuration {tessellation.code}: element {j} is not co-spherical: it has no dual")
+            centers[first + j] = _real_centers(low, element.center, size, lengths, mesh.grid)
+        groups.append(Group(_tessellation_pieces(tessellation, squared), mesh.slots, leaves, sizes[leaves]))
+    return groups, centers
+
+
+def cell_groups(mesh: Mesh, squared: Squared, centers: NDArray[np.float64]) -> list[Group]:
+    """Per shape of the cells that replace leaves: its pieces (grid units, scale 1), its rows of the cells' vertex
+    ids; fills the cells' rows of ``centers``."""
+    cells = mesh.cells
+    if cells is None:
+        return []
+    lengths = np.array(mesh.box.to_float())
+    groups = []
+    for s, shape in enumerate(cells.shapes):
+        rows = np.flatnonzero(cells.shape == s)
+        points: dict[int, Point] = {n: (Fraction(o[0]), Fraction(o[1]), Fraction(o[2]))
+                                    for n, o in enumerate(shape.offsets)}
+        pieces = ShapePieces([element_pieces(points, shape.faces, shape.center, squared)])
+        groups.append(Group(pieces, cells.nodes, rows, np.ones(len(rows), dtype=np.int64)))
+        centers[mesh.leaf_elements + rows] = _real_centers(cells.anchor[rows], shape.center, np.ones(1, np.int64),
+                                                           lengths, mesh.grid)
+    return groups
+
+
+_REMEMBERED: dict[tuple[str, Squared, tuple[tuple[int, ...], ...]], ShapePieces] = {}
+
+
+def _tessellation_pieces(tessellation: LocalTessellation, squared: Squared) -> ShapePieces:
+    """A configuration's pieces, remembered by its code, box and element node lists (meshes share them)."""
+    key = (tessellation.code, squared, tuple(e.nodes for e in tessellation.elements))
+    shape = _REMEMBERED.get(key)
+    if shape is None:
+        points = tessellation.configuration.nodes()
+        shape = _REMEMBERED[key] = ShapePieces([
+            element_pieces({n: points[n] for n in e.nodes}, e.faces, e.center, squared)
+            for e in tessellation.elements if e.center is not None])
+    return shape
+
+
+class _ElementShape(NamedTuple):
+    pieces: ShapePieces
+    ids: list[NDArray[np.int64]]
+    scales: list[int]
+    center: Point
+
+
+def element_groups(box: Box, grid: int, vertices: NDArray[np.integer], squared: Squared,
+                   conn: NDArray[np.integer], element_sizes: NDArray[np.integer]
+                   ) -> tuple[list[Group], NDArray[np.float64]]:
+    """Per distinct element shape (up to translation and powers of two): its pieces, vertex ids, scalings;
+    and the real circumcenter of every element."""
+    verts = np.asarray(vertices, dtype=np.int64)
+    lengths = np.array(box.to_float())
+    centers = np.zeros((len(conn), 3))
+    by_shape: dict[tuple[tuple[int, ...], ...], _ElementShape] = {}
+    for e in range(len(conn)):
+        ids = conn[e, :int(element_sizes[e])].astype(np.int64)
+        coords = verts[ids]
+        low = coords.min(axis=0)
+        rel = coords - low
+        scale = math.gcd(*(int(x) for x in rel.reshape(-1)))
+        scale = scale & -scale  # the largest power of two dividing every offset
+        key: tuple[tuple[int, ...], ...] = tuple(map(tuple, (rel // scale).tolist()))
+        entry = by_shape.get(key)
+        if entry is None:
+            points: dict[int, Point] = {n: (Fraction(int(p[0])), Fraction(int(p[1])), Fraction(int(p[2])))
+                                        for n, p in enumerate(key)}
+            frame = Frame.build(points, squared)
+            element = measure(frame, range(len(key)))
+            if not element.cycles:
+                raise InputError(f"element {e} is flat: it has no dual")
+            if element.sphere is None or element.center is None:
+                raise InputError(f"element {e} is not co-spherical: it has no dual")
+            entry = by_shape[key] = _ElementShape(
+                ShapePieces([element_pieces(points, element.cycles, element.center, squared)]), [], [], element.center)
+        entry.ids.append(ids)
+        entry.scales.append(scale)
+        centers[e] = _real_centers(low, entry.center, np.array(scale), lengths, grid)
+    groups = [Group(shape.pieces, np.array(shape.ids, dtype=np.int64), np.arange(len(shape.ids)),
+                    np.array(shape.scales, dtype=np.int64)) for shape in by_shape.values()]
+    return groups, centers

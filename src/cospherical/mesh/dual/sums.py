@@ -1,0 +1,212 @@
+"""The mesh's sums: its edges and their coefficients, the control volumes and the boundary areas, exactly.
+
+Every group's pieces (:mod:`~cospherical.mesh.dual.shapes`) are put over common
+denominators once; each member then adds its pieces, times its size's power, to the
+global arrays by integer array indexing: integer sums, exact in any order.  Floats
+appear only in the ``float`` outputs (:func:`~cospherical.mesh.dual.arrays.as_floats`).
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from typing import Any, Iterator, Protocol, Sequence
+
+import numpy as np
+from numpy.typing import DTypeLike, NDArray
+
+from ...core.configuration import Box
+from ..assembly import Mesh
+from .arrays import Dual, ExactArray, as_floats, boundary_areas
+from .shapes import Group, cell_groups, element_groups, leaf_groups
+
+__all__ = ["GridVertices", "PACKED_BITS", "mesh_dual"]
+
+_CHUNK = 1 << 21  # instances per block of work: its temporaries stay small and the allocator reuses them
+PACKED_BITS = 63  # an edge instance's key and payload share one int64 while they fit in these bits
+
+
+class GridVertices(Protocol):
+    """What :func:`mesh_dual` reads of a mesh when it is given the elements: its box, grid and integer vertices."""
+
+    @property
+    def box(self) -> Box: ...
+
+    @property
+    def grid(self) -> int: ...
+
+    @property
+    def vertices(self) -> NDArray[Any]: ...
+
+
+def _chunks(count: int, width: int) -> Iterator[slice]:
+    """Slices of ``range(count)`` of about ``_CHUNK`` / ``width`` rows each."""
+    step = max(1, _CHUNK // max(width, 1))
+    for start in range(0, count, step):
+        yield slice(start, min(start + step, count))
+
+
+def _lcm_denominator(values: Sequence[Fraction]) -> int:
+    return math.lcm(1, *(v.denominator for v in values))
+
+
+def _integers(values: Sequence[Fraction], denominator: int) -> NDArray[np.object_]:
+    return np.array([int(v * denominator) for v in values], dtype=object)
+
+
+def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], NDArray[np.integer]] | None = None
+              ) -> Dual:
+    """The exact dual of a mesh.
+
+    By default the elements are the elements of the mesh's leaf tessellations, and their pieces
+    are computed once per configuration, and the cells that replace leaves (global
+    Delaunay mode) once per shape.  ``elements`` (``(connectivity, sizes)`` as
+    :meth:`Mesh.connectivity` gives them, global vertex ids) takes any element list
+    on the mesh's vertices instead, for example cells that span leaves: each element
+    is then measured from its vertices (faces: the hull of its nodes; centre: the
+    sphere through them), once per distinct shape up to translation and scaling by
+    powers of two.  Without ``elements`` the mesh must be a
+    :class:`~cospherical.mesh.assembly.Mesh`.
+    """
+    box = mesh.box
+    grid = int(mesh.grid)
+    squared = (Fraction(box.squared[0]), Fraction(box.squared[1]), Fraction(box.squared[2]))
+    factor_squared = squared[0] * squared[1] * squared[2]
+    verts = np.asarray(mesh.vertices, dtype=np.int64)
+    n_vertices = len(verts)
+    # per group: its pieces, the array and rows that give its members' global vertex ids, their sizes
+    if elements is None:
+        if not isinstance(mesh, Mesh):
+            raise TypeError("mesh_dual: give the elements of a mesh that is not an assembled Mesh")
+        groups, centers = leaf_groups(mesh, squared)
+        groups += cell_groups(mesh, squared, centers)
+        elements = mesh.connectivity()
+    else:
+        groups, centers = element_groups(box, grid, verts, squared, *elements)
+    cden = math.lcm(1, *(_lcm_denominator(group.pieces.edge_q) for group in groups))
+    vden = math.lcm(1, *(_lcm_denominator(group.pieces.volume_q) for group in groups))
+    bden = math.lcm(1, *(_lcm_denominator([q for _, q in group.pieces.boundary]) for group in groups))
+    max_size = max((int(group.sizes.max()) for group in groups if len(group.sizes)), default=1)
+    # int64 sums while every product and sum is bounded below 2**62: the largest numerator (not just the
+    # denominator: on tiny or huge domains the pieces over a*b*c are far from 1) times the size scaling,
+    # times a bound on the pieces met by one edge or vertex
+    largest_coefficient = max((abs(int(q * cden)) for group in groups for q in group.pieces.edge_q), default=0)
+    largest_volume = max((abs(int(q * vden)) for group in groups for q in group.pieces.volume_q), default=0)
+    largest_boundary = max((abs(int(q * bden)) for group in groups for _, q in group.pieces.boundary), default=0)
+    wide = largest_volume * max_size ** 3 * 4096 >= 2**62 or largest_coefficient * max_size * 4096 >= 2**62 or \
+        largest_boundary * max_size ** 2 * 4096 >= 2**62
+    dtype: DTypeLike = object if wide else np.int64
+    edges, coefficient_exact = _edge_sums(groups, n_vertices, cden, dtype)
+    boundary = np.any((verts == 0) | (verts == grid), axis=1)
+    volume_exact: ExactArray = np.zeros(n_vertices, dtype=dtype)
+    boundary_exact: ExactArray = np.zeros((n_vertices, 3), dtype=dtype)  # per axis: the area in the sides normal to it
+    for shape, source, rows, sizes in groups:
+        q = _integers(shape.volume_q, vden).astype(dtype)
+        touching_parts = []  # the members with a vertex on the domain's boundary: only they have boundary areas
+        for part in _chunks(len(rows), len(shape.volume_nodes)):
+            ids = source[rows[part, None], shape.volume_nodes]
+            # integer sums, unbuffered: exact in any order
+            np.add.at(volume_exact, ids, sizes[part, None].astype(dtype) ** 3 * q)
+            if shape.boundary:
+                touching_parts.append(part.start + np.flatnonzero(boundary[ids].any(axis=1)))
+        touching = np.concatenate(touching_parts) if touching_parts else np.zeros(0, dtype=np.int64)
+        for (axis, _, node), share in shape.boundary:
+            ids = source[rows[touching], node].astype(np.int64)
+            on = (verts[ids, axis] == 0) | (verts[ids, axis] == grid)
+            # the face lies in the vertex's plane: on the boundary where that plane is a side of the domain
+            np.add.at(boundary_exact[:, axis], ids[on], sizes[touching][on].astype(dtype) ** 2 * int(share * bden))
+    lengths = np.array(box.to_float())
+    real = verts * (lengths / grid)
+    factor = math.sqrt(factor_squared)
+    coefficient = as_floats(coefficient_exact, cden * grid, factor)
+    length = np.empty(len(edges))
+    for part in _chunks(len(edges), 1):
+        edge_vectors = real[edges[part, 1]] - real[edges[part, 0]]
+        length[part] = np.sqrt((edge_vectors ** 2).sum(axis=1))
+    control_volume = as_floats(volume_exact, vden * grid ** 3, factor)
+    plane_squared = (squared[1] * squared[2], squared[2] * squared[0], squared[0] * squared[1])
+    return Dual(box=box, grid=grid, grid_vertices=verts, vertices=real, edges=edges, length=length,
+                area=coefficient * length, coefficient=coefficient, control_volume=control_volume, boundary=boundary,
+                boundary_area=boundary_areas(boundary_exact, bden * grid ** 2, plane_squared),
+                coefficient_exact=coefficient_exact, coefficient_denominator=cden * grid, volume_exact=volume_exact,
+                volume_denominator=vden * grid ** 3, volume_factor=factor, volume_factor_squared=factor_squared,
+                boundary_area_exact=boundary_exact, boundary_area_denominator=bden * grid ** 2,
+                boundary_factors_squared=plane_squared, element_circumcenter=centers,
+                element_nodes=elements[0], element_sizes=elements[1])
+
+
+def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DTypeLike
+               ) -> tuple[NDArray[np.int64], ExactArray]:
+    """The mesh's edges (m x 2, ``i < j``, sorted) and their summed coefficient numerators.
+
+    Every edge instance (one edge of one group member) becomes an int64 key
+    ``i * 2**v + j`` and a payload: its piece's index into the groups' numerators and
+    its member's size as a power of two (coefficients scale with the size).  While key
+    and payload fit one int64 together they are sorted as one array (a plain sort,
+    several times faster than an argsort, which needs no second array to follow it);
+    else the keys are argsorted and the payloads follow.  Equal keys are then runs,
+    summed in integers: exact in any order.
+    """
+    table: list[int] = []
+    offsets: list[int] = []
+    total, max_shift = 0, 0
+    for shape, _, rows, sizes in groups:
+        offsets.append(len(table))
+        table.extend(int(q * cden) for q in shape.edge_q)
+        total += len(rows) * len(shape.edges)
+        if len(sizes):
+            max_shift = max(max_shift, int(sizes.max()).bit_length() - 1)
+    shift_bits = max_shift.bit_length()
+    payload_bits = (max(len(table) - 1, 0)).bit_length() + shift_bits
+    vertex_bits = max(n_vertices - 1, 1).bit_length()
+    packed = 2 * vertex_bits + payload_bits <= PACKED_BITS
+    keys = np.empty(total, dtype=np.int64)
+    payloads = keys if packed else np.empty(total, dtype=np.int64)
+    at = 0
+    for (shape, source, rows, sizes), offset in zip(groups, offsets):
+        count = len(shape.edges)
+        if not count:
+            continue
+        shifts = np.log2(sizes).astype(np.int64)  # sizes are powers of two: exact
+        pieces = (offset + np.arange(count, dtype=np.int64)) << shift_bits
+        for part in _chunks(len(rows), count):
+            ids = rows[part, None]
+            a = source[ids, shape.edges[:, 0]].astype(np.int64)
+            b = source[ids, shape.edges[:, 1]].astype(np.int64)
+            key = (np.minimum(a, b) << vertex_bits) | np.maximum(a, b)
+            payload = pieces | shifts[part, None]
+            end = at + key.size
+            if packed:
+                keys[at:end] = ((key << payload_bits) | payload).reshape(-1)
+            else:
+                keys[at:end], payloads[at:end] = key.reshape(-1), payload.reshape(-1)
+            at = end
+    key_shift = payload_bits if packed else 0
+    if packed:
+        keys.sort()
+    else:
+        order = np.argsort(keys)
+        keys, payloads = keys[order], payloads[order]
+        del order
+    starts = np.ones(total, dtype=bool)
+    for part in _chunks(total - 1, 1):
+        starts[part.start + 1:part.stop + 1] = (keys[part.start + 1:part.stop + 1] >> key_shift) != (
+            keys[part] >> key_shift)
+    first = np.flatnonzero(starts)
+    del starts
+    unique = np.right_shift(keys[first], key_shift)
+    edges = np.empty((len(first), 2), dtype=np.int64)
+    np.right_shift(unique, vertex_bits, out=edges[:, 0])
+    np.bitwise_and(unique, (1 << vertex_bits) - 1, out=edges[:, 1])
+    del unique
+    numerators = np.array(table, dtype=dtype)
+    powers = np.array([1 << k for k in range(max_shift + 1)], dtype=dtype)
+    sums: ExactArray = np.empty(len(first), dtype=dtype)
+    # blocks of whole runs, so that each run is summed within one block
+    bounds = np.unique(np.r_[np.searchsorted(first, np.arange(0, total, _CHUNK)), len(first)])
+    for lo, hi in zip(bounds[:-1], bounds[1:]):
+        start, stop = first[lo], first[hi] if hi < len(first) else total
+        payload = payloads[start:stop] & ((1 << payload_bits) - 1)
+        parts = numerators[payload >> shift_bits] * powers[payload & ((1 << shift_bits) - 1)]
+        sums[lo:hi] = np.add.reduceat(parts, first[lo:hi] - start)
+    return edges, sums

@@ -1,0 +1,32 @@
+"""The pieces grouped per configuration or element shape (cospherical.mesh.dual.shapes): every path, one dual."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+
+from cospherical.core.configuration import Box
+from cospherical.mesh.assembly import assemble
+from cospherical.mesh.dual import mesh_dual
+from cospherical.mesh.octree import build_octree, parse_shape
+
+from ..test_dual import CACHES
+
+
+def test_element_list_path_equals_the_configuration_path():
+    """The connectivity path (any element list) gives the leaf path's numbers, exactly."""
+    box = Box.parse(["1", "2", "4"])
+    mesh = assemble(build_octree(box, 2, [parse_shape("point:1/3,1/5,1/7")]),
+                    cache=CACHES.setdefault(box.texts, {}))
+    fast, generic = mesh_dual(mesh), mesh_dual(mesh, mesh.connectivity())
+    assert np.array_equal(fast.edges, generic.edges)
+    assert all(Fraction(int(x), fast.coefficient_denominator) == Fraction(int(y), generic.coefficient_denominator)
+               for x, y in zip(fast.coefficient_exact, generic.coefficient_exact))
+    assert all(Fraction(int(x), fast.volume_denominator) == Fraction(int(y), generic.volume_denominator)
+               for x, y in zip(fast.volume_exact, generic.volume_exact))
+    assert all(Fraction(int(x), fast.boundary_area_denominator) == Fraction(int(y), generic.boundary_area_denominator)
+               for x, y in zip(fast.boundary_area_exact.reshape(-1), generic.boundary_area_exact.reshape(-1)))
+    assert np.array_equal(fast.element_circumcenter, generic.element_circumcenter)
+
+
