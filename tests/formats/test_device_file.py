@@ -66,6 +66,10 @@ def test_a_device_does_not_take_a_tree_of_its_own(tmp_path, capsys):
     # the file says its balance: --balance was ignored without a word
     assert main(["mesh", "--device", str(EXAMPLES / "pn-diode.yaml"), "--balance", "edge"]) == 2
     assert "--balance" in capsys.readouterr().err
+    # a device is meshed in one process (the devices page says why)
+    assert main(["mesh", "--device", str(EXAMPLES / "pn-diode.yaml"), "--partitions", "2"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "--partitions" in err and "one process" in err, err
 
 
 def test_numbers_stay_exact_and_names_are_data():

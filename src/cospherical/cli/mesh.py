@@ -168,9 +168,12 @@ def run(args) -> int:
         from ..formats.device_file import read_device
 
         for option, value in (("--refine", args.refine), ("--leaves", args.leaves), ("--levels", args.levels),
-                              ("--balance", args.balance), ("--partitions", args.partitions)):
+                              ("--balance", args.balance)):
             if value is not None:
                 raise InputError(f"{option}: a device file gives its own tree (refine and levels): not with --device")
+        if args.partitions is not None:
+            raise InputError("--partitions: a device is meshed in one process (each region's Delaunay subdivision, "
+                             "its contacts, interfaces and report need the whole region): not with --device")
         args.device = read_device(args.device)  # before the output folder: a bad file writes nothing
     elif args.refine is None and args.leaves is None:
         raise InputError("--domain needs the tree: --refine SHAPE (with --levels L) or --leaves FILE")
