@@ -170,33 +170,6 @@ def test_symmetry_groups_and_orbits():
                 sorted(e.polyhedron.faces for e in theirs.elements)
 
 
-SQUARE = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
-PYRAMID_EDGES = [(0, 1), (1, 2), (2, 3), (3, 0), (0, 4), (1, 4), (2, 4), (3, 4)]
-PYRAMID_FACES = [(0, 1, 2, 3), (0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)]
-
-
-@pytest.mark.parametrize("vertices, edges, faces, message", [
-    (SQUARE + [(0, 0, 0)], PYRAMID_EDGES, PYRAMID_FACES, "corners 0 and 4 are the same point"),
-    (SQUARE + [(1, 1, 0)], PYRAMID_EDGES, PYRAMID_FACES, "same point"),
-    (SQUARE + [(2, 2, 0)], PYRAMID_EDGES, PYRAMID_FACES, "coplanar"),
-    (SQUARE + [("1/2", "1/2", "1/2")], PYRAMID_EDGES, [(0, 1, 3, 2), *PYRAMID_FACES[1:]], "not a convex polygon"),
-    ([(0, 0, 0), (1, 0, 0), (1, 1, "1/2"), (0, 1, 0), ("1/2", "1/2", 1)], PYRAMID_EDGES, PYRAMID_FACES,
-     "not on one plane"),
-    (SQUARE + [("1/2", "1/2", 1), ("1/2", "1/2", "1/4")], PYRAMID_EDGES, PYRAMID_FACES, "corner 5 is on no face"),
-    (SQUARE + [("1/2", "1/2", 1)], PYRAMID_EDGES[:-1], PYRAMID_FACES, "is not among the edges"),
-    (SQUARE + [("1/2", "1/2", 1)], PYRAMID_EDGES + [(0, 2)], PYRAMID_FACES, "not a side of any face"),
-    (SQUARE + [("1/2", "1/2", 1)], PYRAMID_EDGES, PYRAMID_FACES[:-1], "do not close the surface"),
-    ([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), ("1/6", "1/6", "1/6")],  # a tetrahedron with a dent
-     [(0, 1), (0, 2), (0, 3), (1, 2), (2, 3), (3, 1), (1, 4), (2, 4), (3, 4)],
-     [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 4), (2, 3, 4), (3, 1, 4)], "not convex"),
-    (SQUARE + [("1/2", "1/2", 1), ("1/2", 0, 0)], PYRAMID_EDGES, PYRAMID_FACES, "corner 5 lies in the plane"),
-    (SQUARE + [(0.5, 0.5, 1)], PYRAMID_EDGES, PYRAMID_FACES, "not a float"),
-])
-def test_bad_vertices_are_refused(vertices, edges, faces, message):
-    with pytest.raises(InputError, match=message):
-        Shape.from_vertices(vertices, edges, faces)
-
-
 @pytest.mark.oracle_qhull
 def test_general_quadrilateral_face_point():
     # A trapezoid face: the face point is where the two cut lines cross, not the corners' mean.

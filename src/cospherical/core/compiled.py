@@ -27,7 +27,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from ..caches import cached
-from .shapes import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
+from .box import CORNERS, EDGES, FACE_EDGES, FACES, edge_axis
 
 __all__ = ["buffers", "cube_batch", "cube_tables", "fits", "orbit_keys", "walk"]
 

@@ -1,10 +1,10 @@
 """1-irregular configurations of a base element: its shape, Steiner points, face and body points.
 
 One class for every base element, the cuboid one standard shape among prism,
-pyramid and tetrahedron (:mod:`cospherical.core.shapes`, which also holds the
-node numbering: for the cuboid, corners 0-7 in VTK hexahedron order, the
-Steiner point on edge k is node 8+k, face points are nodes 20-25 and the body
-point is node 26, in VTK triquadratic hexahedron order).  Positions are kept in
+pyramid and tetrahedron (:mod:`cospherical.core.shapes`; the box and the node
+numbering are :mod:`cospherical.core.box`'s: for the cuboid, corners 0-7 in VTK
+hexahedron order, the Steiner point on edge k is node 8+k, face points are nodes
+20-25 and the body point is node 26, as that module draws them).  Positions are kept in
 *unit* coordinates (s, t, u), exact rationals; the real point is (s*a, t*b, u*c).
 """
 
@@ -20,7 +20,8 @@ from ..errors import InputError, shown
 from .codes import digit_parameters, edge_code_pattern, parameter_digits, parse_point_suffix, point_suffix
 from .exact import parse_rational
 from .geometry import Rational
-from .shapes import Box, Point, Shape, standard_shape
+from .box import Box, Point
+from .shapes import Shape, standard_shape
 
 # Box: the type of a configuration's box (Configuration.box), public here with the class that takes it
 __all__ = ["Box", "Configuration", "steiner_parameters"]

@@ -14,8 +14,8 @@ everything metric goes through the box's squared lengths
 Node numbering: the corners in the order given (VTK order for the standard
 shapes), then one node per edge (edge k carries node ``len(corners) + k``), then
 one node per quadrilateral face, in face order, then, for a parallelepiped, the
-body point.  For the cuboid this is VTK's triquadratic hexahedron: corners 0-7,
-edge points 8-19, face points 20-25, body point 26.  A Steiner point on edge k
+body point.  For the cuboid: corners 0-7, edge points 8-19, face points 20-25,
+body point 26 (:mod:`cospherical.core.box` draws them).  A Steiner point on edge k
 sits at parameter t in (0, 1) from the edge's *lower end* (its lexicographically
 smallest corner in unit coordinates; for the axis-parallel edges of a cuboid
 this is the lower-coordinate end).  A quadrilateral face may carry a point when
@@ -24,6 +24,9 @@ the same direction); the point is where the two cut lines cross.  Triangles
 carry nothing: a refined neighbour puts nothing there.  The body point of a
 parallelepiped needs a point on all six faces (the element refined into eight).
 
+The box and the cuboid's numbering are :mod:`cospherical.core.box`'s (importable
+from here too), the exact checks of corners, edges and faces
+:func:`cospherical.core.convex.convex_polyhedron`'s.
 Their configurations are :class:`cospherical.core.configuration.Configuration`,
 their tessellation :func:`cospherical.core.tessellation.tessellate`, their
 isometries :func:`cospherical.core.symmetry.shape_symmetries`.
@@ -48,83 +51,19 @@ from typing import Any, Iterable, Sequence
 
 from ..caches import cached
 from ..errors import InputError
+from .box import CORNERS, EDGES, FACE_EDGES, FACES, Box, Point, edge_axis
 from .codes import mask_codes
-from .exact import Length, parse_rational
-from .geometry import (Rational, area_vector, collinear, cross, dot, plane_normal, six_volume, sub,
-                       tetra_six_volume)
+from .convex import Plane, convex_polyhedron
+from .geometry import Rational, dot, six_volume, sub
 
+# Box, the cuboid's numbering and Point live in core.box, mask_codes in core.codes: importable from here too
 __all__ = ["Box", "CORNERS", "EDGES", "ELEMENTS", "FACES", "FACE_EDGES", "Point", "STANDARD_SHAPES", "Shape",
            "edge_axis", "mask_codes", "standard_shape"]
-
-Point = tuple[Rational, Rational, Rational]
-"""Exact unit coordinates (s, t, u): integers where they are whole, Fractions elsewhere."""
-
-
-@dataclass(frozen=True)
-class Box:
-    """Edge lengths a, b, c of the box that scales a base element, exact.
-
-    Examples
-    --------
-    >>> Box.parse(["1", "sqrt(2)", "1.4142"]).texts
-    ('1', 'sqrt(2)', '1.4142')
-    """
-
-    a: Length
-    b: Length
-    c: Length
-
-    @classmethod
-    def parse(cls, lengths: Iterable[str | int | Fraction]) -> "Box":
-        values = list(lengths)
-        if len(values) != 3:
-            raise InputError(f"box {values!r}: needs exactly three lengths A B C")
-        return cls(*(Length.parse(v) for v in values))
-
-    @property
-    def lengths(self) -> tuple[Length, Length, Length]:
-        return (self.a, self.b, self.c)
-
-    @property
-    def squared(self) -> tuple[Fraction, Fraction, Fraction]:
-        return (self.a.squared, self.b.squared, self.c.squared)
-
-    @property
-    def texts(self) -> tuple[str, str, str]:
-        return (self.a.text, self.b.text, self.c.text)
-
-    def to_float(self) -> tuple[float, float, float]:
-        return (float(self.a), float(self.b), float(self.c))
-
-
-# The cuboid's numbering (VTK hexahedron), shared by every part and file format.
-CORNERS: tuple[tuple[int, int, int], ...] = (
-    (0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0),
-    (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1),
-)
-EDGES: tuple[tuple[int, int], ...] = (
-    (0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6),
-    (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7),
-)
-# Face k carries node 20+k (VTK triquadratic hexahedron order).
-FACES: tuple[tuple[int, int, int, int], ...] = (
-    (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7), (0, 1, 2, 3), (4, 5, 6, 7),
-)
-
-
-def edge_axis(edge: int) -> int:
-    """The coordinate axis (0, 1, 2) along which the cuboid's edge ``edge`` runs."""
-    p, q = (CORNERS[i] for i in EDGES[edge])
-    return next(axis for axis in range(3) if p[axis] != q[axis])
-
-
-FACE_EDGES = tuple(tuple(k for k, (p, q) in enumerate(EDGES) if {p, q} <= set(face)) for face in FACES)
 
 _H = Fraction(1, 2)
 # The standard shapes, corners in VTK order (hexahedron, wedge, pyramid, tetra), edges in the
 # order of the VTK quadratic cells, faces as VTK lists them (oriented on building).  The
-# cuboid's numbering is the one of :mod:`cospherical.core.configuration` (face f carries
-# node 20 + f: VTK's triquadratic hexahedron).
+# cuboid's numbering is :mod:`cospherical.core.box`'s (face f carries node 20 + f).
 STANDARD_SHAPES: dict[str, tuple[tuple[tuple[Rational, ...], ...], tuple[tuple[int, int], ...],
                                   tuple[tuple[int, ...], ...]]] = {
     "cuboid": (CORNERS, EDGES, FACES),
@@ -145,24 +84,6 @@ STANDARD_SHAPES: dict[str, tuple[tuple[tuple[Rational, ...], ...], tuple[tuple[i
     ),
 }
 ELEMENTS = tuple(STANDARD_SHAPES)
-# A base element of a mesh has a handful of corners; its tessellation's exact tests grow
-# with their number, so a shape file of thousands is refused before any is read.
-_MAX_CORNERS = 64
-
-
-def _point(value: Any, where: str) -> Point:
-    if isinstance(value, str) or not hasattr(value, "__len__") or len(value) != 3:
-        raise InputError(f"{where} {value!r}: needs three coordinates")
-    x, y, z = (parse_rational(x, where) for x in value)
-    return (x, y, z)
-
-
-def _index(value: object, count: int, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < count:
-        raise InputError(f"{where}: {value!r} is not a corner number 0..{count - 1}")
-    return value
-
-
 @dataclass(frozen=True)
 class Shape:
     """A convex base element: exact corners, edges and faces, scaled by a box.
@@ -179,7 +100,7 @@ class Shape:
     corners: tuple[Point, ...]
     edges: tuple[tuple[int, int], ...]
     faces: tuple[tuple[int, ...], ...]
-    planes: tuple[tuple[tuple[Fraction, Fraction, Fraction], Fraction], ...] = field(repr=False)
+    planes: tuple[Plane, ...] = field(repr=False)
 
     @classmethod
     def from_vertices(cls, vertices: Sequence[Any], edges: Sequence[Any], faces: Sequence[Any],
@@ -207,68 +128,7 @@ class Shape:
         cospherical.errors.InputError: element: the corners are coplanar: no solid
         """
         box = box if isinstance(box, Box) else Box.parse(box)
-        if not all(isinstance(x, Sequence) and not isinstance(x, str) for x in (vertices, edges, faces)):
-            raise InputError(f"{name}: corners, edges and faces must be lists")
-        if not 4 <= len(vertices) <= _MAX_CORNERS:
-            raise InputError(f"{name}: needs 4 to {_MAX_CORNERS} corners, got {len(vertices)}")
-        # a convex polyhedron has at most 2n - 4 faces and 3n - 6 edges: longer lists are refused unread
-        if len(faces) > 2 * len(vertices) or len(edges) > 3 * len(vertices):
-            raise InputError(f"{name}: {len(faces)} faces and {len(edges)} edges: more than {len(vertices)} "
-                             "corners of a convex polyhedron can have")
-        corners = tuple(_point(v, f"corner {i}") for i, v in enumerate(vertices))
-        n = len(corners)
-        first: dict[Point, int] = {}
-        for j, corner in enumerate(corners):
-            i = first.setdefault(corner, j)
-            if i != j:
-                raise InputError(f"{name}: corners {i} and {j} are the same point")
-        # Coplanar in one pass, exactly: a corner off the line of corners 0 and 1 spans their
-        # plane (none: all on one line); the corners are a solid iff one is off that plane.
-        p, q = corners[0], corners[1]
-        r = next((c for c in corners[2:] if not collinear(p, q, c)), None)
-        if r is None or all(tetra_six_volume(p, q, r, c) == 0 for c in corners[2:]):
-            raise InputError(f"{name}: the corners are coplanar: no solid")
-        cycles = []
-        for f, face in enumerate(faces):
-            if isinstance(face, str) or not hasattr(face, "__len__") or len(face) < 3:
-                raise InputError(f"{name}: face {f} {face!r}: needs at least three corners")
-            cycle = tuple(_index(v, n, f"{name}: face {f}") for v in face)
-            if len(set(cycle)) != len(cycle):
-                raise InputError(f"{name}: face {f} {list(cycle)}: a corner appears twice")
-            cycles.append(cycle)
-        oriented, planes = [], []
-        for f, cycle in enumerate(cycles):
-            cycle, plane = _oriented_face(corners, cycle, f, name)
-            oriented.append(cycle)
-            planes.append(plane)
-        sides: dict[frozenset[int], list[int]] = {}
-        for f, cycle in enumerate(oriented):
-            for a, b in zip(cycle, cycle[1:] + cycle[:1]):
-                sides.setdefault(frozenset((a, b)), []).append(f)
-        bad = next((sorted(e) for e, fs in sides.items() if len(fs) != 2), None)
-        if bad is not None:
-            raise InputError(f"{name}: edge {bad[0]}-{bad[1]} belongs to {len(sides[frozenset(bad)])} faces: "
-                             "the faces do not close the surface")
-        missing = [i for i in range(n) if not any(i in c for c in oriented)]
-        if missing:
-            raise InputError(f"{name}: corner {missing[0]} is on no face")
-        pairs = []
-        for k, edge in enumerate(edges):
-            if isinstance(edge, str) or not hasattr(edge, "__len__") or len(edge) != 2:
-                raise InputError(f"{name}: edge {k} {edge!r}: needs two corners")
-            pair = (_index(edge[0], n, f"{name}: edge {k}"), _index(edge[1], n, f"{name}: edge {k}"))
-            if frozenset(pair) not in sides:
-                raise InputError(f"{name}: edge {k} {list(pair)} is not a side of any face")
-            pairs.append(pair)
-        if len({frozenset(p) for p in pairs}) != len(pairs):
-            raise InputError(f"{name}: an edge is given twice")
-        if len(pairs) != len(sides):
-            unlisted = sorted(sorted(e) for e in sides if e not in {frozenset(p) for p in pairs})[0]
-            raise InputError(f"{name}: the side {unlisted[0]}-{unlisted[1]} of a face is not among the edges")
-        if n - len(pairs) + len(oriented) != 2:
-            raise InputError(f"{name}: V - E + F = {n - len(pairs) + len(oriented)}, not 2: "
-                             "not one closed convex surface")
-        return cls(name, box, corners, tuple(pairs), tuple(oriented), tuple(planes))
+        return cls(name, box, *convex_polyhedron(vertices, edges, faces, name))
 
     def __hash__(self) -> int:
         # Hashed once: a shape keys the caches of its symmetries and of its configurations' maps.
@@ -446,44 +306,6 @@ class Shape:
             sides[f] = tuple((self.edge_index(a, b), self.edge_start(self.edge_index(a, b)) == a)
                              for a, b in ((c[0], c[1]), (c[3], c[2]), (c[0], c[3]), (c[1], c[2])))
         return sides
-
-
-def _oriented_face(corners: Sequence[Point], cycle: tuple[int, ...], f: int, name: str
-                   ) -> tuple[tuple[int, ...], tuple[tuple[Fraction, Fraction, Fraction], Fraction]]:
-    """The cycle counter-clockwise seen from outside and the outward plane, after the checks."""
-    pts = [corners[i] for i in cycle]
-    m = len(cycle)
-    normal = area_vector(pts)  # Newell's normal: exact, and nonzero for any convex polygon
-    if normal == (0, 0, 0):  # a self-crossing order can cancel Newell's sum: any corner triple then
-        normal = next((n for a, b, c in combinations(pts, 3) if (n := plane_normal(a, b, c)) != (0, 0, 0)),
-                      normal)
-    if normal == (0, 0, 0):
-        raise InputError(f"{name}: face {f} {list(cycle)}: its corners are on one line")
-    offset = dot(normal, pts[0])
-    if any(dot(normal, p) != offset for p in pts):
-        raise InputError(f"{name}: face {f} {list(cycle)}: its corners are not on one plane")
-    for i in range(m):
-        # Convex in the given order: every other corner strictly on the inner side of each side.
-        p, q = pts[i], pts[(i + 1) % m]
-        inward = cross(normal, sub(q, p))
-        if any(dot(inward, sub(r, p)) <= 0 for j, r in enumerate(pts) if j not in (i, (i + 1) % m)):
-            raise InputError(f"{name}: face {f} {list(cycle)}: not a convex polygon in this order "
-                             "(or three corners on a line)")
-    above = below = False
-    for i, p in enumerate(corners):
-        if i in cycle:
-            continue
-        side = dot(normal, p) - offset
-        if side == 0:
-            raise InputError(f"{name}: corner {i} lies in the plane of face {f} {list(cycle)} without being one "
-                             "of its corners")
-        above, below = above or side > 0, below or side < 0
-    if above and below:
-        raise InputError(f"{name}: not convex: corners lie on both sides of face {f} {list(cycle)}")
-    if above:  # the normal points inwards: turn the face round
-        cycle = (cycle[0], *reversed(cycle[1:]))
-        normal, offset = (-normal[0], -normal[1], -normal[2]), -offset
-    return cycle, ((Fraction(normal[0]), Fraction(normal[1]), Fraction(normal[2])), Fraction(offset))
 
 
 def standard_shape(name: str, box: Box | Iterable[str | int | Fraction] = ("1", "1", "1")) -> Shape:

@@ -30,7 +30,8 @@ from .codes import REVERSED_DIGIT, code_digits, key_code, parse_point_suffix, po
 from .configuration import Box, Configuration
 from .geometry import Rational, cross, determinant, sub, tetra_six_volume
 from .polyhedron import Polyhedron
-from .shapes import CORNERS, EDGES, FACES, Point, Shape, standard_shape
+from .box import CORNERS, EDGES, FACES, Point
+from .shapes import Shape, standard_shape
 
 __all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
            "orbit_point_keys", "orbit_representatives", "shape_symmetries"]

@@ -11,7 +11,7 @@ from .delaunay import delaunay_cells
 from .element_types import ElementType, classify
 from .geometry import Frame, Rational
 from .polyhedron import Polyhedron, polyhedron
-from .shapes import Point
+from .box import Point
 
 __all__ = ["Element", "Tessellation", "element_entry", "tessellate", "tessellation_elements"]
 
