@@ -19,7 +19,6 @@ from pathlib import Path
 import pytest
 
 from cospherical.cli import main
-from cospherical.files import yamlio
 from cospherical.files.outputs import MANIFEST, OutputFolder
 from tests.files.test_outputs import listing, victim
 
@@ -175,35 +174,6 @@ def test_render_refuses_a_summary_with_a_number_that_is_not_finite(tmp_path, cap
     refused(capsys, "render", "--summary", tmp_path / "summary.json", "--out", tmp_path / "out",
             needle="not a finite number" if value == "NaN" else "share")
     assert not (tmp_path / "out").exists()
-
-
-# --- diff --rev: git blobs bounded and decoded like files ---------------------------------------------------------
-
-@pytest.fixture()
-def repo(tmp_path):
-    def git(*args):
-        subprocess.run(["git", "-c", "user.email=t@example.org", "-c", "user.name=t", *args], cwd=tmp_path,
-                       check=True, capture_output=True)
-
-    git("init", "-q")
-    (tmp_path / "latin1.yaml").write_bytes("types: []\nname: caf\xe9\n".encode("latin-1"))
-    (tmp_path / "catalogue.yaml").write_bytes((ROOT / "catalogue" / "catalogue.yaml").read_bytes())
-    git("add", ".")
-    git("commit", "-qm", "files")
-    return tmp_path
-
-
-def test_diff_rev_of_a_file_that_is_not_utf8_is_one_line(repo, capsys):
-    refused(capsys, "diff", "--rev", "HEAD", repo / "latin1.yaml", needle="not UTF-8")
-
-
-def test_diff_rev_bounds_the_blob_before_reading_it(repo, capsys, monkeypatch):
-    size = (repo / "catalogue.yaml").stat().st_size
-    monkeypatch.setattr(yamlio, "MAX_INPUT_BYTES", size - 1)
-    line = refused(capsys, "diff", "--rev", "HEAD", repo / "catalogue.yaml", needle="too large")
-    assert f"({size} bytes; at most {size - 1})" in line
-    monkeypatch.setattr(yamlio, "MAX_INPUT_BYTES", size)
-    assert main(["diff", "--rev", "HEAD", str(repo / "catalogue.yaml")]) == 0
 
 
 # --- processes: closed stdout, Ctrl-C on a Dask cluster -----------------------------------------------------------

@@ -208,21 +208,6 @@ def test_rank_and_reverse_are_mirror_families():
     assert a["criteria"] == b["criteria"] and a["orbits"] == b["orbits"]
 
 
-def test_the_catalogue_holds_every_type_of_the_intersection_studies():
-    from pathlib import Path
-
-    from cospherical.catalogue import shipped_catalogue
-    from cospherical.formats.catalogue_file import intersection_examples
-
-    known = {t.id for t in shipped_catalogue()}
-    examples = {e["element"].type.id for e in intersection_examples()}
-    assert examples <= known
-    results = Path(__file__).resolve().parents[2] / "results" / "intersection"
-    for summary in results.glob("*/intersection-r16-*.json"):
-        for criterion, data in json.loads(summary.read_text())["criteria"].items():
-            assert set(data["types"]) <= examples, (summary.name, criterion)
-
-
 @pytest.fixture(scope="module")
 def r4_table(pool_run, tmp_path_factory):
     """The R = 4 pattern table, as YAML and as an indexed store."""
