@@ -91,7 +91,7 @@ def measure(args, record) -> None:
     for name, check in (("volume", check_volume), ("conformity", check_conformity),
                         ("circumcenters", check_circumcenters), ("delaunay", check_delaunay)):
         result = stage(f"global: {name}", lambda: check(whole))
-        found.update(result.figures() if name == "delaunay" else result)
+        found.update(result.figures())
     stage("global: statistics", lambda: mesh_statistics(whole))
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     print(f"leaves {len(tree):,}  vertices {len(mesh.vertices):,}  elements {len(mesh):,}  "
@@ -103,7 +103,7 @@ def measure(args, record) -> None:
     checks = sum(clock[k][0] for k in ("volume", "conformity", "circumcenters"))
     print(f"volume + conformity + circumcenters {checks:.1f} s; delaunay {clock['delaunay'][0]:.1f} s; "
           f"peak {peak:.2f} GB")
-    print({**volume, **conformity, **centers, **delaunay.figures()})
+    print({**volume.figures(), **conformity.figures(), **centers.figures(), **delaunay.figures()})
     leaf_stages = ("assembly", "volume", "conformity", "circumcenters", "delaunay", "statistics")
     global_stages = ("assembly", "delaunay", *(name for name in clock if name.startswith("global: ")))
     leaf_mode, global_mode = (sum(clock[k][0] for k in stages) for stages in (leaf_stages, global_stages))

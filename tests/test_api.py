@@ -88,3 +88,16 @@ def test_a_broken_path_is_found():
     assert _resolve("cospherical.studies.engine.run_study") is not None
     assert _resolve("cospherical.studies.bisection.run_study") is None
     assert _resolve("cospherical.formats.store") is None
+
+
+def test_a_type_checker_sees_every_lazy_name_where_it_loads():
+    # cospherical/__init__.py loads the names of _API on first use (__getattr__); its
+    # `if TYPE_CHECKING:` imports show a user's checker the same names from the same modules
+    import cospherical
+
+    tree = ast.parse((SRC / "cospherical" / "__init__.py").read_text())
+    block = next(node for node in tree.body if isinstance(node, ast.If) and ast.unparse(node.test) == "TYPE_CHECKING")
+    seen = {alias.asname or alias.name: ("cospherical" + "." * (node.level - 1) + "." + node.module, alias.name)
+            for node in block.body if isinstance(node, ast.ImportFrom) for alias in node.names}
+    lazy = {name: where if isinstance(where, tuple) else (where, name) for name, where in cospherical._API.items()}
+    assert seen == lazy

@@ -36,6 +36,7 @@ Examples
 from __future__ import annotations
 
 import importlib
+from typing import TYPE_CHECKING
 
 from .errors import CosphericalError, FormatError, InputError, UsageError
 from .version import __version__
@@ -63,10 +64,24 @@ _API: dict[str, str | tuple[str, str]] = {
     "MeshReport": "cospherical.mesh.report",
 }
 
+if TYPE_CHECKING:  # a type checker sees the names _API loads on first use (X as X: re-exported)
+    from .core.configuration import Box as Box, Configuration as Configuration
+    from .core.exact import Length as Length
+    from .core.element_types import ElementType as ElementType
+    from .core.tessellation import Element as Element, Tessellation as Tessellation, tessellate as tessellate
+    from .core.shapes import Shape as Shape, standard_shape as standard_shape
+    from .catalogue import Catalogue as Catalogue, load_catalogue as load_catalogue
+    from .catalogue import shipped_catalogue as shipped_catalogue
+    from .catalogue import type_name as type_name
+    from .formats.patterns import PatternTable as PatternTable
+    from .formats.patterns import load as load_patterns  # noqa: F401 (public here as load_patterns: _API)
+    from .api.mesh import build_mesh as build_mesh, OctreeMesh as OctreeMesh, from_treemesh as from_treemesh
+    from .mesh.report import MeshReport as MeshReport
+
 __all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "__version__", *_API]
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> object:
     if name not in _API:
         raise AttributeError(f"module 'cospherical' has no attribute {name!r}")
     where = _API[name]

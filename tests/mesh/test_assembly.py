@@ -28,7 +28,8 @@ def octant_tree(box=CUBE):
 
 
 def checks(mesh) -> dict:
-    return {**check_volume(mesh), **check_conformity(mesh), **check_circumcenters(mesh), **check_delaunay(mesh).figures()}
+    return {**check_volume(mesh).figures(), **check_conformity(mesh).figures(), **check_circumcenters(mesh).figures(),
+            **check_delaunay(mesh).figures()}
 
 
 def small_table(path, box, codes):

@@ -32,7 +32,7 @@ def test_global_delaunay_equals_brute_force_on_a_brick():
         pairs, elements = pairs + inside, elements + (inside > 0)
     assert (found.violating_pairs, found.violations) == (pairs, elements)
     assert found.violations > 0 and len(found.violating_elements) == found.violations
-    assert check_circumcenters(mesh)["leaves_not_fvm_adequate"] > 0
+    assert check_circumcenters(mesh).leaves_not_fvm_adequate > 0
 
 
 def _shapes(vertices: np.ndarray, conn: np.ndarray) -> np.ndarray:
@@ -58,12 +58,12 @@ def test_faces_of_elements_given_by_their_vertices_pair_as_the_meshs_own():
     needed = sum(rows.nbytes for parts in faces.values() for rows in parts)
     found = pair_faces(faces, mesh.vertices, mesh.grid)
     own = check_conformity(mesh)
-    assert found == own and own["nonconforming_faces"] == 0 and own["interior_faces"] > 0
+    assert found == own and own.nonconforming_faces == 0 and own.interior_faces > 0
     # one element's nodes moved to another's: the faces no longer pair
     conn[3] = conn[200]
     broken = pair_faces(element_faces(mesh.vertices, conn, sizes, _shapes(mesh.vertices, conn), BRICK.squared),
                         mesh.vertices, mesh.grid)
-    assert broken["nonconforming_faces"] > 0
+    assert broken.nonconforming_faces > 0
     with pytest.raises(InputError, match="faces need"):
         element_faces(mesh.vertices, conn, sizes, shape, BRICK.squared, most_bytes=needed)
 

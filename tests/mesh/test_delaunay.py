@@ -33,7 +33,7 @@ def mesh_cells(mesh) -> set[frozenset[int]]:
 
 
 def whole(mesh) -> dict:
-    found = {**check_volume(mesh), **check_conformity(mesh), **check_delaunay(mesh).figures()}
+    found = {**check_volume(mesh).figures(), **check_conformity(mesh).figures(), **check_delaunay(mesh).figures()}
     return {k: found[k] for k in ("volume_ok", "nonconforming_faces", "delaunay_violations", "delaunay_ties")}
 
 
@@ -67,7 +67,7 @@ def test_global_mode_equals_qhull_merged_exactly(domain, levels, shapes, balance
     # every leaf element kept is a cell; the replaced leaves hold none of the mesh's leaf elements
     assert mesh_cells(leaf) & expected <= mesh_cells(mesh)
     circumcenters = check_circumcenters(mesh)
-    assert circumcenters["elements_not_cospherical"] == 0
+    assert circumcenters.elements_not_cospherical == 0
 
 
 def _box(values):
@@ -303,11 +303,11 @@ def test_a_table_element_that_is_not_cospherical_is_replaced_by_delaunay_cells()
         return None
 
     mesh = assemble(tree, lookup)
-    assert replaced and check_circumcenters(mesh)["elements_not_cospherical"] == 1
+    assert replaced and check_circumcenters(mesh).elements_not_cospherical == 1
     found = check_delaunay(mesh)
     assert len(found.not_cells) == 1
     result = global_delaunay(mesh, found)
-    assert check_circumcenters(result)["elements_not_cospherical"] == 0
+    assert check_circumcenters(result).elements_not_cospherical == 0
     assert whole(result) == WHOLE
     assert mesh_cells(result) == oracle_cells(result)
 

@@ -604,9 +604,9 @@ def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path, layout=None) ->
     except InputError as error:
         raise FormatError(f"{path}: member element_nodes: {error}") from None
     found = pair_faces(faces, dual.grid_vertices, dual.grid, examples=1, layout=layout)
-    if found["nonconforming_faces"]:
-        corners = [[round(x * dual.grid) for x in corner] for corner in found["nonconforming_examples"][0]]
-        raise FormatError(f"{path}: member element_nodes: the elements are not a mesh: {found['nonconforming_faces']:,} "
+    if found.nonconforming_faces:
+        corners = [[round(x * dual.grid) for x in corner] for corner in found.nonconforming_examples[0]]
+        raise FormatError(f"{path}: member element_nodes: the elements are not a mesh: {found.nonconforming_faces:,} "
                           "faces are neither shared by two elements in opposite orientations nor in the domain's "
                           f"boundary, e.g. the face of grid points {', '.join(map(str, corners[:6]))}"
                           f"{', ...' if len(corners) > 6 else ''}")

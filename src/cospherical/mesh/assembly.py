@@ -20,9 +20,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Callable, Iterable
+from typing import Any, Callable, Iterable, Iterator, NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..catalogue import Catalogue, apply_catalogue_criterion, shipped_catalogue
 from ..core.codes import mask_code, point_suffix
@@ -37,7 +38,7 @@ from ..paper import paper_class
 from .device import Regions
 from .octree import Octree, distinct
 
-__all__ = ["CellShape", "Cells", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "NODE_OFFSETS", "PAPER_FINAL",
+__all__ = ["CellShape", "Cells", "ElementBlock", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "NODE_OFFSETS", "PAPER_FINAL",
            "assemble", "distinct", "local_tessellation", "type_info", "vertex_keys"]
 
 # Twice the unit coordinates of the 27 nodes (corners, edge midpoints, face centres, body).
@@ -51,7 +52,7 @@ PAPER_FINAL = ("Cuboid", "Triangular Prism", "Quadrilateral Pyramid", "Tetrahedr
 
 # lookup(configuration) -> the table's elements (dicts with ``type`` and ``nodes``, and ``mapped_from``
 # when they were carried back from another configuration of the orbit), or None when it lacks them
-Lookup = Callable[[Configuration], "list[dict] | None"]
+Lookup = Callable[[Configuration], "list[dict[str, Any]] | None"]
 
 
 @dataclass(frozen=True)
@@ -168,17 +169,31 @@ class Cells:
     """
 
     shapes: list[CellShape]
-    shape: np.ndarray
-    anchor: np.ndarray
-    nodes: np.ndarray
-    leaf: np.ndarray
-    spanning: np.ndarray
-    proven: np.ndarray
+    shape: NDArray[np.integer[Any]]
+    anchor: NDArray[np.int64]
+    nodes: NDArray[np.integer[Any]]
+    leaf: NDArray[np.integer[Any]]
+    spanning: NDArray[np.bool_]
+    proven: NDArray[np.bool_]
     clusters: int = 0
     largest_cluster: int = 0
 
     def __len__(self) -> int:
         return len(self.shape)
+
+
+class ElementBlock(NamedTuple):
+    """Elements of one kind (:meth:`Mesh.blocks`): one element of a configuration over its leaves, or a cell shape.
+
+    ``rows``: the elements' indices in the mesh; ``nodes``: their global vertex ids (elements x
+    nodes, in the type's node order); ``faces``: cycles of column indices into ``nodes``,
+    counter-clockwise seen from outside; ``type_id``: the element type.
+    """
+
+    rows: NDArray[np.int64]
+    nodes: NDArray[np.integer[Any]]
+    faces: tuple[tuple[int, ...], ...]
+    type_id: str
 
 
 @dataclass
@@ -199,19 +214,22 @@ class Mesh:
 
     tree: Octree
     grid: int
-    vertices: np.ndarray
-    slots: np.ndarray
-    leaf_tessellation: np.ndarray
+    vertices: NDArray[np.int64]
+    slots: NDArray[np.int32]
+    leaf_tessellation: NDArray[np.int32]
     tessellations: list[LocalTessellation]
-    element_offsets: np.ndarray
-    element_leaf: np.ndarray
-    element_local: np.ndarray
-    types: dict[str, dict] = field(default_factory=dict)
-    replaced: np.ndarray | None = None
+    element_offsets: NDArray[np.int64]
+    element_leaf: NDArray[np.int32]
+    element_local: NDArray[np.int16]
+    types: dict[str, dict[str, Any]] = field(default_factory=dict)
+    replaced: NDArray[np.bool_] | None = None
     cells: Cells | None = None
-    catalogue: Catalogue | None = field(default=None, repr=False, compare=False)  # names the types; from assemble
+    # names the types (assemble's catalogue; the shipped one when none is given)
+    catalogue: Catalogue = field(default_factory=shipped_catalogue, repr=False, compare=False)
     regions: Regions | None = field(default=None, repr=False, compare=False)  # a device's regions
-    _groups: list | None = field(default=None, repr=False, compare=False)
+    # the leaves of each tessellation: all of them, and those whose elements are in the mesh (groups())
+    _groups: tuple[list[NDArray[np.intp]], list[NDArray[np.intp]]] | None = field(default=None, repr=False,
+                                                                                   compare=False)
 
     @property
     def box(self) -> Box:
@@ -220,7 +238,7 @@ class Mesh:
     def __len__(self) -> int:
         return len(self.element_leaf)
 
-    def points(self) -> np.ndarray:
+    def points(self) -> NDArray[np.float64]:
         """(n, 3) float64: the vertices in the domain's units, the root box's corner at 0.
 
         The one conversion from the exact grid (``vertices / grid`` of each side) to
@@ -229,7 +247,7 @@ class Mesh:
         return self.vertices * (np.array(self.box.to_float()) / self.grid)
 
     @property
-    def element_region(self) -> np.ndarray | None:
+    def element_region(self) -> NDArray[np.integer[Any]] | None:
         """Per element, the index of its region (its leaf's; a cell's first leaf's), or ``None`` without regions."""
         return None if self.regions is None else self.regions.leaf_region[self.element_leaf]
 
@@ -247,11 +265,11 @@ class Mesh:
         """How many elements come from the leaves' tessellations (the cells follow them)."""
         return len(self) - (len(self.cells) if self.cells is not None else 0)
 
-    def leaf_size(self) -> np.ndarray:
+    def leaf_size(self) -> NDArray[np.int64]:
         """Leaf edge lengths in grid units."""
         return (self.grid >> self.tree.levels.astype(np.int64)).astype(np.int64)
 
-    def groups(self, all_leaves: bool = False):
+    def groups(self, all_leaves: bool = False) -> Iterator[tuple[int, LocalTessellation, NDArray[np.intp]]]:
         """Yield ``(tessellation index, tessellation, leaf indices)`` for every configuration that occurs, in order.
 
         The leaves are those whose elements are in the mesh; ``all_leaves`` also
@@ -263,12 +281,12 @@ class Mesh:
             starts = np.r_[0, np.cumsum(counts)]
             groups = [order[starts[p]:starts[p + 1]] for p in range(len(self.tessellations))]
             kept = groups if self.replaced is None else [g[~self.replaced[g]] for g in groups]
-            self._groups = [groups, kept]
+            self._groups = (groups, kept)
         for p, leaves in enumerate(self._groups[0 if all_leaves else 1]):
             if len(leaves) or all_leaves:
                 yield p, self.tessellations[p], leaves
 
-    def blocks(self):
+    def blocks(self) -> Iterator[ElementBlock]:
         """Yield ``(element indices, global vertex ids (elements x nodes), faces, type id)`` per kind of element.
 
         One block per element of a configuration (over its leaves) and per cell
@@ -278,18 +296,18 @@ class Mesh:
             first = self.element_offsets[leaves]
             for j, element in enumerate(tessellation.elements):
                 column = {n: i for i, n in enumerate(element.nodes)}
-                yield (first + j, self.slots[np.ix_(leaves, element.nodes)],
-                       tuple(tuple(column[n] for n in cycle) for cycle in element.faces), element.type_id)
+                yield ElementBlock(first + j, self.slots[np.ix_(leaves, np.asarray(element.nodes, dtype=np.intp))],
+                                   tuple(tuple(column[n] for n in cycle) for cycle in element.faces), element.type_id)
         if self.cells is not None:
             order = np.argsort(self.cells.shape, kind="stable")
             counts = np.bincount(self.cells.shape, minlength=len(self.cells.shapes))
             starts = np.r_[0, np.cumsum(counts)]
             for s, shape in enumerate(self.cells.shapes):
                 rows = order[starts[s]:starts[s + 1]]
-                yield (self.leaf_elements + rows, self.cells.nodes[rows, :len(shape.offsets)], shape.faces,
-                       shape.type_id)
+                yield ElementBlock(self.leaf_elements + rows, self.cells.nodes[rows, :len(shape.offsets)],
+                                   shape.faces, shape.type_id)
 
-    def element_nodes(self, elements: np.ndarray) -> np.ndarray:
+    def element_nodes(self, elements: NDArray[np.integer[Any]]) -> NDArray[np.int32]:
         """Global vertex ids of the given leaf elements, in their tessellation's node order, padded with -1."""
         width = max((len(e.nodes) for p in self.tessellations for e in p.elements), default=1)
         widest = max((len(p.elements) for p in self.tessellations), default=1)
@@ -299,9 +317,11 @@ class Mesh:
             for j, element in enumerate(tessellation.elements):
                 local[p, j, :len(element.nodes)] = element.nodes
         leaf = self.element_leaf[elements]
-        return self.slots[leaf[:, None], local[self.leaf_tessellation[leaf], self.element_local[elements]]]
+        nodes: NDArray[np.int32] = self.slots[leaf[:, None], local[self.leaf_tessellation[leaf],
+                                                                  self.element_local[elements]]]
+        return nodes
 
-    def connectivity(self) -> tuple[np.ndarray, np.ndarray]:
+    def connectivity(self) -> tuple[NDArray[np.int32], NDArray[np.int8]]:
         """Global vertex ids of every element: (elements x widest) int32 padded with -1, and the sizes."""
         blocks = list(self.blocks())
         width = max((nodes.shape[1] for _, nodes, _, _ in blocks), default=0)
@@ -312,7 +332,7 @@ class Mesh:
             sizes[rows] = nodes.shape[1]
         return conn, sizes
 
-    def element_types(self) -> tuple[list[str], np.ndarray]:
+    def element_types(self) -> tuple[list[str], NDArray[np.int32]]:
         """The type ids met (sorted) and each element's index into them."""
         blocks = [(rows, type_id) for rows, _, _, type_id in self.blocks()]
         ids = sorted({type_id for _, type_id in blocks})
@@ -322,7 +342,7 @@ class Mesh:
             codes[rows] = position[type_id]
         return ids, codes
 
-    def element_fvm(self) -> np.ndarray:
+    def element_fvm(self) -> NDArray[np.bool_]:
         """Per element: its circumcenter lies in its closed leaf (exact; a cell's leaf is its first leaf)."""
         flags = np.zeros(len(self), dtype=bool)
         for _, tessellation, leaves in self.groups():
@@ -333,13 +353,19 @@ class Mesh:
             flags[self.leaf_elements:] = self.cell_center_in_leaf()
         return flags
 
-    def cell_centers(self) -> tuple[np.ndarray, np.ndarray]:
+    def required_cells(self) -> Cells:
+        """The cells, for what only a mesh with re-tessellated cells has (a ``ValueError`` without them)."""
+        if self.cells is None:
+            raise ValueError("the mesh has no re-tessellated cells")
+        return self.cells
+
+    def cell_centers(self) -> tuple[NDArray[Any], NDArray[Any]]:
         """The cells' circumcenters in grid units, exact: numerators (cells x 3) and denominators.
 
         int64 when the numerators and what the checks compare them with (grid points up
         to twice the grid times a denominator) stay below 2**62, else Python integers.
         """
-        cells = self.cells
+        cells = self.required_cells()
         parts = []
         for shape in cells.shapes:
             common = math.lcm(*(c.denominator for c in shape.center))
@@ -356,14 +382,15 @@ class Mesh:
             den[rows] = common
         return num, den
 
-    def cell_center_in_leaf(self) -> np.ndarray:
+    def cell_center_in_leaf(self) -> NDArray[np.bool_]:
         """Per cell: its circumcenter lies in the closed box of its first leaf, decided exactly."""
         num, den = self.cell_centers()
-        size = self.leaf_size()[self.cells.leaf].astype(num.dtype)
-        low = self.tree.positions[self.cells.leaf].astype(num.dtype) * size[:, None]
+        leaf = self.required_cells().leaf
+        size = self.leaf_size()[leaf].astype(num.dtype)
+        low = self.tree.positions[leaf].astype(num.dtype) * size[:, None]
         return in_closed_box(num, den[:, None], low, low + size[:, None]).astype(bool)
 
-def type_info(type_id: str, etype: ElementType | None, catalogue: Catalogue) -> dict:
+def type_info(type_id: str, etype: ElementType | None, catalogue: Catalogue) -> dict[str, Any]:
     """Name, paper class, VTK cell and size of a type: from the catalogue, else from the type itself."""
     entry = catalogue.get(type_id)
     if entry is not None:
@@ -385,7 +412,7 @@ def _leaf_code(edges: int, faces: int) -> str:
     return mask_code(edges, 12) + "+" + point_suffix((f for f in range(6) if faces >> f & 1), False)
 
 
-def vertex_keys(tree: Octree) -> tuple[int, np.ndarray]:
+def vertex_keys(tree: Octree) -> tuple[int, NDArray[np.int64]]:
     """The vertex grid of a tree: its intervals per domain side and the sorted keys of every leaf corner.
 
     A vertex ``(x, y, z)`` of the grid has the key ``(x * (grid + 1) + y) * (grid + 1) + z``;
@@ -399,20 +426,21 @@ def vertex_keys(tree: Octree) -> tuple[int, np.ndarray]:
     return grid, distinct(_node_keys(origin, size // 2, grid, slice(None), slice(0, 8)))
 
 
-def _node_keys(origin: np.ndarray, half: np.ndarray, grid: int, part: slice, nodes: slice) -> np.ndarray:
+def _node_keys(origin: NDArray[np.int64], half: NDArray[np.int64], grid: int, part: slice,
+               nodes: slice) -> NDArray[np.int64]:
     # A point's key (x * n + y) * n + z is linear in the point: a node's key is its leaf origin's key plus
     # half the leaf times the key of the node's offset: one (leaves x nodes) temporary, not eight.
     n = np.int64(grid + 1)
     origin = origin[part]
     offsets = NODE_OFFSETS[nodes]
-    keys = half[part, None] * ((offsets[:, 0] * n + offsets[:, 1]) * n + offsets[:, 2])[None]
+    keys: NDArray[np.int64] = half[part, None] * ((offsets[:, 0] * n + offsets[:, 1]) * n + offsets[:, 2])[None]
     keys += ((origin[:, 0] * n + origin[:, 1]) * n + origin[:, 2])[:, None]
     return keys
 
 
 def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int], None] | None = None,
-             cache: dict | None = None, criterion: str = "optimal",
-             vertices: tuple[int, np.ndarray] | None = None, catalogue: Catalogue | None = None) -> Mesh:
+             cache: dict[tuple[str, str], LocalTessellation] | None = None, criterion: str = "optimal",
+             vertices: tuple[int, NDArray[np.int64]] | None = None, catalogue: Catalogue | None = None) -> Mesh:
     """Mesh an octree: configurations from the vertex set, elements from ``lookup`` (else tessellated).
 
     ``lookup(configuration)`` returns the pattern table's elements of that point set
@@ -440,7 +468,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     origin = tree.positions.astype(np.int64) * size[:, None]
     half = size // 2
     n = np.int64(grid + 1)
-    vertices = np.stack([keys_all // (n * n), (keys_all // n) % n, keys_all % n], axis=1)
+    points = np.stack([keys_all // (n * n), (keys_all // n) % n, keys_all % n], axis=1)
     slots = np.empty((len(tree), 27), dtype=np.int32)
     # bounded temporaries (14 MB): glibc then reuses their memory instead of mapping fresh pages each time
     chunk = 1 << 16
@@ -461,7 +489,8 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     seen = np.bincount(value, minlength=1 << 18) > 0
     distinct = np.flatnonzero(seen)
     leaf_tessellation = (np.cumsum(seen) - 1)[value]
-    tessellations, types = [], {}
+    tessellations: list[LocalTessellation] = []
+    types: dict[str, dict[str, Any]] = {}
     for value in distinct.tolist():
         code = _leaf_code(value & 0xFFF, value >> 12)
         if (code, criterion) not in cache:
@@ -479,12 +508,12 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     element_local = (np.arange(offsets[-1], dtype=np.int64) - offsets[:-1][element_leaf]).astype(np.int16)
     if progress:
         progress(len(tree) - len(tree) // 2)
-    return Mesh(tree, grid, vertices, slots, leaf_tessellation.astype(np.int32).reshape(-1), tessellations, offsets,
+    return Mesh(tree, grid, points, slots, leaf_tessellation.astype(np.int32).reshape(-1), tessellations, offsets,
                 element_leaf, element_local, types, catalogue=catalogue)
 
 
-def _leaf_tessellation(configuration: Configuration, lookup: Lookup | None, types: dict, criterion: str,
-                       catalogue: Catalogue) -> LocalTessellation:
+def _leaf_tessellation(configuration: Configuration, lookup: Lookup | None, types: dict[str, dict[str, Any]],
+                       criterion: str, catalogue: Catalogue) -> LocalTessellation:
     elements = lookup(configuration) if lookup is not None else None
     if elements is not None:
         return local_tessellation(configuration, [(e["type"], e["nodes"]) for e in elements],

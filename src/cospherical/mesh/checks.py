@@ -19,11 +19,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Callable, NamedTuple
+from typing import Any, Callable, Iterable, NamedTuple, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
-from ..core.geometry import Frame, in_closed_box
+from ..core.geometry import Frame, Rational, in_closed_box
 from ..core.morton import morton_codes
 from ..core.polyhedron import measure
 from ..errors import InputError
@@ -38,15 +39,36 @@ from .octree import distinct
 _MAX_EXACT_TESTS = 1 << 24
 _PAIR_CHUNK = 1 << 22
 
-__all__ = ["DelaunayCheck", "check_circumcenters", "check_conformity", "check_delaunay", "check_volume", "element_faces", "grid_weights",
-           "match_seams", "on_domain_boundary", "pair_faces"]
+__all__ = ["CircumcenterCheck", "ConformityCheck", "DelaunayCheck", "OpenFaces", "VolumeCheck", "check_circumcenters",
+           "check_conformity", "check_delaunay", "check_volume", "element_faces", "grid_weights", "match_seams",
+           "on_domain_boundary", "pair_faces"]
 
 
-def check_volume(mesh: Mesh) -> dict:
+@dataclass(frozen=True)
+class VolumeCheck:
+    """What :func:`check_volume` found: the elements' volumes summed, exactly.
+
+    Attributes
+    ----------
+    volume : Fraction
+        The elements' volumes summed, as a fraction of the root box's volume.
+    flat_elements : int
+        Elements of volume <= 0.
+    volume_ok : bool
+        ``volume`` is the domain's (the root box's, or a device's share of it) and no element is flat.
+    """
+
+    volume: Fraction
+    flat_elements: int
+    volume_ok: bool
+
+    def figures(self) -> dict[str, bool | str | int]:
+        """The report's ``volume_ok``, ``volume`` (exact text) and ``flat_elements``, in its order."""
+        return {"volume_ok": self.volume_ok, "volume": str(self.volume), "flat_elements": self.flat_elements}
+
+
+def check_volume(mesh: Mesh) -> VolumeCheck:
     """Volumes sum to the domain's, exactly (integers and rationals), every element of positive volume.
-
-    Returns ``volume_ok``, ``volume`` (the sum as a fraction of the domain, exact text)
-    and ``flat_elements`` (elements of volume <= 0).
 
     Examples
     --------
@@ -54,7 +76,7 @@ def check_volume(mesh: Mesh) -> dict:
     >>> from cospherical.mesh.octree import build_octree, parse_shape
     >>> from cospherical.mesh.assembly import assemble
     >>> check_volume(assemble(build_octree(Box.parse([1, 2, 4]), 0, [])))
-    {'volume_ok': True, 'volume': '1', 'flat_elements': 0}
+    VolumeCheck(volume=Fraction(1, 1), flat_elements=0, volume_ok=True)
     """
     depth = mesh.tree.depth
     total = Fraction(0)
@@ -70,7 +92,7 @@ def check_volume(mesh: Mesh) -> dict:
         share += sum((shape.grid_volume * n for shape, n in zip(mesh.cells.shapes, per_shape)), Fraction(0)) \
             / mesh.grid ** 3
         flat += sum(n for shape, n in zip(mesh.cells.shapes, per_shape) if shape.grid_volume <= 0)
-    return {"volume_ok": share == mesh.domain_share and flat == 0, "volume": str(share), "flat_elements": int(flat)}
+    return VolumeCheck(share, int(flat), share == mesh.domain_share and flat == 0)
 
 
 def _faces(mesh: Mesh) -> dict[int, list[np.ndarray]]:
@@ -82,8 +104,9 @@ def _faces(mesh: Mesh) -> dict[int, list[np.ndarray]]:
     return by_size
 
 
-def element_faces(vertices: np.ndarray, nodes: np.ndarray, sizes: np.ndarray, shape: np.ndarray, squared,
-                  most_bytes: int | None = None) -> dict[int, list[np.ndarray]]:
+def element_faces(vertices: NDArray[np.integer[Any]], nodes: NDArray[np.integer[Any]], sizes: NDArray[np.integer[Any]],
+                  shape: NDArray[np.integer[Any]], squared: Sequence[Rational],
+                  most_bytes: int | None = None) -> dict[int, list[NDArray[np.integer[Any]]]]:
     """Every face of elements given by their vertices, as :func:`pair_faces` reads them: by size, rows of
     vertex ids counter-clockwise seen from outside.
 
@@ -121,7 +144,55 @@ def element_faces(vertices: np.ndarray, nodes: np.ndarray, sizes: np.ndarray, sh
     return faces
 
 
-def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -> dict:
+class OpenFaces(NamedTuple):
+    """Faces of one size that a piece of a partitioned mesh meets once, off the domain's boundary.
+
+    ``faces``: rows of vertex ids, each turned to start at its smallest id and read in the
+    direction whose second id is the smaller (:func:`pair_faces`); ``flipped``: per face,
+    whether that reverses its orientation (counter-clockwise seen from outside its element).
+    """
+
+    size: int
+    faces: NDArray[np.integer[Any]]
+    flipped: NDArray[np.bool_]
+
+
+@dataclass(frozen=True)
+class ConformityCheck:
+    """What :func:`check_conformity` (or :func:`match_seams`) found on a mesh's faces.
+
+    Attributes
+    ----------
+    nonconforming_faces : int
+        Face occurrences that are neither paired nor on the domain's boundary (a hanging face,
+        a T-junction, an overlap).
+    interior_faces : int
+        Faces met twice, in opposite orientations (pairs).
+    boundary_faces : int
+        Faces met once, in the domain's boundary (0 for :func:`match_seams`: the pieces count them).
+    nonconforming_examples : list
+        Up to ``examples`` nonconforming faces, each its vertices' coordinates as fractions of
+        the domain's sides (floats).
+    open_faces : tuple of OpenFaces
+        With ``open_faces=True`` (``mesh`` is one piece of a partitioned mesh): the faces met once
+        off the domain's boundary, not counted as nonconforming but kept here, one
+        :class:`OpenFaces` per face size, for :func:`match_seams` to pair with the other pieces'.
+    """
+
+    nonconforming_faces: int
+    interior_faces: int
+    boundary_faces: int
+    nonconforming_examples: list[list[list[float]]]
+    open_faces: tuple[OpenFaces, ...] = ()
+
+    def figures(self) -> dict[str, int | list[list[list[float]]]]:
+        """The report's ``nonconforming_faces``, ``interior_faces``, ``boundary_faces`` and
+        ``nonconforming_examples``, in its order."""
+        return {"nonconforming_faces": self.nonconforming_faces, "interior_faces": self.interior_faces,
+                "boundary_faces": self.boundary_faces, "nonconforming_examples": self.nonconforming_examples}
+
+
+def check_conformity(mesh: Mesh, examples: int = 5, open_faces: bool = False) -> ConformityCheck:
     """Every interior face shared by exactly two elements, same vertices, opposite orientation; the rest on the boundary.
 
     A face is its cycle of global vertex ids, turned to start at its smallest id
@@ -130,13 +201,10 @@ def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -
     boundary; a face met twice must be met once in each orientation; anything else
     (a hanging face, a T-junction, an overlap) counts as nonconforming.
 
-    ``seams``, a list, makes ``mesh`` one piece of a partitioned mesh: its faces met
-    once off the domain's boundary are not counted but appended to it (size, turned
-    faces, orientations), for :func:`match_seams` to pair with the other pieces'.
-
-    Returns ``nonconforming_faces`` (face occurrences), ``interior_faces`` (pairs),
-    ``boundary_faces`` and up to ``examples`` nonconforming faces (vertex
-    coordinates as fractions of the domain).
+    ``open_faces=True`` makes ``mesh`` one piece of a partitioned mesh: its faces met
+    once off the domain's boundary are not counted but returned
+    (:attr:`ConformityCheck.open_faces`), for :func:`match_seams` to pair with the other
+    pieces'.  Up to ``examples`` nonconforming faces are given as vertex coordinates.
 
     Examples
     --------
@@ -144,15 +212,15 @@ def check_conformity(mesh: Mesh, examples: int = 5, seams: list | None = None) -
     >>> from cospherical.mesh.octree import build_octree, parse_shape
     >>> from cospherical.mesh.assembly import assemble
     >>> found = check_conformity(assemble(build_octree(Box.parse([1, 1, 1]), 1, [parse_shape("point:0.5,0.5,0.5")])))
-    >>> found["nonconforming_faces"], found["interior_faces"], found["boundary_faces"]
+    >>> found.nonconforming_faces, found.interior_faces, found.boundary_faces
     (0, 12, 24)
     """
     layout = mesh.regions.layout if mesh.regions is not None else None
-    return pair_faces(_faces(mesh), mesh.vertices, mesh.grid, examples, seams, layout)
+    return pair_faces(_faces(mesh), mesh.vertices, mesh.grid, examples, open_faces, layout)
 
 
-def pair_faces(faces: dict[int, list[np.ndarray]], vertices: np.ndarray, grid: int, examples: int = 5,
-               seams: list | None = None, layout: DeviceLayout | None = None) -> dict:
+def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArray[np.integer[Any]], grid: int,
+               examples: int = 5, open_faces: bool = False, layout: DeviceLayout | None = None) -> ConformityCheck:
     """:func:`check_conformity` on any elements' faces: ``faces``, by size, lists of arrays whose rows are
     faces as cycles of vertex ids counter-clockwise seen from outside their element; ``vertices``
     the grid points, ``grid`` intervals per side of the box, the domain (or its union of boxes,
@@ -160,6 +228,7 @@ def pair_faces(faces: dict[int, list[np.ndarray]], vertices: np.ndarray, grid: i
     """
     bad_total, interior, boundary = 0, 0, 0
     shown: list[list[list[float]]] = []
+    seams: list[OpenFaces] = []
     for size, parts in sorted(faces.items()):
         rows = np.concatenate(parts)
         parts.clear()
@@ -176,16 +245,15 @@ def pair_faces(faces: dict[int, list[np.ndarray]], vertices: np.ndarray, grid: i
         on_boundary = on_domain_boundary(vertices[turned[single]], grid, layout)
         ok[single[on_boundary]] = True
         boundary += int(on_boundary.sum())
-        if seams is not None:
+        if open_faces:
             seam = single[~on_boundary]
-            seams.append((size, turned[seam], flipped[seam]))
+            seams.append(OpenFaces(size, turned[seam], flipped[seam]))
             ok[seam] = True
         bad = np.flatnonzero(~ok)
         bad_total += len(bad)
         for row in bad[:max(0, examples - len(shown))]:
             shown.append((vertices[turned[row]] / grid).tolist())
-    return {"nonconforming_faces": int(bad_total), "interior_faces": int(interior), "boundary_faces": int(boundary),
-            "nonconforming_examples": shown}
+    return ConformityCheck(int(bad_total), int(interior), int(boundary), shown, tuple(seams))
 
 
 def on_domain_boundary(points: np.ndarray, grid: int, layout: DeviceLayout | None = None) -> np.ndarray:
@@ -206,7 +274,8 @@ def on_domain_boundary(points: np.ndarray, grid: int, layout: DeviceLayout | Non
     return on_boundary
 
 
-def _paired(turned: np.ndarray, flipped: np.ndarray):
+def _paired(turned: NDArray[np.integer[Any]], flipped: NDArray[np.bool_]) -> tuple[
+        NDArray[np.integer[Any]], NDArray[np.bool_], NDArray[np.bool_], int, NDArray[np.intp]]:
     """Sort turned faces; mark those met exactly twice in opposite orientations.
 
     Returns the sorted faces and orientations, the mask of faces so paired, how many
@@ -224,8 +293,9 @@ def _paired(turned: np.ndarray, flipped: np.ndarray):
     return turned, flipped, ok, len(good_pairs), starts[counts == 1]
 
 
-def match_seams(seams: list, vertices, grid: int, examples: int = 5) -> dict:
-    """Pair the faces that the pieces of a partitioned mesh left open (see :func:`check_conformity`'s ``seams``).
+def match_seams(seams: Iterable[OpenFaces], vertices: Callable[[NDArray[np.int64]], NDArray[np.int64]], grid: int,
+                examples: int = 5) -> ConformityCheck:
+    """Pair the faces that the pieces of a partitioned mesh left open (see :func:`check_conformity`'s ``open_faces``).
 
     Why this equals the check of the whole mesh: the pieces hold disjoint sets of
     elements, so a face's occurrences in the whole mesh are the sum of its
@@ -239,21 +309,22 @@ def match_seams(seams: list, vertices, grid: int, examples: int = 5) -> dict:
     only from one side, unpaired here or in its piece.  Either way a check fails, as
     in one process.  ``vertices(ids)`` gives grid points (for the examples).
 
-    Returns ``interior_faces`` (pairs across seams), ``nonconforming_faces`` and
-    ``nonconforming_examples``.
+    Returns the pairs across seams (``interior_faces``) and the faces that do not pair
+    (``boundary_faces`` is 0: the pieces counted those).
     """
+    seams = list(seams)
     interior = bad_total = 0
-    shown: list = []
-    for size in sorted({size for size, _, _ in seams}):
-        parts = [(t, f) for s, t, f in seams if s == size]
-        turned, _, ok, pairs, _ = _paired(np.concatenate([t for t, _ in parts]),
-                                                np.concatenate([f for _, f in parts]))
+    shown: list[list[list[float]]] = []
+    for size in sorted({seam.size for seam in seams}):
+        parts = [seam for seam in seams if seam.size == size]
+        turned, _, ok, pairs, _ = _paired(np.concatenate([seam.faces for seam in parts]),
+                                          np.concatenate([seam.flipped for seam in parts]))
         interior += pairs
         bad = np.flatnonzero(~ok)
         bad_total += len(bad)
         for row in bad[:max(0, examples - len(shown))]:
             shown.append((vertices(turned[row]) / grid).tolist())
-    return {"interior_faces": int(interior), "nonconforming_faces": int(bad_total), "nonconforming_examples": shown}
+    return ConformityCheck(int(bad_total), int(interior), 0, shown)
 
 
 def _row_order(rows: np.ndarray, bits: int) -> np.ndarray:
@@ -272,15 +343,42 @@ def _row_order(rows: np.ndarray, bits: int) -> np.ndarray:
     return np.argsort(keys[0], kind="stable") if len(keys) == 1 else np.lexsort(keys[::-1])
 
 
-def check_circumcenters(mesh: Mesh) -> dict:
+@dataclass(frozen=True)
+class CircumcenterCheck:
+    """What :func:`check_circumcenters` found: where the elements' circumcenters lie, decided exactly.
+
+    Attributes
+    ----------
+    circumcenters_outside_leaf : int
+        Elements whose circumcenter lies outside their own closed leaf (a cell of the global
+        Delaunay subdivision counts against its first leaf).
+    leaves_not_fvm_adequate : int
+        Leaves with at least one such leaf element.
+    elements_not_cospherical : int
+        Elements whose nodes are not on one sphere: not Delaunay elements at all.
+    boundary_circumcenters_outside : int
+        Elements whose circumcenter lies outside the closed domain.
+    """
+
+    circumcenters_outside_leaf: int
+    leaves_not_fvm_adequate: int
+    elements_not_cospherical: int
+    boundary_circumcenters_outside: int
+
+    def figures(self) -> dict[str, int]:
+        """The counts as the report names them, in its order."""
+        return {"circumcenters_outside_leaf": self.circumcenters_outside_leaf,
+                "leaves_not_fvm_adequate": self.leaves_not_fvm_adequate,
+                "elements_not_cospherical": self.elements_not_cospherical,
+                "boundary_circumcenters_outside": self.boundary_circumcenters_outside}
+
+
+def check_circumcenters(mesh: Mesh) -> CircumcenterCheck:
     """Circumcenters in their own closed leaf, decided exactly per configuration, counted over the leaves.
 
-    Returns ``circumcenters_outside_leaf`` (elements; a cell of the global Delaunay
-    subdivision counts against its first leaf), ``leaves_not_fvm_adequate`` (leaves
-    with at least one such leaf element), ``elements_not_cospherical`` (elements whose
-    nodes are not on one sphere: not Delaunay elements at all) and
-    ``boundary_circumcenters_outside``: elements whose circumcenter lies outside the
-    closed domain.  Only elements at the boundary can have one (an empty sphere
+    Returns a :class:`CircumcenterCheck`: elements whose circumcenter lies outside their
+    leaf, leaves not FVM-adequate, elements not co-spherical, and elements whose
+    circumcenter lies outside the closed domain.  Only elements at the boundary can have one (an empty sphere
     whose centre is beyond a boundary plane cuts it); there the box method's
     control volumes need the circumcenter inside, as the paper says.
     """
@@ -292,9 +390,7 @@ def check_circumcenters(mesh: Mesh) -> dict:
             leaves_bad += len(leaves)
     if mesh.cells is not None:
         outside += int((~mesh.cell_center_in_leaf()).sum())
-    return {"circumcenters_outside_leaf": int(outside), "leaves_not_fvm_adequate": int(leaves_bad),
-            "elements_not_cospherical": int(not_spherical),
-            "boundary_circumcenters_outside": _outside_domain(mesh)}
+    return CircumcenterCheck(int(outside), int(leaves_bad), int(not_spherical), _outside_domain(mesh))
 
 
 def _outside_domain(mesh: Mesh) -> int:
@@ -309,10 +405,10 @@ def _outside_domain(mesh: Mesh) -> int:
                 continue
             # the centre in grid units is low + c * size, for c = p / q: compare q * low + p * size with 0 and q * grid,
             # in int64 when every term is below 2**62 (low and size are at most grid), else in Python integers
-            p = [c.numerator for c in element.center]
-            q = [c.denominator for c in element.center]
-            kind = np.int64 if grid * (max(q) + max(map(abs, p))) < 2**62 else object
-            p, q = np.array(p, dtype=kind), np.array(q, dtype=kind)
+            numerators = [c.numerator for c in element.center]
+            denominators = [c.denominator for c in element.center]
+            kind = np.int64 if grid * (max(denominators) + max(map(abs, numerators))) < 2**62 else object
+            p, q = np.array(numerators, dtype=kind), np.array(denominators, dtype=kind)
             at = low.astype(kind) * q[None] + p[None] * size[leaves, None].astype(kind)
             outside += int((~in_closed_box(at, q[None], 0, grid)).sum())
     if mesh.cells is not None:
@@ -429,7 +525,7 @@ def _spheres(mesh: Mesh, points: np.ndarray) -> _Spheres:
     cells = mesh.cells
     for p, tessellation, leaves in (mesh.groups() if cells is None else ()):
         for j, element in enumerate(tessellation.elements):
-            if element.sphere is None:  # reported by check_circumcenters as not co-spherical
+            if element.sphere is None or element.center is None:  # check_circumcenters: not co-spherical
                 without_sphere.append(mesh.element_offsets[leaves].astype(np.int64) + j)
                 continue
             center = (origin[leaves] + np.array([float(x) for x in element.center])[None] * size[leaves, None]) * scale
@@ -529,7 +625,7 @@ def _candidates(mesh: Mesh, points: np.ndarray, spheres: _Spheres, workers: int,
     own[leafy] = (nodes == pair_vertex[leafy, None]).any(axis=1)
     celly = np.flatnonzero(is_cell)
     if len(celly):
-        own[celly] = (mesh.cells.nodes[spheres.leaf[pair_row[celly]]] == pair_vertex[celly, None]).any(axis=1)
+        own[celly] = (mesh.required_cells().nodes[spheres.leaf[pair_row[celly]]] == pair_vertex[celly, None]).any(axis=1)
     return pair_row[~own], pair_vertex[~own]
 
 
@@ -543,7 +639,7 @@ def _exact_sides(mesh: Mesh, spheres: _Spheres, pair_row: np.ndarray, pair_verte
     weights = grid_weights(mesh)
     rows_tessellation, rows_local, rows_leaf = spheres.tessellation, spheres.local, spheres.leaf
     for i, (row, vertex) in enumerate(zip(pair_row.tolist(), pair_vertex.tolist())):
-        if rows_tessellation[row] < 0:
+        if rows_tessellation[row] < 0 and cells is not None:  # a cell's sphere (a mesh with cells)
             shape = cells.shapes[rows_local[row]]
             x = [int(v) - int(o) for v, o in zip(mesh.vertices[vertex], cells.anchor[rows_leaf[row]])]
             side = shape.sphere.side_at(x, weights)
@@ -591,4 +687,4 @@ def grid_weights(mesh: Mesh) -> tuple[int, int, int]:
     """The box's squared lengths as integers in one ratio: the weights of the grid frame."""
     squared = mesh.box.squared
     den = math.lcm(*(w.denominator for w in squared))
-    return tuple(int(w * den) for w in squared)
+    return int(squared[0] * den), int(squared[1] * den), int(squared[2] * den)

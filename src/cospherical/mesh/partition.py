@@ -137,9 +137,8 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: 
             result["failing"] = (piece.leaves[mesh.element_leaf[failing]], mesh.element_local[failing])
             return result
         checked = found
-    seams: list = []
-    figures, _ = mesh_figures(mesh, piece.delaunay, checked=checked, seams=seams)
-    result.update(figures=figures, seams=seams)
+    figures, _, open_faces = mesh_figures(mesh, piece.delaunay, checked=checked, open_faces=True)
+    result.update(figures=figures, seams=open_faces)
     if piece.write is not None:
         piece.write(mesh, piece.path, piece.leaves)
     return result

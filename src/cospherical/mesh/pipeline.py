@@ -38,7 +38,7 @@ import numpy as np
 from ..core.configuration import Box
 from ..errors import InputError
 from .assembly import Lookup, Mesh, assemble
-from ..choices import MODES
+from ..choices import MODES, DelaunayMode
 from .delaunay import delaunay_mesh
 from .device import Device, DeviceLayout, device_layout, device_octree
 from .dual import Dual, dual_summary, mesh_dual
@@ -111,11 +111,12 @@ def tree_from_octree(tree: Octree) -> TreeSource:
     return TreeSource(tree, {"source": "leaves", "depth": tree.depth})
 
 
-def delaunay_mode(criterion: str, delaunay: str | None) -> str:
+def delaunay_mode(criterion: str, delaunay: str | None) -> DelaunayMode:
     """The Delaunay mode asked for, or the criterion's default (``global`` for ``optimal``, else ``leaf``)."""
-    mode = delaunay or ("global" if criterion == "optimal" else "leaf")
-    if mode not in MODES:
-        raise InputError(f"--delaunay {mode!r}: write global or leaf")
+    asked = delaunay or ("global" if criterion == "optimal" else "leaf")
+    mode = next((known for known in MODES if known == asked), None)
+    if mode is None:
+        raise InputError(f"--delaunay {asked!r}: write global or leaf")
     if mode == "global" and criterion != "optimal":
         raise InputError(f"--delaunay global gives the largest co-spherical cells, which --criterion "
                          f"{criterion} splits; use --delaunay leaf with it")

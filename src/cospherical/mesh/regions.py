@@ -104,7 +104,7 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
                            cells.proven, cells.clusters, cells.largest_cluster))
     leaf = {key: sum(f[key] for f in found) for key in found[0]}
     result = with_cells(mesh, bad, _merged(parts), types) if parts else mesh
-    if parts and check_conformity(result, examples=0)["nonconforming_faces"]:
+    if parts and check_conformity(result, examples=0).nonconforming_faces:
         # the regions' subdivisions do not meet face to face: the leaf mesh, conforming by construction
         return mesh, dict(leaf, fallback="leaf elements: the regions' Delaunay subdivisions do not meet face to face"), \
             None

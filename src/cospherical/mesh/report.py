@@ -12,18 +12,20 @@ import copy
 from collections import Counter
 from dataclasses import dataclass, field, fields
 from fractions import Fraction
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Iterable, Mapping, NamedTuple, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..catalogue import Catalogue
 from ..version import __version__
 from .assembly import Mesh
-from .checks import DelaunayCheck, check_circumcenters, check_conformity, check_delaunay, check_volume, match_seams
+from .checks import (DelaunayCheck, OpenFaces, check_circumcenters, check_conformity, check_delaunay, check_volume,
+                     match_seams)
 from .octree import Octree
 from .statistics import level_counts, occurrences, statistics, uniform_study
 
-__all__ = ["CheckedReport", "MeshReport", "checked_mesh_report", "merged_report", "mesh_figures", "mesh_report",
+__all__ = ["CheckedReport", "MeshFigures", "MeshReport", "checked_mesh_report", "merged_report", "mesh_figures", "mesh_report",
            "outside_catalogue"]
 
 # Figures of the pieces that the whole's report adds up.
@@ -34,14 +36,14 @@ _SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_f
            "cells_spanning_leaves")
 
 
-def outside_catalogue(mesh: Mesh) -> list[dict]:
+def outside_catalogue(mesh: Mesh) -> list[dict[str, Any]]:
     """The element types of the mesh its catalogue (:attr:`Mesh.catalogue`) does not name: id, systematic name, count, one example.
 
     The example is one element's vertices in domain units (exact fractions of the
     domain's sides, as text).  Nothing is added to the catalogue.
     """
-    known = mesh.catalogue if mesh.catalogue is not None else ()
-    found: dict[str, dict] = {}
+    known = mesh.catalogue
+    found: dict[str, dict[str, Any]] = {}
     for rows, nodes, _, type_id in mesh.blocks():
         if type_id in known or not len(rows):
             continue
@@ -53,14 +55,28 @@ def outside_catalogue(mesh: Mesh) -> list[dict]:
     return sorted(found.values(), key=lambda e: (-e["count"], e["id"]))
 
 
+class MeshFigures(NamedTuple):
+    """What :func:`mesh_figures` measured on a mesh (or on one piece of a partitioned mesh).
+
+    ``figures``: every count and check as the report names them, figures that add up over
+    pieces (:func:`merged_report` reads them); ``delaunay``: the global Delaunay check
+    (``None`` when skipped); ``open_faces``: the faces a piece leaves open at its seams, when
+    asked (see :func:`~cospherical.mesh.checks.check_conformity`).
+    """
+
+    figures: dict[str, Any]
+    delaunay: DelaunayCheck | None
+    open_faces: tuple[OpenFaces, ...]
+
+
 def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None] | None = None,
                  progress: Callable[[int], None] | None = None, checked: DelaunayCheck | None = None,
-                 seams: list | None = None) -> tuple[dict, DelaunayCheck | None]:
+                 open_faces: bool = False) -> MeshFigures:
     """Every exact check and count of ``mesh`` (or of one piece of a partitioned mesh), as figures that add up,
     and the global Delaunay check (``checked`` when the caller has it; ``None`` when ``delaunay`` is false).
 
-    ``seams``, a list, receives the faces a piece leaves open (see
-    :func:`~cospherical.mesh.checks.check_conformity`).
+    ``open_faces=True``: ``mesh`` is a piece, whose faces left open at its seams are returned,
+    not counted (see :func:`~cospherical.mesh.checks.check_conformity`).
     """
     def start(name: str) -> None:
         if stage:
@@ -70,11 +86,12 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
                "cells_spanning_leaves": int(mesh.cells.spanning.sum()) if mesh.cells is not None else 0}
     start("volume")
     volume = check_volume(mesh)
-    figures.update(volume=Fraction(volume["volume"]), flat_elements=volume["flat_elements"])
+    figures.update(volume=volume.volume, flat_elements=volume.flat_elements)
     start("conformity")
-    figures.update(check_conformity(mesh, seams=seams))
+    conformity = check_conformity(mesh, open_faces=open_faces)
+    figures.update(conformity.figures())
     start("circumcenters")
-    figures.update(check_circumcenters(mesh))
+    figures.update(check_circumcenters(mesh).figures())
     found = None
     if delaunay:
         start("delaunay")
@@ -91,14 +108,15 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
     figures["leaves_tessellated_on_the_fly"] = int(sum(
         len(leaves) for _, p, leaves in mesh.groups(all_leaves=True) if p.on_the_fly))
     figures["types"] = dict(mesh.types)
-    return figures, found
+    return MeshFigures(figures, found, conformity.open_faces)
 
 
-def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dict, patterns: str | None,
-                  criterion: str = "optimal", uniform: bool = True, delaunay: bool = True,
-                  leaf_mesh: dict | None = None, cells: tuple[int, int] = (0, 0), seams: list | None = None,
-                  vertex_points: Callable | None = None, grid: int = 1, *, catalogue: Catalogue,
-                  domain_share: Fraction = Fraction(1)) -> dict:
+def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]], described: Mapping[str, Any],
+                  patterns: str | None, criterion: str = "optimal", uniform: bool = True, delaunay: bool = True,
+                  leaf_mesh: Mapping[str, int] | None = None, cells: tuple[int, int] = (0, 0),
+                  seams: Iterable[OpenFaces] | None = None,
+                  vertex_points: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None = None, grid: int = 1, *,
+                  catalogue: Catalogue, domain_share: Fraction = Fraction(1)) -> dict[str, Any]:
     """The report of a mesh from the :func:`mesh_figures` of its pieces (one piece: the whole mesh).
 
     ``catalogue``: the element catalogue the pieces were assembled with (it names the types).
@@ -109,7 +127,7 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
     root box's (a device's boxes can leave part of their bounding box out).
     """
     summed = {key: sum(part[key] for part in parts) for key in _SUMMED if all(key in part for part in parts)}
-    report = {
+    report: dict[str, Any] = {
         "schema_version": 1,
         "generator": f"cospherical {__version__}",
         "domain": list(tree.box.texts),
@@ -121,8 +139,8 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
         "vertices": int(vertices),
         "elements": sum(part["elements"] for part in parts),
     }
-    type_counts: Counter = sum((Counter(part["type_counts"]) for part in parts), Counter())
-    outside: dict[str, dict] = {}
+    type_counts: Counter[str] = sum((Counter(part["type_counts"]) for part in parts), Counter())
+    outside: dict[str, dict[str, Any]] = {}
     for part in parts:
         for entry in part["types_outside_catalogue"]:
             mine = outside.setdefault(entry["id"], {**entry, "count": 0})
@@ -142,10 +160,12 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
     examples = [e for part in parts for e in part["nonconforming_examples"]]
     conformity = {key: summed[key] for key in ("nonconforming_faces", "interior_faces", "boundary_faces")}
     if seams is not None:
+        if vertex_points is None:
+            raise ValueError("merged_report: seams without vertex_points, which places their faces")
         matched = match_seams(seams, vertex_points, grid)
-        conformity["nonconforming_faces"] += matched["nonconforming_faces"]
-        conformity["interior_faces"] += matched["interior_faces"]
-        examples += matched["nonconforming_examples"]
+        conformity["nonconforming_faces"] += matched.nonconforming_faces
+        conformity["interior_faces"] += matched.interior_faces
+        examples += matched.nonconforming_examples
     report.update(conformity, nonconforming_examples=examples[:5])
     report.update({key: summed[key] for key in ("circumcenters_outside_leaf", "leaves_not_fvm_adequate",
                                                 "elements_not_cospherical", "boundary_circumcenters_outside")})
@@ -155,7 +175,7 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
                                                     "delaunay_exact_tests", "delaunay_violating_fvm_leaves")})
     else:
         report["delaunay_violations"] = None
-    configurations: dict[str, dict] = {}
+    configurations: dict[str, dict[str, Any]] = {}
     for part in parts:
         for code, entry in part["configurations"].items():
             mine = configurations.setdefault(code, {**entry, "leaves": 0})
@@ -167,7 +187,7 @@ def merged_report(tree: Octree, vertices: int, parts: list[dict], described: dic
     report["configurations_mapped"] = mapped
     report["tessellated_on_the_fly"] = on_the_fly
     report["leaves_tessellated_on_the_fly"] = summed["leaves_tessellated_on_the_fly"]
-    types: dict = {}
+    types: dict[str, dict[str, Any]] = {}
     for part in parts:
         types.update(part["types"])
     report.update(statistics(type_counts, configurations, len(tree), types, catalogue,
@@ -188,14 +208,14 @@ class CheckedReport:
         data); ``None`` when the check was skipped.
     """
 
-    report: dict
+    report: dict[str, Any]
     delaunay: DelaunayCheck | None
 
 
-def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal", uniform: bool = True,
-                delaunay: bool = True, stage: Callable[[str], None] | None = None,
+def mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | None, criterion: str = "optimal",
+                uniform: bool = True, delaunay: bool = True, stage: Callable[[str], None] | None = None,
                 progress: Callable[[int], None] | None = None,
-                leaf_mesh: dict | None = None, checked: DelaunayCheck | None = None) -> dict:
+                leaf_mesh: Mapping[str, int] | None = None, checked: DelaunayCheck | None = None) -> dict[str, Any]:
     """Run every check on ``mesh`` and gather the report (the keys of ``schemas/mesh-report.schema.json``).
 
     ``tree`` describes where the octree came from; ``patterns`` names the table read
@@ -223,12 +243,12 @@ def mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "
                                checked).report
 
 
-def checked_mesh_report(mesh: Mesh, tree: dict, patterns: str | None, criterion: str = "optimal",
+def checked_mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | None, criterion: str = "optimal",
                         uniform: bool = True, delaunay: bool = True, stage: Callable[[str], None] | None = None,
-                        progress: Callable[[int], None] | None = None, leaf_mesh: dict | None = None,
+                        progress: Callable[[int], None] | None = None, leaf_mesh: Mapping[str, int] | None = None,
                         checked: DelaunayCheck | None = None) -> CheckedReport:
     """:func:`mesh_report` (the same arguments), and the global Delaunay check it ran or was given."""
-    figures, found = mesh_figures(mesh, delaunay, stage, progress, checked)
+    figures, found, _ = mesh_figures(mesh, delaunay, stage, progress, checked)
     cells = (mesh.cells.clusters, mesh.cells.largest_cluster) if mesh.cells is not None else (0, 0)
     report = merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
                            leaf_mesh, cells, catalogue=mesh.catalogue, domain_share=mesh.domain_share)
@@ -274,14 +294,14 @@ class MeshReport:
     cells_spanning_leaves: int
     regions_retessellated: int
     largest_region_vertices: int
-    types_outside_catalogue: list[dict]
+    types_outside_catalogue: list[dict[str, Any]]
     volume_ok: bool
     volume: str
     flat_elements: int
     nonconforming_faces: int
     interior_faces: int
     boundary_faces: int
-    nonconforming_examples: list
+    nonconforming_examples: list[list[list[float]]]
     circumcenters_outside_leaf: int
     leaves_not_fvm_adequate: int
     elements_not_cospherical: int
@@ -299,17 +319,17 @@ class MeshReport:
     leaves_tessellated_on_the_fly: int = 0
     paper_final_share: float = 0.0
     leaves_in_bisection_family: int = 0
-    type_frequencies: list[dict] = field(default_factory=list)
-    configuration_frequencies: list[dict] = field(default_factory=list)
+    type_frequencies: list[dict[str, Any]] = field(default_factory=list)
+    configuration_frequencies: list[dict[str, Any]] = field(default_factory=list)
     uniform: Mapping[str, Any] | None = None
     negative_coefficients: Mapping[str, int] | None = None
     dual: Mapping[str, Any] | None = None
     device: Mapping[str, Any] | None = None
     timings: Mapping[str, float] = field(default_factory=dict, compare=False)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """The report as ``report.json`` holds it (a new dict, deep-copied: changing it changes nothing here)."""
-        result = {}
+        result: dict[str, Any] = {}
         for item in fields(self):
             value = getattr(self, item.name)
             if item.name == "timings" or (value is None and item.name in _ABSENT_WHEN_NONE):

@@ -62,8 +62,9 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
         if not len(crossing):
             continue
         edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in faces for i in range(len(c))})
-        a = nodes[np.ix_(crossing, [p for p, _ in edges])]  # (crossing elements, edges): vertex ids
-        b = nodes[np.ix_(crossing, [q for _, q in edges])]
+        ends = np.array(edges, dtype=np.intp).reshape(-1, 2)
+        a = nodes[np.ix_(crossing, ends[:, 0])]  # (crossing elements, edges): vertex ids
+        b = nodes[np.ix_(crossing, ends[:, 1])]
         pa, pb = vertices[a].astype(float), vertices[b].astype(float)  # (elements, edges, 3)
         za, zb = pa[..., 2] - z0, pb[..., 2] - z0
         cut = za * zb < 0
