@@ -373,7 +373,7 @@ def dual_table(up: str) -> str:
     """The mixed mesh beside the tetrahedral Delaunay mesh of its vertices, per report made with --dual."""
     reports = [(name, r) for name, r in _reports() if r.get("dual", {}).get("tetrahedral")]
     if not reports:
-        return "*(no report in results/mesh/ was made with --dual)*"
+        return "*(no report in results/mesh/ was made with --dual --tetrahedral-counts)*"
     rows = ["| | " + " | ".join(f"<code>{_text(name)}</code>" for name, _ in reports) + " |",
             "|---|" + "---:|" * len(reports)]
     for key in ("elements", "edges", "faces", "nonzeros"):

@@ -47,6 +47,7 @@ def test_report_round_trip_and_schema():
     assert MeshReport.from_dict(data) == m.report
     assert MeshReport.from_dict(json.loads(json.dumps(data))).to_dict() == data
     assert "timings" not in data and {"assembly", "volume", "dual"} <= set(m.report.timings)
+    assert m.report.dual["tetrahedral"] is None  # the outside mesher runs only when asked (tetrahedral_counts)
     data["leaves"] = -1  # a copy: the report does not change
     assert m.report.leaves == 15
     with pytest.raises(AttributeError):
@@ -55,9 +56,9 @@ def test_report_round_trip_and_schema():
 
 @pytest.mark.parametrize("argv, kwargs", [
     (["--domain", "1", "2", "4", "--levels", "3", "--refine", "sphere:0.5,1,2,0.6", "--patterns",
-      "patterns/leaves-1x2x4.yaml", "--dual", "--no-uniform"],
+      "patterns/leaves-1x2x4.yaml", "--dual", "--tetrahedral-counts", "--no-uniform"],
      dict(domain=(1, 2, 4), levels=3, refine=["sphere:0.5,1,2,0.6"], patterns="patterns/leaves-1x2x4.yaml",
-          dual=True, uniform=False)),
+          dual=True, tetrahedral_counts=True, uniform=False)),
     (["--domain", "1", "1", "1", "--leaves", "examples/leaves.txt", "--delaunay", "leaf", "--no-delaunay"],
      dict(domain=("1", "1", "1"), leaves="examples/leaves.txt", delaunay="leaf", check_delaunay=False)),
 ])
@@ -69,6 +70,9 @@ def test_the_cli_writes_what_write_writes(tmp_path, capsys, argv, kwargs):
     assert set(cli) == {".cospherical-manifest.json", "mesh.vtu", "report.json", "mesh.png"} | (
         {"dual.npz"} if kwargs.get("dual") else set())
     assert cli == api
+    if kwargs.get("tetrahedral_counts"):
+        counts = json.loads((tmp_path / "cli" / "report.json").read_text())["dual"]["tetrahedral"]
+        assert counts["tool"] == "tetgen" and counts["elements"] > 0
 
 
 def test_a_leaf_list_in_memory_is_numbered_as_listed():
@@ -109,6 +113,9 @@ def test_a_leaf_list_in_memory_is_numbered_as_listed():
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], criterion=["optimal"]), "criterion=['optimal']"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], delaunay=[]), "delaunay=[]"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], dual="no"), "dual='no'"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], dual=True, tetrahedral_counts=1),
+     "tetrahedral_counts=1"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], tetrahedral_counts=True), "give dual=True too"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], max_leaves="8"), "max_leaves='8'"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], max_leaves=1.5), "max_leaves=1.5"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], progress=5), "progress=5"),
@@ -173,6 +180,7 @@ def test_the_cli_writes_the_tetrahedra_and_gmsh_file_that_write_writes(tmp_path,
     (["--gmsh-binary"], "give --gmsh VERSION too"),
     (["--gmsh", "3.0"], "invalid choice"),
     (["--tets", "--partitions", "2"], "not with --partitions"),
+    (["--tetrahedral-counts"], "give --dual too"),
 ])
 def test_gmsh_and_tets_options_refused_with_one_line(tmp_path, capsys, argv, needle):
     base = ["mesh", "--domain", "1", "1", "1", "--refine", "point:0.5,0.5,0.5", "--levels", "1", "--no-uniform"]

@@ -71,7 +71,11 @@ def add_arguments(parser) -> None:
     parser.add_argument("--dual", action="store_true",
                         help="the exact finite-volume dual: dual.npz in --out (edges, coefficients, control volumes), "
                         "point data control_volume, boundary_area and cell data circumcenter, delaunay_ok in mesh.vtu, "
-                        "negative_coefficients and the mixed mesh beside a tetrahedral one in the report")
+                        "negative_coefficients in the report")
+    parser.add_argument("--tetrahedral-counts", action="store_true",
+                        help="with --dual: the mixed mesh beside a tetrahedral Delaunay mesh of the same vertices "
+                        "(TetGen's, else Qhull's: elements, edges, faces, nonzeros) in the report; an outside "
+                        "mesher's run, costlier than the dual itself"),
     parser.add_argument("--gmsh", choices=GMSH_VERSIONS, metavar="VERSION",
                         help="also mesh.msh in --out: the mesh split into conforming tetrahedra (no new vertex; the "
                         "exact dual kept, the added edges coupling 0) as a Gmsh file of VERSION 2.2 (DEVSIM's) or "
@@ -179,6 +183,8 @@ def run(args) -> int:
         raise InputError("--domain needs the tree: --refine SHAPE (with --levels L) or --leaves FILE")
     if args.gmsh_binary and args.gmsh is None:
         raise InputError("--gmsh-binary chooses mesh.msh's form: give --gmsh VERSION too")
+    if args.tetrahedral_counts and not args.dual:
+        raise InputError("--tetrahedral-counts counts beside the dual's figures: give --dual too")
     if (args.gmsh is not None or args.tets) and (args.out is None or pieces is not None):
         option = "--gmsh" if args.gmsh is not None else "--tets"
         raise InputError(f"{option} writes into --out DIR, the whole mesh in one process: with --out, not with "
@@ -233,7 +239,8 @@ def _run(args, out: OutputFolder | None) -> int:
         return _in_pieces(args, tree_source(box, **given, max_leaves=max_leaves), out)
     with _bars() as progress:
         mesh = build_mesh(box, **given, patterns=args.patterns, criterion=args.criterion, delaunay=args.delaunay,
-                          dual=args.dual, max_leaves=max_leaves, check_delaunay=not args.no_delaunay,
+                          dual=args.dual, tetrahedral_counts=args.tetrahedral_counts, max_leaves=max_leaves,
+                          check_delaunay=not args.no_delaunay,
                           uniform=not args.no_uniform, progress=progress)
     clock = time.perf_counter()
     if out is not None:

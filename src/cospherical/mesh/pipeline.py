@@ -157,8 +157,8 @@ class _Clock:
 
 def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: str | None = None,
                  criterion: str = "optimal", delaunay: str | None = None, check_delaunay: bool = True,
-                 uniform: bool = True, dual: bool = False, progress: Progress | None = None,
-                 timings: dict[str, float] | None = None) -> PipelineResult:
+                 uniform: bool = True, dual: bool = False, tetrahedral_counts: bool = False,
+                 progress: Progress | None = None, timings: dict[str, float] | None = None) -> PipelineResult:
     """Mesh ``source``'s tree, check it exactly, report it and, with ``dual``, compute its finite-volume dual.
 
     Parameters
@@ -183,6 +183,9 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         Add the uniform-weight bisection study beside the mesh's frequencies.
     dual
         Compute the exact dual now (the report then holds its figures).
+    tetrahedral_counts
+        With ``dual``: count a tetrahedral Delaunay mesh of the same vertices by an outside
+        mesher beside the mixed mesh, in the report's dual figures (``None`` there otherwise).
     progress
         ``progress(stage, total, advance)``, see the module's docstring.
     timings
@@ -212,7 +215,8 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     if dual:
         clock.stage("dual")
         found = mesh_dual(mesh)
-        report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"]))
+        report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"],
+                                   tetrahedral=tetrahedral_counts))
     if source.device is not None:
         clock.stage("regions")
         faces = region_faces(mesh)

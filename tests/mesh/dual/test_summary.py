@@ -17,7 +17,7 @@ def test_the_summary_counts_the_mixed_mesh_and_tetgens_of_the_same_vertices():
     box = Box.parse(["1", "1", "1"])
     mesh = assemble(build_octree(box, 2, [parse_shape("point:1/3,1/5,1/7")]), cache=CACHES.setdefault(box.texts, {}))
     dual = mesh_dual(mesh)
-    summary = dual_summary(dual, len(mesh), 1234)
+    summary = dual_summary(dual, len(mesh), 1234, tetrahedral=True)
     figures, mixed, tets = summary["dual"], summary["dual"]["mixed"], summary["dual"]["tetrahedral"]
     assert summary["negative_coefficients"] == dual.negative_coefficients()
     assert figures["volume_sum"] == "1" and figures["edges"] == len(dual.edges) == mixed["edges"]
@@ -30,4 +30,4 @@ def test_the_summary_counts_the_mixed_mesh_and_tetgens_of_the_same_vertices():
     assert tets["elements"] > mixed["elements"] and tets["edges"] >= mixed["edges"]
     assert len(dual.vertices) - tets["edges"] + tets["faces"] - tets["elements"] == 1
     assert tets["nonzeros"] == len(dual.vertices) + 2 * tets["edges"]
-    assert dual_summary(dual, len(mesh), 1234, tetrahedral=False)["dual"]["tetrahedral"] is None
+    assert dual_summary(dual, len(mesh), 1234)["dual"]["tetrahedral"] is None  # the outside run is asked for

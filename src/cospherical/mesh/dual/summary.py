@@ -10,12 +10,13 @@ from .tetrahedral import TETRAHEDRAL_LIMIT, tetrahedral_counts
 __all__ = ["dual_summary"]
 
 
-def dual_summary(dual: Dual, elements: int, faces: int, tetrahedral: bool = True) -> dict[str, Any]:
+def dual_summary(dual: Dual, elements: int, faces: int, tetrahedral: bool = False) -> dict[str, Any]:
     """The report's figures of a dual: negative coefficients, sums, and the mixed mesh beside a tetrahedral one.
 
-    ``elements`` and ``faces`` are the mixed mesh's (faces: interior plus boundary);
-    ``tetrahedral=False``, or more than :data:`TETRAHEDRAL_LIMIT` vertices, leaves the
-    tetrahedral side ``None``.
+    ``elements`` and ``faces`` are the mixed mesh's (faces: interior plus boundary).
+    ``tetrahedral`` runs the outside mesher (:func:`tetrahedral_counts`: TetGen on 450,000
+    vertices costs several times the dual); without it, or above :data:`TETRAHEDRAL_LIMIT`
+    vertices, the tetrahedral side is ``None``.
     """
     negative = dual.negative_coefficients()
     mixed = {"elements": int(elements), "edges": int(len(dual.edges)), "faces": int(faces),
