@@ -1,61 +1,48 @@
-"""Aspect-ratio sweeps: grid points against direct studies, exact thresholds against boxes on both sides."""
+"""Aspect-ratio sweeps: exact grids of ratios, the study of each box (1, b, c) with b <= c, in grid order."""
 
 from __future__ import annotations
 
 from fractions import Fraction
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
-from cospherical.core.exact import Length, rational_text
-from cospherical.studies.ray import Ray, profile_summary, ray_profile
-from cospherical.studies.sweep import box_statistics, grid_values
-
-RANGES = {"1,r,r": (Fraction(1), Fraction(9, 5)), "1,1,r": (Fraction(3, 2), Fraction(2))}
-
-
-@pytest.fixture(scope="module")
-def profiles():
-    return {ray: ray_profile(Ray.parse(ray), *RANGES[ray]) for ray in RANGES}
+from cospherical.errors import InputError
+from cospherical.studies import sweep as sweeps
+from cospherical.studies.sweep import box_statistics, grid_values, sweep
 
 
-def box_of(ray: str, r_text: str) -> tuple[str, str, str]:
-    return tuple(r_text if part == "r" else "1" for part in ray.split(","))
+@given(st.fractions(min_value=Fraction(1, 100), max_value=100, max_denominator=100),
+       st.fractions(min_value=0, max_value=10, max_denominator=100), st.integers(2, 12))
+def test_a_grid_runs_evenly_from_min_to_max(low, width, steps):
+    high = low + width
+    values = grid_values(f"{low}:{high}:{steps}")
+    assert len(values) == steps and values[0] == low and values[-1] == high
+    assert len({b - a for a, b in zip(values, values[1:])}) == 1  # exact, evenly spaced
 
 
-def rational_inside(lo: Fraction, hi: Fraction) -> Fraction:
-    """A simple rational r with lo < r^2 < hi (u = r^2 bounds)."""
-    target = (Length(lo).__float__() + Length(hi).__float__()) / 2
-    for den in (10, 100, 1000, 10000, 100000):
-        r = Fraction(round(target * den), den)
-        if lo < r * r < hi:
-            return r
-    raise AssertionError("no rational found")
+@pytest.mark.parametrize("spec, needle", [("1:2", "MIN:MAX:STEPS"), ("1:2:x", "whole number"), ("0:2:3", "0 < MIN"),
+                                          ("2:1:3", "MIN <= MAX"), ("1:2:1", "STEPS = 1 only"), ("1:nan:3", "--b .nan.: not an integer")])
+def test_a_bad_grid_is_one_line(spec, needle):
+    with pytest.raises(InputError, match=needle):
+        grid_values(spec, "--b")
+    assert grid_values("3/2:3/2:1") == [Fraction(3, 2)]
 
 
-@pytest.mark.parametrize("ray", sorted(RANGES))
-def test_each_threshold_holds_on_both_sides_and_at_itself(profiles, ray):
-    steps = profiles[ray]
-    assert len(steps) >= 3
-    for step in steps:
-        if step.lo == step.hi:
-            probes = [Length(step.lo).text]  # exactly at the threshold: a sqrt box
-        else:
-            probes = [rational_text(rational_inside(step.lo, step.hi))]
-        for probe in probes:
-            direct = box_statistics(box_of(ray, probe))
-            assert (direct["fvm_adequate"], direct["types"]) == (step.fvm_adequate, len(step.types)), (ray, probe)
+def test_the_cube_is_the_papers_first_box():
+    # The paper's Table 2 (box A): 37,259 elements, every one of the 4096 configurations FVM-adequate.
+    stats = box_statistics(("1", "1", "1"))
+    assert (stats["box"], stats["total"], stats["fvm_adequate"]) == (["1", "1", "1"], 37259, 4096)
 
 
-def test_largest_fully_adequate_ratios(profiles):
-    summary = profile_summary(Ray.parse("1,r,r"), *RANGES["1,r,r"], profiles["1,r,r"])  # the fixture's profile
-    assert summary["largest_fully_adequate"] == {"r": "sqrt(2)", "attained": True}
-    # just above sqrt 2 some configuration fails
-    assert box_statistics(("1", "1.4143", "1.4143"))["fvm_adequate"] < 4096
-
-
-def test_grid_points_agree_with_the_ray(profiles):
-    ray = "1,1,r"
-    for c in grid_values("3/2:2:3"):
-        direct = box_statistics(("1", "1", rational_text(c)))
-        step = next(s for s in profiles[ray] if s.contains(c * c))
-        assert (direct["fvm_adequate"], direct["types"]) == (step.fvm_adequate, len(step.types)), c
+def test_the_boxes_with_b_up_to_c_in_grid_order(monkeypatch):
+    # On the first 64 codes of each box: which boxes, in which order, each box's own figures.
+    codes = sweeps.bisection_codes()[:64]
+    monkeypatch.setattr(sweeps, "bisection_codes", lambda: codes)
+    done = []
+    rows = sweep([Fraction(1), Fraction(3, 2)], [Fraction(1), Fraction(3, 2), Fraction(2)], progress=done.append)
+    assert [row["box"] for row in rows] == [["1", "1", "1"], ["1", "1", "1.5"], ["1", "1", "2"],
+                                            ["1", "1.5", "1.5"], ["1", "1.5", "2"]]
+    assert done == [1] * 5 and rows[2] == box_statistics(("1", "1", "2"))
+    assert len({(row["total"], row["types"]) for row in rows}) > 1  # the boxes differ

@@ -1,0 +1,107 @@
+"""A mesh's report: every figure recounted from the mesh's own arrays, the JSON shape, the typed view of it."""
+
+from __future__ import annotations
+
+from collections import Counter
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from cospherical.core.configuration import Box
+from cospherical.files.yamlio import validate
+from cospherical.mesh.assembly import assemble
+from cospherical.mesh.octree import build_octree, parse_shape
+from cospherical.mesh.report import MeshReport, checked_mesh_report, mesh_report
+
+DOMAIN = (1, 2, 4)
+
+
+@pytest.fixture(scope="module")
+def mesh():
+    """Two levels in a 1 x 2 x 4 box, refined towards a point: 15 leaves."""
+    return assemble(build_octree(Box.parse(list(DOMAIN)), 2, [parse_shape("point:0.1,0.1,0.1")]))
+
+
+@pytest.fixture(scope="module")
+def report(mesh):
+    stages: list[str] = []
+    progress: list[int] = []
+    found = checked_mesh_report(mesh, {"source": "refine"}, None, uniform=False, stage=stages.append,
+                                progress=progress.append)
+    return found, stages, progress
+
+
+def _faces(mesh) -> Counter:
+    faces: Counter = Counter()
+    for _, nodes, cycles, _ in mesh.blocks():
+        for row in nodes:
+            for cycle in cycles:
+                faces[frozenset(int(row[i]) for i in cycle)] += 1
+    return faces
+
+
+def test_the_figures_recounted_from_the_mesh(mesh, report):
+    data = report[0].report
+    validate(data, "mesh-report", "report")
+    blocks = list(mesh.blocks())
+    assert data["elements"] == sum(len(nodes) for _, nodes, _, _ in blocks) == len(mesh)
+    assert data["vertices"] == len(np.unique(mesh.vertices, axis=0))
+    assert data["leaves"] == len(mesh.tree) == sum(data["leaves_per_level"].values())
+    assert data["leaves_per_level"] == {str(k): v for k, v in sorted(Counter(mesh.tree.levels.tolist()).items())}
+    counts = Counter()
+    for _, nodes, _, type_id in blocks:
+        counts[type_id] += len(nodes)
+    assert {row["id"]: row["count"] for row in data["type_frequencies"]} == counts and data["types"] == len(counts)
+    assert (data["volume"], data["volume_ok"], data["flat_elements"]) == ("1", True, 0)
+
+
+def test_faces_recounted_and_the_boundary_covers_the_box(mesh, report):
+    data = report[0].report
+    faces = _faces(mesh)
+    assert data["nonconforming_faces"] == 0 and set(faces.values()) <= {1, 2}
+    assert data["interior_faces"] == sum(n == 2 for n in faces.values())
+    assert data["boundary_faces"] == sum(n == 1 for n in faces.values())
+    # every boundary face lies on a side of the box, and their areas add up to the box's surface
+    points = mesh.points()
+    area = 0.0
+    for face, n in faces.items():
+        if n == 1:
+            corners = points[sorted(face)]
+            assert any(np.all(corners[:, axis] == 0) or np.allclose(corners[:, axis], DOMAIN[axis])
+                       for axis in range(3))
+            centre = corners.mean(axis=0)  # the face is convex: a fan from its centre, in any order of the corners
+            normal_axis = next(a for a in range(3) if np.ptp(corners[:, a]) == 0)
+            u, v = (a for a in range(3) if a != normal_axis)
+            angles = np.arctan2(corners[:, v] - centre[v], corners[:, u] - centre[u])
+            ring = corners[np.argsort(angles)]
+            area += 0.5 * abs(np.sum(ring[:, u] * np.roll(ring[:, v], -1) - np.roll(ring[:, u], -1) * ring[:, v]))
+    a, b, c = DOMAIN
+    assert area == pytest.approx(2 * (a * b + b * c + c * a), rel=1e-12)
+
+
+def test_each_check_is_announced_and_the_delaunay_check_kept(mesh, report):
+    found, stages, progress = report
+    assert stages == ["volume", "conformity", "circumcenters", "delaunay", "statistics"]
+    assert sum(progress) == len(mesh) and found.delaunay is not None
+    assert found.report["delaunay_violations"] == found.delaunay.figures()["delaunay_violations"]
+
+
+def test_without_the_delaunay_check_its_figures_are_absent(mesh):
+    data = mesh_report(mesh, {"source": "refine"}, None, uniform=False, delaunay=False)
+    assert data["delaunay_violations"] is None and "delaunay_ties" not in data and "uniform" not in data
+    validate(data, "mesh-report", "report")
+
+
+def test_the_typed_report_reads_and_writes_the_same_json(report):
+    data = report[0].report
+    typed = MeshReport.from_dict(data, timings={"tree": 0.5})
+    assert typed.to_dict() == data and typed.timings == {"tree": 0.5}
+    assert list(typed.to_dict()) == list(data)  # the order report.json writes
+    assert MeshReport.from_dict(typed.to_dict()) == typed  # timings are not compared
+    copy = typed.to_dict()
+    copy["type_frequencies"][0]["count"] = -1
+    assert typed.type_frequencies[0]["count"] > 0  # a copy: changing it changes nothing
+    with pytest.raises(TypeError):
+        MeshReport.from_dict({**data, "unknown": 1})
+    assert Fraction(typed.volume) == 1
