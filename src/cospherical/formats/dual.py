@@ -106,6 +106,7 @@ import zlib
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -113,6 +114,7 @@ from ..core.configuration import Box
 from ..errors import FormatError, InputError, shown
 from ..files.yamlio import atomic_write, machine_memory, parse_json
 from ..mesh.device import NAME
+from ..mesh.device import DeviceLayout
 from ..mesh.dual import Dual, RegionParts
 
 __all__ = ["DUAL_FORMAT_VERSION", "domain_sums", "dual_layout", "read_dual", "verify_dual", "write_dual"]
@@ -255,7 +257,7 @@ def _member(archive: zipfile.ZipFile, name: str, path: Path, limit: int) -> tupl
     return blob, array
 
 
-def _check_headers(archive: zipfile.ZipFile, path: Path, members: dict) -> None:
+def _check_headers(archive: zipfile.ZipFile, path: Path, members: dict[str, tuple[str, int | str | None, str]]) -> None:
     """Every member's type and shape from its .npy header, checked against the others and against
     this machine's memory before any member's data is read.
 
@@ -335,7 +337,7 @@ def read_dual(path: str | Path) -> Dual:
     return _dual(arrays, manifest, path)
 
 
-def _manifest(raw: np.ndarray, path: Path) -> dict:
+def _manifest(raw: np.ndarray, path: Path) -> dict[str, Any]:
     try:
         text = raw.astype(np.uint8).tobytes().decode()
     except (ValueError, UnicodeDecodeError):
@@ -365,7 +367,7 @@ def _integers(array: np.ndarray, name: str, path: Path) -> np.ndarray:
     return np.array([int(x) for x in text], dtype=object).reshape(array.shape)
 
 
-def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
+def _dual(arrays: dict[str, np.ndarray], manifest: dict[str, Any], path: Path) -> Dual:
     edges = arrays["edges"]
     if len(edges) and (edges.min() < 0 or edges.max() >= len(arrays["grid_vertices"]) or np.any(edges[:, 0] >= edges[:, 1])):
         raise FormatError(f"{path}: member edges: a pair that is not two vertices i < j")
@@ -386,7 +388,7 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
         bden = int(manifest["boundary_area_denominator"])
         factor_squared = Fraction(manifest["volume_factor_squared"])
         factor = math.sqrt(factor_squared)
-        plane_squared = tuple(Fraction(f) for f in factors)
+        plane_squared = (Fraction(factors[0]), Fraction(factors[1]), Fraction(factors[2]))
     except (ValueError, TypeError, ZeroDivisionError, OverflowError) as error:
         raise FormatError(f"{path}: manifest: {error}") from None
     vertices = arrays["grid_vertices"]
@@ -413,14 +415,17 @@ def _dual(arrays: dict, manifest: dict, path: Path) -> Dual:
                 regions=regions)
 
 
-def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n_elements: int, path: Path,
+def _region_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], n_vertices: int, n_edges: int, n_elements: int, path: Path,
                   factor: float, n_face_bound: int) -> RegionParts:
     """A version 4 file's region members, checked: names, indices in range, denominators (before any geometry)."""
-    names, materials = manifest.get("region_names"), manifest.get("region_materials")
-    contacts, regions_of = manifest.get("contact_names"), manifest.get("contact_regions")
-    boxes = manifest.get("contact_boxes")
+    # JSON values, their types checked below
+    names: Any = manifest.get("region_names")
+    materials: Any = manifest.get("region_materials")
+    contacts: Any = manifest.get("contact_names")
+    regions_of: Any = manifest.get("contact_regions")
+    boxes: Any = manifest.get("contact_boxes")
 
-    def texts(value, count=None) -> bool:
+    def texts(value: Any, count: int | None = None) -> bool:
         # the device file's rule for names (they go on to DEVSIM, Gmsh and VTU files as they are)
         return isinstance(value, list) and len(value) <= _MAX_NAMES and (count is None or len(value) == count) and \
             all(isinstance(x, str) and NAME.fullmatch(x) for x in value)
@@ -453,11 +458,11 @@ def _region_parts(arrays: dict, manifest: dict, n_vertices: int, n_edges: int, n
     _distinct_faces(faces, n_face_bound, path)
     if len(arrays["element_region"]) != n_elements:
         raise FormatError(f"{path}: member element_region: not one region per element")
-    origin = manifest.get("origin")
+    origin: Any = manifest.get("origin")
     if not isinstance(origin, list) or len(origin) != 3 or not all(isinstance(x, str) and _FRACTION.fullmatch(x)
                                                                     for x in origin):
         raise FormatError(f"{path}: manifest: origin is not three exact numbers")
-    region_boxes = manifest.get("region_boxes")
+    region_boxes: Any = manifest.get("region_boxes")
     if not isinstance(region_boxes, list) or len(region_boxes) != len(names) or not all(
             isinstance(boxes, list) and 0 < len(boxes) <= 64 and all(
                 isinstance(b, list) and len(b) == 6 and all(isinstance(x, str) and _FRACTION.fullmatch(x) for x in b)
@@ -584,7 +589,7 @@ def _element_shapes(dual: Dual, path: str | Path) -> np.ndarray:
     return shape
 
 
-def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path, layout=None) -> None:
+def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path, layout: DeviceLayout | None = None) -> None:
     """The elements are a mesh of the domain: every face met by exactly two elements, in opposite
     orientations, or by one in the domain's boundary
     (:func:`~cospherical.mesh.checks.pair_faces`, the mesher's own conformity rule).
@@ -628,8 +633,8 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
         raise FormatError(f"{path}: member element_nodes: {error}") from None
     layout = dual_layout(dual, path)
     _check_mesh(dual, shape, path, layout)
-    if layout is not None:
-        _check_element_regions(dual, layout, path)
+    if layout is not None and dual.regions is not None:
+        _check_element_regions(dual, dual.regions, layout, path)
     if not np.array_equal(again.edges, dual.edges):
         raise FormatError(f"{path}: member edges: not the edges of its elements ({len(dual.edges)} edges, "
                           f"its elements have {len(again.edges)})")
@@ -642,7 +647,8 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
         # a / d == b / e  <=>  a e == b d: Python integers, no overflow
         left = ours.astype(object) * their_denominator
         right = theirs.astype(object) * our_denominator
-        return np.asarray(left != right).reshape(len(ours), -1).any(axis=1)
+        unequal: np.ndarray = np.asarray(np.asarray(left != right).reshape(len(ours), -1).any(axis=1))
+        return unequal
 
     wrong = different(again.coefficient_exact, again.coefficient_denominator, dual.coefficient_exact,
                       dual.coefficient_denominator)
@@ -671,17 +677,17 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
                 "boundary_area": boundary_areas(dual.boundary_area_exact, dual.boundary_area_denominator,
                                                 dual.boundary_factors_squared)}
     for name, value in expected.items():
-        wrong = np.asarray(getattr(dual, name) != value).reshape(len(value), -1).any(axis=1)
+        wrong = np.asarray(np.asarray(getattr(dual, name) != value).reshape(len(value), -1).any(axis=1))
         if wrong.any():
             k = first(wrong)
             what = f"edge {dual.edges[k, 0]}-{dual.edges[k, 1]}" if len(value) == len(dual.edges) and name in (
                 "length", "coefficient", "area") else f"vertex {k}"
             raise FormatError(f"{path}: member {name}: {what} is not what the exact values give")
     if dual.regions is not None:
-        _verify_regions(dual, path)
+        _verify_regions(dual, dual.regions, path)
 
 
-def _check_element_regions(dual: Dual, layout, path: str | Path) -> None:
+def _check_element_regions(dual: Dual, parts: RegionParts, layout: DeviceLayout, path: str | Path) -> None:
     """Each element's region is the region of the box it lies in: the owner of the block holding its vertex
     centroid (an interior point; decided in integers, the centroid times the element's size against the block
     planes).  The parts check recomputes from ``element_region``; this proves ``element_region`` itself."""
@@ -694,16 +700,16 @@ def _check_element_regions(dual: Dual, layout, path: str | Path) -> None:
         index = tuple(np.clip(np.searchsorted(layout.planes[a] * factor * size, sums[rows, a], "right") - 1, 0,
                               len(layout.planes[a]) - 2) for a in range(3))
         owner[rows] = layout.owner[index]
-    wrong = np.flatnonzero(owner != dual.regions.element_region)
+    wrong = np.flatnonzero(owner != parts.element_region)
     if len(wrong):
         e = int(wrong[0])
-        names = dual.regions.names
+        names = parts.names
         lies = f"in a box of region {shown(names[owner[e]])}" if owner[e] >= 0 else "outside every region's box"
         raise FormatError(f"{path}: member element_region: element {e} is given region "
-                          f"{shown(names[dual.regions.element_region[e]])} but lies {lies}")
+                          f"{shown(names[parts.element_region[e]])} but lies {lies}")
 
 
-def dual_layout(dual: Dual, path: str | Path):
+def dual_layout(dual: Dual, path: str | Path) -> DeviceLayout | None:
     """A version 4 file's device geometry (its regions' boxes and its contacts) checked again and cut into
     blocks (:class:`~cospherical.mesh.device.DeviceLayout`), or ``None`` for a one-box dual; its bounding box
     must be the file's domain, its low corner the file's origin."""
@@ -713,9 +719,9 @@ def dual_layout(dual: Dual, path: str | Path):
     if parts is None:
         return None
     try:
-        regions = tuple(Region(name, material, tuple(tuple(Fraction(x) for x in box) for box in boxes))
+        regions = tuple(Region(name, material, tuple(_six(box) for box in boxes))
                         for name, material, boxes in zip(parts.names, parts.materials, parts.boxes))
-        contacts = tuple(Contact(name, parts.names[r], tuple(Fraction(x) for x in box))
+        contacts = tuple(Contact(name, parts.names[r], _six(box))
                          for name, r, box in zip(parts.contact_names, parts.contact_regions, parts.contact_boxes))
         device = Device("dual", regions, contacts, (), 0)
         layout = device_layout(device)
@@ -727,7 +733,13 @@ def dual_layout(dual: Dual, path: str | Path):
     return layout
 
 
-def domain_sums(layout) -> tuple[Fraction, tuple[Fraction, Fraction, Fraction]]:
+def _six(texts: tuple[str, ...]) -> tuple[Fraction, Fraction, Fraction, Fraction, Fraction, Fraction]:
+    """A box's six exact texts (low corner, high corner) as fractions; ValueError unless six numbers."""
+    x0, y0, z0, x1, y1, z1 = (Fraction(x) for x in texts)
+    return x0, y0, z0, x1, y1, z1
+
+
+def domain_sums(layout: DeviceLayout) -> tuple[Fraction, tuple[Fraction, Fraction, Fraction]]:
     """What a device's control volumes and boundary areas sum to: its volume as a fraction of the bounding
     box's, and per axis the area of its faces in the bounding box's two sides normal to it as a fraction
     of one side's (the dual's boundary areas are counted in those sides)."""
@@ -741,18 +753,18 @@ def domain_sums(layout) -> tuple[Fraction, tuple[Fraction, Fraction, Fraction]]:
         area = np.outer(steps[b], steps[c])
         layers = np.moveaxis(inside, axis, 0)
         sides.append(Fraction(int((layers[0] * area).sum() + (layers[-1] * area).sum()), layout.steps ** 2))
-    return volume, tuple(sides)
+    return volume, (sides[0], sides[1], sides[2])
 
 
-def _verify_regions(dual: Dual, path: str | Path) -> None:
+def _verify_regions(dual: Dual, parts: RegionParts, path: str | Path) -> None:
     """A version 4 file's region parts computed again from its elements, their regions and its contact faces,
     and compared exactly; each contact's faces lie in its rectangle and cover its area exactly."""
     from ..mesh.regions import region_parts
 
-    parts = dual.regions
     boxes = [tuple(Fraction(x) for x in box) for box in parts.contact_boxes]
     try:
-        lengths = tuple(Fraction(text) for text in dual.box.texts)
+        length_a, length_b, length_c = (Fraction(text) for text in dual.box.texts)
+        lengths = (length_a, length_b, length_c)
     except ValueError:
         raise FormatError(f"{path}: manifest: a device's domain lengths must be rational") from None
     axes = []
@@ -771,7 +783,8 @@ def _verify_regions(dual: Dual, path: str | Path) -> None:
         raise FormatError(f"{path}: member contact_face_nodes: a contact face is no polygon in its contact's "
                           "plane") from None
 
-    def rows_differ(name: str, ours: tuple, theirs: tuple) -> None:
+    def rows_differ(name: str, ours: tuple[tuple[np.ndarray, ...], np.ndarray, int],
+                    theirs: tuple[tuple[np.ndarray, ...], np.ndarray, int]) -> None:
         (a_index, a_values, a_den), (b_index, b_values, b_den) = ours, theirs
         if len(a_index[0]) != len(b_index[0]) or any(not np.array_equal(x, y) for x, y in zip(a_index, b_index)):
             raise FormatError(f"{path}: member {name}: not the rows its elements give ({len(b_index[0])} rows, "
@@ -811,14 +824,13 @@ def _verify_regions(dual: Dual, path: str | Path) -> None:
         if area != (box[b + 3] - box[b]) * (box[d + 3] - box[d]):
             raise FormatError(f"{path}: contact {shown(parts.contact_names[c])}: its faces' area {area} is not its "
                               "rectangle's")
-    _contact_faces_on_elements(dual, path)
+    _contact_faces_on_elements(dual, parts, path)
 
 
-def _contact_faces_on_elements(dual: Dual, path: str | Path) -> None:
+def _contact_faces_on_elements(dual: Dual, parts: RegionParts, path: str | Path) -> None:
     """Each contact face lies on an element of its contact's region: its vertices are that element's (in the
     contact's flat rectangle, checked before, they are the element's face there).  A polygon of the file's own
     (one quad over a whole contact) or a contact naming a region that does not touch it is refused."""
-    parts = dual.regions
     nodes = dual.element_nodes.astype(np.int64)
     owner = np.repeat(np.arange(len(nodes)), nodes.shape[1])  # vertex -> elements, through one sort
     flat = nodes.reshape(-1)
