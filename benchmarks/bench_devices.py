@@ -1,6 +1,6 @@
 """Devices: time and memory of the example devices, and a diode beside the one-box mesh of the same size.
 
-    python benchmarks/bench_devices.py [--levels 7]
+    python benchmarks/bench_devices.py [--levels 7] [--anode]
 
 Whole processes, each measured by the kernel (``os.wait4``: user + system CPU, peak
 resident memory) and by the wall clock, every output written (``--dual --out``):
@@ -13,7 +13,9 @@ resident memory) and by the wall clock, every output written (``--dual --out``):
     device adds (its region arrays, the dual's parts per region, the contact and interface
     faces, contacts.vtu) over a mesh without regions.  The goal: the device at most 1.3
     times the box's CPU.  Level 7 gives 164 k elements; level 8 about 650 k and level 9
-    about 2.6 M (minutes and GBs: run them on a quiet machine).
+    about 2.6 M (minutes and GBs: run them on a quiet machine).  ``--anode`` refines both
+    at the anode contact's plane z = 1 too (``plane:0,0,1,1``), half again the leaves:
+    about 1 M elements at level 8.
 
 Writes results/benchmarks/bench_devices.json (benchmarks/record.py).
 """
@@ -52,6 +54,7 @@ def run_usage(command: list[str]) -> tuple[float, float, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--levels", type=int, default=7, help="the diode's level for the comparison (default 7)")
+    parser.add_argument("--anode", action="store_true", help="refine the diode at its anode's plane z = 1 too")
     args = parser.parse_args()
     cospherical = [sys.executable, "-m", "cospherical", "mesh"]
     with recorded(__file__) as record, tempfile.TemporaryDirectory() as scratch:
@@ -64,9 +67,14 @@ def main() -> None:
             print(f"{path.stem:14s} {report['elements']:>9,} elements  {cpu:6.2f} CPU-s  {wall:6.2f} s  {peak:.2f} GB")
         record.table(["example", "elements", "CPU s", "wall s", "peak GB"], rows)
         diode = Path(scratch) / "diode.yaml"
-        diode.write_text((EXAMPLES / "pn-diode.yaml").read_text().replace("levels: 5", f"levels: {args.levels}"))
+        text = (EXAMPLES / "pn-diode.yaml").read_text().replace("levels: 5", f"levels: {args.levels}")
+        planes = ["plane:0,0,1,0.5"]
+        if args.anode:
+            text = text.replace("refine:\n", "refine:\n  - plane: [0, 0, 1, 1]\n")
+            planes.append("plane:0,0,1,1")
+        diode.write_text(text)
         pair = {}
-        for name, command in (("one box", ["--domain", "1", "1", "1", "--refine", "plane:0,0,1,0.5",
+        for name, command in (("one box", ["--domain", "1", "1", "1", *(f"--refine={p}" for p in planes),
                                            "--levels", str(args.levels), "--no-uniform"]),
                               ("diode device", ["--device", str(diode), "--no-uniform"])):
             out = Path(scratch) / name.replace(" ", "-")
@@ -75,7 +83,8 @@ def main() -> None:
             wall, cpu, peak = pair[name]
             print(f"{name:14s} level {args.levels}: {elements:,} elements  {cpu:6.2f} CPU-s  {wall:6.2f} s  "
                   f"{peak:.2f} GB")
-            record.add(f"{name}, level {args.levels} ({elements:,} elements, --dual --out)",
+            record.add(f"{name}, level {args.levels}{' and the anode plane' if args.anode else ''} "
+                       f"({elements:,} elements, --dual --out)",
                        f"{cpu:.2f} CPU-s, {wall:.2f} s wall, {peak:.2f} GB peak")
         ratio = pair["diode device"][1] / pair["one box"][1]
         memory = pair["diode device"][2] / pair["one box"][2]
