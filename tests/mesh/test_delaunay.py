@@ -124,12 +124,13 @@ def test_python_integers_give_the_same_cells(monkeypatch):
     # large boxes or weights take the exact merge to Python integers: the same cells
     from functools import partial
 
-    import cospherical.mesh.delaunay as delaunay
+    import cospherical.mesh.merged_cells as merged_cells
+    import cospherical.mesh.proposal as proposal
 
     leaf = assemble(build_octree(Box.parse(["1", "2", "4"]), 4, [parse_shape("plane:1,1,1,3")], "edge"))
     fast = mesh_cells(global_delaunay(leaf))
-    for name in ("six_volumes", "circumcenters", "sphere_sides"):
-        monkeypatch.setattr(delaunay, name, partial(getattr(delaunay, name), python_integers=True))
+    for module, name in ((proposal, "six_volumes"), (merged_cells, "circumcenters"), (proposal, "sphere_sides")):
+        monkeypatch.setattr(module, name, partial(getattr(module, name), python_integers=True))
     assert mesh_cells(global_delaunay(leaf)) == fast
 
 
@@ -155,11 +156,11 @@ def test_the_final_check_skips_only_what_the_leaf_check_proved():
 
 def _count_exact(monkeypatch) -> list:
     """Record the clusters the exact engine tetrahedralises (their vertex counts)."""
-    import cospherical.mesh.delaunay as delaunay
+    import cospherical.mesh.proposal as proposal
 
     calls: list = []
-    engine = delaunay.delaunay_tetrahedra
-    monkeypatch.setattr(delaunay, "delaunay_tetrahedra", lambda coords, weights: calls.append(len(coords))
+    engine = proposal.delaunay_tetrahedra
+    monkeypatch.setattr(proposal, "delaunay_tetrahedra", lambda coords, weights: calls.append(len(coords))
                         or engine(coords, weights))
     return calls
 
@@ -219,18 +220,6 @@ def test_a_wrong_float_proposal_is_caught(monkeypatch):
     monkeypatch.setattr(scipy.spatial, "Delaunay", lambda points, **options: qhull(points * [1, 1, 5], **options))
     calls = _count_exact(monkeypatch)
     assert mesh_cells(global_delaunay(leaf)) == expected and calls
-
-
-def test_a_scaled_cell_shape_is_the_shape_of_the_scaled_offsets():
-    # shapes are classified once up to scale; the scaled copy must be what a direct measurement gives
-    from cospherical.mesh.delaunay import _scaled, _shape
-
-    mesh = global_delaunay(assemble(build_octree(Box.parse(["1", "2", "4"]), 3, [parse_shape("point:0.1,0.1,0.1")])))
-    for shape in mesh.cells.shapes[:6]:
-        unit, _ = _shape(list(shape.offsets), mesh.box.squared, {}, mesh.catalogue)
-        for g in (2, 3):
-            direct, _ = _shape([tuple(g * x for x in o) for o in shape.offsets], mesh.box.squared, {}, mesh.catalogue)
-            assert _scaled(unit, g) == direct
 
 
 @settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -316,11 +305,11 @@ def test_a_table_element_that_is_not_cospherical_is_replaced_by_delaunay_cells()
 def test_only_a_wrong_proposals_own_failure_sends_every_cluster_to_the_exact_engine(monkeypatch):
     # Tetrahedra of one centre that are not one cell (NotOneCell) are a proposal's fault: every cluster is
     # redone exactly.  Any other error on the way is a bug and must surface, not be taken for that one.
-    import cospherical.mesh.delaunay as delaunay
+    import cospherical.mesh.merged_cells as merged_cells
 
     leaf = assemble(build_octree(Box.parse(["1", "1", "4"]), 4, [parse_shape("point:0.2,0.7,3.1")], "vertex"))
-    shape = delaunay._shape
-    for error, raised in ((delaunay.NotOneCell, None), (ValueError, ValueError), (KeyError, KeyError)):
+    shape = merged_cells.cell_shape
+    for error, raised in ((merged_cells.NotOneCell, None), (ValueError, ValueError), (KeyError, KeyError)):
         failed: list = []
 
         def once(*args, error=error, failed=failed):
@@ -328,7 +317,7 @@ def test_only_a_wrong_proposals_own_failure_sends_every_cluster_to_the_exact_eng
                 failed.append(True)
                 raise error("planted")
             return shape(*args)
-        monkeypatch.setattr(delaunay, "_shape", once)
+        monkeypatch.setattr(merged_cells, "cell_shape", once)
         calls = _count_exact(monkeypatch)
         if raised is None:
             mesh = global_delaunay(leaf)

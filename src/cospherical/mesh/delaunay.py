@@ -54,7 +54,8 @@ cells of one Delaunay subdivision, D.
 The leaves that hold an element of U give up all their elements: the kept ones
 among them are listed as cells, as they are, marked proven.
 
-The engine (chosen by measurement: scipy's Qhull proposes, integers decide):
+The engine (chosen by measurement: scipy's Qhull proposes, integers decide;
+:mod:`cospherical.mesh.proposal`, and :mod:`cospherical.mesh.merged_cells` makes the cells):
 Qhull's tetrahedra of V_r in floats; every tetrahedron is then measured in
 integers on the vertex grid (weights: the squared box lengths), so only the
 proposal is inexact.  Flat tetrahedra (exactly zero volume) are dropped; a
@@ -135,26 +136,16 @@ from fractions import Fraction
 
 import numpy as np
 
-from ..catalogue import Catalogue
 from ..choices import ENGINES, MODES, DelaunayMode, Engine
-from ..core.geometry import Frame, area_vector, circumcenters, six_volumes, sphere_sides
-from ..core.incremental_delaunay import delaunay_tetrahedra
-from ..core.tessellation import tessellation_elements
 from ..errors import InputError
-from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, distinct, type_info
+from .assembly import Cells, Mesh, distinct
 from .checks import DelaunayCheck, check_delaunay, grid_weights
+from .merged_cells import Locator, NotOneCell, cell_members, classified_cells, inside_cluster, same_sphere
+from .proposal import cluster_tetrahedra
 
 __all__ = ["delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
 _NO_CLUSTER = -1  # the cluster of a leaf element that is kept, and of a vertex of no cluster
-
-
-class NotOneCell(Exception):
-    """Tetrahedra of one exact centre whose vertices are not one co-spherical cell (different radii).
-
-    Only a wrong proposal makes them; :func:`retessellate` then redoes every cluster with
-    the exact engine.  Its own class, so that no other error is taken for this one.
-    """
 
 
 def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull", proposal=None,
@@ -235,7 +226,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: Engine =
     # the clusters' vertex sets are disjoint (a shared vertex would join them): a vertex names its cluster
     vertex_cluster = np.full(len(mesh.vertices), _NO_CLUSTER, dtype=np.int64)
     vertex_cluster[vertices] = pairs // len(mesh.vertices)
-    located = _Locator(mesh)
+    located = Locator(mesh)
     # the other elements of the leaves that give up theirs: cells as they are, proven by the check
     leaves = distinct(mesh.element_leaf[elements])
     counts = mesh.element_offsets[leaves + 1] - mesh.element_offsets[leaves]
@@ -244,19 +235,19 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: Engine =
     proven = mesh.element_nodes(given_up[cluster[given_up] == _NO_CLUSTER])
     bad = _leaves_of(mesh, elements)
     wanted = _cluster_volumes(mesh, elements, part, clusters)
-    tets = [_cluster_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine, proposal) for r in range(clusters)]
+    tets = [cluster_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], engine, proposal) for r in range(clusters)]
     exact = set(range(clusters)) if engine == "exact" else set()
     fallen: set[int] = set()  # clusters that keep their leaf elements (step 8)
     while True:
         tet_cluster = np.concatenate([np.full(len(t), r, dtype=np.int64) for r, t in enumerate(tets)])
         every = np.concatenate(tets)
-        every = every[_inside(mesh, every, tet_cluster, cluster, located)]
+        every = every[inside_cluster(mesh, every, tet_cluster, cluster, located)]
         try:
-            merged = _members(_same_sphere(mesh, every, grid_weights(mesh)), every, len(mesh.vertices)) \
+            merged = cell_members(same_sphere(mesh, every, grid_weights(mesh)), every, len(mesh.vertices)) \
                 if len(every) else np.zeros((0, 1), dtype=np.int64)
             if fallen:
                 merged = _stacked(merged, mesh.element_nodes(elements[np.isin(part, sorted(fallen))]))
-            cells = _cells(mesh, merged, proven, located, types)
+            cells = classified_cells(mesh, merged, proven, located, types)
         except NotOneCell:  # no cell to name a cluster by: no proof per cluster
             failing = set(range(clusters)) - fallen
         else:
@@ -274,7 +265,7 @@ def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: Engine =
             tets[r] = tets[r][:0]
         fallen |= failing & exact
         for r in failing - exact:
-            tets[r] = _cluster_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], "exact")
+            tets[r] = cluster_tetrahedra(mesh, vertices[bounds[r]:bounds[r + 1]], "exact")
         exact |= failing
 
 
@@ -364,259 +355,6 @@ def _clusters(nodes: np.ndarray, vertices: int) -> tuple[np.ndarray, int]:
     used[label[:n]] = True
     part = (np.cumsum(used) - 1)[label[:n]]  # the labels the rows use, numbered in order
     return part, int(part.max()) + 1
-
-
-class _Locator:
-    """Which leaf's closed box holds a point given as an integer multiple of its grid coordinates, exactly."""
-
-    def __init__(self, mesh: Mesh) -> None:
-        tree = mesh.tree
-        self.levels = np.unique(tree.levels)
-        self.grid = mesh.grid
-        self.keys = {}
-        for level in self.levels.tolist():
-            leaves = np.flatnonzero(tree.levels == level)
-            n = np.int64(1) << level
-            p = tree.positions[leaves].astype(np.int64)
-            key = (p[:, 0] * n + p[:, 1]) * n + p[:, 2]
-            order = np.argsort(key)
-            self.keys[level] = (key[order], leaves[order])
-
-    def leaf(self, points: np.ndarray, scale=4) -> np.ndarray:
-        """Leaf of each point given as ``scale`` (a number, or one per point) x its grid coordinates, in the closed domain."""
-        found = np.full(len(points), -1, dtype=np.int64)
-        scale = np.asarray(scale, dtype=np.int64).reshape(-1, 1)
-        for level, (keys, leaves) in self.keys.items():
-            size = scale * (self.grid >> level)
-            n = np.int64(1) << level
-            p = np.minimum(points // size, n - 1)
-            key = (p[:, 0] * n + p[:, 1]) * n + p[:, 2]
-            at = np.minimum(np.searchsorted(keys, key), len(keys) - 1)
-            hit = (keys[at] == key) & (found < 0)
-            found[hit] = leaves[at[hit]]
-        return found
-
-
-def _cluster_tetrahedra(mesh: Mesh, ids: np.ndarray, engine: str = "qhull", proposal=None) -> np.ndarray:
-    """The Delaunay tetrahedra of a cluster's vertices (global ids, in and out), without flat ones.
-
-    ``qhull``: Qhull proposes them in floats and integers check the proposal; where
-    Qhull fails (boxes of extreme aspect ratio, 1e-12 x 1 x 3e9: its first simplex
-    is flat in floats) or the check does, the exact engine
-    (:func:`~cospherical.core.incremental_delaunay.delaunay_tetrahedra`) makes them.
-    ``exact``: the exact engine alone.
-    """
-    coords = mesh.vertices[ids].astype(np.int64)
-    if engine == "qhull":
-        simplices = _qhull_proposal(mesh, coords, proposal)
-        if simplices is not None:
-            return ids[simplices]
-    return ids[np.array(delaunay_tetrahedra(coords.tolist(), grid_weights(mesh)), dtype=np.int64).reshape(-1, 4)]
-
-
-def _qhull_proposal(mesh: Mesh, coords: np.ndarray, proposal=None) -> np.ndarray | None:
-    """Qhull's solid tetrahedra of the points (indices into ``coords``), or ``None`` when Qhull or the check fails.
-
-    The check, in integers: across every face between two solid tetrahedra the far
-    vertex is not strictly inside the near one's sphere (a tiling of the hull that
-    is not Delaunay has such a face; float rounding on thin boxes makes exactly that
-    kind of flip); it is cheap and saves a second pass, but it proves nothing alone:
-    :func:`retessellate` proves the cells.  ``proposal(real_points)``: a triangulation
-    with Qhull's ``simplices``, ``neighbors`` and ``coplanar`` in place of Qhull's (a seam for tests).
-    """
-    from scipy.spatial import Delaunay
-
-    real = (coords - coords.min(axis=0)) * (np.array(mesh.box.to_float()) / mesh.grid)
-    try:
-        triangulation = (proposal or (lambda points: Delaunay(points, qhull_options="Qbb Qc Qz Q12 Qt")))(real)
-    except Exception:  # Qhull's float precision errors: the exact engine takes the cluster
-        return None
-    if len(triangulation.coplanar):
-        return None
-    simplices = triangulation.simplices.astype(np.int64)
-    p = coords[simplices]  # (tets, 4, 3)
-    solid = six_volumes(p) != 0
-    # each face between two solid tetrahedra, once (near < far): the far one's vertex across it
-    near, face = np.nonzero(solid[:, None] & (triangulation.neighbors > np.arange(len(simplices))[:, None]))
-    far = triangulation.neighbors[near, face]
-    pick = solid[far]
-    near, far = near[pick], far[pick]
-    across = simplices[far, np.argmax(triangulation.neighbors[far] == near[:, None], axis=1)]
-    if len(near) and sphere_sides(p[near], coords[across], grid_weights(mesh)).min() < 0:
-        return None
-    return simplices[solid]
-
-
-def _inside(mesh: Mesh, tets: np.ndarray, tet_cluster: np.ndarray, cluster: np.ndarray, located: _Locator) -> np.ndarray:
-    """Per tetrahedron: its centroid lies in a closed element of its cluster, of the leaf whose box holds it (exactly).
-
-    ``cluster``: per leaf element its cluster, ``_NO_CLUSTER`` for the kept ones.  In the leaf's own
-    frame (4 x grid units from its lowest corner) node ``s`` sits at ``2 size
-    NODE_OFFSETS[s]``; an element holds the point when no face plane has it on the
-    side away from the element's vertex centroid.  The numbers are below 100 times
-    the grid (at most 2**17): int64.
-    """
-    coords = mesh.vertices.astype(np.int64)
-    quad = coords[tets].sum(axis=1)
-    # a centroid outside the mesh's leaves (it may hold only some of a tree's) is outside every cluster
-    found = located.leaf(quad)
-    tets, tet_cluster, quad, leaf = tets[found >= 0], tet_cluster[found >= 0], quad[found >= 0], found[found >= 0]
-    size = mesh.leaf_size()[leaf]
-    local = quad - 4 * mesh.tree.positions[leaf].astype(np.int64) * size[:, None]
-    first = mesh.element_offsets[leaf]
-    which = mesh.leaf_tessellation[leaf]
-    inside = np.zeros(len(tets), dtype=bool)
-    order = np.argsort(which, kind="stable")
-    starts = np.searchsorted(which[order], np.arange(len(mesh.tessellations) + 1))
-    for p, element_planes in enumerate(_planes(mesh)):
-        rows = order[starts[p]:starts[p + 1]]
-        for j, planes in enumerate(element_planes):
-            rows_j = rows[cluster[first[rows] + j] == tet_cluster[rows]]
-            holds = np.ones(len(rows_j), dtype=bool)
-            for normal, corner, side in planes:
-                holds &= side * ((local[rows_j] - 2 * size[rows_j, None] * corner) @ normal) >= 0
-            inside[rows_j[holds]] = True
-    result = np.zeros(len(found), dtype=bool)
-    result[np.flatnonzero(found >= 0)] = inside
-    return result
-
-
-def _planes(mesh: Mesh) -> list[list[list[tuple[np.ndarray, np.ndarray, int]]]]:
-    """Per tessellation, per element, its face planes in the node grid: (normal, a point, sign of the inside)."""
-    planes = []
-    for tessellation in mesh.tessellations:
-        planes.append([])
-        for element in tessellation.elements:
-            centroid = NODE_OFFSETS[list(element.nodes)].sum(axis=0)
-            faces = []
-            for cycle in element.faces:
-                points = NODE_OFFSETS[list(cycle)]
-                normal = np.array(area_vector(points.tolist()), dtype=np.int64)
-                side = int(np.sign((centroid - len(element.nodes) * points[0]) @ normal))
-                faces.append((normal, points[0], side))
-            # a flat element (no faces, reported by the volume check) holds nothing
-            planes[-1].append(faces if faces else [(np.zeros(3, dtype=np.int64), NODE_OFFSETS[0], -1)])
-    return planes
-
-
-def _same_sphere(mesh: Mesh, tets: np.ndarray, weights) -> np.ndarray:
-    """Per tetrahedron (global vertex ids), the class of its exact circumcenter: one class, one cell."""
-    num, den = circumcenters(mesh.vertices.astype(np.int64)[tets], weights)
-    key = np.stack((num, den), axis=2).reshape(len(tets), 6)  # per axis its numerator and denominator
-    if key.dtype == object:
-        index: dict = {}
-        return np.array([index.setdefault(tuple(row), len(index)) for row in key.tolist()], dtype=np.int64)
-    return _row_classes(key).reshape(-1)
-
-
-def _members(cell_of_tet: np.ndarray, tets: np.ndarray, vertices: int) -> np.ndarray:
-    """A cell's vertices are its tetrahedra's: per cell its vertex ids, increasing, padded with -1."""
-    pairs = distinct(np.repeat(cell_of_tet, 4) * np.int64(vertices) + tets.reshape(-1))
-    cell, vertex = pairs // vertices, pairs % vertices
-    counts = np.bincount(cell, minlength=int(cell_of_tet.max()) + 1 if len(cell_of_tet) else 0)
-    members = np.full((len(counts), int(counts.max()) if len(counts) else 1), -1, dtype=np.int64)
-    members[cell, np.arange(len(pairs)) - np.r_[0, np.cumsum(counts)[:-1]][cell]] = vertex
-    return members
-
-
-def _cells(mesh: Mesh, merged: np.ndarray, proven: np.ndarray, located: _Locator, types: dict) -> Cells:
-    """The cells (rows of vertex ids, -1 padded): the merged ones and the ``proven`` kept elements, classified and measured.
-
-    Cells are listed in the order of their sorted vertex ids, so the result does not
-    depend on the order Qhull hands its tetrahedra back.
-    """
-    coords = mesh.vertices.astype(np.int64)
-    width = max(merged.shape[1], proven.shape[1])
-    rows = np.full((len(merged) + len(proven), width), -1, dtype=np.int64)
-    rows[:len(merged), :merged.shape[1]] = merged
-    rows[len(merged):, :proven.shape[1]] = proven
-    is_proven = np.r_[np.zeros(len(merged), dtype=bool), np.ones(len(proven), dtype=bool)]
-    # vertex ids increasing, the padding last; then the cells in the order of these rows
-    members = np.sort(np.where(rows < 0, len(coords), rows), axis=1)
-    order = np.lexsort(members.T[::-1])
-    members, is_proven = members[order], is_proven[order]
-    members[members == len(coords)] = -1
-    valid = members >= 0
-    counts = valid.sum(axis=1)
-    n_cells = len(members)
-    anchor_id = members[:, 0]  # the lowest id: the lexicographically smallest point
-    anchor = coords[anchor_id]
-    # shapes: the offsets from the anchor, as a row of encoded integers (sorted as the ids are)
-    offsets = coords[np.maximum(members, 0)] - anchor[:, None]
-    span = int(np.abs(offsets).max()) + 1
-    base = 2 * span + 1
-    code = ((offsets[:, :, 0] + span) * base + offsets[:, :, 1] + span) * base + offsets[:, :, 2] + span
-    code[~valid] = -1
-    shape_of_cell = _row_classes(np.c_[counts, code])
-    by_shape = np.argsort(shape_of_cell, kind="stable")
-    starts = np.searchsorted(shape_of_cell[by_shape], np.arange(int(shape_of_cell.max()) + 2))
-    shapes = []
-    nodes = np.full((n_cells, width), -1, dtype=np.int32)
-    measured: dict = {}  # shapes up to scale (the same cells at another leaf level): classified once
-    for s in range(len(starts) - 1):
-        rows = by_shape[starts[s]:starts[s + 1]]
-        k = int(counts[rows[0]])
-        g = int(np.gcd.reduce(np.abs(offsets[rows[0], :k]).reshape(-1)))
-        unit = offsets[rows[0], :k] // g
-        if unit.tobytes() not in measured:
-            measured[unit.tobytes()] = _shape([tuple(int(x) for x in o) for o in unit], mesh.box.squared, types,
-                                                   mesh.catalogue)
-        shape, order = measured[unit.tobytes()]
-        shapes.append(_scaled(shape, g))
-        nodes[rows, :len(order)] = members[np.ix_(rows, order)]
-    # first leaf: the one whose box holds the cell's vertex centroid (an interior point)
-    points = coords[np.maximum(members, 0)]
-    leaf = located.leaf(np.where(valid[:, :, None], points, 0).sum(axis=1), counts)
-    size = mesh.leaf_size()[leaf]
-    low = mesh.tree.positions[leaf].astype(np.int64) * size[:, None]
-    below = np.where(valid[:, :, None], points < low[:, None], False).any(axis=(1, 2))
-    above = np.where(valid[:, :, None], points > (low + size[:, None])[:, None], False).any(axis=(1, 2))
-    return Cells(shapes, shape_of_cell.astype(np.int32), anchor, nodes, leaf.astype(np.int64), below | above,
-                 is_proven)
-
-
-def _row_classes(rows: np.ndarray) -> np.ndarray:
-    """Per row, the rank of its value among the distinct rows (lexicographic): equal rows, equal class."""
-    order = np.lexsort(rows.T[::-1])
-    ordered = rows[order]
-    new = np.r_[True, np.any(ordered[1:] != ordered[:-1], axis=1)]
-    classes = np.empty(len(rows), dtype=np.int64)
-    classes[order] = np.cumsum(new) - 1
-    return classes
-
-
-def _shape(offsets: list[tuple[int, int, int]], squared, types: dict,
-           catalogue: Catalogue) -> tuple[CellShape, list[int]]:
-    """Classify and measure one cell shape (vertex offsets from the anchor, grid units), exactly.
-
-    Returns the shape and the order of ``offsets`` that is the type's reference order.
-    """
-    points = {i: tuple(Fraction(x) for x in o) for i, o in enumerate(offsets)}
-    elements = tessellation_elements(points, squared)
-    if len(elements) != 1 or len(elements[0].nodes) != len(offsets):
-        raise NotOneCell(f"merged tetrahedra are not one co-spherical cell: {offsets}")
-    element = elements[0]
-    types.setdefault(element.type.id, type_info(element.type.id, element.type, catalogue))
-    order = list(element.nodes)
-    at = {n: i for i, n in enumerate(order)}
-    frame = Frame.build({i: points[n] for i, n in enumerate(order)}, squared)
-    sphere = frame.circumsphere(range(len(order)))
-    center = frame.center(sphere)
-    return CellShape(element.type.id, tuple(offsets[n] for n in order),
-                     tuple(tuple(at[n] for n in cycle) for cycle in element.polyhedron.faces),
-                     element.polyhedron.unit_volume, sphere, center), order
-
-
-def _scaled(shape: CellShape, g: int) -> CellShape:
-    """``shape`` scaled by the integer ``g`` about its anchor: what :func:`_shape` gives for the scaled offsets.
-
-    Lexicographic order, the type and its node order do not change, nor the four
-    nodes of its sphere (:meth:`~cospherical.core.geometry.Sphere.scaled`).
-    """
-    if g == 1:
-        return shape
-    return CellShape(shape.type_id, tuple(tuple(g * x for x in o) for o in shape.offsets), shape.faces,
-                     shape.grid_volume * g ** 3, shape.sphere.scaled(g), tuple(g * c for c in shape.center))
 
 
 def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress=None, convex: bool = True
