@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 
 from cospherical.core.configuration import Box
 from cospherical.mesh.assembly import assemble
-from cospherical.mesh.checks import check_circumcenters, check_delaunay
+from cospherical.mesh.checks import _spheres, check_circumcenters, check_delaunay
 from cospherical.mesh.octree import build_octree, parse_shape
 
 from .test_dual import octrees
@@ -76,3 +78,27 @@ def test_bare_element_lists_pair_as_the_mesh_on_any_octree(mesh):
     conn, sizes = mesh.connectivity()
     faces = element_faces(mesh.vertices, conn, sizes, _shapes(mesh.vertices, conn), mesh.box.squared)
     assert pair_faces(faces, mesh.vertices, mesh.grid) == check_conformity(mesh)
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(octrees())
+def test_the_trees_structure_finds_what_the_search_finds(mesh):
+    """On a vertex-balanced tree the Delaunay check looks up the few grid points that can lie on or in a leaf
+    element's sphere instead of searching; a k-d tree's search over every vertex (the same mesh, its tree
+    not claimed balanced) finds the same violations, ties and elements that are not cells."""
+    assert mesh.tree.vertex_balanced
+    # a leaf's sphere reaches less than 3/4 of the leaf beyond it in a cube (not across the short sides of a brick)
+    if mesh.box.squared == (1, 1, 1):
+        assert len(_spheres(mesh)[0].searched) < len(mesh)
+    mine = check_delaunay(mesh)
+    theirs = check_delaunay(replace(mesh, tree=replace(mesh.tree, vertex_balanced=False), _groups=None))
+    assert (mine.violations, mine.violating_pairs, mine.violating_leaves, mine.ties) == \
+        (theirs.violations, theirs.violating_pairs, theirs.violating_leaves, theirs.ties)
+    for name in ("violating_leaf_ids", "violating_elements", "not_cells"):
+        assert np.array_equal(getattr(mine, name), getattr(theirs, name)), name
+
+
+def test_only_vertex_balance_claims_the_structure():
+    """The check's bound on where vertices lie holds for trees balanced across corners too, not across edges only."""
+    shapes = [parse_shape("point:0.1,0.1,2")]
+    assert build_octree(BRICK, 3, shapes).vertex_balanced and not build_octree(BRICK, 3, shapes, "edge").vertex_balanced

@@ -6,16 +6,42 @@ Whole-mesh properties are decided on the global vertex ids (conformity) and on t
 global vertex set (Delaunay): a leaf's sphere can hold a vertex of a smaller
 neighbour, so no per-leaf test can replace them.
 
-Global Delaunay, exactly: a k-d tree on the vertices' float coordinates proposes,
-for every element, the vertices within its circumradius times (1 + 1e-9); the
-element's own nodes are expected there.  Where the tree finds anything else, each
-such vertex is decided with the integer in-sphere test of the element's
-configuration frame (the same predicate as the tessellation's), so every
-violation and every tie is decided exactly; the float slack only widens the net.
+Global Delaunay, exactly: every vertex that could lie on or in an element's sphere
+is found, and each is decided with the integer in-sphere test of the element's
+configuration frame (the same predicate as the tessellation's), so every violation
+and every tie is decided exactly.  Two ways find them:
+
+- By the tree's structure, for the leaf elements of a full tree whose leaves
+  touching at a face, an edge or a corner differ by at most one level
+  (:attr:`~cospherical.mesh.octree.Octree.vertex_balanced`).  Let B be a leaf of side
+  s (per axis) and d the L-infinity distance from B in units of s.  Then the
+  vertices with d = 0 are B's slots (the leaves touching B are at least s/2, so
+  their corners on B are the 27 half-spacing points, and no vertex is inside a
+  leaf); none has 0 < d < 1/2, and those with 1/2 <= d < 3/4 are points of the
+  lattice of spacing s/4 aligned with B.  Proof: a vertex is a corner of some leaf
+  T; if T is at least s/4 its corners are on that lattice, and at least s/2 puts
+  them at d = 0 or d >= 1/2.  Otherwise T (at most s/8) lies in a cell C of side
+  s/4 of the aligned grid, split, within d <= 1/2 of B.  If C's parent cell (side
+  s/2) touches B, that parent is split into leaves of at most s/4, one of which
+  touches B: two levels apart.  If not, C touches a cell of side s/2 that touches B,
+  and that cell lies in one leaf of at least s/2 (or leaves under s/2 would touch
+  B); a leaf in C of at most s/8 touches it: two levels apart again.  So for an
+  element whose closed sphere stays within d < 3/4 (decided exactly, once per
+  configuration, in the leaf's unit frame: every leaf is the domain scaled), the
+  only vertices that can lie on or in it are its leaf's other slots in the sphere
+  and the lattice points with d = 1/2 in the sphere that are vertices: a handful
+  of exact look-ups per leaf (:func:`_local_candidates`), no search.
+- Otherwise (a cell of the global Delaunay step, a sphere reaching further, a
+  device's tree with holes, a leaf list only checked 1-irregular, a piece's
+  surroundings), a k-d tree on the vertices' float coordinates proposes the
+  vertices within the circumradius times (1 + 1e-9) (:func:`_candidates`); the
+  element's own nodes are expected there and anything else is decided exactly:
+  the float slack only widens the net.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from fractions import Fraction
@@ -28,7 +54,7 @@ from ..core.geometry import Frame, Rational, in_closed_box
 from ..core.morton import morton_codes
 from ..core.polyhedron import measure
 from ..errors import InputError
-from .assembly import Mesh
+from .assembly import LocalTessellation, Mesh
 from .device import DeviceLayout, domain_boundary
 from .octree import distinct
 
@@ -469,23 +495,27 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
 
     Returns a :class:`DelaunayCheck`: the counts of violations and ties and the elements
     that are not cells of the Delaunay subdivision of the vertices.  Four steps: every
-    element's sphere (:func:`_spheres`), the vertices floats find near each
-    (:func:`_candidates`, a k-d tree), each of those decided exactly
-    (:func:`_exact_sides`), and what the signs say (:func:`_found`).
+    element's sphere (:func:`_spheres`), the vertices that can lie on or in each (by the
+    tree's structure, :func:`_local_candidates`, else those floats find near it,
+    :func:`_candidates`, a k-d tree), each of those decided exactly (:func:`_exact_sides`),
+    and what the signs say (:func:`_found`).
 
     In a mesh with re-tessellated cells (:func:`~cospherical.mesh.delaunay.global_delaunay`)
     the leaf elements and the cells marked ``proven`` passed this check on the same
     vertex set when they were kept, so only the other cells are tested (and counted in
     ``delaunay_exact_tests``); ``progress`` is told of the others at once.
     """
-    points = mesh.points()
-    spheres = _spheres(mesh, points)
-    if progress and mesh.cells is not None:
-        progress(len(mesh) - len(spheres.centers))
-    if not len(spheres.centers):
+    spheres, local = _spheres(mesh)
+    local_row, local_vertex = _local_candidates(mesh, local)
+    if progress:
+        progress(len(mesh) - len(spheres.searched))
+    if not len(spheres.tessellation):
         none = np.zeros(0, dtype=np.int64)
         return DelaunayCheck(0, 0, 0, 0, 0, none, none, spheres.without_sphere)
-    pair_row, pair_vertex = _candidates(mesh, points, spheres, workers, progress)
+    pair_row, pair_vertex = local_row, local_vertex
+    if len(spheres.searched):
+        found_row, found_vertex = _candidates(mesh, mesh.points(), spheres, workers, progress)
+        pair_row, pair_vertex = np.r_[pair_row, found_row], np.r_[pair_vertex, found_vertex]
     return _found(mesh, spheres, pair_row, _exact_sides(mesh, spheres, pair_row, pair_vertex))
 
 
@@ -493,22 +523,87 @@ class _Spheres(NamedTuple):
     """The spheres :func:`check_delaunay` tests, one row each: a leaf element's or a fresh cell's.
 
     ``tessellation``: the leaf's tessellation (-1: a cell); ``local``: the element in it (a
-    cell: its shape); ``leaf``: the leaf (a cell: its index among the cells); ``centers`` and
-    ``radii`` in real units (floats: they only propose); ``nodes``: the element's vertex
-    count; ``without_sphere``: the leaf elements that have none (not co-spherical), sorted.
+    cell: its shape); ``leaf``: the leaf (a cell: its index among the cells); ``nodes``: the
+    element's vertex count; ``searched``: the rows whose vertices a k-d tree finds, and for
+    them ``centers`` and ``radii`` in real units (floats: they only propose);
+    ``without_sphere``: the leaf elements that have none (not co-spherical), sorted.
     """
 
     tessellation: np.ndarray
     local: np.ndarray
     leaf: np.ndarray
+    nodes: np.ndarray
+    searched: np.ndarray
     centers: np.ndarray
     radii: np.ndarray
-    nodes: np.ndarray
     without_sphere: np.ndarray
 
 
-def _spheres(mesh: Mesh, points: np.ndarray) -> _Spheres:
-    """Every sphere to test: each leaf element's (a mesh without cells), else each fresh cell's.
+class _Suspects(NamedTuple):
+    """What can lie on or in a leaf element's closed sphere besides its nodes (see the module docstring).
+
+    ``slots``: the leaf's other slots in it; ``lattice``: (m, 3) int64, the points of the
+    lattice of spacing a quarter leaf, at L-infinity distance half a leaf from it, in it
+    (in quarters of the leaf, from its low corner).
+    """
+
+    slots: tuple[int, ...]
+    lattice: np.ndarray
+
+
+# The lattice of quarter leaves around a leaf (in quarters, the leaf is 0..4 on each axis), at half a
+# leaf from it (L-infinity): where vertices beside a leaf's own slots can lie within 3/4 of a leaf
+_QUARTERS = np.array(list(itertools.product(range(-3, 8), repeat=3)), dtype=np.int64)
+_HALF_A_LEAF_OUT = _QUARTERS[np.maximum(np.maximum(-_QUARTERS, _QUARTERS - 4), 0).max(axis=1) == 2]
+
+
+def _leaf_suspects(tessellation: LocalTessellation, squared: tuple[Fraction, Fraction, Fraction]
+                   ) -> list[_Suspects | None]:
+    """Per element of a configuration, its :class:`_Suspects`, or ``None`` when its closed sphere reaches 3/4 of
+    a leaf beyond the leaf on some axis (or it has none): decided exactly in the leaf's unit frame, where the
+    squared distance is the sum over the axes of ``squared[k]`` (the box's squared lengths) times the squared
+    difference.
+    """
+    nodes = tessellation.configuration.nodes()
+    scale_w = math.lcm(*(w.denominator for w in squared))
+    weights = [int(w * scale_w) for w in squared]
+    # integer coordinates: unit coordinates times m (a multiple of 4, so the lattice's quarters are whole)
+    m = math.lcm(4, *(c.denominator for e in tessellation.elements if e.center is not None for c in e.center),
+                 *(x.denominator for point in nodes.values() for x in point))
+
+    def scaled(point: Sequence[int | Fraction]) -> list[int]:
+        return [x.numerator * (m // x.denominator) for x in point]
+
+    whole = {s: scaled(point) for s, point in nodes.items()}
+    found: list[_Suspects | None] = []
+    for element in tessellation.elements:
+        if element.center is None:
+            found.append(None)
+            continue
+        center = scaled(element.center)
+
+        def squared_distance(point: list[int]) -> int:
+            return sum(w * (x - c) ** 2 for w, x, c in zip(weights, point, center))
+
+        radius2 = squared_distance(whole[element.nodes[0]])
+        # the sphere's extent on each axis, from its centre: strictly inside -3/4 .. 7/4 of the leaf
+        if not all(low > 0 and high > 0 and radius2 < w * low * low and radius2 < w * high * high
+                   for w, c in zip(weights, center) for low, high in [(c + 3 * m // 4, 7 * m // 4 - c)]):
+            found.append(None)
+            continue
+        own = set(element.nodes)
+        slots = tuple(s for s, point in whole.items() if s not in own and squared_distance(point) <= radius2)
+        # int64 when every term is below 2**61 (the lattice reaches 7/4 of the leaf), else Python integers
+        kind = np.int64 if max(weights) * (2 * m + max(map(abs, center))) ** 2 < 2**61 else object
+        offsets = _HALF_A_LEAF_OUT.astype(kind) * (m // 4) - np.array(center, dtype=kind)
+        distance = (offsets * offsets * np.array(weights, dtype=kind)).sum(axis=1)
+        found.append(_Suspects(slots, _HALF_A_LEAF_OUT[np.flatnonzero(distance <= radius2)]))
+    return found
+
+
+def _spheres(mesh: Mesh) -> tuple[_Spheres, list[tuple[int, np.ndarray, _Suspects]]]:
+    """Every sphere to test: each leaf element's (a mesh without cells), else each fresh cell's; and, for the
+    rows whose candidates the tree's structure gives, (first row, leaves, suspects) per block of alike rows.
 
     The leaf elements kept beside re-tessellated cells, and the cells marked proven, passed
     this very check on the same vertex set when they were chosen: only the other cells are
@@ -518,52 +613,105 @@ def _spheres(mesh: Mesh, points: np.ndarray) -> _Spheres:
     scale = np.array(mesh.box.to_float()) / grid
     size = grid >> mesh.tree.levels.astype(np.int64)
     origin = mesh.tree.positions.astype(np.int64) * size[:, None]
-    rows_tessellation, rows_local, rows_leaf, centers, radii, n_nodes = [], [], [], [], [], []
+    points = None
+    rows_tessellation, rows_local, rows_leaf, n_nodes, searched, centers, radii = [], [], [], [], [], [], []
+    local: list[tuple[int, np.ndarray, _Suspects]] = []
+    rows = 0
     # A table element that is not co-spherical (a table may hold one) has no sphere to test, and
     # is not a cell of the Delaunay subdivision: it joins the elements that are not cells.
     without_sphere = [np.zeros(0, dtype=np.int64)]
     cells = mesh.cells
+    structured = mesh.tree.vertex_balanced and mesh.regions is None
     for p, tessellation, leaves in (mesh.groups() if cells is None else ()):
+        suspects = _leaf_suspects(tessellation, mesh.box.squared) if structured else [None] * len(tessellation.elements)
         for j, element in enumerate(tessellation.elements):
             if element.sphere is None or element.center is None:  # check_circumcenters: not co-spherical
                 without_sphere.append(mesh.element_offsets[leaves].astype(np.int64) + j)
                 continue
-            center = (origin[leaves] + np.array([float(x) for x in element.center])[None] * size[leaves, None]) * scale
-            first = points[mesh.slots[leaves, element.nodes[0]]]
             rows_tessellation.append(np.full(len(leaves), p, dtype=np.int32))
             rows_local.append(np.full(len(leaves), j, dtype=np.int16))
             rows_leaf.append(leaves.astype(np.int64))
-            centers.append(center)
-            radii.append(np.sqrt(((first - center) ** 2).sum(axis=1)))
             n_nodes.append(np.full(len(leaves), len(element.nodes), dtype=np.int64))
+            suspect = suspects[j]
+            if suspect is not None:
+                local.append((rows, leaves, suspect))
+            else:
+                points = mesh.points() if points is None else points
+                center = (origin[leaves] + np.array([float(x) for x in element.center])[None]
+                          * size[leaves, None]) * scale
+                first = points[mesh.slots[leaves, element.nodes[0]]]
+                searched.append(np.arange(rows, rows + len(leaves)))
+                centers.append(center)
+                radii.append(np.sqrt(((first - center) ** 2).sum(axis=1)))
+            rows += len(leaves)
     if cells is not None and len(cells):
+        points = mesh.points()
         # a cell is a row of tessellation -1 whose "leaf" is its index among the cells
         fresh = np.flatnonzero(~cells.proven)
         fresh = fresh[np.argsort(cells.shape[fresh], kind="stable")]
         starts = np.searchsorted(cells.shape[fresh], np.arange(len(cells.shapes) + 1))
         for s, shape in enumerate(cells.shapes):
-            rows = fresh[starts[s]:starts[s + 1]]
-            center = (cells.anchor[rows] + np.array([float(x) for x in shape.center])[None]) * scale
-            first = points[cells.nodes[rows, 0]]
-            rows_tessellation.append(np.full(len(rows), -1, dtype=np.int32))
-            rows_local.append(np.full(len(rows), s, dtype=np.int16))
-            rows_leaf.append(rows.astype(np.int64))
+            chosen = fresh[starts[s]:starts[s + 1]]
+            center = (cells.anchor[chosen] + np.array([float(x) for x in shape.center])[None]) * scale
+            first = points[cells.nodes[chosen, 0]]
+            rows_tessellation.append(np.full(len(chosen), -1, dtype=np.int32))
+            rows_local.append(np.full(len(chosen), s, dtype=np.int16))
+            rows_leaf.append(chosen.astype(np.int64))
+            n_nodes.append(np.full(len(chosen), len(shape.offsets), dtype=np.int64))
+            searched.append(np.arange(rows, rows + len(chosen)))
             centers.append(center)
             radii.append(np.sqrt(((first - center) ** 2).sum(axis=1)))
-            n_nodes.append(np.full(len(rows), len(shape.offsets), dtype=np.int64))
-    if not sum(len(c) for c in centers):
-        none = np.zeros(0, dtype=np.int64)
-        return _Spheres(none.astype(np.int32), none.astype(np.int16), none, np.zeros((0, 3)), np.zeros(0), none,
-                        np.sort(np.concatenate(without_sphere)))
-    return _Spheres(np.concatenate(rows_tessellation), np.concatenate(rows_local), np.concatenate(rows_leaf),
-                    np.concatenate(centers), np.concatenate(radii), np.concatenate(n_nodes),
-                    np.sort(np.concatenate(without_sphere)))
+            rows += len(chosen)
+
+    def joined(parts: list[np.ndarray], empty: np.ndarray) -> np.ndarray:
+        return np.concatenate(parts) if parts else empty
+
+    none = np.zeros(0, dtype=np.int64)
+    return _Spheres(joined(rows_tessellation, none.astype(np.int32)), joined(rows_local, none.astype(np.int16)),
+                    joined(rows_leaf, none), joined(n_nodes, none), joined(searched, none),
+                    joined(centers, np.zeros((0, 3))), joined(radii, np.zeros(0)),
+                    np.sort(np.concatenate(without_sphere))), local
+
+
+def _local_candidates(mesh: Mesh, local: list[tuple[int, np.ndarray, _Suspects]]) -> tuple[np.ndarray, np.ndarray]:
+    """(sphere row, vertex) pairs to decide exactly for the spheres the tree's structure bounds: per block of
+    alike rows (one element of a configuration on its leaves, from ``first`` on), the leaves' slots in the
+    sphere and the lattice points in it that are vertices (a grid point's key looked up among the vertices')."""
+    if not local:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    grid = mesh.grid
+    n = np.int64(grid + 1)
+    vertices = mesh.vertices.astype(np.int64)
+    keys = (vertices[:, 0] * n + vertices[:, 1]) * n + vertices[:, 2]  # increasing: a vertex's id is its rank
+    size = grid >> mesh.tree.levels.astype(np.int64)
+    rows_found, vertices_found = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
+    for first, leaves, suspects in local:
+        rows = first + np.arange(len(leaves), dtype=np.int64)
+        for slot in suspects.slots:
+            rows_found.append(rows)
+            vertices_found.append(mesh.slots[leaves, slot].astype(np.int64))
+        if not len(suspects.lattice):
+            continue
+        side = size[leaves]
+        low = mesh.tree.positions[leaves].astype(np.int64) * side[:, None]
+        # (leaves, points, 3): a lattice point is a grid point only where a quarter leaf is whole grid steps
+        scaled = suspects.lattice[None] * side[:, None, None]
+        at = low[:, None] + scaled // 4
+        candidate = ((scaled % 4 == 0) & (at >= 0) & (at <= grid)).all(axis=2)
+        which, point = np.nonzero(candidate)
+        key = (at[which, point, 0] * n + at[which, point, 1]) * n + at[which, point, 2]
+        rank = np.minimum(np.searchsorted(keys, key), len(keys) - 1)
+        present = keys[rank] == key
+        rows_found.append(rows[which[present]])
+        vertices_found.append(rank[present])
+    return np.concatenate(rows_found), np.concatenate(vertices_found)
 
 
 def _candidates(mesh: Mesh, points: np.ndarray, spheres: _Spheres, workers: int,
                 progress: Callable[[int], None] | None) -> tuple[np.ndarray, np.ndarray]:
     """(sphere row, vertex) pairs to decide exactly: the vertices that floats put near a sphere, the
-    sphere's own nodes left out, for every sphere that does not hold exactly its own nodes.
+    sphere's own nodes left out, for every searched sphere (``spheres.searched``) that does not hold
+    exactly its own nodes.
 
     A k-d tree of the vertices counts those within each sphere's radius (a hair more); the count
     is the element's node count for a sphere with nothing else near it, and only the others
@@ -593,7 +741,7 @@ def _candidates(mesh: Mesh, points: np.ndarray, spheres: _Spheres, workers: int,
         if progress:
             progress(len(part))
     # the element's own nodes are on its sphere; anything more (or less) is looked at exactly
-    suspect = np.flatnonzero(counts != spheres.nodes)
+    suspect = np.flatnonzero(counts != spheres.nodes[spheres.searched])
     tests = int(counts[suspect].sum())
     if tests > _MAX_EXACT_TESTS:
         raise InputError(f"the exact Delaunay check needs {tests:,} sphere tests, above the bound of "
@@ -611,7 +759,7 @@ def _candidates(mesh: Mesh, points: np.ndarray, spheres: _Spheres, workers: int,
         if any(x is None for x in found):  # a search thread that ran out of memory leaves None
             raise MemoryError
         lengths = np.fromiter((len(x) for x in found), dtype=np.int64, count=len(found))
-        pairs_row.append(np.repeat(rows, lengths))
+        pairs_row.append(np.repeat(spheres.searched[rows], lengths))
         found_vertices = np.fromiter((v for x in found for v in x), dtype=np.int64, count=int(lengths.sum()))
         pairs_vertex.append(found_vertices if near is None else near[found_vertices])
     pair_row = np.concatenate(pairs_row) if pairs_row else np.zeros(0, dtype=np.int64)

@@ -315,11 +315,17 @@ class Octree:
 
     ``depth`` is the finest leaf level.  Leaf ``i`` is the box
     ``positions[i] / 2**levels[i]`` (+ one cell) in unit coordinates of the domain.
+    ``vertex_balanced``: known by construction to tile the whole domain with leaves that
+    touch across a face, an edge or a corner only when at most one level apart
+    (:func:`build_octree` with ``balance="vertex"``); the exact Delaunay check then bounds
+    where a vertex can lie near a leaf (:mod:`cospherical.mesh.checks`).  ``False``
+    claims nothing.
     """
 
     box: Box
     levels: np.ndarray
     positions: np.ndarray
+    vertex_balanced: bool = False
 
     @property
     def depth(self) -> int:
@@ -419,7 +425,7 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balanc
         split[level - 1] = np.union1d(split[level - 1], parents)
     levels_, positions = _leaves_from_splits(split)
     check_leaf_count(len(levels_), f"{name}: balanced, the tree has", max_leaves)
-    return Octree(box, levels_, positions)
+    return Octree(box, levels_, positions, vertex_balanced=balance == "vertex")
 
 
 # ---------------------------------------------------------------------------

@@ -105,6 +105,7 @@ class Piece:
     cells: Cells | None = None
     replaced: np.ndarray | None = None
     types: dict | None = None
+    vertex_balanced: bool = False  # the whole tree's (Octree.vertex_balanced): the piece's vertices are its
 
 
 def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: Catalogue) -> dict:
@@ -121,7 +122,7 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: 
     and nothing more; else ``figures`` (:func:`~cospherical.mesh.report.mesh_figures`)
     and ``seams`` (the faces it leaves open).
     """
-    tree = Octree(piece.box, piece.levels, piece.positions)
+    tree = Octree(piece.box, piece.levels, piece.positions, piece.vertex_balanced)
     mesh = assemble(tree, lookup[0](*lookup[1]) if lookup is not None else None, criterion=piece.criterion,
                     vertices=(piece.grid, keys), catalogue=catalogue)
     result: dict = {"index": piece.index}
@@ -166,7 +167,8 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
     def task(k: int, **more) -> tuple:
         leaves = parts[k]
         return (Piece(k, tree.box, tree.levels[leaves], tree.positions[leaves], leaves, grid, criterion, mode,
-                      delaunay, write, path(k) if path is not None else None, **more),)
+                      delaunay, write, path(k) if path is not None else None, **more,
+                      vertex_balanced=tree.vertex_balanced),)
 
     def told(stage: str, total: int, finished):
         if progress is not None:
