@@ -423,7 +423,8 @@ def mesh_region_parts(mesh: Mesh, dual: Dual, faces: RegionFaces) -> RegionParts
     names = [r.name for r in device.regions]
     contacts = tuple((c.name, names.index(c.region), tuple(str(x) for x in c.box), c.axis) for c in device.contacts)
     lengths = tuple(high - low for low, high in device.bounds)
-    duals = [mesh_dual(_region_mesh(mesh, r)) for r in range(len(names))]
+    # one region holds every element: its dual is the mesh's (computing it again cost a fifth of a diode's run)
+    duals = [dual] if len(names) == 1 else [mesh_dual(_region_mesh(mesh, r)) for r in range(len(names))]
     return region_parts(mesh.box, mesh.grid, mesh.vertices, dual, mesh.element_region, mesh.regions.names,
                         mesh.regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths,
                         device.origin, duals,
