@@ -27,14 +27,16 @@ counts above) before anything is computed from it.
 from __future__ import annotations
 
 import re
+from fractions import Fraction
 from pathlib import Path
+from typing import Any
 
 import yaml
 
 from ..core.exact import parse_rational
 from ..errors import FormatError, InputError
 from ..files.yamlio import check_nesting, load_document, read_text, validate
-from ..mesh.device import Contact, Device, Region
+from ..mesh.device import Contact, Coordinates, Device, Region
 from ..mesh.octree import Shape, parse_shape
 
 __all__ = ["DEVICE_FILE_VERSION", "MAX_DEVICE_BYTES", "parse_device", "read_device"]
@@ -46,14 +48,14 @@ MAX_DEVICE_BYTES = 64 * 1024
 class _ExactLoader(yaml.SafeLoader):
     """Safe loading that keeps a YAML float as its text (so ``0.1`` stays the decimal 1/10) and refuses repeated keys."""
 
-    def compose_node(self, parent, index):
+    def compose_node(self, parent: yaml.Node | None, index: int) -> yaml.Node | None:
         # an alias can make a small text a huge tree (a "billion laughs"): a device file needs none
         if self.check_event(yaml.AliasEvent):
             raise yaml.composer.ComposerError(None, None, "an alias (*name): not allowed in a device file",
-                                              self.peek_event().start_mark)
+                                              self.peek_event().start_mark)  # type: ignore[no-untyped-call]
         return super().compose_node(parent, index)
 
-    def construct_mapping(self, node, deep=False):
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         keys = [self.construct_object(k, deep=deep) for k, _ in node.value]
         for i, key in enumerate(keys):
             if not isinstance(key, str) or key in keys[:i]:
@@ -62,13 +64,18 @@ class _ExactLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep)
 
 
-_ExactLoader.add_constructor("tag:yaml.org,2002:float", lambda loader, node: loader.construct_scalar(node))
+def _float_text(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> str:
+    """A YAML float as its text: exact, read by :func:`~cospherical.core.exact.parse_rational`."""
+    return str(loader.construct_scalar(node))
+
+
+_ExactLoader.add_constructor("tag:yaml.org,2002:float", _float_text)
 
 # YAML 1.1 integers that are not what they look like: 010 is 8 (octal), 1:30 is 90 (base 60), 0x10 is 16
 _DECIMAL_INTEGER = re.compile(r"[-+]?(0|[1-9][0-9]*)")
 
 
-def _decimal_integer(loader, node) -> int:
+def _decimal_integer(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> int:
     """An integer written in decimal digits; YAML 1.1's other forms are refused rather than read as another number."""
     text = loader.construct_scalar(node)
     if not _DECIMAL_INTEGER.fullmatch(text):
@@ -107,8 +114,10 @@ def parse_device(text: str, name: str = "device file") -> Device:
         raise FormatError(f"{name}: a device file is a mapping with 'device' and 'regions'")
     validate(data, "device", name)
 
-    def numbers(values, what: str) -> tuple:
-        return tuple(parse_rational(str(v) if not isinstance(v, int) else v, f"{name}: {what}") for v in values)
+    def numbers(values: list[Any], what: str) -> Coordinates:
+        x0, y0, z0, x1, y1, z1 = (Fraction(parse_rational(str(v) if not isinstance(v, int) else v, f"{name}: {what}"))
+                                  for v in values)
+        return (x0, y0, z0, x1, y1, z1)
 
     regions = tuple(Region(r["name"], r["material"],
                            tuple(numbers(box, f"region {r['name']!r} box {k}") for k, box in enumerate(r["boxes"])))

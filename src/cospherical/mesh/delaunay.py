@@ -132,7 +132,9 @@ checks of 5 fail with any proposal, the exact engine's included:
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 
@@ -141,14 +143,15 @@ from ..errors import InputError
 from .assembly import Cells, Mesh, distinct
 from .checks import DelaunayCheck, check_delaunay, grid_weights
 from .merged_cells import Locator, NotOneCell, cell_members, classified_cells, inside_cluster, same_sphere
-from .proposal import cluster_tetrahedra
+from .proposal import Proposal, cluster_tetrahedra
 
 __all__ = ["delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
 _NO_CLUSTER = -1  # the cluster of a leaf element that is kept, and of a vertex of no cluster
 
 
-def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull", proposal=None,
+def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull",
+                    proposal: Proposal | None = None,
                     convex: bool = True) -> Mesh:
     """The exact Delaunay subdivision of ``mesh``'s vertices, as a :class:`Mesh` (see the module's proof).
 
@@ -173,7 +176,7 @@ def global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engi
 
 
 def _global_delaunay(mesh: Mesh, found: DelaunayCheck | None = None, engine: Engine = "qhull",
-                     proposal=None, convex: bool = True) -> tuple[Mesh, DelaunayCheck | None]:
+                     proposal: Proposal | None = None, convex: bool = True) -> tuple[Mesh, DelaunayCheck | None]:
     """:func:`global_delaunay`, and :func:`check_delaunay` on the result when it ran (a cluster was re-tessellated)."""
     if engine not in ENGINES:
         raise InputError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
@@ -196,8 +199,8 @@ def _leaves_of(mesh: Mesh, elements: np.ndarray) -> np.ndarray:
     return bad
 
 
-def retessellate(mesh: Mesh, elements: np.ndarray, types: dict, engine: Engine = "qhull",
-                 proposal=None, convex: bool = True) -> tuple[Cells, DelaunayCheck]:
+def retessellate(mesh: Mesh, elements: np.ndarray, types: dict[str, dict[str, Any]], engine: Engine = "qhull",
+                 proposal: Proposal | None = None, convex: bool = True) -> tuple[Cells, DelaunayCheck]:
     """The cells of the Delaunay subdivision of ``mesh``'s vertices that replace the leaves holding ``elements``.
 
     ``elements``: the leaf elements that are not cells of it (see the module's proof).
@@ -289,7 +292,7 @@ def _cluster_volumes(mesh: Mesh, elements: np.ndarray, part: np.ndarray, cluster
     return volumes
 
 
-def _sums(key: np.ndarray, values: np.ndarray, base: int):
+def _sums(key: np.ndarray, values: np.ndarray, base: int) -> Iterator[tuple[tuple[int, int], int]]:
     """Per distinct key, ((key // base, key % base), the sum of its values (Python integers))."""
     order = np.argsort(key, kind="stable")
     key, values = key[order], values[order]
@@ -298,13 +301,16 @@ def _sums(key: np.ndarray, values: np.ndarray, base: int):
         yield divmod(int(key[start]), base), total
 
 
-def _failing_clusters(mesh: Mesh, found: DelaunayCheck, vertex_cluster: np.ndarray, wanted: list) -> set[int]:
+def _failing_clusters(mesh: Mesh, found: DelaunayCheck, vertex_cluster: np.ndarray,
+                      wanted: list[Fraction]) -> set[int]:
     """The clusters whose re-tessellated cells are not proven cells of the Delaunay subdivision (the module's proof).
 
     A cluster fails when one of its cells is not empty or ties with a vertex, or when
     its cells' exact volumes do not sum to its elements'.
     """
     cells = mesh.cells
+    if cells is None:
+        raise RuntimeError("a trial mesh without its cells")
     fresh = np.flatnonzero(~cells.proven)
     # A fresh cell's vertices are its tetrahedra's, all of one cluster (the clusters' vertex sets are
     # disjoint): its first vertex names the cluster.  The proven cells belong to no cluster.
@@ -324,7 +330,7 @@ def _failing_clusters(mesh: Mesh, found: DelaunayCheck, vertex_cluster: np.ndarr
     return failing | {r for r, (v, w) in enumerate(zip(volumes, wanted)) if v != w}
 
 
-def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict) -> Mesh:
+def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict[str, dict[str, Any]]) -> Mesh:
     """``mesh`` with the elements of the marked leaves replaced by ``cells`` (whose ``leaf`` indexes its leaves);
     ``types``: the element types of the result."""
     counts = np.array([len(p.elements) for p in mesh.tessellations], dtype=np.int64)[mesh.leaf_tessellation]
@@ -357,7 +363,8 @@ def _clusters(nodes: np.ndarray, vertices: int) -> tuple[np.ndarray, int]:
     return part, int(part.max()) + 1
 
 
-def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress=None, convex: bool = True
+def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress: Callable[[int], None] | None = None,
+                  convex: bool = True
                   ) -> tuple[Mesh, dict[str, int] | None, DelaunayCheck | None]:
     """The mesh a user asked for: ``leaf`` (the leaf mesh as assembled) or ``global`` (its exact Delaunay subdivision).
 

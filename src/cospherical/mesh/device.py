@@ -33,16 +33,19 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 
+from ..choices import Balance
 from ..core.configuration import Box
 from ..errors import InputError, shown
 from .octree import MAX_LEVEL, Octree, Shape, build_octree, parse_shape
 
-__all__ = ["AXES", "Contact", "Device", "DeviceLayout", "MAX_BOXES", "MAX_CONTACTS", "MAX_REFINE", "MAX_REGIONS", "NAME",
+__all__ = ["AXES", "Contact", "Coordinates", "Device", "DeviceLayout", "MAX_BOXES", "MAX_CONTACTS", "MAX_REFINE", "MAX_REGIONS", "NAME",
            "Region", "Regions", "checked_device", "device_layout", "device_octree"]
 
 AXES = "xyz"
@@ -97,7 +100,7 @@ class Device:
     contacts: tuple[Contact, ...]
     refine: tuple[Shape, ...]
     levels: int
-    balance: str = "vertex"
+    balance: Balance = "vertex"
 
     @property
     def bounds(self) -> tuple[tuple[Fraction, Fraction], ...]:
@@ -107,7 +110,8 @@ class Device:
 
     @property
     def origin(self) -> tuple[Fraction, Fraction, Fraction]:
-        return tuple(low for low, _ in self.bounds)
+        (x, _), (y, _), (z, _) = self.bounds
+        return (x, y, z)
 
     @property
     def has_faces(self) -> bool:
@@ -236,7 +240,8 @@ def _any(marks: np.ndarray, r0: np.ndarray, r1: np.ndarray, c0: np.ndarray, c1: 
     r0, r1 = np.clip(r0, 0, marks.shape[0]), np.clip(r1, 0, marks.shape[0])
     c0, c1 = np.clip(c0, 0, marks.shape[1]), np.clip(c1, 0, marks.shape[1])
     r1, c1 = np.maximum(r1, r0), np.maximum(c1, c0)
-    return table[r1, c1] - table[r0, c1] - table[r1, c0] + table[r0, c0] > 0
+    held: np.ndarray = table[r1, c1] - table[r0, c1] - table[r1, c0] + table[r0, c0] > 0
+    return held
 
 
 def _dyadic_level(value: Fraction, low: Fraction, length: Fraction) -> int | None:
@@ -259,20 +264,21 @@ def checked_device(device: Device) -> Device:
     if not isinstance(device, Device):
         raise InputError(f"device {shown(device)}: a Device, or a device file's path")
 
-    def sequence(value, what: str, most: int) -> tuple:
+    def sequence(value: object, what: str, most: int) -> tuple[Any, ...]:
         if not isinstance(value, (tuple, list)) or len(value) > most:
             raise InputError(f"device {shown(device.name)}: its {what}: a list of at most {most}, not {shown(value)}")
         return tuple(value)
 
-    def name(value, what: str) -> str:
+    def name(value: object, what: str) -> str:
         if not isinstance(value, str) or not NAME.fullmatch(value):
             raise InputError(f"{what} name {shown(value)}: 1 to 64 of A-Z a-z 0-9 _ . + -")
         return value
 
-    def coordinates(value, what: str) -> tuple:
+    def coordinates(value: object, what: str) -> Coordinates:
         if not isinstance(value, (tuple, list)) or len(value) != 6:
             raise InputError(f"{what}: six coordinates x0 y0 z0 x1 y1 z1, not {shown(value)}")
-        return tuple(parse_rational(x, what) for x in value)
+        x0, y0, z0, x1, y1, z1 = (Fraction(parse_rational(x, what)) for x in value)
+        return (x0, y0, z0, x1, y1, z1)
 
     name(device.name, "device")
     regions = []
@@ -317,7 +323,7 @@ def device_layout(device: Device) -> DeviceLayout:
     if len(device.contacts) > MAX_CONTACTS:
         raise InputError(f"device {shown(device.name)}: {len(device.contacts)} contacts, at most {MAX_CONTACTS}")
     for kind, names in (("region", [r.name for r in regions]), ("contact", [c.name for c in device.contacts])):
-        seen: set = set()
+        seen: set[str] = set()
         for name in names:
             if name in seen:
                 raise InputError(f"device {shown(device.name)}: two {kind}s named {shown(name)}")
@@ -368,7 +374,7 @@ def device_layout(device: Device) -> DeviceLayout:
             resolving = max(resolving, level)
     steps = 1 << resolving
 
-    def grid(box) -> list[int]:
+    def grid(box: Coordinates) -> list[int]:
         return [int((box[i] - bounds[i % 3][0]) / lengths[i % 3] * steps) for i in range(6)]
 
     gridded = [grid(box) for _, box in checked]
@@ -379,20 +385,19 @@ def device_layout(device: Device) -> DeviceLayout:
     for index, ((r, k, _), g) in enumerate(zip(boxes, gridded)):
         span = tuple(slice(int(np.searchsorted(planes[a], g[a])), int(np.searchsorted(planes[a], g[a + 3])))
                      for a in range(3))
-        taken = owner_box[span]
-        if (taken >= 0).any():
-            other = int(taken[taken >= 0][0])
-            r0, k0, _ = boxes[other]
+        claimed = owner_box[span]
+        if (claimed >= 0).any():
+            r0, k0, _ = boxes[int(claimed[claimed >= 0][0])]
             raise InputError(f"{where(r, k)} overlaps {where(r0, k0)}")
         owner[span] = r
         owner_box[span] = index
     _check_connected(owner_box, boxes, where)
-    contacts = []
+    contacts: list[tuple[int, int, tuple[int, int], tuple[int, int]]] = []
     for contact, g in zip(device.contacts, gridded[len(boxes):]):
         axis = contact.axis
         b, c = (axis + 1) % 3, (axis + 2) % 3
-        value = g[axis]
-        i = int(np.searchsorted(planes[axis], value))
+        at = g[axis]
+        i = int(np.searchsorted(planes[axis], at))
         span_b = slice(int(np.searchsorted(planes[b], g[b])), int(np.searchsorted(planes[b], g[b + 3])))
         span_c = slice(int(np.searchsorted(planes[c], g[c])), int(np.searchsorted(planes[c], g[c + 3])))
         moved = np.moveaxis(owner, axis, 0)
@@ -407,27 +412,29 @@ def device_layout(device: Device) -> DeviceLayout:
             raise InputError(f"contact {shown(contact.name)}: not on the boundary of region {shown(contact.region)} "
                              f"(the rectangle {AXES[axis]} = {contact.box[axis]} must have the region on one side "
                              "only, everywhere)")
-        for other, (axis0, value0, (p0, p1), (q0, q1)) in zip(device.contacts, contacts):
-            if axis0 == axis and value0 == value and max(p0, g[b]) < min(p1, g[b + 3]) and \
+        for earlier, (axis0, at0, (p0, p1), (q0, q1)) in zip(device.contacts, contacts):
+            if axis0 == axis and at0 == at and max(p0, g[b]) < min(p1, g[b + 3]) and \
                     max(q0, g[c]) < min(q1, g[c + 3]):
-                raise InputError(f"contact {shown(contact.name)} overlaps contact {shown(other.name)}: a face is in "
-                                 "one contact")
-        contacts.append((axis, value, (g[b], g[b + 3]), (g[c], g[c + 3])))
-    volume_unit = math.prod(lengths) / steps ** 3
+                raise InputError(f"contact {shown(contact.name)} overlaps contact {shown(earlier.name)}: a face is "
+                                 "in one contact")
+        contacts.append((axis, at, (g[b], g[b + 3]), (g[c], g[c + 3])))
+    volume_unit = Fraction(math.prod(lengths)) / steps ** 3
     sizes = [np.diff(p) for p in planes]
     block_volume = sizes[0][:, None, None] * sizes[1][None, :, None] * sizes[2][None, None, :]
     volumes = tuple(int(block_volume[owner == r].sum()) * volume_unit for r in range(len(regions)))
-    return DeviceLayout(device, resolving, planes, owner, tuple(contacts), volumes)
+    return DeviceLayout(device, resolving, (planes[0], planes[1], planes[2]), owner, tuple(contacts), volumes)
 
 
-def _check_connected(owner_box: np.ndarray, boxes: list, where) -> None:
+def _check_connected(owner_box: np.ndarray, boxes: list[tuple[int, int, Coordinates]],
+                     where: Callable[[int, int], str]) -> None:
     """Refuse a domain whose blocks are not one piece through shared faces (naming a box of another piece)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
     inside = owner_box >= 0
     index = np.arange(owner_box.size).reshape(owner_box.shape)
-    rows, cols = [], []
+    rows: list[np.ndarray] = []
+    cols: list[np.ndarray] = []
     for axis in range(3):
         a = [slice(None)] * 3
         b = [slice(None)] * 3
@@ -435,8 +442,8 @@ def _check_connected(owner_box: np.ndarray, boxes: list, where) -> None:
         both = inside[tuple(a)] & inside[tuple(b)]
         rows.append(index[tuple(a)][both])
         cols.append(index[tuple(b)][both])
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(owner_box.size,) * 2)
+    row, col = np.concatenate(rows), np.concatenate(cols)
+    graph = coo_matrix((np.ones(len(row), dtype=np.int8), (row, col)), shape=(owner_box.size,) * 2)
     _, label = connected_components(graph, directed=False)
     pieces = np.unique(label[inside.reshape(-1)])
     if len(pieces) > 1:
@@ -476,10 +483,11 @@ def leaf_owner(layout: DeviceLayout, levels: np.ndarray, positions: np.ndarray) 
     resolving = layout.resolving_level
     low = np.where((levels <= resolving)[:, None], positions.astype(np.int64) << np.maximum(resolving - levels, 0)[:, None],
                    positions.astype(np.int64) >> np.maximum(levels - resolving, 0)[:, None])
-    return layout.owner[layout.blocks_of(low)].astype(np.int64)
+    owner: np.ndarray = layout.owner[layout.blocks_of(low)].astype(np.int64)
+    return owner
 
 
-def _shifted(shape: Shape, origin) -> Shape:
+def _shifted(shape: Shape, origin: tuple[Fraction, Fraction, Fraction]) -> Shape:
     """A refinement shape in device coordinates moved to the bounding box's frame (its low corner at 0)."""
     v = list(shape.values)
     if shape.kind in ("point", "sphere", "box"):

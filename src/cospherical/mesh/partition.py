@@ -38,8 +38,9 @@ Why a piece is the whole mesh's restriction, element for element:
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -55,6 +56,10 @@ from .octree import Octree, distinct
 from .report import merged_report, mesh_figures
 
 __all__ = ["MAX_PARTITIONS", "Piece", "mesh_in_pieces", "mesh_piece", "morton_pieces"]
+
+# The pattern lookup as it travels to a worker (a closure does not): a factory and its arguments.
+LookupRecipe = tuple[Callable[..., Any], tuple[Any, ...]]
+T = TypeVar("T")
 
 # More pieces than this is a mistake, not a plan: one file each, in one folder.
 MAX_PARTITIONS = 4096
@@ -100,15 +105,15 @@ class Piece:
     criterion: str
     mode: str
     delaunay: bool
-    write: Callable | None
+    write: Callable[..., None] | None
     path: str | None
     cells: Cells | None = None
     replaced: np.ndarray | None = None
-    types: dict | None = None
+    types: dict[str, dict[str, Any]] | None = None
     vertex_balanced: bool = False  # the whole tree's (Octree.vertex_balanced): the piece's vertices are its
 
 
-def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: Catalogue) -> dict:
+def mesh_piece(piece: Piece, keys: np.ndarray, lookup: LookupRecipe | None, catalogue: Catalogue) -> dict[str, Any]:
     """Mesh, check and write one piece (run in a worker); see the module for why it equals its part of the whole.
 
     ``keys``: the whole tree's vertex keys; ``lookup``: ``(factory, arguments)`` that make
@@ -125,10 +130,11 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: 
     tree = Octree(piece.box, piece.levels, piece.positions, piece.vertex_balanced)
     mesh = assemble(tree, lookup[0](*lookup[1]) if lookup is not None else None, criterion=piece.criterion,
                     vertices=(piece.grid, keys), catalogue=catalogue)
-    result: dict = {"index": piece.index}
+    result: dict[str, Any] = {"index": piece.index}
     checked = None
     if piece.cells is not None:
-        mesh = with_cells(mesh, piece.replaced, piece.cells, {**mesh.types, **piece.types})
+        replaced = piece.replaced if piece.replaced is not None else np.zeros(len(tree), dtype=bool)
+        mesh = with_cells(mesh, replaced, piece.cells, {**mesh.types, **(piece.types or {})})
     elif piece.mode == "global":
         found = check_delaunay(mesh)
         result["leaf_mesh"] = found.leaf_mesh(len(mesh))
@@ -145,11 +151,11 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: tuple | None, catalogue: 
     return result
 
 
-def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: str, mode: str,
-                   described: dict, patterns: str | None, uniform: bool = True, delaunay: bool = True,
-                   write: Callable | None = None, path: Callable[[int], str] | None = None, jobs: int = 1,
+def mesh_in_pieces(tree: Octree, pieces: int, lookup: LookupRecipe | None, criterion: str, mode: str,
+                   described: dict[str, Any], patterns: str | None, uniform: bool = True, delaunay: bool = True,
+                   write: Callable[..., None] | None = None, path: Callable[[int], str] | None = None, jobs: int = 1,
                    scheduler: str | None = None, dask_workers: int | None = None, catalogue: Catalogue | None = None,
-                   progress: Callable[[str, int, int], None] | None = None) -> dict:
+                   progress: Callable[[str, int, int], None] | None = None) -> dict[str, Any]:
     """Mesh ``tree`` in ``pieces`` tasks (each writing ``path(k)`` with ``write``); return the whole mesh's report.
 
     ``lookup``: ``(factory, arguments)`` of the pattern lookup (``None``: every
@@ -164,13 +170,13 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
     grid, keys = vertex_keys(tree)
     parts = morton_pieces(tree, pieces)
 
-    def task(k: int, **more) -> tuple:
+    def task(k: int, **more: Any) -> tuple[Piece]:
         leaves = parts[k]
         return (Piece(k, tree.box, tree.levels[leaves], tree.positions[leaves], leaves, grid, criterion, mode,
                       delaunay, write, path(k) if path is not None else None, **more,
                       vertex_balanced=tree.vertex_balanced),)
 
-    def told(stage: str, total: int, finished):
+    def told(stage: str, total: int, finished: Iterable[T]) -> Iterator[T]:
         if progress is not None:
             progress(stage, total, 0)
         for item in finished:
@@ -188,8 +194,8 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
         marked = np.sort(np.concatenate([results[k].get("marked", np.zeros(0, dtype=np.int64))
                                          for k in range(pieces)]))
         if len(marked):
-            failing = [results[k]["failing"] for k in range(pieces) if "failing" in results[k]]
-            failing = tuple(np.concatenate([f[i] for f in failing]) for i in range(2))
+            found = [results[k]["failing"] for k in range(pieces) if "failing" in results[k]]
+            failing = (np.concatenate([f[0] for f in found]), np.concatenate([f[1] for f in found]))
             again, regions = _cells_by_piece(tree, parts, marked, failing, grid, keys, lookup, criterion,
                                                      catalogue)
             results.update(told("again", len(again), completed(
@@ -205,9 +211,10 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: tuple | None, criterion: s
                          criterion, uniform, delaunay, leaf_mesh, regions, seams, points, grid, catalogue=catalogue)
 
 
-def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray, failing: tuple, grid: int,
-                    keys: np.ndarray, lookup: tuple | None, criterion: str,
-                    catalogue: Catalogue) -> tuple[dict[int, dict], tuple[int, int]]:
+def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray,
+                    failing: tuple[np.ndarray, np.ndarray], grid: int,
+                    keys: np.ndarray, lookup: LookupRecipe | None, criterion: str,
+                    catalogue: Catalogue) -> tuple[dict[int, dict[str, Any]], tuple[int, int]]:
     """Re-tessellate the marked leaves (whole-tree indices) and give each cell to the piece of its first leaf.
 
     ``failing``: the elements that are not Delaunay cells, as (whole-tree leaf, index in the leaf).

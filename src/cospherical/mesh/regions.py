@@ -33,9 +33,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Callable
+from collections.abc import Sequence
+from typing import Any, Callable
 
 import numpy as np
+
+from ..choices import DelaunayMode
+from ..core.configuration import Box
+from ..errors import InputError
 
 from .assembly import Cells, Lookup, Mesh, assemble, vertex_keys
 from .checks import DelaunayCheck, check_conformity
@@ -49,9 +54,9 @@ __all__ = ["RegionFaces", "contact_areas", "device_mesh", "device_report", "mesh
 
 
 def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, lookup: Lookup | None = None,
-                criterion: str = "optimal", mode: str = "global",
+                criterion: str = "optimal", mode: DelaunayMode = "global",
                 progress: Callable[[str, int | None, int], None] | None = None,
-                cache: dict | None = None) -> tuple[Mesh, dict | None, DelaunayCheck | None]:
+                cache: dict[Any, Any] | None = None) -> tuple[Mesh, dict[str, Any] | None, DelaunayCheck | None]:
     """Mesh a device's tree: the leaf mesh, then in ``global`` mode the exact Delaunay subdivision region by region.
 
     Returns what :func:`~cospherical.mesh.delaunay.delaunay_mesh` returns: the mesh,
@@ -80,7 +85,9 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
     bounds = _box_bounds(layout) * factor
     first_box = np.cumsum([0] + [len(r.boxes) for r in device.regions])
     done: list[tuple[np.ndarray, Mesh, DelaunayCheck | None]] = []
-    parts, found, types = [], [], dict(mesh.types)
+    parts: list[Cells] = []
+    found: list[dict[str, int]] = []
+    types = dict(mesh.types)
     bad = np.zeros(len(tree), dtype=bool)
     for r in range(count):
         leaves = np.flatnonzero(leaf_region == r)
@@ -91,8 +98,8 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
         ids = np.flatnonzero(on)
         sub = assemble(Octree(tree.box, tree.levels[leaves], tree.positions[leaves]), lookup, cache=cache,
                        criterion=criterion, vertices=(grid, keys[ids]), catalogue=mesh.catalogue)
-        result, leaf, checked = delaunay_mesh(sub, "global", convex=layout.convex(r))
-        found.append(leaf)
+        result, figures, checked = delaunay_mesh(sub, "global", convex=layout.convex(r))
+        found.append(figures or {})
         done.append((leaves, result, checked))
         if result.cells is None:
             continue
@@ -102,7 +109,7 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
         nodes = np.where(cells.nodes >= 0, ids[np.maximum(cells.nodes, 0)], -1).astype(np.int32)
         parts.append(Cells(cells.shapes, cells.shape, cells.anchor, nodes, leaves[cells.leaf], cells.spanning,
                            cells.proven, cells.clusters, cells.largest_cluster))
-    leaf = {key: sum(f[key] for f in found) for key in found[0]}
+    leaf: dict[str, Any] = {key: sum(f[key] for f in found) for key in found[0]}
     result = with_cells(mesh, bad, _merged(parts), types) if parts else mesh
     if parts and check_conformity(result, examples=0).nonconforming_faces:
         # the regions' subdivisions do not meet face to face: the leaf mesh, conforming by construction
@@ -171,6 +178,14 @@ def _merged(parts: list[Cells]) -> Cells:
                  max(c.largest_cluster for c in parts))
 
 
+def device_of(mesh: Mesh) -> tuple[Regions, DeviceLayout, np.ndarray]:
+    """A device mesh's regions, layout and each element's region; a mesh of no device is refused."""
+    regions = mesh.regions
+    if regions is None or regions.layout is None:
+        raise InputError("not a device's mesh: it has no regions")
+    return regions, regions.layout, regions.leaf_region[mesh.element_leaf]
+
+
 @dataclass(frozen=True)
 class RegionFaces:
     """A device mesh's named face sets: contacts and interfaces (polygons of global vertex ids, -1 padded).
@@ -207,9 +222,7 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     contact's closed rectangle (a face of a conforming mesh lies in one leaf face,
     which lies inside or outside the contact: the tree was refined so).
     """
-    regions = mesh.regions
-    layout = regions.layout
-    element_region = mesh.element_region
+    regions, layout, element_region = device_of(mesh)
     rows, polygons = [], []
     width = 0
     for element_rows, nodes, faces, _ in mesh.blocks():
@@ -269,7 +282,7 @@ def region_faces(mesh: Mesh) -> RegionFaces:
 
 def contact_areas(mesh: Mesh, faces: RegionFaces) -> list[Fraction]:
     """Each contact's area from its faces, exactly, in device units (the polygons' shoelace areas)."""
-    layout = mesh.regions.layout
+    _, layout, _ = device_of(mesh)
     lengths = [high - low for low, high in layout.device.bounds]
     areas = [Fraction(0)] * len(layout.contacts)
     vertices = mesh.vertices.astype(np.int64)
@@ -289,16 +302,18 @@ def contact_areas(mesh: Mesh, faces: RegionFaces) -> list[Fraction]:
 class _Vertices:
     """What :func:`~cospherical.mesh.dual.mesh_dual` reads of a mesh when it is given the elements."""
 
-    box: object
+    box: Box
     grid: int
     vertices: np.ndarray
 
 
-def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_region: np.ndarray,
-                 names: tuple[str, ...], materials: tuple[str, ...], contacts: tuple = (),
+def region_parts(box: Box, grid: int, vertices: np.ndarray, dual: Dual, element_region: np.ndarray,
+                 names: tuple[str, ...], materials: tuple[str, ...],
+                 contacts: tuple[tuple[str, int, tuple[str, ...], int], ...] = (),
                  contact_face_nodes: np.ndarray | None = None, contact_face_contact: np.ndarray | None = None,
-                 lengths: tuple[Fraction, Fraction, Fraction] | None = None, origin=("0", "0", "0"),
-                 region_duals: list[Dual] | None = None, boxes: tuple = ()) -> RegionParts:
+                 lengths: tuple[Fraction, Fraction, Fraction] | None = None,
+                 origin: Sequence[object] = ("0", "0", "0"), region_duals: list[Dual] | None = None,
+                 boxes: tuple[tuple[tuple[str, ...], ...], ...] = ()) -> RegionParts:
     """The dual of each region's elements alone (exact), as parts of ``dual`` (see :class:`RegionParts`).
 
     A region's part of a control volume or of a coupling is the dual of its own
@@ -313,7 +328,14 @@ def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_regio
     """
     keys = dual.edges[:, 0].astype(np.int64) * len(vertices) + dual.edges[:, 1]
     mesh = _Vertices(box, grid, vertices)
-    vv, vr, ve, ce, cr, cx, vden, cden = [], [], [], [], [], [], [], []
+    vv: list[np.ndarray] = []
+    vr: list[np.ndarray] = []
+    ve: list[np.ndarray] = []
+    ce: list[np.ndarray] = []
+    cr: list[np.ndarray] = []
+    cx: list[np.ndarray] = []
+    vden: list[int] = []
+    cden: list[int] = []
     for r in range(len(names)):
         rows = np.flatnonzero(element_region == r)
         part = region_duals[r] if region_duals is not None else \
@@ -331,11 +353,11 @@ def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_regio
     volume_denominator, coupling_denominator = math.lcm(*vden), math.lcm(*cden)
     volume_exact = _common(ve, vden, volume_denominator)
     coupling_exact = _common(cx, cden, coupling_denominator)
-    vv, vr = np.concatenate(vv), np.concatenate(vr)
-    order = np.lexsort((vr, vv))
-    ce, cr = np.concatenate(ce), np.concatenate(cr)
-    corder = np.lexsort((cr, ce))
-    if contact_face_nodes is None:
+    volume_vertex, volume_region = np.concatenate(vv), np.concatenate(vr)
+    order = np.lexsort((volume_region, volume_vertex))
+    coupling_edge, coupling_region = np.concatenate(ce), np.concatenate(cr)
+    corder = np.lexsort((coupling_region, coupling_edge))
+    if contact_face_nodes is None or contact_face_contact is None:
         contact_face_nodes = np.zeros((0, 3), dtype=np.int32)
         contact_face_contact = np.zeros(0, dtype=np.int32)
     shares = _contact_shares(vertices, grid, contact_face_nodes, contact_face_contact,
@@ -343,8 +365,9 @@ def region_parts(box, grid: int, vertices: np.ndarray, dual: Dual, element_regio
     pairs = sorted(shares)
     contact_denominator = math.lcm(1, *(q.denominator for q in shares.values()))
     return RegionParts(
-        tuple(names), tuple(materials), element_region.astype(np.int32), vv[order].astype(np.int64),
-        vr[order], volume_exact[order], volume_denominator, ce[corder].astype(np.int64), cr[corder],
+        tuple(names), tuple(materials), element_region.astype(np.int32), volume_vertex[order].astype(np.int64),
+        volume_region[order], volume_exact[order], volume_denominator, coupling_edge[corder].astype(np.int64),
+        coupling_region[corder],
         coupling_exact[corder], coupling_denominator, tuple(c[0] for c in contacts), tuple(c[1] for c in contacts),
         tuple(tuple(c[2]) for c in contacts), contact_face_nodes.astype(np.int32),
         contact_face_contact.astype(np.int32), np.array([v for v, _ in pairs], dtype=np.int64).reshape(-1),
@@ -372,7 +395,7 @@ def _common(parts: list[np.ndarray], denominators: list[int], common: int) -> np
 
 
 def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: np.ndarray, axes: list[int],
-                    lengths) -> dict[tuple[int, int], Fraction]:
+                    lengths: Sequence[Fraction] | None) -> dict[tuple[int, int], Fraction]:
     """Per (vertex, contact), its part of the contact's faces' area, exactly (device units).
 
     A co-circular face gives each vertex the triangles between it, the midpoints of
@@ -380,7 +403,9 @@ def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: n
     area whatever the shape); computed once per face shape up to translation.
     """
     shares: dict[tuple[int, int], Fraction] = {}
-    cache: dict = {}
+    cache: dict[tuple[int, bytes], list[Fraction]] = {}
+    if len(faces) and lengths is None:
+        raise InputError("contact faces need the bounding box's lengths")
     for face, c in zip(faces.tolist(), which.tolist()):
         ids = [v for v in face if v >= 0]
         axis = axes[c]
@@ -388,6 +413,7 @@ def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: n
         points = vertices[ids][:, [b, d]].astype(np.int64)
         key = (axis, (points - points[0]).tobytes())
         if key not in cache:
+            assert lengths is not None
             scale = (Fraction(lengths[b]) / grid, Fraction(lengths[d]) / grid)
             p = [(Fraction(int(x)) * scale[0], Fraction(int(y)) * scale[1]) for x, y in (points - points[0])]
             cache[key] = _polygon_shares(p)
@@ -418,22 +444,23 @@ def _polygon_shares(p: list[tuple[Fraction, Fraction]]) -> list[Fraction]:
 
 def mesh_region_parts(mesh: Mesh, dual: Dual, faces: RegionFaces) -> RegionParts:
     """:func:`region_parts` of a device mesh, its contacts from ``faces``."""
-    layout = mesh.regions.layout
+    regions, layout, element_region = device_of(mesh)
     device = layout.device
     names = [r.name for r in device.regions]
     contacts = tuple((c.name, names.index(c.region), tuple(str(x) for x in c.box), c.axis) for c in device.contacts)
-    lengths = tuple(high - low for low, high in device.bounds)
+    (x0, x1), (y0, y1), (z0, z1) = device.bounds
+    lengths = (x1 - x0, y1 - y0, z1 - z0)
     # one region holds every element: its dual is the mesh's (computing it again cost a fifth of a diode's run)
     duals = [dual] if len(names) == 1 else [mesh_dual(_region_mesh(mesh, r)) for r in range(len(names))]
-    return region_parts(mesh.box, mesh.grid, mesh.vertices, dual, mesh.element_region, mesh.regions.names,
-                        mesh.regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths,
+    return region_parts(mesh.box, mesh.grid, mesh.vertices, dual, element_region, regions.names,
+                        regions.materials, contacts, faces.contact_nodes, faces.contact_face_contact, lengths,
                         device.origin, duals,
                         tuple(tuple(tuple(str(x) for x in box) for box in r.boxes) for r in device.regions))
 
 
 def _region_mesh(mesh: Mesh, region: int) -> Mesh:
     """The mesh of one region's elements alone (the other leaves marked replaced, the other cells left out)."""
-    leaf_region = mesh.regions.leaf_region
+    leaf_region = device_of(mesh)[0].leaf_region
     other = leaf_region != region
     if mesh.replaced is not None:
         other = other | mesh.replaced
@@ -449,10 +476,11 @@ def _region_mesh(mesh: Mesh, region: int) -> Mesh:
 
 def region_volumes(mesh: Mesh) -> list[Fraction]:
     """Each region's elements' volume, exactly, as a fraction of the root box's volume."""
-    count = len(mesh.regions.names)
+    regions, _, _ = device_of(mesh)
+    count = len(regions.names)
     depth = mesh.tree.depth
     volumes = [Fraction(0)] * count
-    leaf_region = mesh.regions.leaf_region
+    leaf_region = regions.leaf_region
     for _, tessellation, leaves in mesh.groups():
         unit = sum((e.unit_volume for e in tessellation.elements), Fraction(0))
         weight = 8 ** (depth - mesh.tree.levels[leaves].astype(np.int64))
@@ -468,20 +496,20 @@ def region_volumes(mesh: Mesh) -> list[Fraction]:
     return volumes
 
 
-def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> dict:
+def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> dict[str, Any]:
     """The report's ``device`` section: per region its elements, nodes, volume (exact) and, with the dual
     (its parts per region computed), its negative coefficients (interior: off the domain's boundary) and
     control volume sum; per contact its faces, nodes, area; per interface its faces and nodes."""
-    layout = mesh.regions.layout
+    _, layout, element_region = device_of(mesh)
     device = layout.device
     lengths = [high - low for low, high in device.bounds]
     box_volume = lengths[0] * lengths[1] * lengths[2]
-    element_region = mesh.element_region
     conn, _ = mesh.connectivity()
     volumes = region_volumes(mesh)
     negative = None
     parts = dual.regions if dual is not None else None
-    if parts is not None:
+    if dual is not None and parts is not None:
+        factor = _factor(dual)
         keys = dual.edges[parts.coupling_edge, 0].astype(np.int64) * len(mesh.vertices) + \
             dual.edges[parts.coupling_edge, 1]
         on_boundary = np.isin(keys, faces.boundary_edges)
@@ -492,12 +520,12 @@ def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> d
     regions = []
     for r, region in enumerate(device.regions):
         rows = conn[element_region == r]
-        entry = {"name": region.name, "material": region.material, "elements": int(len(rows)),
+        entry: dict[str, Any] = {"name": region.name, "material": region.material, "elements": int(len(rows)),
                  "nodes": int(len(np.unique(rows[rows >= 0]))), "volume": str(volumes[r] * box_volume),
                  "volume_ok": volumes[r] * box_volume == layout.region_volumes[r]}
-        if negative is not None:
+        if negative is not None and parts is not None:
             entry["negative_coefficients"] = negative[r]
-            entry["control_volume_sum"] = str(parts.region_volumes()[r] * _factor(dual))
+            entry["control_volume_sum"] = str(parts.region_volumes()[r] * factor)
         regions.append(entry)
     areas = contact_areas(mesh, faces)
     contacts = []
