@@ -1,0 +1,26 @@
+"""The intersection study's runs that several test modules read: made once per test process."""
+
+from __future__ import annotations
+
+import pytest
+
+from cospherical.studies.intersection import run_intersection
+
+
+@pytest.fixture(scope="session")
+def pool_run():
+    """The R = 4 study, run by a process pool of two workers."""
+    return run_intersection(4, jobs=2)
+
+
+@pytest.fixture(scope="session")
+def r4_table(pool_run, tmp_path_factory):
+    """The R = 4 pattern table, as YAML and as an indexed store."""
+    from cospherical.catalogue import shipped_catalogue
+    from cospherical.formats.intersection_table import write_pattern_table
+    from cospherical.studies.intersection.table import TableRun
+
+    folder = tmp_path_factory.mktemp("r4")
+    write_pattern_table(TableRun(pool_run, jobs=2), shipped_catalogue().version, yaml_path=folder / "r4.yaml",
+                        store=folder / "r4.sqlite")
+    return folder / "r4.yaml", folder / "r4.sqlite"

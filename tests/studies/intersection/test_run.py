@@ -1,0 +1,117 @@
+"""Running the intersection study: its two stages against the Python path, every backend alike, resumption."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+
+from cospherical import Box
+from cospherical.studies.engine import bisection_codes
+from cospherical.studies.intersection import intersection_codes, run_intersection
+from cospherical.studies.summary import study_summary
+
+
+def test_resolution_2_is_the_bisection_study(paper_studies):
+    # The compiled two-stage pipeline against the Python path (exact walk in Python
+    # integers, Study, choose) on the 4096 bisection configurations, every criterion:
+    # the cube's study is the session's (conftest.py).
+    ours = run_intersection(2, jobs=1)
+    codes = sorted("".join("%x" % d for d in row) for row in intersection_codes(2))
+    assert codes == sorted(bisection_codes())
+    bisection = study_summary(paper_studies["A"])
+    assert paper_studies["A"].box.texts == ("1", "1", "1")
+    assert ours["criteria"]["optimal"]["total"] == 37259
+    for criterion, data in bisection["criteria"].items():
+        mine = ours["criteria"][criterion]
+        assert mine["total"] == data["total"] and mine.get("splits") == data.get("splits"), criterion
+        assert {k: (v["count"], v["configurations"]) for k, v in mine["types"].items()} == \
+               {k: (v["count"], v["configurations"]) for k, v in data["types"].items()}, criterion
+    assert (ours["fvm_adequate"], ours["fvm_adequate_open"]) == (bisection["fvm_adequate"], bisection["fvm_adequate_open"])
+
+
+def test_process_pool_dask_and_brute_force_agree(pool_run, full, monkeypatch):
+    dask = run_intersection(4, dask_workers=2)
+    assert pool_run["configurations"] == 66**3 and pool_run["orbits"] == 32077
+    assert dask == pool_run
+    assert set(pool_run["criteria"]) == {"optimal", "internal_faces", "internal_edges_and_faces"}
+    # Every configuration tessellated against one per orbit counted as many times as its orbit
+    # has members: the whole family with --full (its 287,496 configurations take 20 CPU-s), by
+    # default a seeded 1 in 32 of the orbits, each with all its members (the statistics of a
+    # set of whole orbits are the same either way).
+    if full:
+        brute, by_orbits = run_intersection(4, jobs=2, brute_force=True), pool_run
+    else:
+        brute, by_orbits = _sampled_orbits_both_ways(monkeypatch)
+    assert brute["orbits"] == brute["configurations"] == by_orbits["configurations"]
+    assert {**brute, "orbits": by_orbits["orbits"]} == by_orbits
+
+
+def _sampled_orbits_both_ways(monkeypatch):
+    """The R = 4 study on a seeded sample of whole orbits: brute force, and one per orbit."""
+    import cospherical.studies.intersection.run as run
+    from cospherical.core.symmetry import box_symmetries, orbit_keys
+    from cospherical.studies.intersection import orbits
+
+    digits = intersection_codes(4)
+    keys, _ = orbit_keys(digits, box_symmetries(Box.parse(["1", "1", "1"])), "compiled")  # each code's orbit
+    codes = (digits.astype(np.int64) << (4 * np.arange(11, -1, -1))).sum(axis=1)
+    reps, sizes, _ = orbits(4)
+    pick = np.sort(np.random.default_rng(4).choice(len(reps), len(reps) // 32, replace=False))
+    members = np.sort(codes[np.isin(keys, reps[pick])])
+    assert len(members) == sizes[pick].sum() > len(pick)
+    monkeypatch.setattr(run, "orbits", lambda resolution, order: (reps[pick], sizes[pick], len(members)))
+    monkeypatch.setattr(run, "all_configurations", lambda resolution, order: members)
+    return run_intersection(4, brute_force=True), run_intersection(4)  # in this process: the pool ran above
+
+
+def test_compiled_stage_agrees_with_the_python_walk_on_a_sample():
+    # Stage 1 (the compiled kernel on many codes) against tessellate() with the Python walk.
+    from cospherical import Configuration
+    from cospherical.core.delaunay import delaunay_cells
+    from cospherical.core.geometry import Frame
+    from cospherical.core.polyhedron import polyhedron
+    from cospherical.core.symmetry import key_code
+    from cospherical.studies.intersection import all_configurations, tessellate_chunk
+
+    codes = all_configurations(16)
+    sample = np.sort(codes[np.random.default_rng(16).choice(len(codes), 300, replace=False)])
+    cells = tessellate_chunk(sample)
+    for i, code in enumerate(sample.tolist()):
+        cfg = Configuration.from_code(key_code(code))
+        frame = Frame.build(cfg.nodes(), cfg.box.squared)
+        python = [polyhedron(frame, cell) for cell in delaunay_cells(frame, backend="python")]
+        assert cells["tets"][i] == sum(len(p.nodes) == 4 for p in python)
+        assert cells["polys"][i] == sum(len(p.nodes) > 4 for p in python)
+        assert cells["closed"][i] == all(p.center_in_box(closed=True) for p in python)
+        assert cells["open"][i] == all(p.center_in_box(closed=False) for p in python)
+    offsets = np.concatenate([[0], np.cumsum(cells["polys"])])
+    i = int(np.argmax(cells["polys"]))
+    cfg = Configuration.from_code(key_code(int(sample[i])))
+    frame = Frame.build(cfg.nodes(), cfg.box.squared)
+    masks = {sum(1 << n for n in cell.nodes) for cell in delaunay_cells(frame, backend="python") if len(cell.nodes) > 4}
+    assert set(cells["poly_mask"][offsets[i]:offsets[i + 1]].tolist()) == masks
+
+
+def test_the_paper_figures_beside_ours(pool_run):
+    from cospherical.paper import paper_comparison, paper_study_key
+
+    key, notes = paper_study_key(pool_run)
+    assert key == "intersection_cube" and "insertion_order" in notes
+    table = paper_comparison(pool_run, key)
+    assert table["total"] == {"paper": 46491970, "ours": pool_run["criteria"]["optimal"]["total"]}
+
+
+def test_an_interrupted_run_resumes_to_the_same_result(tmp_path):
+    args = [sys.executable, "-m", "cospherical", "study", "intersection", "--resolution", "2", "--jobs", "2",
+            "--chunk-size", "16", "--out", str(tmp_path), "--resume", "--format", "json"]
+    full = json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
+    assert full["criteria"]["optimal"]["total"] == 37259
+    chunks = sorted((tmp_path / "checkpoints").glob("*-cells-*.npz"))
+    assert len(chunks) > 3 and list((tmp_path / "checkpoints").glob("*-elements-*.json"))
+    for chunk in chunks[::2] + sorted((tmp_path / "checkpoints").glob("*-elements-*.json"))[:1]:
+        chunk.unlink()  # as if the run had stopped before these
+    resumed = json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
+    assert resumed == full
