@@ -80,12 +80,14 @@ vertices and elements the file holds and compares every edge, coefficient, contr
 volume and boundary area with the file's, exactly, and every float with the one the
 exact value gives.  A change that keeps the sums (one coefficient ``+k``, another
 ``-k``) is refused with the first edge it changed.  The cost is that of computing
-the dual from its elements: 0.9 CPU-s for the 50,912 elements of the 21,512-leaf
-example of the results page, linear in the elements.  Sums cannot see elements that
+the dual from its elements (their shapes found by sorting, each shape measured once):
+0.7 CPU-s in all, the proof below included, for the 50,912 elements of the 21,512-leaf
+example of the results page, 4.9 CPU-s for the 799,984 of the README's level-8 tree.
+Sums cannot see elements that
 overlap and leave a hole of the same volume, so the elements are also proved a mesh
 of the domain: every face shared by exactly two elements in opposite orientations, or
-by one in the domain's boundary (the mesher's own conformity rule; 0.2 CPU-s more on
-that example, its memory bounded before the faces are made).  Elements whose distinct shapes
+by one in the domain's boundary (the mesher's own conformity rule, its memory bounded
+before the faces are made).  Elements whose distinct shapes
 would need more exact hull work than their number justifies (a small file of many
 different 64-vertex shapes would take hours) are refused before any hull is computed.
 The circumcentres

@@ -11,7 +11,6 @@ its members with their sizes: what :mod:`~cospherical.mesh.dual.sums` scatters.
 
 from __future__ import annotations
 
-import math
 from fractions import Fraction
 from typing import TYPE_CHECKING, NamedTuple, Sequence
 
@@ -133,45 +132,71 @@ def _tessellation_pieces(tessellation: LocalTessellation, squared: Squared) -> S
     return shape
 
 
-class _ElementShape(NamedTuple):
-    pieces: ShapePieces
-    ids: list[NDArray[np.int64]]
-    scales: list[int]
-    center: Point
+def _measured_pieces(key: NDArray[np.int64], squared: Squared, element: int) -> tuple[ShapePieces, Point]:
+    """The pieces and centre of one element shape (its vertices' grid offsets, in its own order), measured exactly:
+    faces from its hull, centre from the sphere through it; ``element`` names it when it has no dual."""
+    points: dict[int, Point] = {n: (Fraction(int(p[0])), Fraction(int(p[1])), Fraction(int(p[2])))
+                                for n, p in enumerate(key.tolist())}
+    frame = Frame.build(points, squared)
+    measured = measure(frame, range(len(points)))
+    if not measured.cycles:
+        raise InputError(f"element {element} is flat: it has no dual")
+    if measured.sphere is None or measured.center is None:
+        raise InputError(f"element {element} is not co-spherical: it has no dual")
+    return ShapePieces([element_pieces(points, measured.cycles, measured.center, squared)]), measured.center
+
+
+_ROW_HASH = np.random.default_rng(20260101).integers(1, 2**63, size=3 * 64, dtype=np.uint64) | np.uint64(1)
+
+
+def _equal_rows(keys: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Classes of equal rows: each class's first row, and each row's class.  The rows are hashed to one
+    integer each (a sort of integers, not of rows) and the classes then proved by comparing every row with
+    its class's first; a collision (never seen) falls back to sorting the rows themselves."""
+    hashed = (keys.astype(np.uint64) * _ROW_HASH[:keys.shape[1]]).sum(axis=1, dtype=np.uint64)  # wraps: a hash
+    _, first, which = np.unique(hashed, return_index=True, return_inverse=True)
+    if not np.array_equal(keys[first][which.reshape(-1)], keys):
+        _, first, which = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    return first, which.reshape(-1)
 
 
 def element_groups(box: Box, grid: int, vertices: NDArray[np.integer], squared: Squared,
                    conn: NDArray[np.integer], element_sizes: NDArray[np.integer]
                    ) -> tuple[list[Group], NDArray[np.float64]]:
     """Per distinct element shape (up to translation and powers of two): its pieces, vertex ids, scalings;
-    and the real circumcenter of every element."""
+    and the real circumcenter of every element.
+
+    An element's shape is its vertices' offsets from its low corner, in its own vertex
+    order, divided by its scale: the largest power of two dividing every offset (the
+    lowest bit set in any of them).  The shapes are found with one sort per element
+    size, and each is measured once, in the order of its first element (which an error
+    names).
+    """
     verts = np.asarray(vertices, dtype=np.int64)
     lengths = np.array(box.to_float())
+    sizes = np.asarray(element_sizes, dtype=np.int64)
     centers = np.zeros((len(conn), 3))
-    by_shape: dict[tuple[tuple[int, ...], ...], _ElementShape] = {}
-    for e in range(len(conn)):
-        ids = conn[e, :int(element_sizes[e])].astype(np.int64)
+    # per shape: its first element, the element size, the shape, its members (indices into that size's rows),
+    # and that size's elements, vertex ids, low corners and scales
+    found = []
+    for size in np.unique(sizes).tolist():
+        members = np.flatnonzero(sizes == size)
+        ids = np.asarray(conn[members, :size], dtype=np.int64)
         coords = verts[ids]
-        low = coords.min(axis=0)
-        rel = coords - low
-        scale = math.gcd(*(int(x) for x in rel.reshape(-1)))
-        scale = scale & -scale  # the largest power of two dividing every offset
-        key: tuple[tuple[int, ...], ...] = tuple(map(tuple, (rel // scale).tolist()))
-        entry = by_shape.get(key)
-        if entry is None:
-            points: dict[int, Point] = {n: (Fraction(int(p[0])), Fraction(int(p[1])), Fraction(int(p[2])))
-                                        for n, p in enumerate(key)}
-            frame = Frame.build(points, squared)
-            element = measure(frame, range(len(key)))
-            if not element.cycles:
-                raise InputError(f"element {e} is flat: it has no dual")
-            if element.sphere is None or element.center is None:
-                raise InputError(f"element {e} is not co-spherical: it has no dual")
-            entry = by_shape[key] = _ElementShape(
-                ShapePieces([element_pieces(points, element.cycles, element.center, squared)]), [], [], element.center)
-        entry.ids.append(ids)
-        entry.scales.append(scale)
-        centers[e] = _real_centers(low, entry.center, np.array(scale), lengths, grid)
-    groups = [Group(shape.pieces, np.array(shape.ids, dtype=np.int64), np.arange(len(shape.ids)),
-                    np.array(shape.scales, dtype=np.int64)) for shape in by_shape.values()]
+        low = coords.min(axis=1)
+        rel = (coords - low[:, None, :]).reshape(len(members), -1)
+        bits = np.bitwise_or.reduce(rel, axis=1)
+        scale = bits & -bits  # the largest power of two dividing every offset
+        keys = rel // np.maximum(scale, 1)[:, None]
+        first, which = _equal_rows(keys)
+        # each shape's members, in element order
+        by_shape = np.split(np.argsort(which, kind="stable"), np.cumsum(np.bincount(which))[:-1])
+        for k in range(len(first)):
+            found.append((int(members[first[k]]), size, keys[first[k]], by_shape[k], members, ids, low, scale))
+    groups = []
+    for element, size, shape, mine, members, ids, low, scale in sorted(found, key=lambda entry: entry[0]):
+        pieces, center = _measured_pieces(shape.reshape(size, 3), squared, element)
+        centers[members[mine]] = (low[mine] + np.array([float(x) for x in center]) * scale[mine, None]) * (
+            lengths / grid)
+        groups.append(Group(pieces, ids[mine], np.arange(len(mine)), scale[mine]))
     return groups, centers
