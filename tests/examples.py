@@ -38,7 +38,7 @@ SMALLER = [
     (re.compile(r"^(python benchmarks/bench_startup.py)"), r"\1 --runs 1 --every 64 --tables 'bisection-tetra*'"),
     (re.compile(r"^(python benchmarks/bench_bisection.py)"), r"\1 --every 64"),
     (re.compile(r"^(cospherical sweep --ratios \S+):\d+ (\S+):\d+"), r"\1:2 \2:2"),  # 2 x 2 grid values
-    # a short stretch of the ray (6 steps of 1,r,r: 2 CPU-s in-process, against 8 for 1:4); studies/test_sweep.py
+    # a short stretch of the ray (6 steps of 1,r,r: 2 CPU-s in-process, against 8 for 1:4); studies/test_ray.py
     # checks the thresholds of 1 <= r <= 9/5 and 3/2 <= r <= 2 against direct studies on both sides of each
     (re.compile(r"^(cospherical sweep --ray \S+) --range \S+"), r"\1 --range 1:5/4"),
     # a placeholder host fails the same way after 1 s as after the default 30 s of waiting

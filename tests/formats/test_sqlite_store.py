@@ -1,7 +1,7 @@
 """The indexed pattern-table store (SQLite): a damaged or hostile store is one line, exit 2, in bounded memory.
 
 The store is read where ``cospherical check`` (and every reader) meets it; the R = 4
-store's entries against its YAML are compared in ``studies/test_intersection.py``, which
+store's entries against its YAML are compared in ``studies/intersection/test_table.py``, which
 makes both.
 """
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections import Counter
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cospherical import Box
@@ -43,6 +43,7 @@ def test_the_summary_is_the_count_of_every_configuration_tessellated(study):
 
 
 @given(st.dictionaries(st.sampled_from(["v4f4-a", "v5f5-b", "v6f5-c", "v8f6-d"]), st.integers(1, 10**6), min_size=1))
+@settings(max_examples=40)
 def test_a_frequency_table_adds_up_and_orders_by_count(counts):
     classes = {"v4f4-a": "Tetrahedron", "v5f5-b": None, "v6f5-c": "Tetrahedron", "v8f6-d": None}
     types = {i: TypeInfo(f"name {i}", classes[i], 4, 6, 4) for i in counts}

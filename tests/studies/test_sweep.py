@@ -5,7 +5,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cospherical.errors import InputError
@@ -15,6 +15,7 @@ from cospherical.studies.sweep import box_statistics, grid_values, sweep
 
 @given(st.fractions(min_value=Fraction(1, 100), max_value=100, max_denominator=100),
        st.fractions(min_value=0, max_value=10, max_denominator=100), st.integers(2, 12))
+@settings(max_examples=40)
 def test_a_grid_runs_evenly_from_min_to_max(low, width, steps):
     high = low + width
     values = grid_values(f"{low}:{high}:{steps}")
