@@ -30,9 +30,13 @@ and every tie is decided exactly.  Two ways find them:
   configuration, in the leaf's unit frame: every leaf is the domain scaled), the
   only vertices that can lie on or in it are its leaf's other slots in the sphere
   and the lattice points with d = 1/2 in the sphere that are vertices: a handful
-  of exact look-ups per leaf (:func:`_local_candidates`), no search.
+  of exact look-ups per leaf (:func:`_local_candidates`), no search.  The proof
+  reads only the whole tree's structure: a part of its leaves (a device keeps those
+  inside its boxes, a region's mesh those of the region) has a part of its vertices,
+  each where the whole tree has it, so the look-ups still find every vertex that
+  can be on or in a sphere.
 - Otherwise (a cell of the global Delaunay step, a sphere reaching further, a
-  device's tree with holes, a leaf list only checked 1-irregular, a piece's
+  leaf list only checked 1-irregular, a piece's
   surroundings), a k-d tree on the vertices' float coordinates proposes the
   vertices within the circumradius times (1 + 1e-9) (:func:`_candidates`); the
   element's own nodes are expected there and anything else is decided exactly:
@@ -621,7 +625,7 @@ def _spheres(mesh: Mesh) -> tuple[_Spheres, list[tuple[int, np.ndarray, _Suspect
     # is not a cell of the Delaunay subdivision: it joins the elements that are not cells.
     without_sphere = [np.zeros(0, dtype=np.int64)]
     cells = mesh.cells
-    structured = mesh.tree.vertex_balanced and mesh.regions is None
+    structured = mesh.tree.vertex_balanced
     for p, tessellation, leaves in (mesh.groups() if cells is None else ()):
         suspects = _leaf_suspects(tessellation, mesh.box.squared) if structured else [None] * len(tessellation.elements)
         for j, element in enumerate(tessellation.elements):

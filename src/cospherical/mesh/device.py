@@ -470,7 +470,8 @@ def device_octree(layout: DeviceLayout, max_leaves: int | None = None) -> tuple[
                              f"{layout.resolving_level})")
     region = leaf_owner(layout, tree.levels, tree.positions)
     keep = region >= 0
-    return Octree(tree.box, tree.levels[keep], tree.positions[keep]), region[keep].astype(np.int32)
+    return (Octree(tree.box, tree.levels[keep], tree.positions[keep], tree.vertex_balanced),
+            region[keep].astype(np.int32))
 
 
 def leaf_owner(layout: DeviceLayout, levels: np.ndarray, positions: np.ndarray) -> np.ndarray:

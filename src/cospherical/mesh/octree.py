@@ -315,9 +315,10 @@ class Octree:
 
     ``depth`` is the finest leaf level.  Leaf ``i`` is the box
     ``positions[i] / 2**levels[i]`` (+ one cell) in unit coordinates of the domain.
-    ``vertex_balanced``: known by construction to tile the whole domain with leaves that
-    touch across a face, an edge or a corner only when at most one level apart
-    (:func:`build_octree` with ``balance="vertex"``); the exact Delaunay check then bounds
+    ``vertex_balanced``: known by construction to be leaves of a tree over the whole domain
+    whose leaves touch across a face, an edge or a corner only when at most one level apart
+    (:func:`build_octree` with ``balance="vertex"``): all of them, or a part (a device keeps
+    the leaves inside its boxes); the exact Delaunay check then bounds
     where a vertex can lie near a leaf (:mod:`cospherical.mesh.checks`).  ``False``
     claims nothing.
     """
