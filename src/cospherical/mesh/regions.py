@@ -96,7 +96,8 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
         for low_high in bounds[first_box[r]:first_box[r + 1]]:
             on |= np.all((points >= low_high[:3]) & (points <= low_high[3:]), axis=1)
         ids = np.flatnonzero(on)
-        sub = assemble(Octree(tree.box, tree.levels[leaves], tree.positions[leaves]), lookup, cache=cache,
+        sub = assemble(Octree(tree.box, tree.levels[leaves], tree.positions[leaves], tree.vertex_balanced), lookup,
+                       cache=cache,
                        criterion=criterion, vertices=(grid, keys[ids]), catalogue=mesh.catalogue)
         result, figures, checked = delaunay_mesh(sub, "global", convex=layout.convex(r))
         found.append(figures or {})
@@ -288,12 +289,15 @@ def contact_areas(mesh: Mesh, faces: RegionFaces) -> list[Fraction]:
     vertices = mesh.vertices.astype(np.int64)
     for c, (axis, _, _, _) in enumerate(layout.contacts):
         b, d = (axis + 1) % 3, (axis + 2) % 3
-        twice = 0
-        for polygon in faces.contact_nodes[faces.contact_face_contact == c]:
-            p = vertices[polygon[polygon >= 0]]
-            x, y = p[:, b], p[:, d]
-            twice += abs(int((x * np.roll(y, -1) - np.roll(x, -1) * y).sum()))
-        areas[c] = Fraction(twice, 2 * mesh.grid ** 2) * lengths[b] * lengths[d]
+        polygons = faces.contact_nodes[faces.contact_face_contact == c]
+        valid = polygons >= 0
+        # each vertex with the next one of its polygon (the first after the last)
+        following = np.roll(polygons, -1, axis=1)
+        following = np.where(following >= 0, following, polygons[:, :1])
+        x, y = vertices[np.maximum(polygons, 0), b], vertices[np.maximum(polygons, 0), d]
+        nx, ny = vertices[np.maximum(following, 0), b], vertices[np.maximum(following, 0), d]
+        twice = np.abs(np.where(valid, x * ny - nx * y, 0).sum(axis=1))  # below 2 * grid**2 each
+        areas[c] = Fraction(int(twice.sum()), 2 * mesh.grid ** 2) * lengths[b] * lengths[d]
     return areas
 
 
@@ -389,9 +393,17 @@ def _narrow(values: list[int]) -> np.ndarray:
 
 
 def _common(parts: list[np.ndarray], denominators: list[int], common: int) -> np.ndarray:
-    """Numerators over their own denominators, brought over one ``common`` denominator (exact)."""
-    values = [int(x) * (common // d) for part, d in zip(parts, denominators) for x in part.tolist()]
-    return _narrow(values)
+    """Numerators over their own denominators, brought over one ``common`` denominator (exact).
+
+    What :func:`_narrow` makes of the Python integers, computed in int64 when every scaled
+    value fits with room for sums (the bound is checked on each part's largest value).
+    """
+    room = 2**62 // max(1, sum(len(part) for part in parts))
+    if all(part.dtype != object and (not len(part) or int(np.abs(part).max()) * (common // d) < room)
+           for part, d in zip(parts, denominators)):
+        return np.concatenate([part.astype(np.int64) * np.int64(common // d) for part, d in zip(parts, denominators)]
+                              + [np.zeros(0, dtype=np.int64)])
+    return _narrow([int(x) * (common // d) for part, d in zip(parts, denominators) for x in part.tolist()])
 
 
 def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: np.ndarray, axes: list[int],
@@ -402,24 +414,39 @@ def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: n
     its two edges and the face's circle centre (signed: they add up to the face's
     area whatever the shape); computed once per face shape up to translation.
     """
-    shares: dict[tuple[int, int], Fraction] = {}
-    cache: dict[tuple[int, bytes], list[Fraction]] = {}
-    if len(faces) and lengths is None:
+    if not len(faces):
+        return {}
+    if lengths is None:
         raise InputError("contact faces need the bounding box's lengths")
-    for face, c in zip(faces.tolist(), which.tolist()):
-        ids = [v for v in face if v >= 0]
-        axis = axes[c]
-        b, d = (axis + 1) % 3, (axis + 2) % 3
-        points = vertices[ids][:, [b, d]].astype(np.int64)
-        key = (axis, (points - points[0]).tobytes())
-        if key not in cache:
-            assert lengths is not None
-            scale = (Fraction(lengths[b]) / grid, Fraction(lengths[d]) / grid)
-            p = [(Fraction(int(x)) * scale[0], Fraction(int(y)) * scale[1]) for x, y in (points - points[0])]
-            cache[key] = _polygon_shares(p)
-        for v, q in zip(ids, cache[key]):
-            shares[v, c] = shares.get((v, c), Fraction(0)) + q
-    return shares
+    n, width = faces.shape
+    valid = faces >= 0
+    axis = np.asarray(axes, dtype=np.int64)[which]
+    points = vertices[np.maximum(faces, 0)].astype(np.int64)  # (faces, width, 3)
+    rows, columns = np.arange(n)[:, None], np.arange(width)[None]
+    # each face in its plane's two axes, from its first vertex: one shape per (axis, offsets)
+    u = np.where(valid, points[rows, columns, ((axis + 1) % 3)[:, None]], 0)
+    v = np.where(valid, points[rows, columns, ((axis + 2) % 3)[:, None]], 0)
+    u, v = np.where(valid, u - u[:, :1], -1), np.where(valid, v - v[:, :1], -1)
+    _, first, shape_of = np.unique(np.c_[axis, u, v], axis=0, return_index=True, return_inverse=True)
+    measured = []
+    for f in first.tolist():
+        a, size = int(axis[f]), int(valid[f].sum())
+        scale = (Fraction(lengths[(a + 1) % 3]) / grid, Fraction(lengths[(a + 2) % 3]) / grid)
+        measured.append(_polygon_shares([(int(x) * scale[0], int(y) * scale[1])
+                                         for x, y in zip(u[f, :size].tolist(), v[f, :size].tolist())]))
+    # every share over one denominator, as integers; a face's vertex gets its shape's share at its place
+    common = math.lcm(1, *(q.denominator for m in measured for q in m))
+    table = [[int(q * common) for q in m] + [0] * (width - len(m)) for m in measured]
+    if max(abs(x) for row in table for x in row) >= 2**62 // max(1, n * width):
+        raise InputError(f"contact face shares over {common:,} do not fit the integers this sums them in")
+    value = np.array(table, dtype=np.int64)[shape_of.reshape(-1)][valid]
+    key = faces[valid].astype(np.int64) * (int(which.max()) + 1) + np.broadcast_to(which[:, None], faces.shape)[valid]
+    order = np.argsort(key, kind="stable")
+    key, value = key[order], value[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    totals = np.add.reduceat(value, starts)
+    base = int(which.max()) + 1
+    return {divmod(int(k), base): Fraction(int(t), common) for k, t in zip(key[starts].tolist(), totals.tolist())}
 
 
 def _polygon_shares(p: list[tuple[Fraction, Fraction]]) -> list[Fraction]:
