@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Callable, NamedTuple, Sequence
+from typing import TYPE_CHECKING, Any, Callable, NamedTuple, Sequence
 
 import numpy as np
 
@@ -35,12 +35,14 @@ from ..errors import InputError, shown
 from ..files.outputs import OutputFolder
 from ..formats.gmsh import GMSH_VERSIONS
 from ..mesh.assembly import Lookup, Mesh
-from ..mesh.dual import Dual
 from ..mesh.device import Device
 from ..mesh.octree import Octree, Shape
 from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode, full_dual, run_pipeline,
                              tree_from_device, tree_from_leaves, tree_from_octree, tree_from_refine)
 from ..mesh.report import MeshReport
+
+if TYPE_CHECKING:  # the dual's modules are imported when a dual is made
+    from ..mesh.dual import Dual
 
 __all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "device_cut_axis", "from_treemesh",
            "mesh_writes", "output_names",

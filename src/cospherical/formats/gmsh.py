@@ -39,13 +39,16 @@ $EndElements
 from __future__ import annotations
 
 import io
+from typing import TYPE_CHECKING
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError, shown
 from ..files.outputs import atomic_open
-from ..mesh.tetrahedra import SimplexMesh
+
+if TYPE_CHECKING:  # GMSH_VERSIONS is read by every mesh command: the tetrahedra's module only when one is written
+    from ..mesh.tetrahedra import SimplexMesh
 
 __all__ = ["GMSH_VERSIONS", "msh_bytes", "write_msh"]
 

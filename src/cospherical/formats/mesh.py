@@ -24,8 +24,7 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
-from typing import Sequence
-from xml.sax.saxutils import quoteattr
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 
@@ -36,8 +35,11 @@ from ..errors import FormatError, InputError
 from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
-from ..mesh.regions import RegionFaces
 from .check import EntryCheck
+from .vtu import quoteattr
+
+if TYPE_CHECKING:  # the device's modules are imported where a device is meshed
+    from ..mesh.regions import RegionFaces
 
 __all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "VtuGrid", "vtu_arrays", "vtu_grid",
            "write_faces_vtu",

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import zlib
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -27,7 +26,7 @@ from ..core.tessellation import Tessellation
 from ..errors import InputError
 from ..files.yamlio import atomic_open
 
-__all__ = ["VTK_CELL", "narrow", "text_array", "write_grid", "write_vtu"]
+__all__ = ["VTK_CELL", "narrow", "quoteattr", "text_array", "write_grid", "write_vtu"]
 
 # VTK's cell type numbers (vtkCellType.h) of the cells an element can be.
 VTK_CELL = {"tetra": 10, "hexahedron": 12, "wedge": 13, "pyramid": 14, "polyhedron": 42}
@@ -41,6 +40,22 @@ BLOCK = 1 << 22
 # zlib's fastest level. Measured on the README sphere tree's 55.7 MB of arrays: level 1 12.5 MB in 0.38 s CPU,
 # VTK's default (zlib's 6) 12.3 MB in 2.4 s, level 9 12.4 MB in 11 s; run-length or Huffman-only 25 MB in 0.3 s.
 LEVEL = 1
+
+
+def quoteattr(text: str) -> str:
+    """``text`` as a quoted XML attribute value, as :func:`xml.sax.saxutils.quoteattr` writes it.
+
+    Here because importing :mod:`xml.sax.saxutils` imports :mod:`urllib.request` (and with it
+    :mod:`http.client`, :mod:`email`, :mod:`ssl`): a good part of the mesh command's start-up.
+    """
+    for raw, entity in (("&", "&amp;"), (">", "&gt;"), ("<", "&lt;"), ("\n", "&#10;"), ("\r", "&#13;"),
+                        ("\t", "&#9;")):
+        text = text.replace(raw, entity)
+    if '"' not in text:
+        return f'"{text}"'
+    if "'" not in text:
+        return f"'{text}'"
+    return '"{}"'.format(text.replace('"', "&quot;"))
 
 
 def _compressed(array: np.ndarray) -> bytes:

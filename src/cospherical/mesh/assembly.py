@@ -286,17 +286,23 @@ class Mesh:
             if len(leaves) or all_leaves:
                 yield p, self.tessellations[p], leaves
 
-    def blocks(self) -> Iterator[ElementBlock]:
+    def blocks(self, near: NDArray[np.bool_] | None = None) -> Iterator[ElementBlock]:
         """Yield ``(element indices, global vertex ids (elements x nodes), faces, type id)`` per kind of element.
 
         One block per element of a configuration (over its leaves) and per cell
-        shape; ``faces`` are cycles of column indices into the vertex ids.
+        shape; ``faces`` are cycles of column indices into the vertex ids.  ``near``
+        (a mask over the leaves): only the leaf elements of those leaves (every cell).
         """
         for _, tessellation, leaves in self.groups():
+            if near is not None:
+                leaves = leaves[near[leaves]]
+                if not len(leaves):
+                    continue
             first = self.element_offsets[leaves]
+            slots = self.slots[leaves]  # the configuration's slots once, each element's columns from it
             for j, element in enumerate(tessellation.elements):
                 column = {n: i for i, n in enumerate(element.nodes)}
-                yield ElementBlock(first + j, self.slots[np.ix_(leaves, np.asarray(element.nodes, dtype=np.intp))],
+                yield ElementBlock(first + j, slots[:, np.asarray(element.nodes, dtype=np.intp)],
                                    tuple(tuple(column[n] for n in cycle) for cycle in element.faces), element.type_id)
         if self.cells is not None:
             order = np.argsort(self.cells.shape, kind="stable")
@@ -306,6 +312,19 @@ class Mesh:
                 rows = order[starts[s]:starts[s + 1]]
                 yield ElementBlock(self.leaf_elements + rows, self.cells.nodes[rows, :len(shape.offsets)],
                                    shape.faces, shape.type_id)
+
+    def block_types(self) -> Iterator[tuple[NDArray[np.int64], str]]:
+        """:meth:`blocks`' element indices and type ids alone (no vertex ids gathered)."""
+        for _, tessellation, leaves in self.groups():
+            first = self.element_offsets[leaves]
+            for j, element in enumerate(tessellation.elements):
+                yield first + j, element.type_id
+        if self.cells is not None:
+            order = np.argsort(self.cells.shape, kind="stable")
+            counts = np.bincount(self.cells.shape, minlength=len(self.cells.shapes))
+            starts = np.r_[0, np.cumsum(counts)]
+            for s, shape in enumerate(self.cells.shapes):
+                yield self.leaf_elements + order[starts[s]:starts[s + 1]], shape.type_id
 
     def element_nodes(self, elements: NDArray[np.integer[Any]]) -> NDArray[np.int32]:
         """Global vertex ids of the given leaf elements, in their tessellation's node order, padded with -1."""
@@ -334,7 +353,7 @@ class Mesh:
 
     def element_types(self) -> tuple[list[str], NDArray[np.int32]]:
         """The type ids met (sorted) and each element's index into them."""
-        blocks = [(rows, type_id) for rows, _, _, type_id in self.blocks()]
+        blocks = list(self.block_types())
         ids = sorted({type_id for _, type_id in blocks})
         position = {t: i for i, t in enumerate(ids)}
         codes = np.zeros(len(self), dtype=np.int32)

@@ -58,7 +58,7 @@ from ..core.geometry import Frame, Rational, in_closed_box
 from ..core.morton import morton_codes
 from ..core.polyhedron import measure
 from ..errors import InputError
-from .assembly import LocalTessellation, Mesh
+from .assembly import NODE_OFFSETS, LocalTessellation, Mesh
 from .device import DeviceLayout, domain_boundary
 from .octree import distinct
 
@@ -125,13 +125,56 @@ def check_volume(mesh: Mesh) -> VolumeCheck:
     return VolumeCheck(share, int(flat), share == mesh.domain_share and flat == 0)
 
 
-def _faces(mesh: Mesh) -> dict[int, list[np.ndarray]]:
-    """Every element face as a row of global vertex ids, by face size."""
-    by_size: dict[int, list[np.ndarray]] = {}
-    for _, nodes, faces, _ in mesh.blocks():
-        for cycle in faces:
-            by_size.setdefault(len(cycle), []).append(nodes[:, list(cycle)])
-    return by_size
+def _faces(mesh: Mesh, examples: int) -> tuple[dict[int, list[NDArray[np.integer[Any]]]], ConformityCheck]:
+    """The faces to pair across the mesh as rows of global vertex ids, by size; and what the faces inside the
+    leaves gave, paired once per configuration (see :func:`check_conformity`)."""
+    by_size: dict[int, list[NDArray[np.integer[Any]]]] = {}
+    pairs = bad = 0
+    shown: list[list[list[float]]] = []
+    for _, tessellation, leaves in mesh.groups():
+        slots = mesh.slots[leaves]
+        inner_pairs, inner_bad, outer = _leaf_faces(tessellation)
+        pairs += inner_pairs * len(leaves)
+        bad += len(inner_bad) * len(leaves)
+        for cycle in inner_bad[:max(0, examples - len(shown))]:
+            shown.append((mesh.vertices[slots[0, list(cycle)]] / mesh.grid).tolist())
+        for cycle in outer:
+            by_size.setdefault(len(cycle), []).append(slots[:, list(cycle)])
+    for _, nodes, faces, _ in mesh.blocks(np.zeros(len(mesh.tree), dtype=bool)):  # the cells alone
+        for face in faces:
+            by_size.setdefault(len(face), []).append(nodes[:, list(face)])
+    return by_size, ConformityCheck(bad, pairs, 0, shown)
+
+
+def _leaf_faces(tessellation: LocalTessellation) -> tuple[int, list[tuple[int, ...]], list[tuple[int, ...]]]:
+    """A configuration's element faces off its leaf's boundary, paired among themselves: how many pairs,
+    and the occurrences that do not pair (cycles of node ids); and its faces in the leaf's boundary,
+    which pair with other leaves' faces.
+
+    A face off the leaf's boundary has points inside the leaf, where no other leaf's element
+    reaches, so it pairs inside the leaf or nowhere: the same in every leaf of the configuration
+    (slots are distinct vertices), decided here once.
+    """
+    met: dict[tuple[int, ...], list[bool]] = {}
+    outer: list[tuple[int, ...]] = []
+    for element in tessellation.elements:
+        for cycle in element.faces:
+            offsets = NODE_OFFSETS[list(cycle)]  # twice the unit coordinates: 0 and 2 on the leaf's sides
+            if any(offsets[0, axis] in (0, 2) and (offsets[:, axis] == offsets[0, axis]).all() for axis in range(3)):
+                outer.append(cycle)
+                continue
+            start = cycle.index(min(cycle))
+            turned = cycle[start:] + cycle[:start]
+            flipped = turned[1] > turned[-1]
+            met.setdefault(turned[:1] + turned[:0:-1] if flipped else turned, []).append(flipped)
+    pairs = 0
+    unpaired: list[tuple[int, ...]] = []
+    for face, orientations in met.items():
+        if len(orientations) == 2 and orientations[0] != orientations[1]:
+            pairs += 1
+        else:
+            unpaired.extend([face] * len(orientations))
+    return pairs, unpaired, outer
 
 
 def element_faces(vertices: NDArray[np.integer[Any]], nodes: NDArray[np.integer[Any]], sizes: NDArray[np.integer[Any]],
@@ -225,11 +268,14 @@ class ConformityCheck:
 def check_conformity(mesh: Mesh, examples: int = 5, open_faces: bool = False) -> ConformityCheck:
     """Every interior face shared by exactly two elements, same vertices, opposite orientation; the rest on the boundary.
 
-    A face is its cycle of global vertex ids, turned to start at its smallest id
-    and read in the direction whose second id is the smaller; the direction it had
-    is its orientation.  A face met once must lie in one plane of the domain's
+    A face is its set of global vertex ids (the faces are convex polygons, hulls: the
+    same vertices make the same polygon); its orientation is the direction its cycle
+    goes on from its smallest id, to the smaller or the larger of that id's neighbours.  A face met once must lie in one plane of the domain's
     boundary; a face met twice must be met once in each orientation; anything else
-    (a hanging face, a T-junction, an overlap) counts as nonconforming.
+    (a hanging face, a T-junction, an overlap) counts as nonconforming.  The faces off
+    every leaf's boundary pair inside their leaf or not at all, alike in every leaf of a
+    configuration: they are paired once per configuration; the faces in leaves' sides and
+    the cells' faces are paired across the whole mesh.
 
     ``open_faces=True`` makes ``mesh`` one piece of a partitioned mesh: its faces met
     once off the domain's boundary are not counted but returned
@@ -246,7 +292,11 @@ def check_conformity(mesh: Mesh, examples: int = 5, open_faces: bool = False) ->
     (0, 12, 24)
     """
     layout = mesh.regions.layout if mesh.regions is not None else None
-    return pair_faces(_faces(mesh), mesh.vertices, mesh.grid, examples, open_faces, layout)
+    faces, inside = _faces(mesh, examples)
+    found = pair_faces(faces, mesh.vertices, mesh.grid, examples, open_faces, layout)
+    return ConformityCheck(inside.nonconforming_faces + found.nonconforming_faces,
+                           inside.interior_faces + found.interior_faces, found.boundary_faces,
+                           (inside.nonconforming_examples + found.nonconforming_examples)[:examples], found.open_faces)
 
 
 def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArray[np.integer[Any]], grid: int,
@@ -262,27 +312,33 @@ def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArr
     for size, parts in sorted(faces.items()):
         rows = np.concatenate(parts)
         parts.clear()
-        start = np.argmin(rows, axis=1)
-        # column by column (np.choose), not through a (faces x size) int64 index: a fraction of the memory
-        turned = np.empty_like(rows)
+        # the faces are convex polygons (hulls): the same vertices are the same polygon, so a face is paired by
+        # its sorted ids (a tenth of the time of turning every cycle; the few shown or left open are turned)
+        sorted_ids = np.sort(rows, axis=1)
+        # the orientation: whether the cycle goes on from its smallest id to the larger of that id's neighbours
+        # (column by column: numpy's reductions along rows of three or four are slow)
+        after = np.empty(len(rows), dtype=rows.dtype)
+        before = np.empty(len(rows), dtype=rows.dtype)
         for column in range(size):
-            turned[:, column] = np.choose((start + column) % size, rows.T)
-        del rows
-        flipped = turned[:, 1] > turned[:, -1]
-        turned[flipped, 1:] = turned[flipped, :0:-1]
-        turned, flipped, ok, pairs, single = _paired(turned, flipped)
+            here = rows[:, column] == sorted_ids[:, 0]
+            after[here] = rows[here, (column + 1) % size]
+            before[here] = rows[here, column - 1]
+        flipped = after > before
+        del after, before, here
+        sorted_ids, flipped, ok, pairs, single, order = _paired(sorted_ids, flipped)
         interior += pairs
-        on_boundary = on_domain_boundary(vertices[turned[single]], grid, layout)
+        on_boundary = on_domain_boundary(vertices[sorted_ids[single]], grid, layout)
+        del sorted_ids
         ok[single[on_boundary]] = True
         boundary += int(on_boundary.sum())
         if open_faces:
             seam = single[~on_boundary]
-            seams.append(OpenFaces(size, turned[seam], flipped[seam]))
+            seams.append(OpenFaces(size, _turned(rows[order[seam]]), flipped[seam]))
             ok[seam] = True
         bad = np.flatnonzero(~ok)
         bad_total += len(bad)
-        for row in bad[:max(0, examples - len(shown))]:
-            shown.append((vertices[turned[row]] / grid).tolist())
+        for row in _turned(rows[order[bad[:max(0, examples - len(shown))]]]):
+            shown.append((vertices[row] / grid).tolist())
     return ConformityCheck(int(bad_total), int(interior), int(boundary), shown, tuple(seams))
 
 
@@ -304,23 +360,38 @@ def on_domain_boundary(points: np.ndarray, grid: int, layout: DeviceLayout | Non
     return on_boundary
 
 
+def _turned(rows: NDArray[np.integer[Any]]) -> NDArray[np.integer[Any]]:
+    """Faces (cycles of ids) turned to start at their smallest id and go on to the smaller of its neighbours."""
+    start = np.argmin(rows, axis=1) if len(rows) else np.zeros(0, dtype=np.intp)
+    size = rows.shape[1]
+    turned: NDArray[np.integer[Any]] = rows[np.arange(len(rows))[:, None], (start[:, None] + np.arange(size)) % size]
+    flipped = turned[:, 1] > turned[:, -1]
+    turned[flipped, 1:] = turned[flipped, :0:-1]
+    return turned
+
+
 def _paired(turned: NDArray[np.integer[Any]], flipped: NDArray[np.bool_]) -> tuple[
-        NDArray[np.integer[Any]], NDArray[np.bool_], NDArray[np.bool_], int, NDArray[np.intp]]:
-    """Sort turned faces; mark those met exactly twice in opposite orientations.
+        NDArray[np.integer[Any]], NDArray[np.bool_], NDArray[np.bool_], int, NDArray[np.intp], NDArray[np.intp]]:
+    """Sort faces (each in one canonical form: turned, or its ids sorted); mark those met exactly twice in
+    opposite orientations.
 
     Returns the sorted faces and orientations, the mask of faces so paired, how many
-    pairs, and the indices of the faces met once.
+    pairs, the indices of the faces met once, and the order that sorted them.
     """
-    order = _row_order(turned, max(1, int(turned.max()).bit_length() if turned.size else 1))
+    order, keys = _row_order(turned, max(1, int(turned.max()).bit_length() if turned.size else 1))
     turned, flipped = turned[order], flipped[order]
-    new = np.r_[True, np.any(turned[1:] != turned[:-1], axis=1)]
+    new = np.ones(len(turned), dtype=bool)
+    new[1:] = False
+    for key in keys:  # neighbours in the order differ where a packed key does
+        key = key[order]
+        new[1:] |= key[1:] != key[:-1]
     starts = np.flatnonzero(new)
     counts = np.diff(np.r_[starts, len(turned)])
     ok = np.zeros(len(turned), dtype=bool)
     pairs = starts[counts == 2]
     good_pairs = pairs[flipped[pairs] != flipped[pairs + 1]]
     ok[good_pairs] = ok[good_pairs + 1] = True
-    return turned, flipped, ok, len(good_pairs), starts[counts == 1]
+    return turned, flipped, ok, len(good_pairs), starts[counts == 1], order
 
 
 def match_seams(seams: Iterable[OpenFaces], vertices: Callable[[NDArray[np.int64]], NDArray[np.int64]], grid: int,
@@ -347,7 +418,7 @@ def match_seams(seams: Iterable[OpenFaces], vertices: Callable[[NDArray[np.int64
     shown: list[list[list[float]]] = []
     for size in sorted({seam.size for seam in seams}):
         parts = [seam for seam in seams if seam.size == size]
-        turned, _, ok, pairs, _ = _paired(np.concatenate([seam.faces for seam in parts]),
+        turned, _, ok, pairs, _, _ = _paired(np.concatenate([seam.faces for seam in parts]),
                                           np.concatenate([seam.flipped for seam in parts]))
         interior += pairs
         bad = np.flatnonzero(~ok)
@@ -357,8 +428,9 @@ def match_seams(seams: Iterable[OpenFaces], vertices: Callable[[NDArray[np.int64
     return ConformityCheck(int(bad_total), int(interior), 0, shown)
 
 
-def _row_order(rows: np.ndarray, bits: int) -> np.ndarray:
-    """The lexicographic order of ``rows`` of ids below ``2**bits``: ids packed into as few int64 keys as hold them.
+def _row_order(rows: np.ndarray, bits: int) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The lexicographic order of ``rows`` of ids below ``2**bits``, and the keys it sorts: ids packed into as
+    few int64 keys as hold them (two rows are equal when their keys are).
 
     Sorting one or two keys costs a fraction of a lexicographic sort of every column.
     """
@@ -370,7 +442,7 @@ def _row_order(rows: np.ndarray, bits: int) -> np.ndarray:
             key <<= bits
             key |= rows[:, column]
         keys.append(key)
-    return np.argsort(keys[0], kind="stable") if len(keys) == 1 else np.lexsort(keys[::-1])
+    return (np.argsort(keys[0], kind="stable") if len(keys) == 1 else np.lexsort(keys[::-1])), keys
 
 
 @dataclass(frozen=True)

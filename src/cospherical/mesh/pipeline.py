@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
 
@@ -41,10 +41,12 @@ from .assembly import Lookup, Mesh, assemble
 from ..choices import MODES, DelaunayMode
 from .delaunay import delaunay_mesh
 from .device import Device, DeviceLayout, device_layout, device_octree
-from .dual import Dual, dual_summary, mesh_dual
 from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape
-from .regions import RegionFaces, device_mesh, device_report, mesh_region_parts, region_faces
 from .report import MeshReport, checked_mesh_report
+
+if TYPE_CHECKING:  # the dual's and a device's regions' modules are imported when they are asked for
+    from .dual import Dual
+    from .regions import RegionFaces
 
 __all__ = ["PipelineResult", "Progress", "TreeSource", "delaunay_mode", "full_dual", "run_pipeline", "tree_from_device",
            "tree_from_leaves", "tree_from_octree", "tree_from_refine"]
@@ -201,6 +203,8 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
 
     clock.stage("assembly")
     if source.device is not None:
+        from .regions import device_mesh
+
         mesh, leaf_mesh, checked = device_mesh(source.device, tree, source.leaf_region, lookup, criterion, mode,
                                                progress=progress)
     else:
@@ -213,11 +217,15 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     report = checked_report.report
     found = faces = None
     if dual:
+        from .dual import dual_summary, mesh_dual
+
         clock.stage("dual")
         found = mesh_dual(mesh)
         report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"],
                                    tetrahedral=tetrahedral_counts))
     if source.device is not None:
+        from .regions import device_report, region_faces
+
         clock.stage("regions")
         faces = region_faces(mesh)
         if found is not None:
@@ -235,8 +243,12 @@ def full_dual(mesh: Mesh, faces: RegionFaces | None, dual: Dual | None = None) -
     ``faces``: the device's region faces (:attr:`PipelineResult.faces`), ``None`` for a one-box mesh.
     The one place both the pipeline (``dual=True``) and a dual asked for later make it.
     """
+    from .dual import mesh_dual
+
     if dual is None:
         dual = mesh_dual(mesh)
     if faces is not None and dual.regions is None:
+        from .regions import mesh_region_parts
+
         dual.regions = mesh_region_parts(mesh, dual, faces)
     return dual

@@ -44,6 +44,8 @@ def outside_catalogue(mesh: Mesh) -> list[dict[str, Any]]:
     """
     known = mesh.catalogue
     found: dict[str, dict[str, Any]] = {}
+    if all(type_id in known for _, type_id in mesh.block_types()):  # the common case: no vertex ids gathered
+        return []
     for rows, nodes, _, type_id in mesh.blocks():
         if type_id in known or not len(rows):
             continue

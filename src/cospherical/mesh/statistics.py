@@ -65,7 +65,7 @@ def occurrences(mesh: Mesh) -> tuple[Counter, dict[str, dict]]:
     Both add up over the pieces of a partitioned mesh (leaves summed per code).
     """
     type_counts: Counter = Counter()
-    for rows, _, _, type_id in mesh.blocks():
+    for rows, type_id in mesh.block_types():
         if len(rows):
             type_counts[type_id] += len(rows)
     configurations = {}

@@ -54,9 +54,7 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
     low = mesh.tree.positions[:, axis].astype(np.int64) * mesh.leaf_size()
     near = (low < z0) & (low + mesh.leaf_size() > z0)
     vertices = mesh.vertices[:, list(across)]  # the picture's two axes, then the cut's
-    for element_rows, nodes, faces, type_id in mesh.blocks():
-        keep = near[mesh.element_leaf[element_rows]] | (mesh.element_local[element_rows] < 0)
-        nodes, element_rows = nodes[keep], element_rows[keep]
+    for element_rows, nodes, faces, type_id in mesh.blocks(near):
         z = vertices[nodes, 2]  # (elements, nodes)
         crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
         if not len(crossing):
