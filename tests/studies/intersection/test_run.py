@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from cospherical import Box
 from cospherical.studies.engine import bisection_codes
@@ -115,3 +116,32 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path):
         chunk.unlink()  # as if the run had stopped before these
     resumed = json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
     assert resumed == full
+
+
+@pytest.mark.parametrize("code", ["0088c4044048", "8888a0000808", "4c0000c40000"])
+def test_a_cell_named_by_its_node_mask_is_the_configurations_cell(code):
+    # Stage 1 names a cell (node mask, configuration); the polyhedron rebuilt from that name is the cell the
+    # Python walk finds in the whole configuration. A mask that is no cell of it is refused.
+    from cospherical import Configuration
+    from cospherical.core.delaunay import delaunay_cells
+    from cospherical.core.geometry import Frame
+    from cospherical.core.polyhedron import polyhedron
+    from cospherical.studies.intersection.run import NotACell, cell_polyhedron
+
+    configuration = Configuration.from_code(code)
+    frame = Frame.build(configuration.nodes(), configuration.box.squared)
+    cells = delaunay_cells(frame, backend="python")
+    for cell in cells:
+        points, poly = cell_polyhedron(sum(1 << n for n in cell.nodes), int(code, 16))
+        expected = polyhedron(frame, cell)
+        assert [n for n, _ in points] == list(cell.nodes)
+        assert (poly.faces, poly.face_kinds, poly.unit_volume, poly.center) == \
+               (expected.faces, expected.face_kinds, expected.unit_volume, expected.center)
+    largest = max(cells, key=lambda c: len(c.nodes))
+    neighbour = next(c for c in cells if c is not largest and set(c.nodes) & set(largest.nodes))
+    assert 26 not in configuration.nodes()  # no body point: not every face is split
+    for nodes in (set(largest.nodes) | set(neighbour.nodes),  # two cells together: not on one sphere
+                  set(largest.nodes) - {largest.nodes[0]},    # part of a cell: its sphere has the rest on it
+                  set(largest.nodes) | {26}):                 # a node the configuration lacks
+        with pytest.raises(NotACell):
+            cell_polyhedron(sum(1 << n for n in nodes), int(code, 16))
