@@ -75,51 +75,67 @@ def element_pieces(points: Mapping[int, Point], faces: Sequence[Sequence[int]], 
     >>> pieces.edges[0, 1], pieces.volumes[0], len(pieces.edges), pieces.boundary[2, 0][0]
     (Fraction(1, 4), Fraction(1, 8), 12, Fraction(1, 4))
     """
-    # Integers throughout, one fraction per face and edge: coordinates times D (midpoints stay
-    # integers), squared lengths as integer weights W = lam * w, a face centre times D * S
+    # Integers throughout, one fraction per edge, vertex and boundary share: coordinates times D
+    # (midpoints stay integers), squared lengths as integer weights W = lam * w, a face centre times
+    # D * S (S per face); every face's sums are brought to the common S^2 of the element (the lcm of
+    # its faces'), so that the pieces are summed as integers and divided once
     w = tuple(Fraction(x) for x in squared)
     lam = math.lcm(*(x.denominator for x in w))
     weight = tuple(int(x * lam) for x in w)
     inverse = tuple(math.lcm(*weight) // x for x in weight)
-    scale = 2 * math.lcm(*(Fraction(x).denominator for p in (*points.values(), center) for x in p))
-    ip = {n: tuple(int(Fraction(x) * scale) for x in p) for n, p in points.items()}
-    ic = tuple(int(Fraction(x) * scale) for x in center)
-    edges: dict[tuple[int, int], Fraction] = {}
-    volumes: dict[int, Fraction] = {n: Fraction(0) for n in points}
-    boundary: dict[tuple[int, Fraction], dict[int, Fraction]] = {}
+    scale = 2 * math.lcm(*(x.denominator for p in (*points.values(), center) for x in p))
+    ip = {n: tuple(x.numerator * (scale // x.denominator) for x in p) for n, p in points.items()}
+    ic = tuple(x.numerator * (scale // x.denominator) for x in center)
+    # per face: its S^2, its edges' (key, piece, squared length), each vertex's volume and boundary area sums
+    measured: list[tuple[int, list[tuple[tuple[int, int], int, int]], dict[int, int],
+                         tuple[int, Fraction] | None, dict[int, int]]] = []
     for cycle in faces:
         p0, p1, p2 = (ip[n] for n in cycle[:3])
         normal = plane_normal(p0, p1, p2)  # no three points of a circle are collinear
         face_center, s = plane_projection(ic, p0, normal, inverse)  # the face's circle centre, times D * S
         cs = tuple(x * s for x in ic)
         plane = [k for k in range(3) if normal[k] != 0]
-        shares = None
+        in_plane = None
         if len(plane) == 1:  # in a coordinate plane: it may be on the domain's boundary
             k = plane[0]
-            shares = boundary.setdefault((k, Fraction(p0[k], scale)), {})
+            in_plane = (k, Fraction(p0[k], scale))
             outward = 1 if normal[k] > 0 else -1
-            face_area: dict[int, int] = {}
+        face_edges = []
         face_volume: dict[int, int] = {}
+        face_area: dict[int, int] = {}
         for u, v in zip(cycle, (*cycle[1:], cycle[0])):
             xu, xv = ip[u], ip[v]
             mid = tuple((xu[k] + xv[k]) // 2 * s for k in range(3))
             along = sub(xu, xv)
             piece = determinant(along, sub(face_center, mid), sub(cs, mid))  # times D^3 S^2
             length2 = sum(weight[k] * along[k] * along[k] for k in range(3))  # times lam D^2
-            key = (u, v) if u < v else (v, u)
-            edges[key] = edges.get(key, Fraction(0)) + Fraction(piece * lam, 2 * scale * s * s * length2)
+            face_edges.append(((u, v) if u < v else (v, u), piece, length2))
             face_volume[u] = face_volume.get(u, 0) + piece
             face_volume[v] = face_volume.get(v, 0) + piece
-            if shares is not None:
+            if in_plane is not None:
                 # triangles (x_u, m, f) and (m, x_v, f): equal areas, half a base each (times D^2 S^2)
                 xs = tuple(x * s for x in xu)
                 area = outward * plane_normal(xs, mid, face_center)[k]
                 face_area[u] = face_area.get(u, 0) + area
                 face_area[v] = face_area.get(v, 0) + area
+        measured.append((s * s, face_edges, face_volume, in_plane, face_area))
+    common = math.lcm(*(s2 for s2, *_ in measured))
+    edge_sums: dict[tuple[int, int], list[int]] = {}  # key -> [piece sum times common S^2, squared length]
+    volume_sums = {n: 0 for n in points}
+    area_sums: dict[tuple[int, Fraction], dict[int, int]] = {}
+    for s2, face_edges, face_volume, in_plane, face_area in measured:
+        factor = common // s2
+        for key, piece, length2 in face_edges:
+            edge_sums.setdefault(key, [0, length2])[0] += piece * factor
         for node, total in face_volume.items():
-            volumes[node] += Fraction(total, 12 * scale ** 3 * s * s)
-        if shares is not None:
+            volume_sums[node] += total * factor
+        if in_plane is not None:
+            sums = area_sums.setdefault(in_plane, {})
             for node, total in face_area.items():
-                shares[node] = shares.get(node, Fraction(0)) + Fraction(total, 2 * scale * scale * s * s)
+                sums[node] = sums.get(node, 0) + total * factor
+    edges = {key: Fraction(total * lam, 2 * scale * common * length2) for key, (total, length2) in edge_sums.items()}
+    volumes = {node: Fraction(total, 12 * scale ** 3 * common) for node, total in volume_sums.items()}
+    boundary = {plane: {node: Fraction(total, 2 * scale * scale * common) for node, total in sums.items()}
+                for plane, sums in area_sums.items()}
     return ElementPieces(edges, volumes, boundary)
 

@@ -50,8 +50,13 @@ def _lcm_denominator(values: Sequence[Fraction]) -> int:
     return math.lcm(1, *(v.denominator for v in values))
 
 
+def _over(q: Fraction, denominator: int) -> int:
+    """``q * denominator`` for a multiple ``denominator`` of ``q``'s: an integer, without a Fraction made."""
+    return q.numerator * (denominator // q.denominator)
+
+
 def _integers(values: Sequence[Fraction], denominator: int) -> NDArray[np.object_]:
-    return np.array([int(v * denominator) for v in values], dtype=object)
+    return np.array([_over(v, denominator) for v in values], dtype=object)
 
 
 def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], NDArray[np.integer]] | None = None
@@ -90,9 +95,9 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
     # int64 sums while every product and sum is bounded below 2**62: the largest numerator (not just the
     # denominator: on tiny or huge domains the pieces over a*b*c are far from 1) times the size scaling,
     # times a bound on the pieces met by one edge or vertex
-    largest_coefficient = max((abs(int(q * cden)) for group in groups for q in group.pieces.edge_q), default=0)
-    largest_volume = max((abs(int(q * vden)) for group in groups for q in group.pieces.volume_q), default=0)
-    largest_boundary = max((abs(int(q * bden)) for group in groups for _, q in group.pieces.boundary), default=0)
+    largest_coefficient = max((abs(_over(q, cden)) for group in groups for q in group.pieces.edge_q), default=0)
+    largest_volume = max((abs(_over(q, vden)) for group in groups for q in group.pieces.volume_q), default=0)
+    largest_boundary = max((abs(_over(q, bden)) for group in groups for _, q in group.pieces.boundary), default=0)
     wide = largest_volume * max_size ** 3 * 4096 >= 2**62 or largest_coefficient * max_size * 4096 >= 2**62 or \
         largest_boundary * max_size ** 2 * 4096 >= 2**62
     dtype: DTypeLike = object if wide else np.int64
@@ -114,7 +119,7 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
             ids = source[rows[touching], node].astype(np.int64)
             on = (verts[ids, axis] == 0) | (verts[ids, axis] == grid)
             # the face lies in the vertex's plane: on the boundary where that plane is a side of the domain
-            np.add.at(boundary_exact[:, axis], ids[on], sizes[touching][on].astype(dtype) ** 2 * int(share * bden))
+            np.add.at(boundary_exact[:, axis], ids[on], sizes[touching][on].astype(dtype) ** 2 * _over(share, bden))
     lengths = np.array(box.to_float())
     real = verts * (lengths / grid)
     factor = math.sqrt(factor_squared)
@@ -152,7 +157,7 @@ def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DType
     total, max_shift = 0, 0
     for shape, _, rows, sizes in groups:
         offsets.append(len(table))
-        table.extend(int(q * cden) for q in shape.edge_q)
+        table.extend(_over(q, cden) for q in shape.edge_q)
         total += len(rows) * len(shape.edges)
         if len(sizes):
             max_shift = max(max_shift, int(sizes.max()).bit_length() - 1)
