@@ -277,3 +277,27 @@ def test_the_node_orders_check_accepts_are_those_vtk_finds_valid():
         points += [tuple(map(float, nodes[n])) for n in ids]
     assert accepted == _vtk_valid(points, cells)
     assert sum(accepted) == turns
+
+
+def test_an_entry_met_again_is_checked_once_and_a_changed_one_again(tmp_path, capsys):
+    # check shares its work across the files of one run (SharedChecks): an entry that passed is
+    # skipped where it recurs (same text, points, box, base element and criteria), nowhere else.
+    from cospherical.formats.check import EntryCheck, SharedChecks, check_patterns
+    from cospherical.formats.patterns import load
+
+    good = leaf_table(tmp_path / "good.yaml", leaf_entries("000000000000+f", "800000000000+f"))
+    shared = SharedChecks()
+    check_patterns(load(good), shipped_catalogue(), "good", shared=shared)
+    table = load(good)
+    texts = {code: table.configurations.text(code) for code in table.configurations}
+    again = EntryCheck(table.header, shipped_catalogue(), "again", shared=shared)
+    assert all(again.passed_before(code, text) for code, text in texts.items())
+    other_box = EntryCheck({**table.header, "box": ["1", "2", "4"]}, shipped_catalogue(), "brick", shared=shared)
+    assert not any(other_box.passed_before(code, text) for code, text in texts.items())
+    assert not again.passed_before("000000000000+f", texts["000000000000+f"].replace("true", "false", 1))
+    # the broken table after the good one: its untouched entry is skipped, its broken one still refused
+    code, broken, needle = BROKEN["a Kuhn tetrahedron twice"]
+    bad = broken_table(tmp_path / "broken.yaml", code, broken)
+    assert main(["check", str(good), str(bad)]) == 2
+    line = capsys.readouterr().err.strip()
+    assert len(line.splitlines()) == 1 and needle in line and f"broken.yaml: configurations/{code}" in line, line

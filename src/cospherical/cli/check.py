@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..catalogue import catalogue_path, load_catalogue
-from ..formats.check import check_catalogue, check_patterns, read_document_file
+from ..formats.check import SharedChecks, check_catalogue, check_patterns, read_document_file
 from .output import path_argument, say
 
 
@@ -26,9 +26,9 @@ DESCRIPTION = ("Validate catalogues (schema, unique ids, consistent faces, known
 def add_arguments(parser) -> None:
     parser.add_argument("files", nargs="+", type=path_argument, metavar="FILE",
                         help="catalogues, pattern tables (YAML, or the SQLite store of study intersection --patterns) "
-                        "and dual.npz files of mesh --dual, checked in order (about 10-20 s per 4096-configuration "
-                        "pattern table: every configuration is recomputed; about 1 s per 20,000-leaf dual.npz: its dual "
-                        "is computed again)")
+                        "and dual.npz files of mesh --dual, checked in order (about 1-2 s per 4096-configuration "
+                        "pattern table: every configuration is recomputed, an entry met again in a later file of the "
+                        "same box checked once; about 1 s per 20,000-leaf dual.npz: its dual is computed again)")
     parser.add_argument("--catalogue", type=path_argument, metavar="FILE",
                         help="catalogue that pattern tables refer to (default: the shipped one)")
     parser.add_argument("--no-tiling", action="store_true", help="skip the geometric tiling check (faster)")
@@ -36,7 +36,7 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     catalogue = None
-    measured: dict = {}  # elements measured once across the tables (one catalogue for all of them)
+    shared = SharedChecks()  # what recurs across the tables is checked once (one catalogue for all of them)
     for path in args.files:
         if path.suffix == ".npz":
             _check_dual(path)
@@ -50,7 +50,7 @@ def run(args) -> int:
             catalogue_file = args.catalogue or catalogue_path()
             catalogue = load_catalogue(catalogue_file)
             check_catalogue(catalogue, str(catalogue_file))
-        check_patterns(document, catalogue, str(path), tiling=not args.no_tiling, measured=measured)
+        check_patterns(document, catalogue, str(path), tiling=not args.no_tiling, shared=shared)
         say(f"{path}: ok, pattern table of {len(document.configurations)} configurations")
     return 0
 

@@ -74,15 +74,25 @@ class Measured:
     center: tuple[Fraction, Fraction, Fraction] | None
 
 
-def measure(frame: Frame, members: Iterable[int]) -> Measured:
+def measure(frame: Frame, members: Iterable[int],
+            hull: tuple[tuple[tuple[int, ...], ...], Fraction] | None = None) -> Measured:
     """Measure the element whose vertices are ``members`` (indices into the frame), exactly: the one
-    place a mesh, a pattern check and the dual get an element's faces, volume and sphere from."""
+    place a mesh, a pattern check and the dual get an element's faces, volume and sphere from.
+
+    ``hull``: the ``(cycles, unit_volume)`` of an earlier measure of the same members at the same
+    unit coordinates in a box of other lengths: the hull and the volume over the box's do not depend
+    on the lengths (a positive scaling of the axes keeps faces, orientation and volume ratios), so
+    they are taken as they are; the sphere is the lengths' own.
+    """
     members = list(members)
-    try:
-        cycles = tuple(cycle for cycle, _ in hull_faces(frame, members))
-    except ValueError:  # flat: no hull, no volume
-        cycles = ()
-    volume = Fraction(six_volume(frame.coords, cycles), 6 * frame.scale ** 3) if cycles else Fraction(0)
+    if hull is not None:
+        cycles, volume = hull
+    else:
+        try:
+            cycles = tuple(cycle for cycle, _ in hull_faces(frame, members))
+        except ValueError:  # flat: no hull, no volume
+            cycles = ()
+        volume = Fraction(six_volume(frame.coords, cycles), 6 * frame.scale ** 3) if cycles else Fraction(0)
     sphere = frame.circumsphere(members)
     return Measured(cycles, volume, sphere, frame.center(sphere) if sphere is not None else None)
 

@@ -153,15 +153,34 @@ def _refuse_constant(text: str):
     raise ValueError(f"{text} is not a YAML value")
 
 
-# YAML 1.1 reads a number as a float only with a dot and, if it has an exponent, a
-# signed one (PyYAML reads 1e5 and 1.0e5 as strings); JSON takes all three.  A
-# number in our entries follows "[", ":" or ",": refuse what the two read differently.
-_NOT_YAML_NUMBER = re.compile(r"[\[:,] ?-?[0-9]+(?:\.[0-9]*)?[eE](?![-+])|[\[:,] ?-?[0-9]+[eE]")
+def _yaml_float(text: str) -> float:
+    """A JSON float that YAML 1.1 reads as a float too: with an exponent, only after a dot and signed
+    (PyYAML reads 1e5 and 1.0e5 as strings; JSON takes all three)."""
+    exponent = max(text.find("e"), text.find("E"))
+    if exponent >= 0 and ("." not in text or text[exponent + 1] not in "+-"):
+        raise ValueError(f"{text[:exponent + 1]}...: not a YAML 1.1 float (write a dot and a signed exponent)")
+    return float(text)
 
-# Decoding with a hook per object (to catch a repeated key) costs 4x plain decoding:
-# decode plainly, and only when the key count shows a key was dropped, again with it.
-_PLAIN = json.JSONDecoder(parse_constant=_refuse_constant)
-_STRICT = json.JSONDecoder(object_pairs_hook=_refuse_repeats, parse_constant=_refuse_constant)
+
+def _decode_counting(text: str) -> tuple[object, int]:
+    """The text decoded, and how many keys its objects kept: fewer than the text writes means a
+    repeated key was dropped.  A hook per object costs less than writing the value back to count;
+    a decoder per call keeps the count to the call (threads may decode at once)."""
+    kept = 0
+
+    def count(value: dict) -> dict:
+        nonlocal kept
+        kept += len(value)
+        return value
+
+    value = json.JSONDecoder(parse_constant=_refuse_constant, parse_float=_yaml_float, object_hook=count).decode(text)
+    return value, kept
+
+
+# Decoding with a hook per key-value list (to catch a repeated key) costs 4x plain decoding:
+# decode counting the keys, and only when a key was dropped, again with that hook.
+_STRICT = json.JSONDecoder(object_pairs_hook=_refuse_repeats, parse_constant=_refuse_constant,
+                           parse_float=_yaml_float)
 
 
 def decode_entry(text: str, where: str):
@@ -178,13 +197,10 @@ def decode_entry(text: str, where: str):
     cospherical.errors.FormatError: demo: repeated key 'a'
     """
     try:
-        found = _NOT_YAML_NUMBER.search(text)
-        if found:
-            raise ValueError(f"{found.group(0).lstrip('[:, ')}...: not a YAML 1.1 float (write a dot and a signed exponent)")
-        value = _PLAIN.decode(text)
-        # A dropped repeat shows as fewer keys written back than read (a '": ' inside
-        # a string counts on both sides alike).
-        if json.dumps(value, ensure_ascii=False).count('": ') != text.count('": '):
+        value, kept = _decode_counting(text)
+        # A dropped repeat shows as fewer keys kept than the text writes (a '": ' inside a
+        # string counts as one more written: decoded again, with the hook, to be sure).
+        if kept != text.count('": '):
             value = _STRICT.decode(text)
         return value
     except (ValueError, RecursionError) as error:

@@ -13,6 +13,7 @@ its boundary).
 
 from __future__ import annotations
 
+import hashlib
 from collections import Counter
 from dataclasses import dataclass
 from fractions import Fraction
@@ -20,7 +21,6 @@ from math import lcm
 from pathlib import Path
 from typing import Any
 
-from ..caches import cached
 from ..catalogue import Catalogue, CatalogueType, catalogue_from_text
 from ..core.base_element import base_element
 from ..core.configuration import Box
@@ -32,10 +32,10 @@ from ..errors import FormatError, InputError
 from ..files.flowyaml import split_section
 from ..files.yamlio import parse_yaml, read_text, validate
 from .diff import document_kind
-from .patterns import entry_elements, load, table_from_data, table_from_text
+from .patterns import Entries, entry_elements, load, table_from_data, table_from_text
 from .sqlite_store import is_store
 
-__all__ = ["EntryCheck", "check_catalogue", "check_patterns", "document_data", "read_document", "read_document_file",
+__all__ = ["EntryCheck", "SharedChecks", "check_catalogue", "check_patterns", "document_data", "read_document", "read_document_file",
            "validated"]
 
 
@@ -69,13 +69,43 @@ def _check_unique(catalogue: Catalogue, name: str) -> None:
             raise FormatError(f"{name}: types: {field} {repeated[0]!r} appears more than once")
 
 
-def check_patterns(table, catalogue: Catalogue | None, name: str, tiling: bool = True, measured: dict | None = None) -> None:
+class SharedChecks:
+    """What the checks of several tables against one catalogue share, so that each thing is done once.
+
+    - an element (type, mirror flag, points) is measured once per box and base element;
+    - a configuration's points are computed once per base element and point policy: they
+      are unit coordinates, the same for every box; so is which face planes of the base
+      element hold a point, and an element's hull and volume over the box's;
+    - an entry (its text, for the same point set, box, base element and criteria) that
+      passed once is not decoded or checked again: the leaf tables repeat most of the
+      bisection tables' entries (4,095 of 6,210), and its verdict cannot differ.
+    """
+
+    def __init__(self) -> None:
+        self.measured: dict[tuple[Any, ...], dict[tuple[Any, ...], _Measured | str]] = {}
+        self.positions: dict[tuple[Any, ...], dict[str, tuple[str, dict[int, int]]]] = {}
+        self.points: dict[tuple[tuple[int, int], ...], int] = {}  # a point's integer pairs -> its id
+        self.coordinates: list[tuple[Fraction, Fraction, Fraction]] = []  # id -> the point (unit coordinates)
+        self.planes: dict[Shape, list[int]] = {}  # per shape, id -> bit mask of the face planes holding the point
+        # points (ids, in an element's node order) -> its hull's cycles and unit volume, the same in every box
+        self.hulls: dict[tuple[int, ...], tuple[tuple[tuple[int, ...], ...], Fraction]] = {}
+        self.passed: set[tuple[Any, ...]] = set()  # (context, point-set code, digest of the entry's text)
+
+
+def check_patterns(table, catalogue: Catalogue | None, name: str, tiling: bool = True,
+                   shared: SharedChecks | None = None) -> None:
     """Check a loaded :class:`~cospherical.formats.patterns.PatternTable` against the catalogue and geometry.
 
-    ``measured``: a dict the checks of several tables share (against one catalogue), so that an
-    element that recurs across tables of the same box and base element is measured once."""
-    check = EntryCheck(table.header, catalogue, name, tiling, measured)
-    for code, entry in table.configurations.items():
+    ``shared``: what the checks of several tables (against one catalogue) share
+    (:class:`SharedChecks`), so that what recurs across them is done once."""
+    check = EntryCheck(table.header, catalogue, name, tiling, shared)
+    configurations = table.configurations
+    if isinstance(configurations, Entries):
+        # an entry that passed in an earlier table is neither decoded nor checked again
+        for code, entry, text in configurations.items_with_texts(skip=check.passed_before):
+            check(code, entry, text)
+        return
+    for code, entry in configurations.items():
         check(code, entry)
 
 
@@ -97,13 +127,14 @@ class EntryCheck:
     :class:`FormatError` naming the table, the configuration and the element.
 
     An element (its type, mirror flag and points) recurs across a table's configurations
-    and criteria: it is measured once (once across tables too, given one ``measured`` dict
-    for the checks of several tables against the same catalogue).
+    and criteria: it is measured once (once across tables too, given one
+    :class:`SharedChecks` for the checks of several tables against the same catalogue).
     """
 
     def __init__(self, header: dict, catalogue: Catalogue | None, name: str, geometry: bool = True,
-                 measured: dict | None = None):
+                 shared: SharedChecks | None = None):
         self._types = catalogue if catalogue is not None and len(catalogue) else None
+        self._known = frozenset(t.id for t in catalogue) if self._types is not None else None
         self._name = name
         self._geometry = geometry and bool(self._types)
         try:
@@ -114,22 +145,66 @@ class EntryCheck:
         self._scale = box.to_float()
         self._criteria = header["criteria"]
         self._family = base_element(header.get("element", "cuboid"), box, header["face_points"])
+        shape = self._family.shape
+        self._shared = shared = SharedChecks() if shared is None else shared
         # what an element's measure depends on besides its type, mirror flag and points
-        measured = {} if measured is None else measured
-        self._measured: dict[tuple, _Measured | str] = measured.setdefault(
-            (self._squared, self._family.shape, self._scale), {})
+        self._measured = shared.measured.setdefault((self._squared, shape, self._scale), {})
+        # a configuration's points depend on the shape in unit coordinates and the point policy, not on the box
+        self._positions = shared.positions.setdefault(
+            (shape.name, shape.corners, shape.edges, shape.faces, header["face_points"]), {})
+        # what an entry's verdict depends on besides its text and its points
+        self._context = (self._squared, shape, self._scale, tuple(self._criteria), self._geometry,
+                         catalogue.version if catalogue is not None else None)
         self._placed: dict[tuple, _Placed | str] = {}
+        unit = shape.unit_volume
+        self._unit_volume = (unit.numerator, unit.denominator)
 
-    def __call__(self, code: str, entry: dict) -> None:
+    def passed_before(self, code: str, text: str) -> bool:
+        """Whether the entry ``text`` of ``code`` passed this check already (in this table's context)."""
+        try:
+            point_set, _ = self._points(code)
+        except InputError:
+            return False  # refused with its place when it is checked
+        return (self._context, point_set, _digest(text)) in self._shared.passed
+
+    def _points(self, code: str) -> tuple[tuple[tuple[int, int], ...], dict[int, int]]:
+        """A configuration's points: node -> point id (:class:`SharedChecks`), and the same as a
+        sorted tuple (the point set: what an entry's verdict depends on besides the table)."""
+        found = self._positions.get(code)
+        if found is None:
+            cfg = self._family.configuration(code)
+            ids, coordinates = self._shared.points, self._shared.coordinates
+            positions = {}
+            # Points interned as ids: they key the cache of measured elements, and hashing
+            # Fractions would be most of the check's time.
+            for n, point in cfg.nodes().items():
+                pairs = tuple((x.numerator, x.denominator) for x in point)
+                i = ids.get(pairs)
+                if i is None:
+                    i = ids[pairs] = len(coordinates)
+                    coordinates.append((Fraction(point[0]), Fraction(point[1]), Fraction(point[2])))
+                positions[n] = i
+            found = self._positions[code] = (tuple(sorted(positions.items())), positions)
+        return found
+
+    def _plane_masks(self, points: tuple[int, ...], shape: Shape) -> list[int]:
+        """Per point (ids), the bit mask of the base element's face planes it lies in, exactly."""
+        masks = self._shared.planes.setdefault(shape, [])
+        coordinates = self._shared.coordinates
+        if len(masks) < len(coordinates):
+            for point in coordinates[len(masks):]:
+                masks.append(sum(1 << f for f, (normal, offset) in enumerate(shape.planes)
+                                 if normal[0] * point[0] + normal[1] * point[1] + normal[2] * point[2] == offset))
+        return [masks[p] for p in points]
+
+    def __call__(self, code: str, entry: dict, text: str | None = None) -> None:
+        """Check ``entry``, the entry of ``code``; ``text``: the entry as written (remembered once it passes)."""
         where = f"{self._name}: configurations/{code}"
         try:
-            cfg = self._family.configuration(code)
+            point_set, positions = self._points(code)
         except InputError as error:
             raise FormatError(f"{where}: {error}") from None
-        nodes = cfg.nodes()
-        # Positions as integer pairs: they key the cache of measured elements, and hashing
-        # Fractions would be most of the check's time.
-        positions = {n: tuple((x.numerator, x.denominator) for x in point) for n, point in nodes.items()}
+        shape = self._family.shape
         checked: list = []
         inside = True
         for c, criterion in enumerate(self._criteria):
@@ -137,29 +212,36 @@ class EntryCheck:
             if any(elements is other for other in checked):  # a reference to an earlier criterion's elements
                 continue
             checked.append(elements)
-            measured = self._elements(elements, positions, cfg.shape, f"{where}/{criterion}")
+            all_inside = self._elements(elements, positions, shape, f"{where}/{criterion}")
             if c == 0:
-                inside = all(m.inside for m in measured)
+                inside = all_inside
         if self._geometry:
             if entry["fvm_adequate"] != inside:
                 raise FormatError(f"{where}: fvm_adequate is {entry['fvm_adequate']}, recomputed {inside}")
+        if text is not None:
+            self._shared.passed.add((self._context, point_set, _digest(text)))
 
-    def _elements(self, elements: list, positions: dict, shape: Shape, where: str) -> list[_Placed]:
-        """Check one criterion's elements (see the class); returns them measured."""
-        measured = []
-        total = Fraction(0)
-        faces: Counter = Counter()  # (oriented face, on the boundary) -> the elements that have it
-        across: dict = {}  # a face inside the base element -> the same face seen from its other side
+    def _elements(self, elements: list, positions: dict[int, int], shape: Shape, where: str) -> bool:
+        """Check one criterion's elements (see the class); returns whether every circumcenter is inside."""
+        placed_all: list[_Placed] = []
+        unit_num, unit_den = self._unit_volume
+        total, denominator = 0, 1  # the volume so far: total / denominator
+        seen: set = set()  # (oriented face, on the boundary) of the elements so far
+        needed: set = set()  # the faces inside the base element seen from their other side
+        clash = False  # a face met twice from the same side: found again, with its message, below
+        inside = True
         where_is = positions.get
+        known = self._known
+        geometry = self._geometry
         for k, element in enumerate(elements):
             nodes = element["nodes"]
             points = tuple(map(where_is, nodes))
             if None in points:
                 missing = [n for n in nodes if n not in positions]
                 raise FormatError(f"{where}/{k}: node {missing[0]} is not a point of this configuration")
-            if self._types is not None and element["type"] not in self._types:
+            if known is not None and element["type"] not in known:
                 raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
-            if not self._geometry:
+            if not geometry:
                 continue
             found = self._place(element, tuple(nodes), points, shape)
             if isinstance(found, str):
@@ -167,41 +249,67 @@ class EntryCheck:
             if element["circumcenter"] != found.real_center:  # numbers (the schema): 1 == 1.0, as float() made them
                 raise FormatError(f"{where}/{k}: circumcenter {element['circumcenter']}, recomputed "
                                   f"{found.real_center}")
-            total += found.volume
+            num, den = found.volume_pair
+            if denominator % den:
+                common = lcm(denominator, den)
+                total *= common // denominator
+                denominator = common
+            total += num * (denominator // den)
             # Every element has a positive volume: past the base element's, the rest cannot tile it
             # (and a hostile entry of thousands of elements is refused after a few).
-            if total > shape.unit_volume:
+            if total * unit_den > unit_num * denominator:
                 raise FormatError(f"{where}: the elements do not fill the {_shape_name(shape)}: the first {k + 1} "
-                                  f"already have volume {total} of {shape.unit_volume}")
-            faces.update(found.faces)
-            across.update(found.across)
-            measured.append(found)
-        if not self._geometry:
-            return measured
-        if total != shape.unit_volume:
+                                  f"already have volume {Fraction(total, denominator)} of {shape.unit_volume}")
+            if not clash and not seen.isdisjoint(found.face_keys):
+                clash = True
+            seen |= found.face_keys
+            needed |= found.opposites
+            inside = inside and found.inside
+            placed_all.append(found)
+        if not geometry:
+            return inside
+        if total * unit_den != unit_num * denominator:
             raise FormatError(f"{where}: the elements do not fill the {_shape_name(shape)} "
-                              f"(volume {total} of {shape.unit_volume})")
-        _check_faces(faces, across, where)
-        return measured
+                              f"(volume {Fraction(total, denominator)} of {shape.unit_volume})")
+        if clash or not needed <= seen:
+            faces: Counter = Counter()  # (oriented face, on the boundary) -> the elements that have it
+            across: dict = {}  # a face inside the base element -> the same face seen from its other side
+            for found in placed_all:
+                faces.update(found.faces)
+                across.update(found.across)
+            _check_faces(faces, across, where)
+        return inside
 
-    def _place(self, element: dict, nodes: tuple, points: tuple, shape: Shape) -> _Placed | str:
+    def _place(self, element: dict, nodes: tuple, points: tuple[int, ...], shape: Shape) -> _Placed | str:
         """The element measured (once per type, mirror flag and points) and its faces in node ids
         (once per node list at those points: the same nodes recur across a table's configurations)."""
         mirror = bool(element.get("mirror"))
         key = (element["type"], mirror, nodes, points)
         placed = self._placed.get(key)
         if placed is None:
-            found = self._measure(element, points, shape)
+            found = self._measure(element["type"], mirror, points, shape)
             placed = self._placed[key] = found if isinstance(found, str) else _Placed.of(found, nodes, shape)
         return placed
 
-    def _measure(self, element: dict, points: tuple, shape: Shape) -> _Measured | str:
-        key = (element["type"], bool(element.get("mirror")), points)
+    def _measure(self, type_id: str, mirror: bool, points: tuple[int, ...], shape: Shape) -> _Measured | str:
+        key = (type_id, mirror, points)
         found = self._measured.get(key)
         if found is None:
-            found = self._measured[key] = _measure_element(element["type"], key[1], points, self._squared,
-                                                           self._types[element["type"]], self._scale, shape)
+            coordinates = self._shared.coordinates
+            assert self._types is not None  # measured only with a catalogue (geometry)
+            hulls = self._shared.hulls
+            found = self._measured[key] = _measure_element(
+                type_id, mirror, tuple(coordinates[p] for p in points), self._plane_masks(points, shape),
+                self._squared, self._types[type_id], self._scale, hulls.get(points))
+            if not isinstance(found, str):
+                hulls.setdefault(points, (found.faces, found.volume))
         return found
+
+
+def _digest(text: str) -> bytes:
+    """An entry's text as :class:`SharedChecks` remembers it: a collision-resistant digest, not the text
+    (the tables' texts would stay in memory)."""
+    return hashlib.blake2b(text.encode(), digest_size=16).digest()
 
 
 @dataclass(frozen=True)
@@ -221,28 +329,33 @@ class _Measured:
 class _Placed:
     """A measured element at its nodes: what an entry's check sums and counts, made once."""
 
-    volume: Fraction
+    volume_pair: tuple[int, int]  # its unit volume, numerator and denominator
     real_center: list[float]
     inside: bool  # its exact circumcenter in the closed base element (the FVM test)
     faces: tuple[tuple[tuple[int, ...], bool], ...]  # (oriented face in node ids, on the boundary)
     across: dict  # each face inside the base element -> the same face from its other side
+    face_keys: frozenset  # the faces, as a set
+    opposites: frozenset  # the faces the neighbours across its inner faces must have
 
     @classmethod
     def of(cls, found: _Measured, nodes: tuple, shape: Shape) -> _Placed:
         faces = tuple((_turned(tuple(nodes[p] for p in cycle)), on_boundary)
                       for cycle, on_boundary in zip(found.faces, found.on_boundary))
         across = {face: (_turned(face[0][::-1]), False) for face in faces if not face[1]}
-        return cls(found.volume, found.real_center, shape.contains(found.center), faces, across)
+        return cls((found.volume.numerator, found.volume.denominator), found.real_center,
+                   shape.contains(found.center), faces, across, frozenset(faces), frozenset(across.values()))
 
 
-def _measure_element(type_id: str, mirror: bool, points: tuple, squared, catalogued: CatalogueType, scale,
-                     shape: Shape) -> _Measured | str:
+def _measure_element(type_id: str, mirror: bool, points: tuple, plane_masks: list[int], squared,
+                     catalogued: CatalogueType, scale,
+                     hull: tuple[tuple[tuple[int, ...], ...], Fraction] | None = None) -> _Measured | str:
     """An element of type ``type_id`` (``catalogued``, its catalogue entry) listed by ``points``
-    (integer pairs of unit coordinates) in the base element ``shape`` of squared lengths ``squared``
-    (``scale``: its lengths as floats), measured; or why it is not one (text)."""
-    unit = {i: tuple(Fraction(n, d) for n, d in point) for i, point in enumerate(points)}
-    frame = Frame.build(unit, squared)  # frame index = position in the element's node list
-    element = measure(frame, range(len(points)))
+    (unit coordinates; ``plane_masks``: per point, the face planes of the base element that hold it)
+    in a base element of squared lengths ``squared`` (``scale``: its lengths as floats), measured; or
+    why it is not one (text).  ``hull``: its cycles and unit volume measured before in another box
+    (:func:`~cospherical.core.polyhedron.measure`)."""
+    frame = Frame.build(dict(enumerate(points)), squared)  # frame index = position in the element's node list
+    element = measure(frame, range(len(points)), hull)
     cycles = tuple(sorted(element.cycles))
     if element.sphere is None or {i for cycle in cycles for i in cycle} != set(range(len(points))):
         return "its nodes are not the vertices of a convex element on one sphere"
@@ -257,7 +370,7 @@ def _measure_element(type_id: str, mirror: bool, points: tuple, squared, catalog
     if reference != {_turned(cycle) for cycle in cycles}:
         return (f"the nodes are not in the reference order of type {type_id}: its faces do not run "
                 "counter-clockwise seen from outside (a mirrored, upside-down or reordered element)")
-    return _Measured(element.unit_volume, cycles, _on_boundary(frame, cycles, shape), element.center,
+    return _Measured(element.unit_volume, cycles, _on_boundary(cycles, plane_masks), element.center,
                      [float(x) * s for x, s in zip(element.center, scale)])
 
 
@@ -280,22 +393,16 @@ def _check_faces(faces: Counter, across: dict, where: str) -> None:
                               "meet face to face")
 
 
-def _on_boundary(frame: Frame, cycles, shape: Shape) -> tuple[bool, ...]:
-    """Per face cycle (frame indices): whether it lies in a face plane of the base element ``shape``."""
-    coords = frame.coords
-    return tuple(any(all(a * x + b * y + c * z == offset for x, y, z in (coords[p] for p in cycle))
-                     for (a, b, c), offset in _integer_planes(shape, frame.scale)) for cycle in cycles)
-
-
-@cached(maxsize=256)
-def _integer_planes(shape: Shape, scale: int) -> tuple[tuple[tuple[int, int, int], int], ...]:
-    """The face planes of ``shape`` in a frame's integer coordinates (``x = coords / scale``), as integer
-    normals and offsets: the test of a point runs on integers."""
-    planes = []
-    for normal, offset in shape.planes:
-        common = lcm(*(x.denominator for x in (*normal, offset * scale)))
-        planes.append((tuple(int(x * common) for x in normal), int(offset * scale * common)))
-    return tuple(planes)
+def _on_boundary(cycles, plane_masks: list[int]) -> tuple[bool, ...]:
+    """Per face cycle (positions in the node list): whether it lies in a face plane of the base element,
+    i.e. one plane holds all its points (``plane_masks``: per point, the planes that hold it)."""
+    found = []
+    for cycle in cycles:
+        common = -1
+        for p in cycle:
+            common &= plane_masks[p]
+        found.append(common != 0)
+    return tuple(found)
 
 
 def _shape_name(shape: Shape) -> str:

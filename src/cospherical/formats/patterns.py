@@ -169,19 +169,28 @@ class Entries(Mapping):
         not looked up before are not kept, so a table of millions of
         configurations is checked in bounded memory.
         """
+        return ((code, entry) for code, entry, _ in self.items_with_texts(chunk))
+
+    def items_with_texts(self, chunk: int = 4096, skip: Callable[[str, str], bool] | None = None):
+        """Every (code, entry, entry's text as written), as :meth:`items`; ``skip(code, text)``: true
+        for an entry to pass over, neither decoded nor validated (one checked before)."""
         # An indexed store streams its rows; a dict of lines is read in place.
         pairs = self._texts.texts() if hasattr(self._texts, "texts") else self._texts.items()
         batch: dict = {}
+        texts: dict[str, str] = {}
         for code, text in pairs:
             self._check_code(code)
+            if skip is not None and skip(code, text):
+                continue
             entry = self._decoded.get(code)
             batch[code] = entry if entry is not None else decode_entry(text, f"{self._name}: configurations/{code}")
+            texts[code] = text
             if len(batch) == chunk:
                 _check_entries({**self._header, "configurations": batch}, self._name, header_checked=True)
-                yield from batch.items()
-                batch = {}
+                yield from ((code, entry, texts[code]) for code, entry in batch.items())
+                batch, texts = {}, {}
         _check_entries({**self._header, "configurations": batch}, self._name, header_checked=True)
-        yield from batch.items()
+        yield from ((code, entry, texts[code]) for code, entry in batch.items())
 
     def values(self):
         return (entry for _, entry in self.items())
