@@ -218,7 +218,8 @@ class RegionFaces:
 def region_faces(mesh: Mesh) -> RegionFaces:
     """The contact and interface faces of a device mesh (see :class:`RegionFaces`).
 
-    Faces are paired by their sorted global vertex ids; a face met once lies on a
+    Faces flat in a block plane (the only ones that can be) are paired by their sorted
+    global vertex ids; a face met once lies on a
     contact when it is flat in the contact's plane and its vertices lie in the
     contact's closed rectangle (a face of a conforming mesh lies in one leaf face,
     which lies inside or outside the contact: the tree was refined so).
@@ -226,10 +227,14 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     regions, layout, element_region = device_of(mesh)
     rows, polygons = [], []
     width = 0
+    vertices = mesh.vertices.astype(np.int64)
+    planes = [plane * (mesh.grid // layout.steps) for plane in layout.planes]
     for element_rows, nodes, faces, _ in mesh.blocks():
         for cycle in faces:
-            rows.append(element_rows)
-            polygons.append(nodes[:, list(cycle)])
+            polygon = nodes[:, list(cycle)]
+            on = _on_a_plane(vertices, polygon, planes)
+            rows.append(element_rows[on])
+            polygons.append(polygon[on])
             width = max(width, len(cycle))
     if not rows:
         empty = np.zeros((0, 0), dtype=np.int32)
@@ -279,6 +284,22 @@ def region_faces(mesh: Mesh) -> RegionFaces:
                        interfaces.astype(np.int32), names, face[lower].astype(np.int32),
                        np.stack([element[lower], element[upper]], axis=1), which.astype(np.int32).reshape(-1),
                        np.unique(keys))
+
+
+def _on_a_plane(vertices: np.ndarray, polygon: np.ndarray, planes: list[np.ndarray]) -> np.ndarray:
+    """Which faces (rows of vertex ids) lie flat in one of the device's block planes (grid units per axis).
+
+    Only those can be a contact or interface face or lie on the domain's boundary (every
+    box face lies in a block plane), and both copies of a shared face are kept: what is
+    paired among them is paired as among all faces, at a fraction of the sort.
+    """
+    first = vertices[polygon[:, 0]]
+    on = np.zeros(len(polygon), dtype=bool)
+    for axis in range(3):
+        rows = np.flatnonzero(np.isin(first[:, axis], planes[axis]))
+        flat = np.all(vertices[polygon[rows], axis] == first[rows, axis, None], axis=1)
+        on[rows[flat]] = True
+    return on
 
 
 def contact_areas(mesh: Mesh, faces: RegionFaces) -> list[Fraction]:
@@ -539,7 +560,8 @@ def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> d
         factor = _factor(dual)
         keys = dual.edges[parts.coupling_edge, 0].astype(np.int64) * len(mesh.vertices) + \
             dual.edges[parts.coupling_edge, 1]
-        on_boundary = np.isin(keys, faces.boundary_edges)
+        at = np.minimum(np.searchsorted(faces.boundary_edges, keys), max(len(faces.boundary_edges) - 1, 0))
+        on_boundary = (faces.boundary_edges[at] == keys) if len(faces.boundary_edges) else np.zeros(len(keys), bool)
         below = np.asarray(parts.coupling_exact < 0)
         negative = [{"interior": int((below & ~on_boundary & (parts.coupling_region == r)).sum()),
                      "boundary": int((below & on_boundary & (parts.coupling_region == r)).sum())}
@@ -548,7 +570,7 @@ def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> d
     for r, region in enumerate(device.regions):
         rows = conn[element_region == r]
         entry: dict[str, Any] = {"name": region.name, "material": region.material, "elements": int(len(rows)),
-                 "nodes": int(len(np.unique(rows[rows >= 0]))), "volume": str(volumes[r] * box_volume),
+                 "nodes": int(np.count_nonzero(np.bincount(rows[rows >= 0], minlength=1))), "volume": str(volumes[r] * box_volume),
                  "volume_ok": volumes[r] * box_volume == layout.region_volumes[r]}
         if negative is not None and parts is not None:
             entry["negative_coefficients"] = negative[r]
