@@ -475,3 +475,18 @@ def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, ca
     assert case != "an element given the other region" or "member element_region" in err, err
     assert case != "a contact on a region it does not touch" or "is no face of an element of its region" in err \
         or "not on the boundary of region 'ox'" in err, err
+
+
+def test_each_member_is_what_numpy_save_writes():
+    """The writer makes each .npy itself (one copy of the data): its bytes are numpy.save's, for every kind of
+    member (ints, floats, bools, bytes, decimal text, empty, a non-contiguous view)."""
+    import io
+
+    from cospherical.formats.dual import _npy
+
+    for array in (np.arange(10), np.zeros((5, 3)), np.array([], dtype=np.int64), np.zeros((0, 3)),
+                  np.array(["12", "-3"], dtype="U200"), np.array([], dtype="U200"), np.frombuffer(b"{}", np.uint8),
+                  np.ones((4, 3), dtype=bool), np.arange(6, dtype=np.int32).reshape(3, 2)[:, :1]):
+        saved = io.BytesIO()
+        np.save(saved, array, allow_pickle=False)
+        assert bytes(_npy(array)) == saved.getvalue()

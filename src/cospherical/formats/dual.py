@@ -168,16 +168,25 @@ _MAX_GRID = 1 << 40
 _FRACTION = re.compile(r"-?[0-9]{1,%d}(/[1-9][0-9]{0,%d})?" % (_MAX_TEXT_DIGITS - 1, _MAX_TEXT_DIGITS - 1))
 
 
-def _npy(array: np.ndarray) -> bytes:
-    buffer = io.BytesIO()
-    np.lib.format.write_array(buffer, np.ascontiguousarray(array), allow_pickle=False)
-    return buffer.getvalue()
+def _npy(array: np.ndarray) -> bytearray:
+    """The ``.npy`` file of ``array`` (what ``numpy.save`` writes: a version 1.0 header, the C-order data),
+    made with one copy of the data."""
+    array = np.ascontiguousarray(array)
+    if array.dtype.hasobject:
+        raise ValueError("dual.npz holds no pickles: an object array must be written as text")
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, np.lib.format.header_data_from_array_1_0(array))
+    blob = bytearray(header.tell() + array.nbytes)
+    blob[:header.tell()] = header.getvalue()
+    np.frombuffer(blob, dtype=np.uint8, offset=header.tell())[:] = array.reshape(-1).view(np.uint8)
+    return blob
 
 
 def _exact(array: np.ndarray) -> np.ndarray:
     if array.dtype != object:
         return array
-    return np.array([str(int(x)) for x in array.reshape(-1)], dtype=f"U{_MAX_DIGITS}").reshape(array.shape)
+    # Python integers as decimal text (str of each, in one cast)
+    return array.astype(f"U{_MAX_DIGITS}")
 
 
 def write_dual(dual: Dual, path: str | Path) -> None:
