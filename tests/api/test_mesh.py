@@ -119,6 +119,7 @@ def test_a_leaf_list_in_memory_is_numbered_as_listed():
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], max_leaves="8"), "max_leaves='8'"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], max_leaves=1.5), "max_leaves=1.5"),
     (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], progress=5), "progress=5"),
+    (dict(domain=(1, 1, 1), levels=1, refine=["point:0,0,0"], checks="some"), "checks='some'"),
     (dict(device=5), "device=5"),
     (dict(device=""), "device=''"),
     (dict(device="d.yaml", balance="edge"), "not balance="),  # the file says its balance: was ignored
@@ -204,3 +205,17 @@ def test_write_refuses_an_empty_folder_and_a_cut_outside_the_domain(tmp_path, mo
             mesh.write(**kwargs)
         assert needle in str(raised.value) and "\n" not in str(raised.value)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_report_says_which_checks_ran_and_how():
+    """The report's checks: each exact check run; the Delaunay spheres bounded by the tree's structure or,
+    with checks="all", every one searched (the same findings); a check not asked for named with its reason."""
+    common = dict(domain=(1, 1, 1), levels=2, refine=["sphere:0.5,0.5,0.5,0.3"], uniform=False)
+    bounded, searched = (cospherical.build_mesh(**common, checks=c).report.to_dict() for c in ("default", "all"))
+    assert bounded["checks"]["run"] == ["volume", "conformity", "circumcenters", "delaunay"]
+    assert bounded["checks"]["delaunay_spheres"] == {"bounded_by_the_tree": bounded["elements"], "searched": 0}
+    assert searched["checks"]["delaunay_spheres"] == {"bounded_by_the_tree": 0, "searched": bounded["elements"]}
+    assert {k: v for k, v in bounded.items() if k != "checks"} == {k: v for k, v in searched.items() if k != "checks"}
+    skipped = cospherical.build_mesh(**common, check_delaunay=False).report.checks
+    assert "delaunay" not in skipped["run"] and "--no-delaunay" in skipped["not_run"]["delaunay"]
+    validate(bounded, "mesh-report", "report")

@@ -429,7 +429,8 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
                patterns: Any = None, criterion: str = "optimal", delaunay: str | None = None,
                balance: str | None = None, dual: bool = False, tetrahedral_counts: bool = False,
                device: str | Path | Device | None = None, max_leaves: int | None = None,
-               check_delaunay: bool = True, uniform: bool = True, progress: Progress | None = None) -> OctreeMesh:
+               check_delaunay: bool = True, uniform: bool = True, progress: Progress | None = None,
+               checks: str = "default") -> OctreeMesh:
     """Mesh an octree: each leaf's elements, globally Delaunay, checked exactly, reported; the dual on request.
 
     Parameters
@@ -477,6 +478,10 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         Run the global empty-sphere check; add the uniform bisection study to the report.
     progress
         ``progress(stage, total, advance)`` as long stages go (see :mod:`cospherical.mesh.pipeline`).
+    checks
+        ``"all"``: the Delaunay check searches the vertices near every element's sphere,
+        none bounded by the tree's structure (a cross-check; the report's ``checks`` says
+        which ran and how); ``"default"``: bounded where the tree allows.
 
     Examples
     --------
@@ -486,7 +491,8 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
     """
     _check_keywords(domain=domain, refine=refine, tree=tree, patterns=patterns, criterion=criterion,
                     delaunay=delaunay, dual=dual, tetrahedral_counts=tetrahedral_counts, device=device,
-                    max_leaves=max_leaves, check_delaunay=check_delaunay, uniform=uniform, progress=progress)
+                    max_leaves=max_leaves, check_delaunay=check_delaunay, uniform=uniform, progress=progress,
+                    checks=checks)
     if device is not None:
         given = [name for name, value in (("domain", domain), ("levels", levels), ("refine", refine),
                                           ("leaves", leaves), ("tree", tree), ("balance", balance))
@@ -517,7 +523,8 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         timings["table"] = time.perf_counter() - clock
     return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,
                                    check_delaunay=check_delaunay, uniform=uniform, dual=dual,
-                                   tetrahedral_counts=tetrahedral_counts, progress=progress, timings=timings), origin)
+                                   tetrahedral_counts=tetrahedral_counts, progress=progress, timings=timings,
+                                   checks=checks), origin)
 
 
 def _domain_box(domain: Sequence[Any] | Box | None, tree: Octree | None) -> Box:
@@ -565,13 +572,15 @@ def _check_keywords(**given: Any) -> None:
         "max_leaves": (lambda v: isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= 1,
                        "a positive integer"),
         "progress": (callable, "a callable progress(stage, total, advance)"),
+        "checks": (lambda v: v in ("default", "all"), "default or all"),
         "dual": (flag, "True or False"), "check_delaunay": (flag, "True or False"), "uniform": (flag, "True or False"),
         "tetrahedral_counts": (flag, "True or False"),
     }
     for name, value in given.items():
         fits, wanted = rules[name]
         if value is not None and not fits(value) or value is None and name in ("criterion", "dual", "check_delaunay",
-                                                                                  "uniform", "tetrahedral_counts"):
+                                                                                  "uniform", "tetrahedral_counts",
+                                                                                  "checks"):
             raise InputError(f"{name}={shown(value)}: {wanted}")
 
 

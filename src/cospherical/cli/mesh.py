@@ -6,6 +6,7 @@ import os
 import sys
 import time
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -106,6 +107,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--dask-workers", type=int, metavar="N",
                         help="run the pieces on a local Dask cluster of N processes (with --partitions)")
     parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check of the result")
+    parser.add_argument("--check", choices=("default", "all"), default="default",
+                        help="all: the Delaunay check searches the vertices near every element's sphere with a k-d "
+                        "tree, none bounded by the tree's structure (a cross-check of that bound); the report's "
+                        "checks says which checks ran and how")
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
 
@@ -241,7 +246,7 @@ def _run(args, out: OutputFolder | None) -> int:
         mesh = build_mesh(box, **given, patterns=args.patterns, criterion=args.criterion, delaunay=args.delaunay,
                           dual=args.dual, tetrahedral_counts=args.tetrahedral_counts, max_leaves=max_leaves,
                           check_delaunay=not args.no_delaunay,
-                          uniform=not args.no_uniform, progress=progress)
+                          uniform=not args.no_uniform, progress=progress, checks=args.check)
     clock = time.perf_counter()
     if out is not None:
         mesh.write_files(out.path, at, args.gmsh, args.gmsh_binary, args.tets)
@@ -290,7 +295,20 @@ def _print(args, report: dict) -> None:
     if args.format == "json":
         sys.stdout.write(report_json(report))
     else:
-        sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in _SUMMARY_KEYS))
+        sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in _SUMMARY_KEYS) + _checks_line(report))
+
+
+def _checks_line(report: dict) -> str:
+    """The summary's line of the checks that ran (and how the Delaunay check found each sphere's vertices)."""
+    checks = report["checks"]
+    spheres = checks.get("delaunay_spheres")
+    line = "checks: " + ", ".join(checks["run"])
+    if spheres is not None:
+        line += (f" (Delaunay: {spheres['bounded_by_the_tree']:,} spheres bounded by the tree's structure, "
+                 f"{spheres['searched']:,} searched)")
+    for name, why in checks.get("not_run", {}).items():
+        line += f"; not run: {name}, {why}"
+    return line + "\n"
 
 
 def _print_device(device: dict) -> None:
@@ -323,6 +341,8 @@ def _in_pieces(args, source: TreeSource, out: OutputFolder | None) -> int:
     from ..formats.mesh import write_piece, write_pvtu
     from ..mesh.partition import mesh_in_pieces
 
+    if args.check == "all":  # every sphere searched (see build_mesh's checks)
+        source = replace(source, tree=replace(source.tree, vertex_balanced=False))
     tree, described, listed = source.tree, source.described, source.leaf_order
     mode = delaunay_mode(args.criterion, args.delaunay)
     table = None

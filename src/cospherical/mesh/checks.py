@@ -543,6 +543,9 @@ class DelaunayCheck:
         The elements that violate, tie or have no sphere, sorted: those that are not cells of the
         Delaunay subdivision of the vertices, which :func:`~cospherical.mesh.delaunay.global_delaunay`
         replaces.
+    bounded, searched : int
+        Spheres whose candidate vertices came from the tree's structure (see the module
+        docstring), and spheres whose came from a k-d tree's search.
     """
 
     violations: int
@@ -553,6 +556,8 @@ class DelaunayCheck:
     violating_leaf_ids: np.ndarray
     violating_elements: np.ndarray
     not_cells: np.ndarray
+    bounded: int = 0
+    searched: int = 0
 
     def figures(self) -> dict[str, int]:
         """The counts as the report names them (``delaunay_violations``, ...), in its order."""
@@ -592,7 +597,8 @@ def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None]
     if len(spheres.searched):
         found_row, found_vertex = _candidates(mesh, mesh.points(), spheres, workers, progress)
         pair_row, pair_vertex = np.r_[pair_row, found_row], np.r_[pair_vertex, found_vertex]
-    return _found(mesh, spheres, pair_row, _exact_sides(mesh, spheres, pair_row, pair_vertex))
+    return _found(mesh, spheres, pair_row, _exact_sides(mesh, spheres, pair_row, pair_vertex),
+                  (len(spheres.tessellation) - len(spheres.searched), len(spheres.searched)))
 
 
 class _Spheres(NamedTuple):
@@ -878,7 +884,8 @@ def _exact_sides(mesh: Mesh, spheres: _Spheres, pair_row: np.ndarray, pair_verte
     return sides
 
 
-def _found(mesh: Mesh, spheres: _Spheres, pair_row: np.ndarray, sides: np.ndarray) -> DelaunayCheck:
+def _found(mesh: Mesh, spheres: _Spheres, pair_row: np.ndarray, sides: np.ndarray,
+           spheres_by: tuple[int, int]) -> DelaunayCheck:
     """What the exact sides of the (sphere row, vertex) pairs say: the violations, the ties, and the
     elements that are not cells of the Delaunay subdivision (those violating or tying, and those
     without a sphere)."""
@@ -898,7 +905,7 @@ def _found(mesh: Mesh, spheres: _Spheres, pair_row: np.ndarray, sides: np.ndarra
                                  if cells is not None else np.zeros(0, dtype=np.int64)])
     not_cells = np.sort(np.r_[elements(distinct(pair_row[sides <= 0])), spheres.without_sphere])
     return DelaunayCheck(int(len(bad_rows)), int(inside.sum()), int(len(bad_leaves)), int((sides == 0).sum()),
-                         int(len(pair_row)), bad_leaves, elements(bad_rows), not_cells)
+                         int(len(pair_row)), bad_leaves, elements(bad_rows), not_cells, *spheres_by)
 
 
 def _morton_order(points: np.ndarray, low: np.ndarray, high: np.ndarray, bits: int = 10) -> np.ndarray:

@@ -30,7 +30,7 @@ Examples
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
@@ -160,7 +160,8 @@ class _Clock:
 def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: str | None = None,
                  criterion: str = "optimal", delaunay: str | None = None, check_delaunay: bool = True,
                  uniform: bool = True, dual: bool = False, tetrahedral_counts: bool = False,
-                 progress: Progress | None = None, timings: dict[str, float] | None = None) -> PipelineResult:
+                 progress: Progress | None = None, timings: dict[str, float] | None = None,
+                 checks: str = "default") -> PipelineResult:
     """Mesh ``source``'s tree, check it exactly, report it and, with ``dual``, compute its finite-volume dual.
 
     Parameters
@@ -192,11 +193,17 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         ``progress(stage, total, advance)``, see the module's docstring.
     timings
         Seconds of stages run before (the tree, the table), put first in the report's timings.
+    checks
+        ``all``: the Delaunay check searches the vertices near every sphere with a k-d tree,
+        none bounded by the tree's structure (the cross-check of that bound: see
+        :mod:`cospherical.mesh.checks`); ``default``: bounded where the tree allows.
     """
     mode = delaunay_mode(criterion, delaunay)
+    if checks not in ("default", "all"):
+        raise InputError(f"checks={checks!r}: default or all")
     timings = dict(timings or {})
     clock = _Clock(timings)
-    tree = source.tree
+    tree = source.tree if checks == "default" else replace(source.tree, vertex_balanced=False)
 
     def told(stage: str, total: int) -> Callable[[int], None] | None:
         return (lambda n: progress(stage, total, n)) if progress is not None else None

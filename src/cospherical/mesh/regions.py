@@ -129,7 +129,8 @@ def _summed_checks(whole: Mesh, done: list[tuple[np.ndarray, Mesh, DelaunayCheck
     if any(checked is None for _, _, checked in done):
         return None
     counts = {name: sum(getattr(c, name) for _, _, c in done if c is not None)
-              for name in ("violations", "violating_pairs", "violating_leaves", "ties", "exact_tests")}
+              for name in ("violations", "violating_pairs", "violating_leaves", "ties", "exact_tests", "bounded",
+                           "searched")}
     leaf_ids, elements, not_cells = [], [], []
     first_cell = whole.leaf_elements
     for leaves, sub, checked in done:
@@ -146,9 +147,11 @@ def _summed_checks(whole: Mesh, done: list[tuple[np.ndarray, Mesh, DelaunayCheck
         elements.append(numbered(checked.violating_elements))
         not_cells.append(numbered(checked.not_cells))
         first_cell += len(sub.cells) if sub.cells is not None else 0
+    leaf_ids_found, elements_found, not_cells_found = (np.sort(np.concatenate(a)).astype(np.int64)
+                                                       for a in (leaf_ids, elements, not_cells))
     return DelaunayCheck(counts["violations"], counts["violating_pairs"], counts["violating_leaves"], counts["ties"],
-                         counts["exact_tests"], *(np.sort(np.concatenate(a)).astype(np.int64)
-                                                  for a in (leaf_ids, elements, not_cells)))
+                         counts["exact_tests"], leaf_ids_found, elements_found, not_cells_found, counts["bounded"],
+                         counts["searched"])
 
 
 def _box_bounds(layout: DeviceLayout) -> np.ndarray:

@@ -33,7 +33,7 @@ _SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_f
            "leaves_not_fvm_adequate", "elements_not_cospherical", "boundary_circumcenters_outside",
            "delaunay_violations", "delaunay_violating_pairs", "delaunay_violating_leaves", "delaunay_ties",
            "delaunay_exact_tests", "delaunay_violating_fvm_leaves", "leaves_tessellated_on_the_fly",
-           "cells_spanning_leaves")
+           "cells_spanning_leaves", "delaunay_spheres_bounded", "delaunay_spheres_searched")
 
 
 def outside_catalogue(mesh: Mesh) -> list[dict[str, Any]]:
@@ -103,6 +103,7 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
         fvm = np.array([p.fvm_adequate for p in mesh.tessellations],
                        dtype=bool)[mesh.leaf_tessellation[found.violating_leaf_ids]]
         figures["delaunay_violating_fvm_leaves"] = int(fvm.sum())
+        figures["delaunay_spheres_bounded"], figures["delaunay_spheres_searched"] = found.bounded, found.searched
     start("statistics")
     figures["type_counts"], figures["configurations"] = occurrences(mesh)
     kept = {p.code for _, p, _ in mesh.groups()}
@@ -194,7 +195,21 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]
         types.update(part["types"])
     report.update(statistics(type_counts, configurations, len(tree), types, catalogue,
                              uniform_study(tree.box, catalogue) if uniform else None))
+    report["checks"] = _checks_run(patterns is not None, delaunay, summed)
     return report
+
+
+def _checks_run(table: bool, delaunay: bool, summed: Mapping[str, int]) -> dict[str, Any]:
+    """The report's ``checks``: which exact checks ran, which did not and why, and how the Delaunay check
+    found the vertices near each sphere (bounded by the tree's structure, or searched)."""
+    checks: dict[str, Any] = {"run": (["table_entries"] if table else [])
+                              + ["volume", "conformity", "circumcenters"] + (["delaunay"] if delaunay else [])}
+    if delaunay:
+        checks["delaunay_spheres"] = {"bounded_by_the_tree": summed.get("delaunay_spheres_bounded", 0),
+                                      "searched": summed.get("delaunay_spheres_searched", 0)}
+    else:
+        checks["not_run"] = {"delaunay": "not asked for (--no-delaunay): delaunay_violations is null"}
+    return checks
 
 
 @dataclass(frozen=True)
@@ -262,7 +277,7 @@ def checked_mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | Non
 # the dual's figures (only with the dual) and a device's regions and contacts (only for a device).
 _ABSENT_WHEN_NONE = frozenset({"delaunay_violating_pairs", "delaunay_violating_leaves", "delaunay_ties",
                                "delaunay_exact_tests", "delaunay_violating_fvm_leaves", "uniform",
-                               "negative_coefficients", "dual", "device"})
+                               "negative_coefficients", "dual", "device", "checks"})
 
 
 @dataclass(frozen=True)
@@ -327,6 +342,7 @@ class MeshReport:
     negative_coefficients: Mapping[str, int] | None = None
     dual: Mapping[str, Any] | None = None
     device: Mapping[str, Any] | None = None
+    checks: Mapping[str, Any] | None = None
     timings: Mapping[str, float] = field(default_factory=dict, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
