@@ -1,12 +1,12 @@
 """Devices: time and memory of the example devices, and a diode beside the one-box mesh of the same size.
 
-    python benchmarks/bench_devices.py [--levels 7] [--anode]
+    python benchmarks/bench_devices.py [--levels 7] [--anode] [--devices GLOB]
 
 Whole processes, each measured by the kernel (``os.wait4``: user + system CPU, peak
 resident memory) and by the wall clock, every output written (``--dual --out``):
 
 (1) ``cospherical mesh --device examples/devices/NAME.yaml --dual --out DIR`` for each
-    example device, as shipped;
+    example device, as shipped (``--devices GLOB``: those whose name matches);
 (2) the pn diode (one silicon cube refined at its junction plane z = 1/2, two contacts)
     at ``--levels L`` against ``cospherical mesh --domain 1 1 1 --refine plane:0,0,1,0.5
     --levels L --dual --out DIR``, the same tree and the same elements as one box: what a
@@ -55,11 +55,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--levels", type=int, default=7, help="the diode's level for the comparison (default 7)")
     parser.add_argument("--anode", action="store_true", help="refine the diode at its anode's plane z = 1 too")
+    parser.add_argument("--devices", default="*", metavar="GLOB", help="the example devices (1) meshes (default: all)")
     args = parser.parse_args()
     cospherical = [sys.executable, "-m", "cospherical", "mesh"]
     with recorded(__file__) as record, tempfile.TemporaryDirectory() as scratch:
         rows = []
-        for path in sorted(EXAMPLES.glob("*.yaml")):
+        for path in sorted(EXAMPLES.glob(f"{args.devices}.yaml")):
             out = Path(scratch) / path.stem
             wall, cpu, peak = run_usage(cospherical + ["--device", str(path), "--dual", "--out", str(out)])
             report = json.loads((out / "report.json").read_text())

@@ -26,15 +26,18 @@ ROOT = Path(__file__).resolve().parents[1]
 SMALLER = [
     (re.compile(r"--resolution \d+"), "--resolution 2"),
     (re.compile(r"^(cospherical study intersection)(?!.*--resolution)"), r"\1 --resolution 2"),
-    (re.compile(r"^(python benchmarks/bench_intersection.py)"), r"\1 --resolution 2 --sample 3"),
+    (re.compile(r"^(python benchmarks/bench_intersection.py)"), r"\1 --resolution 2 --sample 3 --jobs 1"),
+    # one process where the study runs: a pool of two costs about 3 times the CPU at R = 2
+    (re.compile(r"^(python benchmarks/bench_patterns.py)"), r"\1 --jobs 1"),
     (re.compile(r"^(python benchmarks/bench_tessellate.py)"), r"\1 --samples 5"),
     (re.compile(r"^(python benchmarks/bench_mesh.py)"), r"\1 --levels 4"),
     (re.compile(r"^(python benchmarks/bench_regions.py)"), r"\1 --levels 4"),
-    (re.compile(r"^(python benchmarks/bench_devices.py).*"), r"\1 --levels 4"),
-    (re.compile(r"^(python benchmarks/bench_scale.py)"), r"\1 --levels 3"),  # L 10 is two processes of minutes and GBs
-    (re.compile(r"^(python benchmarks/bench_outputs.py)"), r"\1 --levels 3"),
+    # every example device is meshed as shipped by mesh/test_regions.py (and mos-capacitor by the devices page)
+    (re.compile(r"^(python benchmarks/bench_devices.py).*"), r"\1 --levels 2 --devices pn-diode"),
+    (re.compile(r"^(python benchmarks/bench_scale.py)"), r"\1 --levels 2"),  # L 10 is two processes of minutes and GBs
+    (re.compile(r"^(python benchmarks/bench_outputs.py)"), r"\1 --levels 2"),
     # CGAL's wheel is the script's own set-up, not the tests': the example runs with TetGen alone
-    (re.compile(r"^(python benchmarks/bench_peers.py)"), r"\1 --levels 3 --runs 1 --peers tetgen"),
+    (re.compile(r"^(python benchmarks/bench_peers.py)"), r"\1 --levels 2 --runs 1 --peers tetgen"),
     (re.compile(r"^(python benchmarks/bench_startup.py)"), r"\1 --runs 1 --every 64 --tables 'bisection-tetra*'"),
     (re.compile(r"^(python benchmarks/bench_bisection.py)"), r"\1 --every 64"),
     (re.compile(r"^(cospherical sweep --ratios \S+):\d+ (\S+):\d+"), r"\1:2 \2:2"),  # 2 x 2 grid values
@@ -121,20 +124,72 @@ def smaller(line: str) -> str:
     return line
 
 
-def run_shell_example(line: str, cwd: Path) -> None:
-    """Run one example line as a reader would (the venv's commands first on PATH) and check its outcome."""
+# Commands that start worker processes (a pool by default, Dask, pieces): run in a process of their own,
+# never forked from a test worker's process
+_WORKERS = re.compile(r"^cospherical (study intersection|sweep|reproduce)\b|--(jobs|dask-workers|scheduler|partitions)\b")
+
+
+def in_process_argv(command: str, cwd: Path) -> list[str] | None:
+    """The arguments of a plain ``cospherical ...`` line that ``cospherical.cli.main`` can run in this process.
+
+    The console script is ``cospherical.cli:main``: called with the words bash would pass it (quotes
+    removed, globs expanded in ``cwd`` as bash expands them), it runs the same code, without the second
+    of start-up (the imports) a process costs; the README's lines run as processes, so the console script
+    itself is run there. ``None`` for a line with more shell in it, or one that starts worker processes.
+    """
+    import glob
+    import shlex
+
+    if not command.startswith("cospherical ") or _WORKERS.search(command) or re.search(r"[;&|$<>`(){}\\]",
+                                                                                      re.sub(r"'[^']*'", "", command)):
+        return None
+    argv = []
+    for word in shlex.split(command)[1:]:
+        found = sorted(glob.glob(word, root_dir=cwd)) if re.search(r"[*?[]", word) else []
+        argv += found or [word]
+    return argv
+
+
+def _run_in_process(argv: list[str], cwd: Path) -> tuple[int, str]:
+    """``cospherical.cli.main(argv)`` in ``cwd``: its exit status and what it wrote on stderr."""
+    import signal
+
+    from cospherical.cli import main
+
+    handlers = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
+    out, err = io.TextIOWrapper(io.BytesIO(), encoding="utf-8"), io.StringIO()
+    try:
+        with _chdir(cwd), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            status = main(argv)
+    finally:
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
+    return status, err.getvalue()
+
+
+def run_shell_example(line: str, cwd: Path, in_process: bool = False) -> None:
+    """Run one example line as a reader would (the venv's commands first on PATH) and check its outcome.
+
+    ``in_process``: a plain ``cospherical ...`` line runs through ``cospherical.cli.main`` in this process
+    (:func:`in_process_argv`).
+    """
     command = smaller(line)
-    bin_dir = str(Path(sys.executable).parent)
-    env = {**os.environ, "PATH": bin_dir + os.pathsep + os.environ["PATH"]}
+    argv = in_process_argv(command, cwd) if in_process else None
     with no_stray_files(cwd, line):
-        result = subprocess.run(["bash", "-c", command], cwd=cwd, env=env, capture_output=True, text=True,
-                                timeout=1800)  # a guard against hangs only: a loaded machine is slow
+        if argv is not None:
+            returncode, stderr = _run_in_process(argv, cwd)
+        else:
+            bin_dir = str(Path(sys.executable).parent)
+            env = {**os.environ, "PATH": bin_dir + os.pathsep + os.environ["PATH"]}
+            result = subprocess.run(["bash", "-c", command], cwd=cwd, env=env, capture_output=True, text=True,
+                                    timeout=1800)  # a guard against hangs only: a loaded machine is slow
+            returncode, stderr = result.returncode, result.stderr
     if "SCHEDULER" in command:  # a placeholder host: one line, exit 2
-        assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1, result.stderr
+        assert returncode == 2 and len(stderr.strip().splitlines()) == 1, stderr
         return
     expected = (0, 1) if " diff " in f" {command} " else (0,)
-    assert result.returncode in expected, (command, result.stderr[-2000:])
-    assert "Traceback" not in result.stderr
+    assert returncode in expected, (command, stderr[-2000:])
+    assert "Traceback" not in stderr
 
 
 def run_python_example(snippet: str, cwd: Path, name: str) -> str:

@@ -160,7 +160,7 @@ def _docs_lines() -> list[str]:
 
 @pytest.mark.parametrize("line", _docs_lines())
 def test_docs_shell_example_runs(scratch, line):
-    run_shell_example(line, scratch)
+    run_shell_example(line, scratch, in_process=True)
 
 
 SNIPPETS = [(page, snippet) for page, text in PAGES.items() for snippet in python_examples(text)]
@@ -182,6 +182,11 @@ def test_an_example_that_leaves_a_file_in_the_checkout_fails(tmp_path):
     run_shell_example("echo 'out/' > .gitignore", checkout)  # a committed file rewritten: what regenerating is
     with pytest.raises(AssertionError, match=r"left files in the checkout: \['stray\.txt'\]"):
         run_shell_example("echo stray > stray.txt", checkout)
+    # a line run in-process is held to the same outcome: a refusal (exit 2) fails it, a stray file too
+    with pytest.raises(AssertionError, match="80000000000Z"):
+        run_shell_example("cospherical tessellate --box 1 1 1 --code 80000000000Z", checkout, in_process=True)
+    with pytest.raises(AssertionError, match=r"left files in the checkout: \['t\.vtu'\]"):
+        run_shell_example("cospherical tessellate --box 1 1 1 --code 880000000000 --vtu t.vtu", checkout, in_process=True)
     with pytest.raises(AssertionError, match=r"left files in the checkout: \['new/deep\.py'\]"):
         run_python_example("from pathlib import Path\nPath('new').mkdir()\nPath('new/deep.py').write_text('')",
                            checkout, "a page")
