@@ -518,12 +518,23 @@ def _distinct_rows(nodes: np.ndarray, used: np.ndarray, path: Path, member: str,
     twice = np.any(ordered[:, 1:] == ordered[:, :-1], axis=1)
     if twice.any():
         raise FormatError(f"{path}: member {member}: {row} {int(np.flatnonzero(twice)[0])} names a vertex twice")
-    if len(ordered) > 1:
+    if len(ordered) > 1 and _distinct_by_hash(ordered):
+        return
+    if len(ordered) > 1:  # a repeated row (or a hash collision): found, and the first pair named, by sorting rows
         order = np.lexsort(ordered.T[::-1])
         same = np.flatnonzero(np.all(ordered[order[1:]] == ordered[order[:-1]], axis=1))
         if len(same):
             first, second = sorted((int(order[same[0]]), int(order[same[0] + 1])))
             raise FormatError(f"{path}: member {member}: {row}s {first} and {second} have the same vertices")
+
+
+def _distinct_by_hash(rows: np.ndarray) -> bool:
+    """Whether the rows are all different, proved by sorting one hash per row and comparing the rows whose hashes
+    are equal (``False``: some are equal, or two different rows share a hash)."""
+    from ..mesh.dual.shapes import row_hashes
+
+    hashed = np.sort(row_hashes(rows))
+    return not np.any(hashed[1:] == hashed[:-1])
 
 
 def _elements(nodes: np.ndarray, sizes: np.ndarray, n_vertices: int, path: Path) -> tuple[np.ndarray, np.ndarray]:

@@ -26,7 +26,7 @@ from .pieces import ElementPieces, Point, element_pieces
 if TYPE_CHECKING:
     from ..assembly import LocalTessellation, Mesh
 
-__all__ = ["Group", "ShapePieces", "cell_groups", "element_groups", "leaf_groups"]
+__all__ = ["Group", "ShapePieces", "cell_groups", "element_groups", "leaf_groups", "row_hashes"]
 
 Squared = tuple[Fraction, Fraction, Fraction]
 
@@ -149,12 +149,18 @@ def _measured_pieces(key: NDArray[np.int64], squared: Squared, element: int) -> 
 _ROW_HASH = np.random.default_rng(20260101).integers(1, 2**63, size=3 * 64, dtype=np.uint64) | np.uint64(1)
 
 
+def row_hashes(rows: NDArray[np.integer]) -> NDArray[np.uint64]:
+    """One integer per row of at most 192 integers (equal rows, equal hashes): to sort integers instead of rows,
+    the rows' equality then proved by comparing them."""
+    hashed: NDArray[np.uint64] = (rows.astype(np.uint64) * _ROW_HASH[:rows.shape[1]]).sum(axis=1, dtype=np.uint64)
+    return hashed  # the products and sums wrap around: a hash
+
+
 def _equal_rows(keys: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Classes of equal rows: each class's first row, and each row's class.  The rows are hashed to one
     integer each (a sort of integers, not of rows) and the classes then proved by comparing every row with
     its class's first; a collision (never seen) falls back to sorting the rows themselves."""
-    hashed = (keys.astype(np.uint64) * _ROW_HASH[:keys.shape[1]]).sum(axis=1, dtype=np.uint64)  # wraps: a hash
-    _, first, which = np.unique(hashed, return_index=True, return_inverse=True)
+    _, first, which = np.unique(row_hashes(keys), return_index=True, return_inverse=True)
     if not np.array_equal(keys[first][which.reshape(-1)], keys):
         _, first, which = np.unique(keys, axis=0, return_index=True, return_inverse=True)
     return first, which.reshape(-1)
