@@ -427,29 +427,34 @@ def device_layout(device: Device) -> DeviceLayout:
 
 def _check_connected(owner_box: np.ndarray, boxes: list[tuple[int, int, Coordinates]],
                      where: Callable[[int, int], str]) -> None:
-    """Refuse a domain whose blocks are not one piece through shared faces (naming a box of another piece)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    """Refuse a domain whose blocks are not one piece through shared faces (naming a box of another piece).
 
-    inside = owner_box >= 0
-    index = np.arange(owner_box.size).reshape(owner_box.shape)
-    rows: list[np.ndarray] = []
-    cols: list[np.ndarray] = []
-    for axis in range(3):
-        a = [slice(None)] * 3
-        b = [slice(None)] * 3
-        a[axis], b[axis] = slice(1, None), slice(None, -1)
-        both = inside[tuple(a)] & inside[tuple(b)]
-        rows.append(index[tuple(a)][both])
-        cols.append(index[tuple(b)][both])
-    row, col = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.ones(len(row), dtype=np.int8), (row, col)), shape=(owner_box.size,) * 2)
-    _, label = connected_components(graph, directed=False)
-    pieces = np.unique(label[inside.reshape(-1)])
-    if len(pieces) > 1:
-        first = label[inside.reshape(-1)][0]
-        stray = owner_box.reshape(-1)[(label != first) & inside.reshape(-1)][0]
-        r, k, _ = boxes[int(stray)]
+    Two blocks inside share a face only where their boxes touch along a face (the same
+    box, or two whose faces meet over a rectangle of positive area: boxes do not
+    overlap), so the pieces are those of the boxes' graph: at most 64 boxes, joined here
+    exactly, with no graph library (a one-box device needs none of it).
+    """
+    piece = list(range(len(boxes)))
+
+    def root(i: int) -> int:
+        while piece[i] != i:
+            i = piece[i]
+        return i
+
+    for i, (_, _, a) in enumerate(boxes):
+        for j in range(i):
+            b = boxes[j][2]
+            if any((a[k + 3] == b[k] or b[k + 3] == a[k])
+                   and all(min(a[m + 3], b[m + 3]) > max(a[m], b[m]) for m in range(3) if m != k)
+                   for k in range(3)):
+                piece[root(i)] = root(j)
+    label = np.array([root(i) for i in range(len(boxes))], dtype=np.int64)
+    inside = (owner_box >= 0).reshape(-1)
+    of_block = label[np.maximum(owner_box.reshape(-1), 0)]
+    first = of_block[inside][0]  # the piece of the first block inside, in block order
+    strays = np.flatnonzero(inside & (of_block != first))
+    if len(strays):
+        r, k, _ = boxes[int(owner_box.reshape(-1)[strays[0]])]
         raise InputError(f"{where(r, k)} does not touch the rest of the device along a face: a device is one "
                          "connected piece (mesh each piece as its own device)")
 
