@@ -219,3 +219,13 @@ def test_the_report_says_which_checks_ran_and_how():
     skipped = cospherical.build_mesh(**common, check_delaunay=False).report.checks
     assert "delaunay" not in skipped["run"] and "--no-delaunay" in skipped["not_run"]["delaunay"]
     validate(bounded, "mesh-report", "report")
+
+
+def test_writing_tells_progress_file_by_file(tmp_path):
+    """The writers' bar (mesh --out on a large tree) advances once per file, to the count of the folder's names."""
+    told: list = []
+    m = cospherical.build_mesh(domain=(1, 1, 1), levels=1, refine=["point:0.5,0.5,0.5"], uniform=False, dual=True)
+    m.write_files(lambda name: tmp_path / name, progress=lambda stage, total, n: told.append((stage, total, n)))
+    assert {stage for stage, _, _ in told} == {"outputs"} and sum(n for _, _, n in told) == len(told) == 4
+    assert {total for _, total, _ in told} == {4} and sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["mesh.vtu", "report.json", "mesh.png", "dual.npz"])

@@ -19,15 +19,21 @@ from cospherical.mesh.report import MeshReport, mesh_report
 BOX = Box.parse([1, 2, 4])
 
 
+def _faces(report: MeshReport) -> int:
+    """Every element face, as the conformity check met them: twice each interior one, once the rest."""
+    return 2 * report.interior_faces + report.boundary_faces + report.nonconforming_faces
+
+
 def test_progress_adds_up_to_each_stage_total_and_timings_follow_the_stages():
     told = defaultdict(list)
     source = tree_from_refine(BOX, 3, ["sphere:0.5,1,2,0.6"])
     result = run_pipeline(source, uniform=False, dual=True,
                           progress=lambda stage, total, n: told[stage].append((total, n)))
-    assert set(told) == {"assembly", "regions"}  # the final check is the global step's own, not run again
+    # the final check is the global step's own, not run again; the faces paired have no total known before
+    assert set(told) == {"assembly", "regions", "conformity", "dual"}
     for stage, calls in told.items():
         totals = {total for total, _ in calls}
-        assert len(totals) == 1 and sum(n for _, n in calls) == totals.pop(), stage
+        assert len(totals) == 1 and sum(n for _, n in calls) == (totals.pop() or _faces(result.report)), stage
     assert told["assembly"][0][0] == len(source.tree)
     assert told["regions"][0][0] == result.report.leaf_mesh["elements"]
     assert list(result.report.timings) == ["assembly", "global Delaunay", "volume", "conformity", "circumcenters",
@@ -44,7 +50,8 @@ def test_a_device_tells_the_same_stages_with_their_own_totals():
     told = defaultdict(list)
     source = tree_from_device(device)
     result = run_pipeline(source, uniform=False, progress=lambda stage, total, n: told[stage].append((total, n)))
-    assert set(told) == {"assembly", "regions"}
+    assert set(told) == {"assembly", "regions", "conformity"}
+    assert sum(n for _, n in told["conformity"]) == _faces(result.report)
     assert told["assembly"][0][0] == len(source.tree) == sum(n for _, n in told["assembly"])
     assert told["regions"][0][0] == result.report.leaf_mesh["elements"] == sum(n for _, n in told["regions"])
 
@@ -57,7 +64,7 @@ def test_the_pipeline_in_leaf_mode_is_the_steps_by_hand():
                           progress=lambda stage, total, n: told.__setitem__(stage, told[stage] + n))
     assert isinstance(result.report, MeshReport) and result.report.to_dict() == by_hand
     assert by_hand["delaunay_violations"] > 0 and len(result.violating) == by_hand["delaunay_violations"]
-    assert dict(told) == {"assembly": len(tree), "delaunay": len(result.mesh)}
+    assert dict(told) == {"assembly": len(tree), "delaunay": len(result.mesh), "conformity": _faces(result.report)}
 
 
 def test_a_leaf_list_keeps_its_numbering():

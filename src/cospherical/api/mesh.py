@@ -303,32 +303,47 @@ class OctreeMesh:
             self.write_files(out.path, cut, gmsh, binary, tets)
 
     def write_files(self, path: Callable[[str], Path], cut: float | None = None, gmsh: str | None = None,
-                    binary: bool = False, tets: bool = False) -> None:
-        """Write the outputs, each to ``path(name)`` (an :class:`~cospherical.files.outputs.OutputFolder`'s ``path``)."""
+                    binary: bool = False, tets: bool = False, progress: Progress | None = None) -> None:
+        """Write the outputs, each to ``path(name)`` (an :class:`~cospherical.files.outputs.OutputFolder`'s ``path``);
+        ``progress("outputs", files, n)`` is told as files are written."""
         from ..formats.mesh import write_report, write_vtu
         from ..outputs.mesh_picture import cut_png
 
         mesh, report, source = self.assembled, self.report, self._result.source
         if gmsh is not None and gmsh not in GMSH_VERSIONS:
             raise InputError(f"Gmsh version {gmsh!r}: write one of {', '.join(GMSH_VERSIONS)}")
+        layout = source.device
+        files = len(output_names(report.dual is not None, layout is not None and layout.device.has_faces,
+                                 gmsh is not None, tets))
+
+        def wrote(n: int = 1) -> None:
+            if progress is not None:
+                progress("outputs", files, n)
+
         if gmsh is not None or tets:
             self._write_tetrahedra(path, gmsh, binary, tets)
+            wrote((gmsh is not None) + tets)
         with_dual = report.dual is not None
         if with_dual:
             from ..formats.dual import write_dual
 
             write_dual(self.dual, path("dual.npz"))
+            wrote()
         point_data, cell_data = self._vtu_data(with_dual)
         if source.device is not None:
             self._write_device(path, cut, point_data, cell_data)
+            wrote(files - (gmsh is not None) - tets - with_dual)
             return
         write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=source.leaf_order)
+        wrote()
         at = default_cut(source.shapes, self.box) if cut is None else cut
         shapes = ", ".join(source.described.get("refine", [])) or source.described.get("file", "")
         cut_png(mesh, path("mesh.png"), at=at,
                 title=f"{' x '.join(self.box.texts)}: {shapes}; {report.leaves:,} leaves, {report.elements:,} "
                       f"elements, {report.types} types (cut at z = {at * float(self.box.c):.4g})")
+        wrote()
         write_report(report.to_dict(), path("report.json"))
+        wrote()
 
     def _write_tetrahedra(self, path: Callable[[str], Path], gmsh: str | None, binary: bool, tets: bool) -> None:
         """``mesh.msh`` and ``tets.vtu``: the conforming tetrahedral split (:mod:`cospherical.mesh.tetrahedra`)."""

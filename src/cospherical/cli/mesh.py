@@ -247,9 +247,9 @@ def _run(args, out: OutputFolder | None) -> int:
                           dual=args.dual, tetrahedral_counts=args.tetrahedral_counts, max_leaves=max_leaves,
                           check_delaunay=not args.no_delaunay,
                           uniform=not args.no_uniform, progress=progress, checks=args.check)
-    clock = time.perf_counter()
-    if out is not None:
-        mesh.write_files(out.path, at, args.gmsh, args.gmsh_binary, args.tets)
+        clock = time.perf_counter()
+        if out is not None:
+            mesh.write_files(out.path, at, args.gmsh, args.gmsh_binary, args.tets, progress=progress)
     timings = {**mesh.report.timings, "outputs": time.perf_counter() - clock}
     report = mesh.report.to_dict()
     _print(args, report)
@@ -267,7 +267,8 @@ def _run(args, out: OutputFolder | None) -> int:
 
 # The bars of the pipeline's long stages: label and unit; drawn on large trees only (and only on a terminal)
 _BARS = {"assembly": ("assembling", "leaf"), "regions": ("Delaunay check (leaf mesh)", "element"),
-         "delaunay": ("Delaunay check", "element")}
+         "delaunay": ("Delaunay check", "element"), "conformity": ("conformity check", "face"),
+         "dual": ("finite-volume dual", "dual"), "outputs": ("writing outputs", "file")}
 _LARGE_TREE = 50_000
 # --partitions: a piece takes seconds on any tree worth cutting, so its bars are drawn whatever the size
 _PIECE_BARS = {"pieces": ("meshing pieces", "piece"), "again": ("pieces re-tessellated across seams", "piece")}

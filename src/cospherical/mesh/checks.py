@@ -125,7 +125,8 @@ def check_volume(mesh: Mesh) -> VolumeCheck:
     return VolumeCheck(share, int(flat), share == mesh.domain_share and flat == 0)
 
 
-def _faces(mesh: Mesh, examples: int) -> tuple[dict[int, list[NDArray[np.integer[Any]]]], ConformityCheck]:
+def _faces(mesh: Mesh, examples: int, progress: Callable[[int], None] | None = None
+           ) -> tuple[dict[int, list[NDArray[np.integer[Any]]]], ConformityCheck]:
     """The faces to pair across the mesh as rows of global vertex ids, by size; and what the faces inside the
     leaves gave, paired once per configuration (see :func:`check_conformity`)."""
     by_size: dict[int, list[NDArray[np.integer[Any]]]] = {}
@@ -136,6 +137,8 @@ def _faces(mesh: Mesh, examples: int) -> tuple[dict[int, list[NDArray[np.integer
         inner_pairs, inner_bad, outer = _leaf_faces(tessellation)
         pairs += inner_pairs * len(leaves)
         bad += len(inner_bad) * len(leaves)
+        if progress:
+            progress((2 * inner_pairs + len(inner_bad)) * len(leaves))
         for cycle in inner_bad[:max(0, examples - len(shown))]:
             shown.append((mesh.vertices[slots[0, list(cycle)]] / mesh.grid).tolist())
         for cycle in outer:
@@ -265,7 +268,8 @@ class ConformityCheck:
                 "boundary_faces": self.boundary_faces, "nonconforming_examples": self.nonconforming_examples}
 
 
-def check_conformity(mesh: Mesh, examples: int = 5, open_faces: bool = False) -> ConformityCheck:
+def check_conformity(mesh: Mesh, examples: int = 5, open_faces: bool = False,
+                     progress: Callable[[int], None] | None = None) -> ConformityCheck:
     """Every interior face shared by exactly two elements, same vertices, opposite orientation; the rest on the boundary.
 
     A face is its set of global vertex ids (the faces are convex polygons, hulls: the
@@ -281,6 +285,7 @@ def check_conformity(mesh: Mesh, examples: int = 5, open_faces: bool = False) ->
     once off the domain's boundary are not counted but returned
     (:attr:`ConformityCheck.open_faces`), for :func:`match_seams` to pair with the other
     pieces'.  Up to ``examples`` nonconforming faces are given as vertex coordinates.
+    ``progress(n)`` is told as faces are paired (``n`` more).
 
     Examples
     --------
@@ -292,15 +297,16 @@ def check_conformity(mesh: Mesh, examples: int = 5, open_faces: bool = False) ->
     (0, 12, 24)
     """
     layout = mesh.regions.layout if mesh.regions is not None else None
-    faces, inside = _faces(mesh, examples)
-    found = pair_faces(faces, mesh.vertices, mesh.grid, examples, open_faces, layout)
+    faces, inside = _faces(mesh, examples, progress)
+    found = pair_faces(faces, mesh.vertices, mesh.grid, examples, open_faces, layout, progress)
     return ConformityCheck(inside.nonconforming_faces + found.nonconforming_faces,
                            inside.interior_faces + found.interior_faces, found.boundary_faces,
                            (inside.nonconforming_examples + found.nonconforming_examples)[:examples], found.open_faces)
 
 
 def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArray[np.integer[Any]], grid: int,
-               examples: int = 5, open_faces: bool = False, layout: DeviceLayout | None = None) -> ConformityCheck:
+               examples: int = 5, open_faces: bool = False, layout: DeviceLayout | None = None,
+               progress: Callable[[int], None] | None = None) -> ConformityCheck:
     """:func:`check_conformity` on any elements' faces: ``faces``, by size, lists of arrays whose rows are
     faces as cycles of vertex ids counter-clockwise seen from outside their element; ``vertices``
     the grid points, ``grid`` intervals per side of the box, the domain (or its union of boxes,
@@ -339,6 +345,8 @@ def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArr
         bad_total += len(bad)
         for row in _turned(rows[order[bad[:max(0, examples - len(shown))]]]):
             shown.append((vertices[row] / grid).tolist())
+        if progress:
+            progress(len(rows))
     return ConformityCheck(int(bad_total), int(interior), int(boundary), shown, tuple(seams))
 
 

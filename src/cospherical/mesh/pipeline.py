@@ -15,7 +15,8 @@ one layer up: :func:`run_pipeline` takes the table's ``lookup`` already made, an
 the caller writes what it returns.  ``progress(stage, total, advance)`` is told as a
 long stage goes (``assembly`` through the leaves, ``regions`` through the leaf
 mesh's elements in the global Delaunay step, ``delaunay`` through the elements in
-the final check), ``total`` the stage's size, so a command line can draw a bar per
+the final check, ``conformity`` through the faces paired, ``dual`` once done), ``total``
+the stage's size (``None``: not known before), so a command line can draw a bar per
 stage and a library user can pass nothing.
 
 Examples
@@ -205,7 +206,7 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     clock = _Clock(timings)
     tree = source.tree if checks == "default" else replace(source.tree, vertex_balanced=False)
 
-    def told(stage: str, total: int) -> Callable[[int], None] | None:
+    def told(stage: str, total: int | None) -> Callable[[int], None] | None:
         return (lambda n: progress(stage, total, n)) if progress is not None else None
 
     clock.stage("assembly")
@@ -220,14 +221,19 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         mesh, leaf_mesh, checked = delaunay_mesh(mesh, mode, progress=told("regions", len(mesh)))
     checked_report = checked_mesh_report(mesh, source.described, patterns, criterion, uniform=uniform,
                                          delaunay=check_delaunay, stage=clock.stage,
-                                         progress=told("delaunay", len(mesh)), leaf_mesh=leaf_mesh, checked=checked)
+                                         progress=told("delaunay", len(mesh)), leaf_mesh=leaf_mesh, checked=checked,
+                                         conformity_progress=told("conformity", None))
     report = checked_report.report
     found = faces = None
     if dual:
         from .dual import dual_summary, mesh_dual
 
         clock.stage("dual")
+        if progress is not None:
+            progress("dual", 1, 0)
         found = mesh_dual(mesh)
+        if progress is not None:
+            progress("dual", 1, 1)
         report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"],
                                    tetrahedral=tetrahedral_counts))
     if source.device is not None:

@@ -73,12 +73,13 @@ class MeshFigures(NamedTuple):
 
 def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None] | None = None,
                  progress: Callable[[int], None] | None = None, checked: DelaunayCheck | None = None,
-                 open_faces: bool = False) -> MeshFigures:
+                 open_faces: bool = False, conformity_progress: Callable[[int], None] | None = None) -> MeshFigures:
     """Every exact check and count of ``mesh`` (or of one piece of a partitioned mesh), as figures that add up,
     and the global Delaunay check (``checked`` when the caller has it; ``None`` when ``delaunay`` is false).
 
     ``open_faces=True``: ``mesh`` is a piece, whose faces left open at its seams are returned,
-    not counted (see :func:`~cospherical.mesh.checks.check_conformity`).
+    not counted (see :func:`~cospherical.mesh.checks.check_conformity`).  ``progress`` is told as the
+    Delaunay check goes, ``conformity_progress`` as faces are paired.
     """
     def start(name: str) -> None:
         if stage:
@@ -90,7 +91,7 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
     volume = check_volume(mesh)
     figures.update(volume=volume.volume, flat_elements=volume.flat_elements)
     start("conformity")
-    conformity = check_conformity(mesh, open_faces=open_faces)
+    conformity = check_conformity(mesh, open_faces=open_faces, progress=conformity_progress)
     figures.update(conformity.figures())
     start("circumcenters")
     figures.update(check_circumcenters(mesh).figures())
@@ -263,9 +264,12 @@ def mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | None, crite
 def checked_mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | None, criterion: str = "optimal",
                         uniform: bool = True, delaunay: bool = True, stage: Callable[[str], None] | None = None,
                         progress: Callable[[int], None] | None = None, leaf_mesh: Mapping[str, int] | None = None,
-                        checked: DelaunayCheck | None = None) -> CheckedReport:
-    """:func:`mesh_report` (the same arguments), and the global Delaunay check it ran or was given."""
-    figures, found, _ = mesh_figures(mesh, delaunay, stage, progress, checked)
+                        checked: DelaunayCheck | None = None,
+                        conformity_progress: Callable[[int], None] | None = None) -> CheckedReport:
+    """:func:`mesh_report` (the same arguments), and the global Delaunay check it ran or was given;
+    ``conformity_progress`` is told as faces are paired."""
+    figures, found, _ = mesh_figures(mesh, delaunay, stage, progress, checked,
+                                     conformity_progress=conformity_progress)
     cells = (mesh.cells.clusters, mesh.cells.largest_cluster) if mesh.cells is not None else (0, 0)
     report = merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
                            leaf_mesh, cells, catalogue=mesh.catalogue, domain_share=mesh.domain_share)
