@@ -98,6 +98,29 @@ def test_the_trees_structure_finds_what_the_search_finds(mesh):
         assert np.array_equal(getattr(mine, name), getattr(theirs, name)), name
 
 
+def test_the_lattice_at_half_a_leaf_is_looked_up_on_a_tree_and_on_a_part_of_it():
+    """Spheres of a brick's leaf elements reach half a leaf beyond the leaf: there the look-up of the quarter-leaf
+    lattice must find the vertices of smaller neighbours that violate (random cube trees never need it, their
+    spheres stay within 3/8 of a leaf).  The whole tree, and the part a device would keep with one octant of the
+    box dropped, agree with the k-d tree's search in every figure, and their look-ups did find lattice vertices."""
+    from cospherical.mesh.checks import _local_candidates
+    from cospherical.mesh.octree import Octree
+
+    tree = build_octree(BRICK, 4, [parse_shape("point:0.1,0.1,0.1")])
+    octant = ((tree.positions >> (tree.levels.astype(np.int64) - 1)[:, None]) == (1, 0, 0)).all(axis=1)
+    for part in (tree, Octree(tree.box, tree.levels[~octant], tree.positions[~octant], tree.vertex_balanced)):
+        mesh = assemble(part)
+        looked_up, _ = _local_candidates(mesh, _spheres(mesh)[1])
+        assert len(looked_up) > 0
+        mine = check_delaunay(mesh)
+        theirs = check_delaunay(replace(mesh, tree=replace(mesh.tree, vertex_balanced=False), _groups=None))
+        assert mine.violations > 0
+        assert (mine.violations, mine.violating_pairs, mine.violating_leaves, mine.ties) == \
+            (theirs.violations, theirs.violating_pairs, theirs.violating_leaves, theirs.ties)
+        for name in ("violating_leaf_ids", "violating_elements", "not_cells"):
+            assert np.array_equal(getattr(mine, name), getattr(theirs, name)), name
+
+
 def test_only_vertex_balance_claims_the_structure():
     """The check's bound on where vertices lie holds for trees balanced across corners too, not across edges only."""
     shapes = [parse_shape("point:0.1,0.1,2")]

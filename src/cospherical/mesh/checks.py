@@ -20,8 +20,10 @@ and every tie is decided exactly.  Two ways find them:
   leaf); none has 0 < d < 1/2, and those with 1/2 <= d < 3/4 are points of the
   lattice of spacing s/4 aligned with B.  Proof: a vertex is a corner of some leaf
   T; if T is at least s/4 its corners are on that lattice, and at least s/2 puts
-  them at d = 0 or d >= 1/2.  Otherwise T (at most s/8) lies in a cell C of side
-  s/4 of the aligned grid, split, within d <= 1/2 of B.  If C's parent cell (side
+  them at d = 0 or d >= 1/2.  A T of side s/4 with a corner at 0 < d < 1/2 has a
+  parent cell (side s/2) within d < 1/2 of B, hence touching B, split into leaves
+  of at most s/4, one of which touches B: two levels apart.  Otherwise T (at most
+  s/8) lies in a cell C of side s/4 of the aligned grid, split, within d <= 1/2 of B.  If C's parent cell (side
   s/2) touches B, that parent is split into leaves of at most s/4, one of which
   touches B: two levels apart.  If not, C touches a cell of side s/2 that touches B,
   and that cell lies in one leaf of at least s/2 (or leaves under s/2 would touch
