@@ -4,6 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
+from cospherical.errors import FormatError
+from cospherical.files.flowyaml import decode_entry
+
 PATTERNS = Path(__file__).resolve().parents[2] / "patterns"
 
 
@@ -26,3 +31,12 @@ def test_a_table_not_in_our_line_form_is_told_apart_without_cutting_it_into_line
     ours = (PATTERNS / "bisection-tetrahedron-1x1x1.yaml").read_text()
     header, entries = split_section(ours, "configurations")  # our own form still takes the fast path
     assert entries and "configurations" not in header
+
+
+@pytest.mark.parametrize("colon", [":", " :", " : ", "\t:\n", "\r\n:  "])
+def test_a_repeated_key_is_refused_however_its_colon_is_spaced(colon):
+    # one key spaced otherwise and one the usual way: as many '": ' as keys kept
+    text = '{"b": {"c"' + colon + '2, "c": 3}}'
+    with pytest.raises(FormatError, match="e.json: repeated key 'c'"):
+        decode_entry(text, "e.json")
+    assert decode_entry(text.replace('"c": 3', '"d": 3'), "e.json") == {"b": {"c": 2, "d": 3}}

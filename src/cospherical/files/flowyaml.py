@@ -178,7 +178,9 @@ def _decode_counting(text: str) -> tuple[object, int]:
 
 
 # Decoding with a hook per key-value list (to catch a repeated key) costs 4x plain decoding:
-# decode counting the keys, and only when a key was dropped, again with that hook.
+# decode counting the keys, and only when a key was dropped, again with that hook.  Every key
+# ends in a quote, JSON whitespace and a colon; a match inside a string only counts one more.
+_KEY_END = re.compile(r'"[ \t\n\r]*:')
 _STRICT = json.JSONDecoder(object_pairs_hook=_refuse_repeats, parse_constant=_refuse_constant,
                            parse_float=_yaml_float)
 
@@ -198,9 +200,9 @@ def decode_entry(text: str, where: str):
     """
     try:
         value, kept = _decode_counting(text)
-        # A dropped repeat shows as fewer keys kept than the text writes (a '": ' inside a
-        # string counts as one more written: decoded again, with the hook, to be sure).
-        if kept != text.count('": '):
+        # A dropped repeat shows as fewer keys kept than the text writes (a key's end inside
+        # a string counts as one more written: decoded again, with the hook, to be sure).
+        if kept != len(_KEY_END.findall(text)):
             value = _STRICT.decode(text)
         return value
     except (ValueError, RecursionError) as error:
