@@ -115,13 +115,14 @@ class Dual:
 
         A boundary edge lies in one of the domain's boundary planes.
         """
-        negative = self.coefficient_exact < 0
+        negative = np.flatnonzero(self.coefficient_exact < 0)  # few: only their ends are looked at
         g = self.grid_vertices
-        a, b = g[self.edges[:, 0]], g[self.edges[:, 1]]
-        on_plane = np.zeros(len(self.edges), dtype=bool)
+        a, b = g[self.edges[negative, 0]], g[self.edges[negative, 1]]
+        on_plane = np.zeros(len(negative), dtype=bool)
         for side in (0, self.grid):
             on_plane |= np.any((a == side) & (b == side), axis=1)
-        return {"interior": int((negative & ~on_plane).sum()), "boundary": int((negative & on_plane).sum())}
+        boundary = int(on_plane.sum())
+        return {"interior": len(negative) - boundary, "boundary": boundary}
 
 
 @dataclass
