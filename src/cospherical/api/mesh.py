@@ -29,8 +29,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, NamedTuple, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..core.configuration import Box
+from ..core.geometry import Rational
 from ..errors import InputError, shown
 from ..files.outputs import OutputFolder
 from ..formats.gmsh import GMSH_VERSIONS
@@ -209,7 +211,7 @@ class OctreeMesh:
     :class:`~cospherical.mesh.assembly.Mesh` (leaf by leaf, for the lower-level functions).
     """
 
-    def __init__(self, result: PipelineResult, origin: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
+    def __init__(self, result: PipelineResult, origin: Sequence[Rational | float] = (0.0, 0.0, 0.0)) -> None:
         self._result = result
         self._dual = result.dual
         self.origin = tuple(float(x) for x in origin)
@@ -362,20 +364,21 @@ class OctreeMesh:
                        split.nodes.reshape(-1), 4 * np.arange(1, count + 1),
                        cell_data={"element": split.parent, "region": split.region})
 
-    def _vtu_data(self, with_dual: bool) -> tuple[dict, dict]:
+    def _vtu_data(self, with_dual: bool) -> tuple[dict[str, NDArray[Any]], dict[str, NDArray[Any]]]:
         """The point and cell data ``mesh.vtu`` adds with the dual: control volumes, boundary areas, circumcenters, delaunay_ok."""
         if not with_dual:
             return {}, {}
         dual = self.dual
-        point_data = {"control_volume": dual.control_volume, "boundary_area": dual.boundary_area}
-        cell_data = {"circumcenter": dual.element_circumcenter}
+        point_data: dict[str, NDArray[Any]] = {"control_volume": dual.control_volume,
+                                               "boundary_area": dual.boundary_area}
+        cell_data: dict[str, NDArray[Any]] = {"circumcenter": dual.element_circumcenter}
         if self.violating is not None:
             ok = np.ones(len(self.assembled), dtype=np.int8)
             ok[self.violating] = 0
             cell_data["delaunay_ok"] = ok
         return point_data, cell_data
 
-    def to_pyvista(self):
+    def to_pyvista(self) -> Any:  # a pyvista.UnstructuredGrid: the optional library stays out of the checker
         """The mesh as a ``pyvista.UnstructuredGrid``: ``mesh.vtu``'s grid in memory, polyhedra and data included.
 
         Standard VTK cells where an element is one, ``VTK_POLYHEDRON`` for the others,
@@ -391,7 +394,7 @@ class OctreeMesh:
         point_data, cell_data = self._vtu_data(self._dual is not None)
         return to_pyvista(self.assembled, point_data, cell_data, self._result.source.leaf_order, self.origin)
 
-    def to_meshio(self):
+    def to_meshio(self) -> Any:  # a meshio.Mesh (meshio has no type information)
         """The mesh split into tetrahedra as a ``meshio.Mesh`` (meshio holds standard cells, not mixed polyhedra).
 
         Conforming, no new vertex, the exact dual kept (the added edges couple 0):
@@ -403,8 +406,8 @@ class OctreeMesh:
 
         return to_meshio(self.assembled, self.vertices, self._result.source.leaf_order)
 
-    def _write_device(self, path: Callable[[str], Path], cut: float | None, point_data: dict,
-                      cell_data: dict) -> None:
+    def _write_device(self, path: Callable[[str], Path], cut: float | None, point_data: dict[str, NDArray[Any]],
+                      cell_data: dict[str, NDArray[Any]]) -> None:
         """A device's files: ``mesh.vtu`` with cell data ``region`` (names and materials in field data),
         ``contacts.vtu`` (its contact and interface faces, when it has any), ``mesh.png`` coloured by region, ``report.json``."""
         from ..formats.mesh import write_faces_vtu, write_report, write_vtu
@@ -412,16 +415,18 @@ class OctreeMesh:
         from ..outputs.mesh_picture import cut_png
 
         mesh, report, layout = self.assembled, self.report, self._result.source.device
-        regions = mesh.regions
+        regions, faces = mesh.regions, self._result.faces
+        if layout is None or regions is None or faces is None:
+            raise ValueError("_write_device: not a device's mesh (no layout, regions or faces)")
         device = layout.device
         fields = {"region_names": text_array("\n".join(regions.names)),
                   "region_materials": text_array("\n".join(regions.materials)),
                   "origin": text_array(" ".join(str(x) for x in device.origin))}
         write_vtu(mesh, path("mesh.vtu"), point_data=point_data,
-                  cell_data={"region": mesh.element_region.astype(np.int32), **cell_data}, field_data=fields,
+                  cell_data={"region": regions.leaf_region[mesh.element_leaf].astype(np.int32), **cell_data}, field_data=fields,
                   origin=device.origin)
         if device.has_faces:
-            write_faces_vtu(mesh, self._result.faces, path("contacts.vtu"), origin=device.origin)
+            write_faces_vtu(mesh, faces, path("contacts.vtu"), origin=device.origin)
         axis = device_cut_axis(device)
         at = 0.5 if cut is None else cut
         low, high = device.bounds[axis]
@@ -526,7 +531,10 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
 
             device = read_device(device)
         source = tree_from_device(device, max_leaves)
-        origin = source.device.device.origin  # the checked device's (exact coordinates)
+        layout = source.device
+        if layout is None:
+            raise ValueError("tree_from_device gave no device layout")
+        origin: Sequence[Rational | float] = layout.device.origin  # the checked device's (exact coordinates)
     else:
         source = tree_source(box, levels, refine, leaves=leaves, tree=tree, balance=balance or "vertex",
                              max_leaves=max_leaves)
@@ -584,7 +592,7 @@ def _check_keywords(**given: Any) -> None:
         "criterion": (lambda v: isinstance(v, str) and v in CRITERIA, f"one of {', '.join(CRITERIA)}"),
         "delaunay": (lambda v: isinstance(v, str), "global or leaf"),
         "device": (lambda v: isinstance(v, Device) or path_like(v), "a device file's path, or a Device"),
-        "max_leaves": (lambda v: isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= 1,
+        "max_leaves": (lambda v: isinstance(v, (int, np.integer)) and not isinstance(v, bool) and bool(v >= 1),
                        "a positive integer"),
         "progress": (callable, "a callable progress(stage, total, advance)"),
         "checks": (lambda v: v in ("default", "all"), "default or all"),

@@ -241,6 +241,8 @@ def _run(args, out: OutputFolder | None) -> int:
         given = {"levels": _levels(args.levels), "refine": shapes, "balance": args.balance or "vertex"}
     box = Box.parse(args.domain) if args.device is None else None
     if args.partitions is not None:
+        if box is None:  # refused with its reason before (_pieces): a device is meshed in one process
+            raise InputError("--partitions: not with --device")
         return _in_pieces(args, tree_source(box, **given, max_leaves=max_leaves), out)
     with _bars() as progress:
         mesh = build_mesh(box, **given, patterns=args.patterns, criterion=args.criterion, delaunay=args.delaunay,
@@ -368,7 +370,7 @@ def _in_pieces(args, source: TreeSource, out: OutputFolder | None) -> int:
                                 write=write if out is not None else None,
                                 path=paths.__getitem__ if paths is not None else None, jobs=args.jobs,
                                 scheduler=args.scheduler, dask_workers=args.dask_workers, progress=progress)
-    if out is not None:
+    if out is not None and paths is not None:
         write_pvtu(out.path("mesh.pvtu"), [Path(p) for p in paths])
         write_report(report, out.path("report.json"))
     _print(args, report)

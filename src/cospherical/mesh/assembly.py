@@ -187,13 +187,14 @@ class ElementBlock(NamedTuple):
 
     ``rows``: the elements' indices in the mesh; ``nodes``: their global vertex ids (elements x
     nodes, in the type's node order); ``faces``: cycles of column indices into ``nodes``,
-    counter-clockwise seen from outside; ``type_id``: the element type.
+    counter-clockwise seen from outside; ``type_id``: the element type (``None`` for elements known
+    only by their vertices: :func:`~cospherical.mesh.tetrahedra.element_blocks`).
     """
 
     rows: NDArray[np.int64]
     nodes: NDArray[np.integer[Any]]
     faces: tuple[tuple[int, ...], ...]
-    type_id: str
+    type_id: str | None
 
 
 @dataclass

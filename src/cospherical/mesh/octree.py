@@ -363,7 +363,7 @@ def check_leaf_count(count: int, what: str, max_leaves: int | None = None) -> No
                          f"(half this machine's memory at {BYTES_PER_LEAF} bytes a leaf; --max-leaves N sets it)")
 
 
-def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balance = "vertex",
+def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = "vertex",
                  max_leaves: int | None = None,
                  must_split: Callable[[int, np.ndarray], np.ndarray] | None = None, resolve: int = 0,
                  name: str | None = None) -> Octree:
@@ -394,7 +394,8 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balanc
     if balance == "face":
         raise InputError("--balance face: balance across faces alone is not 1-irregular "
                          "(an edge can get two Steiner points); use edge or vertex")
-    if balance not in BALANCES:
+    known = next((kind for kind in BALANCES if kind == balance), None)
+    if known is None:
         raise InputError(f"--balance {shown(balance)}: choose vertex or edge")
     if isinstance(levels, bool) or not isinstance(levels, int) or not 0 <= levels <= MAX_LEVEL:
         raise InputError(f"--levels {shown(levels)}: must be an integer from 0 to {MAX_LEVEL}")
@@ -418,7 +419,7 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: Balanc
         # every cell of the next level is or holds a leaf: the estimate's guard, before the children exist
         check_leaf_count(8 * len(split[-1]), f"{name}: level {level + 1} has at least", max_leaves)
         existing = _children(level, split[-1])
-    offsets = _offsets(balance)
+    offsets = _offsets(known)
     for level in range(deepest - 1, 0, -1):
         # every neighbour of a split cell must exist: its parent must be split
         need = _neighbours(level, _cells_of(level, split[level]), offsets)

@@ -32,9 +32,10 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..core.configuration import Box
 from ..errors import InputError
@@ -70,11 +71,11 @@ class TreeSource:
     """
 
     tree: Octree
-    described: dict
-    leaf_order: np.ndarray | None = None
+    described: dict[str, Any]
+    leaf_order: NDArray[np.int64] | None = None
     shapes: tuple[Shape, ...] = ()
     device: DeviceLayout | None = None
-    leaf_region: np.ndarray | None = None
+    leaf_region: NDArray[np.integer[Any]] | None = None
 
 
 def tree_from_refine(box: Box, levels: int, refine: Sequence[str | Shape], balance: str = "vertex",
@@ -213,6 +214,8 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     if source.device is not None:
         from .regions import device_mesh
 
+        if source.leaf_region is None:
+            raise ValueError("run_pipeline: a device's tree source without its leaves' regions (tree_from_device)")
         mesh, leaf_mesh, checked = device_mesh(source.device, tree, source.leaf_region, lookup, criterion, mode,
                                                progress=progress)
     else:

@@ -47,7 +47,7 @@ def outside_catalogue(mesh: Mesh) -> list[dict[str, Any]]:
     if all(type_id in known for _, type_id in mesh.block_types()):  # the common case: no vertex ids gathered
         return []
     for rows, nodes, _, type_id in mesh.blocks():
-        if type_id in known or not len(rows):
+        if type_id is None or type_id in known or not len(rows):  # a mesh's blocks all have types
             continue
         entry = found.setdefault(type_id, {"id": type_id, "name": mesh.types.get(type_id, {}).get("name", type_id),
                                            "count": 0, "example": None})

@@ -10,6 +10,7 @@ system), and the share of elements the paper's seven final elements cover.
 from __future__ import annotations
 
 from collections import Counter
+from typing import Any
 
 import numpy as np
 
@@ -17,13 +18,14 @@ from ..catalogue import Catalogue
 from ..core.configuration import Box, Configuration
 from ..studies.engine import bisection_codes, run_study
 from .assembly import PAPER_FINAL, Mesh, type_info
+from .octree import Octree
 
 __all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "statistics", "uniform_study"]
 
 _BISECTION_CONFIGURATIONS = 4096
 
 
-def uniform_study(box: Box, catalogue: Catalogue) -> dict:
+def uniform_study(box: Box, catalogue: Catalogue) -> dict[str, Any]:
     """Element counts per type of the uniform-weight bisection study of ``box`` (octree policy, optimal),
     the types named by ``catalogue``."""
     study = run_study("bisection", box, bisection_codes(), "octree", criteria=("optimal",))
@@ -44,11 +46,14 @@ def in_bisection_family(configuration: Configuration) -> bool:
     >>> in_bisection_family(Configuration.from_code("800000000000+f"))
     True
     """
-    digits = configuration.point_set_code.split("+")[0]
+    code = configuration.point_set_code
+    if code is None:  # a configuration without a point-set code is not one of the family's
+        return False
+    digits = code.split("+")[0]
     return Configuration.from_code(digits, configuration.box).point_set_code == configuration.point_set_code
 
 
-def mesh_statistics(mesh: Mesh, uniform: dict | None = None) -> dict:
+def mesh_statistics(mesh: Mesh, uniform: dict[str, Any] | None = None) -> dict[str, Any]:
     """Per element type and per configuration, how often it occurs in the mesh, beside the uniform study.
 
     Returns ``type_frequencies`` (by decreasing count), ``configuration_frequencies``
@@ -59,16 +64,16 @@ def mesh_statistics(mesh: Mesh, uniform: dict | None = None) -> dict:
     return statistics(type_counts, configurations, len(mesh.tree), mesh.types, mesh.catalogue, uniform)
 
 
-def occurrences(mesh: Mesh) -> tuple[Counter, dict[str, dict]]:
+def occurrences(mesh: Mesh) -> tuple[Counter[str], dict[str, dict[str, Any]]]:
     """Elements per type id, and per configuration code its leaves (replaced ones too) and what it is.
 
     Both add up over the pieces of a partitioned mesh (leaves summed per code).
     """
-    type_counts: Counter = Counter()
+    type_counts: Counter[str] = Counter()
     for rows, type_id in mesh.block_types():
         if len(rows):
             type_counts[type_id] += len(rows)
-    configurations = {}
+    configurations: dict[str, dict[str, Any]] = {}
     for _, tessellation, leaves in mesh.groups(all_leaves=True):
         configurations[tessellation.code] = {
             "code": tessellation.code,
@@ -81,11 +86,12 @@ def occurrences(mesh: Mesh) -> tuple[Counter, dict[str, dict]]:
     return type_counts, configurations
 
 
-def statistics(type_counts: Counter, configurations: dict[str, dict], total_leaves: int, types: dict,
-               catalogue: Catalogue, uniform: dict | None = None) -> dict:
+def statistics(type_counts: Counter[str], configurations: dict[str, dict[str, Any]], total_leaves: int,
+               types: dict[str, dict[str, Any]], catalogue: Catalogue,
+               uniform: dict[str, Any] | None = None) -> dict[str, Any]:
     """:func:`mesh_statistics` from the :func:`occurrences` of a mesh (or of all its pieces, added up);
     ``catalogue`` names the types met nowhere else."""
-    configurations = sorted(({
+    frequencies = sorted(({
         "code": c["code"], "leaves": c["leaves"], "share": _share(c["leaves"], total_leaves),
         "uniform_share": _share(1, _BISECTION_CONFIGURATIONS) if c["in_bisection_family"] else None,
         "elements_per_leaf": c["elements_per_leaf"], "fvm_adequate": c["fvm_adequate"],
@@ -106,11 +112,11 @@ def statistics(type_counts: Counter, configurations: dict[str, dict], total_leav
             "uniform_share": _share(uniform_counts.get(type_id, 0), uniform_total) if uniform else None,
         })
     final = sum(r["count"] for r in rows if r["paper_class"] in PAPER_FINAL)
-    result = {
+    result: dict[str, Any] = {
         "paper_final_share": _share(final, total),
-        "leaves_in_bisection_family": int(sum(c["leaves"] for c in configurations if c["uniform_share"] is not None)),
+        "leaves_in_bisection_family": int(sum(c["leaves"] for c in frequencies if c["uniform_share"] is not None)),
         "type_frequencies": rows,
-        "configuration_frequencies": configurations,
+        "configuration_frequencies": frequencies,
     }
     if uniform:
         uniform_final = sum(r["uniform_count"] for r in rows if r["paper_class"] in PAPER_FINAL)
@@ -119,7 +125,7 @@ def statistics(type_counts: Counter, configurations: dict[str, dict], total_leav
     return result
 
 
-def level_counts(tree) -> dict[str, int]:
+def level_counts(tree: Octree) -> dict[str, int]:
     """Leaves per level of an octree (levels that occur)."""
     counts = np.bincount(tree.levels.astype(np.int64))
     return {str(level): int(n) for level, n in enumerate(counts.tolist()) if n}

@@ -48,16 +48,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from fractions import Fraction
+from typing import TYPE_CHECKING, Any, Iterable, Protocol, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
+
+from ..core.geometry import Rational
+from .assembly import ElementBlock, Mesh
 
 if TYPE_CHECKING:
-    from .assembly import Mesh
     from .dual import Dual
     from .regions import RegionFaces
 
-__all__ = ["SIDES", "BoundaryTriangles", "SimplexMesh", "Tetrahedra", "boundary_triangles", "fan_triangles",
+__all__ = ["SIDES", "BoundaryTriangles", "ElementSource", "SimplexMesh", "Tetrahedra", "boundary_triangles", "fan_triangles",
            "dual_simplex_mesh", "element_blocks", "simplex_mesh", "split_tetrahedra"]
 
 
@@ -117,12 +121,27 @@ def fan_triangles(face: np.ndarray) -> np.ndarray:
     return np.stack([first, second, third], axis=2)
 
 
-def _regions(mesh) -> np.ndarray:
+class ElementSource(Protocol):
+    """What :func:`split_tetrahedra` reads of a mesh: its elements (:meth:`blocks`), their count and regions.
+
+    :class:`~cospherical.mesh.assembly.Mesh` is one; a bare element list (a ``dual.npz``'s) is another.
+    ``element_region``: per element its region's index, ``None`` for a mesh of one region.
+    """
+
+    def __len__(self) -> int: ...
+
+    @property
+    def element_region(self) -> NDArray[np.integer[Any]] | None: ...
+
+    def blocks(self) -> Iterable[ElementBlock]: ...
+
+
+def _regions(mesh: ElementSource) -> NDArray[np.int32]:
     region = mesh.element_region
     return np.zeros(len(mesh), dtype=np.int32) if region is None else np.asarray(region, dtype=np.int32)
 
 
-def split_tetrahedra(mesh, blocks=None) -> Tetrahedra:
+def split_tetrahedra(mesh: ElementSource, blocks: Iterable[ElementBlock] | None = None) -> Tetrahedra:
     """Every element of ``mesh`` split into tetrahedra (see the module's docstring for the rule).
 
     ``blocks``: the elements as :meth:`~cospherical.mesh.assembly.Mesh.blocks` gives them
@@ -150,26 +169,25 @@ def split_tetrahedra(mesh, blocks=None) -> Tetrahedra:
     return Tetrahedra(tets[order], parent, _regions(mesh)[parent])
 
 
-def element_blocks(grid_vertices: np.ndarray, squared, nodes: np.ndarray, sizes: np.ndarray) -> list:
+def element_blocks(grid_vertices: NDArray[np.integer[Any]], squared: Sequence[Rational],
+                   nodes: NDArray[np.integer[Any]], sizes: NDArray[np.integer[Any]]) -> list[ElementBlock]:
     """Blocks (as :meth:`~cospherical.mesh.assembly.Mesh.blocks` gives them) of an element list on grid vertices.
 
     For elements known only by their vertices (a ``dual.npz``): each distinct shape, up to
     translation and scaling by powers of two, gets its faces from its exact hull once.
     """
-    from fractions import Fraction
-
     from ..core.geometry import Frame
     from ..core.polyhedron import measure
     from ..errors import InputError
 
     verts = np.asarray(grid_vertices, dtype=np.int64)
-    by_shape: dict[tuple, list] = {}
+    by_shape: dict[tuple[tuple[int, ...], ...], list[int]] = {}
     for e in range(len(nodes)):
         ids = np.asarray(nodes[e, :int(sizes[e])], dtype=np.int64)
         rel = verts[ids] - verts[ids].min(axis=0)
         scale = math.gcd(*(int(x) for x in rel.reshape(-1)))
         scale = scale & -scale
-        by_shape.setdefault(tuple(map(tuple, (rel // scale).tolist())), []).append(e)
+        by_shape.setdefault(tuple(tuple(row) for row in (rel // scale).tolist()), []).append(e)
     blocks = []
     for key, rows in by_shape.items():
         points = {n: tuple(Fraction(int(x)) for x in p) for n, p in enumerate(key)}
@@ -177,16 +195,24 @@ def element_blocks(grid_vertices: np.ndarray, squared, nodes: np.ndarray, sizes:
         if not element.cycles:
             raise InputError(f"element {rows[0]} is flat: it has no tetrahedra")
         ids = np.array(rows, dtype=np.int64)
-        blocks.append((ids, np.asarray(nodes)[ids, :len(key)].astype(np.int64), element.cycles, None))
+        blocks.append(ElementBlock(ids, np.asarray(nodes)[ids, :len(key)].astype(np.int64), element.cycles, None))
     return blocks
 
 
-def boundary_triangles(mesh, blocks=None) -> BoundaryTriangles:
-    """The triangles of the element faces that lie in the domain's sides (the outer surface, split conformingly)."""
+def boundary_triangles(mesh: Mesh | Dual, blocks: Iterable[ElementBlock] | None = None) -> BoundaryTriangles:
+    """The triangles of the element faces that lie in the domain's sides (the outer surface, split conformingly).
+
+    ``blocks``: the elements (default: the mesh's own); a :class:`~cospherical.mesh.dual.Dual`'s
+    must be given (:func:`element_blocks`).
+    """
     grid = int(mesh.grid)
-    vertices = np.asarray(mesh.grid_vertices if hasattr(mesh, "grid_vertices") else mesh.vertices, dtype=np.int64)
+    vertices = np.asarray(mesh.vertices if isinstance(mesh, Mesh) else mesh.grid_vertices, dtype=np.int64)
+    if blocks is None:
+        if not isinstance(mesh, Mesh):
+            raise TypeError("boundary_triangles: a Dual's elements are given as blocks (element_blocks)")
+        blocks = mesh.blocks()
     parts, parents, sides = [], [], []
-    for rows, nodes, faces, _ in (mesh.blocks() if blocks is None else blocks):
+    for rows, nodes, faces, _ in blocks:
         nodes = np.asarray(nodes, dtype=np.int64)
         for cycle in faces:
             face = nodes[:, list(cycle)]
@@ -290,7 +316,7 @@ def dual_simplex_mesh(dual: Dual) -> SimplexMesh:
     blocks = element_blocks(dual.grid_vertices, dual.box.squared, dual.element_nodes, dual.element_sizes)
     parts = dual.regions
     count = len(dual.element_sizes)
-    tets = split_tetrahedra(_ElementList(count, None if parts is None else parts.element_region), blocks)
+    tets = split_tetrahedra(_ElementList(count, None if parts is None else parts.element_region, blocks))
     points = np.asarray(dual.vertices, dtype=np.float64)
     if parts is None:
         outer = boundary_triangles(dual, blocks)
@@ -324,9 +350,14 @@ def _interfaces(tets: Tetrahedra) -> tuple[tuple[np.ndarray, np.ndarray], list[t
 class _ElementList:
     """``count`` elements with their regions (or one region), for :func:`split_tetrahedra` given its blocks."""
 
-    def __init__(self, count: int, element_region: np.ndarray | None = None):
+    def __init__(self, count: int, element_region: NDArray[np.integer[Any]] | None,
+                 blocks: Sequence[ElementBlock]) -> None:
         self.count = count
         self.element_region = element_region
+        self._blocks = blocks
 
     def __len__(self) -> int:
         return self.count
+
+    def blocks(self) -> Sequence[ElementBlock]:
+        return self._blocks

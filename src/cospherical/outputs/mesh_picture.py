@@ -55,6 +55,8 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
     near = (low < z0) & (low + mesh.leaf_size() > z0)
     vertices = mesh.vertices[:, list(across)]  # the picture's two axes, then the cut's
     for element_rows, nodes, faces, type_id in mesh.blocks(near):
+        if type_id is None:  # a mesh's blocks all have types: only an element list's have none
+            raise ValueError("mesh_picture: an element without a type")
         z = vertices[nodes, 2]  # (elements, nodes)
         crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
         if not len(crossing):
