@@ -149,8 +149,12 @@ def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DType
     its member's size as a power of two (coefficients scale with the size).  While key
     and payload fit one int64 together they are sorted as one array (a plain sort,
     several times faster than an argsort, which needs no second array to follow it);
-    else the keys are argsorted and the payloads follow.  Equal keys are then runs,
-    summed in integers: exact in any order.
+    else the keys are argsorted and the payloads follow.  Both sorts are numpy's stable
+    one (a merge sort that takes sorted runs as they come): the instances come group by
+    group, member by member, and members near in the tree have near vertex ids, so the
+    keys arrive in long runs; on the README's level-8 tree this halves the sort's time
+    against the default quicksort.  Equal keys are then runs, summed in integers: exact
+    in any order.
     """
     table: list[int] = []
     offsets: list[int] = []
@@ -188,9 +192,9 @@ def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DType
             at = end
     key_shift = payload_bits if packed else 0
     if packed:
-        keys.sort()
+        keys.sort(kind="stable")
     else:
-        order = np.argsort(keys)
+        order = np.argsort(keys, kind="stable")
         keys, payloads = keys[order], payloads[order]
         del order
     starts = np.ones(total, dtype=bool)
