@@ -490,13 +490,21 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     n = np.int64(grid + 1)
     points = np.stack([keys_all // (n * n), (keys_all // n) % n, keys_all % n], axis=1)
     slots = np.empty((len(tree), 27), dtype=np.int32)
+    # A leaf of the finest level has no smaller neighbour, so no point on its edges' and faces' midpoints
+    # (any vertex there is a corner of a smaller leaf): only its corners and its centre are looked up.
+    finest = tree.levels == tree.depth
     # bounded temporaries (14 MB): glibc then reuses their memory instead of mapping fresh pages each time
     chunk = 1 << 16
     for start in range(0, len(tree), chunk):
         part = slice(start, start + chunk)
         keys = _node_keys(origin, half, grid, part, slice(None))
-        where = np.minimum(np.searchsorted(keys_all, keys), len(keys_all) - 1)
-        slots[part] = np.where(keys_all[where] == keys, where, -1)
+        wanted = np.ones(keys.shape, dtype=bool)
+        wanted[finest[part], 8:26] = False
+        found = np.full(keys.shape, -1, dtype=np.int32)
+        asked = keys[wanted]
+        where = np.minimum(np.searchsorted(keys_all, asked), len(keys_all) - 1)
+        found[wanted] = np.where(keys_all[where] == asked, where, -1)
+        slots[part] = found
         if progress:
             progress(min(chunk, len(tree) - start) // 2)
     if (slots[:, 26] >= 0).any():
