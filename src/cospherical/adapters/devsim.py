@@ -46,19 +46,41 @@ import io
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
-from typing import Sequence
+from typing import Protocol, Sequence, Union
 
 import numpy as np
 
 from ..errors import InputError, shown
+from ..mesh.assembly import Mesh
 from ..mesh.dual import Dual
 from ..mesh.tetrahedra import SimplexMesh
 
-__all__ = ["EXACT_EDGE_COUPLE", "EXACT_NODE_VOLUME", "DevsimDevice", "create_device", "import_devsim"]
+__all__ = ["EXACT_EDGE_COUPLE", "EXACT_NODE_VOLUME", "MeshInput", "DevsimDevice", "MeshWithDual", "create_device",
+           "import_devsim"]
 
 EXACT_NODE_VOLUME = "ExactNodeVolume"
 EXACT_EDGE_COUPLE = "ExactEdgeCouple"
 CONTACT_MATERIAL = "metal"
+
+
+class MeshWithDual(Protocol):
+    """What :func:`create_device` reads of a mesh object: its assembled mesh and its exact dual.
+
+    The API's :class:`~cospherical.api.mesh.OctreeMesh` is one (the API sits above the
+    adapters, so it is named here by what it has, not imported); its dual is computed once
+    and carries a device's parts per region.
+    """
+
+    @property
+    def assembled(self) -> Mesh: ...
+
+    @property
+    def dual(self) -> Dual: ...
+
+
+# What create_device builds from: a mesh object with its dual, an assembled mesh (its dual computed
+# here), or a mesh folder holding dual.npz (``cospherical mesh --dual --out DIR``).
+MeshInput = Union[MeshWithDual, Mesh, str, Path]
 
 
 def import_devsim() -> ModuleType:
@@ -109,7 +131,7 @@ class _Source:
     materials: tuple = ()
 
 
-def _source(mesh) -> _Source:
+def _source(mesh: MeshInput) -> _Source:
     """The simplices and exact geometry of an API mesh, an assembled mesh, or a mesh folder holding dual.npz."""
     from ..mesh.dual import mesh_dual
     from ..mesh.tetrahedra import dual_simplex_mesh, simplex_mesh
@@ -135,12 +157,14 @@ def _source(mesh) -> _Source:
         return _Source(simplices, dual, _region_geometry(dual, parts),
                        {name: parts.names[r] for name, r in zip(parts.contact_names, parts.contact_regions)},
                        tuple(parts.materials))
-    assembled = getattr(mesh, "assembled", mesh)  # the API's mesh holds the assembled one
-    if not hasattr(assembled, "blocks"):
+    if isinstance(mesh, Mesh):
+        assembled, dual = mesh, mesh_dual(mesh)
+    elif isinstance(getattr(mesh, "assembled", None), Mesh):  # the API's mesh holds the assembled one
+        # and computes its dual once (with its parts per region)
+        assembled, dual = mesh.assembled, mesh.dual
+    else:  # a caller without a type checker can hand in anything
         raise InputError(f"create_device: {type(mesh).__name__} is not a mesh (give the API's mesh, "
                          "an assembled mesh or a mesh folder)")
-    given = getattr(mesh, "dual", None)  # the API's mesh computes its dual once (with its parts per region)
-    dual = given if isinstance(given, Dual) else mesh_dual(assembled)
     regions = getattr(assembled, "regions", None)
     if regions is None or regions.layout is None:
         simplices = simplex_mesh(assembled)
@@ -171,7 +195,7 @@ def _region_geometry(dual: Dual, parts) -> dict:
     return geometry
 
 
-def create_device(mesh, device: str = "device", contacts: Sequence[str] | None = None, material: str = "Silicon",
+def create_device(mesh: MeshInput, device: str = "device", contacts: Sequence[str] | None = None, material: str = "Silicon",
                   scale: float = 1.0) -> DevsimDevice:
     """Build DEVSIM's mesh and device from ``mesh``, the exact dual installed as its geometry.
 

@@ -44,6 +44,7 @@ from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode
 from ..mesh.report import MeshReport
 
 if TYPE_CHECKING:  # the dual's modules are imported when a dual is made
+    from ..adapters.devsim import MeshWithDual
     from ..mesh.dual import Dual
 
 __all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "device_cut_axis", "from_treemesh",
@@ -640,3 +641,9 @@ def from_treemesh(tree_mesh: Any, **options: Any) -> OctreeMesh:
         # discretize balances across faces only unless asked: the one fix a TreeMesh user needs
         raise InputError(f"{error}: build the TreeMesh with diagonal_balance=True") from None
     return OctreeMesh(mesh._result, leaves.origin)
+
+
+if TYPE_CHECKING:
+    def _devsim_takes(mesh: OctreeMesh) -> MeshWithDual:
+        """The type checker proves that create_device takes the API's mesh (its Protocol, below the API)."""
+        return mesh
