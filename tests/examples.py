@@ -41,6 +41,10 @@ SMALLER = [
     (re.compile(r"^(python benchmarks/bench_startup.py)"), r"\1 --runs 1 --every 64 --tables 'bisection-tetra*'"),
     (re.compile(r"^(python benchmarks/bench_bisection.py)"), r"\1 --every 64"),
     (re.compile(r"^(cospherical sweep --ratios \S+):\d+ (\S+):\d+"), r"\1:2 \2:2"),  # 2 x 2 grid values
+    # at these sizes a pool costs more than the work: one process (studies/intersection/test_run.py and
+    # cli/test_sweep.py run the pools, test_hostile.py and test_outputs.py interrupt them)
+    (re.compile(r"^(cospherical (?:sweep|study intersection) (?!.*--(?:jobs|dask-workers|scheduler)\b).*)$"),
+     r"\1 --jobs 1"),
     # a short stretch of the ray (6 steps of 1,r,r: 2 CPU-s in-process, against 8 for 1:4); studies/test_ray.py
     # checks the thresholds of 1 <= r <= 9/5 and 3/2 <= r <= 2 against direct studies on both sides of each
     (re.compile(r"^(cospherical sweep --ray \S+) --range \S+"), r"\1 --range 1:5/4"),
@@ -126,7 +130,8 @@ def smaller(line: str) -> str:
 
 # Commands that start worker processes (a pool by default, Dask, pieces): run in a process of their own,
 # never forked from a test worker's process
-_WORKERS = re.compile(r"^cospherical (study intersection|sweep|reproduce)\b|--(jobs|dask-workers|scheduler|partitions)\b")
+_WORKERS = re.compile(r"^cospherical (?:(?:study intersection|sweep)\b(?!.*--jobs 1\b)|reproduce\b)"
+                      r"|--(?:jobs (?!1\b)|dask-workers|scheduler|partitions)")
 
 
 def in_process_argv(command: str, cwd: Path) -> list[str] | None:
