@@ -141,3 +141,21 @@ def test_both_balances_give_whole_meshes(balance):
     assert found["volume_ok"] and found["nonconforming_faces"] == 0 and found["delaunay_violations"] == 0
     again = leaves_octree(CUBE, tree.levels, tree.positions)  # the leaf-list check accepts it
     assert np.array_equal(again.positions, tree.positions)
+
+
+def test_a_part_of_a_tree_sees_the_whole_trees_points_on_its_leaves():
+    """A part of a tree (a partition piece, a device's region) assembled with the whole tree's vertices gives
+    its leaves the whole tree's slots: a leaf at the part's finest level can still have the corners of smaller
+    leaves of the whole tree on its edges and faces (the part's depth is not the grid's)."""
+    from cospherical.mesh.assembly import vertex_keys
+    from cospherical.mesh.octree import Octree
+
+    tree = build_octree(Box.parse([1, 1, 1]), 4, [parse_shape("point:0.1,0.1,0.1")])
+    whole = assemble(tree)
+    part = np.flatnonzero(tree.levels <= 2)
+    sub = assemble(Octree(tree.box, tree.levels[part], tree.positions[part], tree.vertex_balanced),
+                   vertices=vertex_keys(tree))
+    assert tree.depth == 4 and sub.tree.depth == 2
+    hanging = (whole.slots[part, 8:26] >= 0).any(axis=1) & (tree.levels[part] == 2)
+    assert hanging.any()  # leaves at the part's finest level with points of smaller leaves on them
+    assert np.array_equal(sub.slots, whole.slots[part])

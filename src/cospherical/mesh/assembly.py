@@ -492,7 +492,9 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     slots = np.empty((len(tree), 27), dtype=np.int32)
     # A leaf of the finest level has no smaller neighbour, so no point on its edges' and faces' midpoints
     # (any vertex there is a corner of a smaller leaf): only its corners and its centre are looked up.
-    finest = tree.levels == tree.depth
+    # The finest level is the grid's (two grid steps a leaf), not this tree's: a part of a tree (a
+    # partition piece, a device's region) may stop levels above the whole, beside smaller leaves.
+    finest = size == 2
     # bounded temporaries (14 MB): glibc then reuses their memory instead of mapping fresh pages each time
     chunk = 1 << 16
     for start in range(0, len(tree), chunk):
