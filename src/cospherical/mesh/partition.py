@@ -201,6 +201,10 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: LookupRecipe | None, crite
             results.update(told("again", len(again), completed(
                 mesh_piece, {k: task(k, **more) for k, more in again.items()}, jobs, scheduler, dask_workers,
                 common=(keys, lookup, catalogue))))
+            # As in one process, the spheres counted are those of the final check, the fresh cells': the leaf
+            # elements kept were proven by the leaf mesh's check, whose spheres the one process does not count
+            for k in set(range(pieces)) - set(again):
+                results[k]["figures"].update(delaunay_spheres_bounded=0, delaunay_spheres_searched=0)
     seams = [seam for k in range(pieces) for seam in results[k]["seams"]]
     n = np.int64(grid + 1)
 
