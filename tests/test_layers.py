@@ -44,9 +44,13 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     # One element's pieces know nothing of the mesh's sums built on them.
     pieces = tmp_path / "cospherical" / "mesh" / "dual" / "pieces.py"
     pieces.write_text(pieces.read_text() + "\nfrom .sums import mesh_dual  # wrong on purpose\n")
+    # The tree's arrays know nothing of the refinement that fills them.
+    tree = tmp_path / "cospherical" / "mesh" / "tree.py"
+    tree.write_text(tree.read_text() + "\nfrom .octree import build_octree  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
-    assert "Contracts: 0 kept, 6 broken." in result.stdout
+    assert "Contracts: 0 kept, 7 broken." in result.stdout
+    assert "cospherical.mesh.tree -> cospherical.mesh.octree" in result.stdout
     assert "cospherical.mesh.dual.pieces -> cospherical.mesh.dual.sums" in result.stdout
     assert "cospherical.studies.intersection.statistics is not allowed to import" in result.stdout
     assert "cospherical.formats.diff -> cospherical.studies.engine" in result.stdout

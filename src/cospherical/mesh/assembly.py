@@ -36,7 +36,7 @@ from ..core.tessellation import tessellate
 from ..errors import InputError
 from ..paper import paper_class
 from .device import Regions
-from .octree import Octree, distinct
+from .tree import Octree, distinct
 
 __all__ = ["CellShape", "Cells", "ElementBlock", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "NODE_OFFSETS", "PAPER_FINAL",
            "assemble", "distinct", "local_tessellation", "type_info", "vertex_keys"]

@@ -62,7 +62,7 @@ from ..core.polyhedron import measure
 from ..errors import InputError
 from .assembly import NODE_OFFSETS, LocalTessellation, Mesh
 from .device import DeviceLayout, domain_boundary
-from .octree import distinct
+from .tree import distinct
 
 # Vertices found near spheres and tested exactly, at most: each test is a few microseconds of
 # Python integers and its pair ~100 bytes. A 1.38 M-leaf sphere tree needs 2.5 M; a box of

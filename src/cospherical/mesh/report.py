@@ -22,7 +22,7 @@ from ..version import __version__
 from .assembly import Mesh
 from .checks import (DelaunayCheck, OpenFaces, check_circumcenters, check_conformity, check_delaunay, check_volume,
                      match_seams)
-from .octree import Octree
+from .tree import Octree
 from .statistics import level_counts, occurrences, statistics, uniform_study
 
 __all__ = ["CheckedReport", "MeshFigures", "MeshReport", "checked_mesh_report", "merged_report", "mesh_figures", "mesh_report",

@@ -18,7 +18,7 @@ from ..catalogue import Catalogue
 from ..core.configuration import Box, Configuration
 from ..studies.engine import bisection_codes, run_study
 from .assembly import PAPER_FINAL, Mesh, type_info
-from .octree import Octree
+from .tree import Octree
 
 __all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "statistics", "uniform_study"]
 
