@@ -47,9 +47,13 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     # The tree's arrays know nothing of the refinement that fills them.
     tree = tmp_path / "cospherical" / "mesh" / "tree.py"
     tree.write_text(tree.read_text() + "\nfrom .octree import build_octree  # wrong on purpose\n")
+    # A cluster's cells know nothing of the step that asks for them (they were split out of it).
+    merged_cells = tmp_path / "cospherical" / "mesh" / "merged_cells.py"
+    merged_cells.write_text(merged_cells.read_text() + "\nfrom .delaunay import retessellate  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
-    assert "Contracts: 0 kept, 7 broken." in result.stdout
+    assert "Contracts: 0 kept, 8 broken." in result.stdout
+    assert "cospherical.mesh.merged_cells -> cospherical.mesh.delaunay" in result.stdout
     assert "cospherical.mesh.tree -> cospherical.mesh.octree" in result.stdout
     assert "cospherical.mesh.dual.pieces -> cospherical.mesh.dual.sums" in result.stdout
     assert "cospherical.studies.intersection.statistics is not allowed to import" in result.stdout
