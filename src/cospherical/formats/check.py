@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from math import lcm
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from ..catalogue import Catalogue, CatalogueType, catalogue_from_text
 from ..core.base_element import base_element
@@ -83,7 +83,7 @@ class SharedChecks:
 
     def __init__(self) -> None:
         self.measured: dict[tuple[Any, ...], dict[tuple[Any, ...], _Measured | str]] = {}
-        self.positions: dict[tuple[Any, ...], dict[str, tuple[str, dict[int, int]]]] = {}
+        self.positions: dict[tuple[Any, ...], dict[str, tuple[tuple[tuple[int, int], ...], dict[int, int]]]] = {}
         self.points: dict[tuple[tuple[int, int], ...], int] = {}  # a point's integer pairs -> its id
         self.coordinates: list[tuple[Fraction, Fraction, Fraction]] = []  # id -> the point (unit coordinates)
         self.planes: dict[Shape, list[int]] = {}  # per shape, id -> bit mask of the face planes holding the point
@@ -134,7 +134,7 @@ class EntryCheck:
     def __init__(self, header: dict, catalogue: Catalogue | None, name: str, geometry: bool = True,
                  shared: SharedChecks | None = None):
         self._types = catalogue if catalogue is not None and len(catalogue) else None
-        self._known = frozenset(t.id for t in catalogue) if self._types is not None else None
+        self._known = frozenset(t.id for t in self._types) if self._types is not None else None
         self._name = name
         self._geometry = geometry and bool(self._types)
         try:
@@ -209,6 +209,8 @@ class EntryCheck:
         inside = True
         for c, criterion in enumerate(self._criteria):
             elements = entry_elements(entry, criterion)
+            if elements is None:  # the schema, checked first, gives every criterion its elements
+                raise FormatError(f"{where}/{criterion}: no elements")
             if any(elements is other for other in checked):  # a reference to an earlier criterion's elements
                 continue
             checked.append(elements)
@@ -243,7 +245,8 @@ class EntryCheck:
                 raise FormatError(f"{where}/{k}: unknown element type {element['type']!r}")
             if not geometry:
                 continue
-            found = self._place(element, tuple(nodes), points, shape)
+            # no None among the points: refused just above
+            found = self._place(element, tuple(nodes), cast("tuple[int, ...]", points), shape)
             if isinstance(found, str):
                 raise FormatError(f"{where}/{k}: {found}")
             if element["circumcenter"] != found.real_center:  # numbers (the schema): 1 == 1.0, as float() made them
@@ -357,7 +360,7 @@ def _measure_element(type_id: str, mirror: bool, points: tuple, plane_masks: lis
     frame = Frame.build(dict(enumerate(points)), squared)  # frame index = position in the element's node list
     element = measure(frame, range(len(points)), hull)
     cycles = tuple(sorted(element.cycles))
-    if element.sphere is None or {i for cycle in cycles for i in cycle} != set(range(len(points))):
+    if element.sphere is None or element.center is None or {i for cycle in cycles for i in cycle} != set(range(len(points))):
         return "its nodes are not the vertices of a convex element on one sphere"
     etype, _, mirrored = classify_faces(cycles, tuple(face_kind(frame, cycle) for cycle in cycles))
     if type_id != etype.id:

@@ -168,6 +168,8 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table",
 
     def lookup(configuration: Configuration):
         code = configuration.point_set_code
+        if code is None:  # a table holds configurations by their point-set codes
+            return None
         try:
             return elements(code)
         except KeyError:
@@ -213,6 +215,8 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
         if found is not None:
             return found
         code = configuration.point_set_code
+        if code is None:  # a table holds configurations by their point-set codes
+            return None
         (representative,), (index,) = orbit_representatives([code], symmetries)
         if representative == code:
             return None
@@ -224,7 +228,8 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
         elements = []
         for element in found:
             nodes = [back[int(n)] for n in element["nodes"]]
-            order = None if symmetry.proper else _MIRRORED_VTK.get(vtk.get(element["type"]))
+            kind = vtk.get(element["type"])
+            order = None if symmetry.proper or kind is None else _MIRRORED_VTK.get(kind)
             if order is not None and len(order) == len(nodes):
                 nodes = [nodes[i] for i in order]
             elements.append({**element, "nodes": nodes, "mapped_from": representative})
@@ -260,7 +265,8 @@ def vtu_arrays(mesh: Mesh) -> dict:
         blocks = [(rows, nodes, np.array([-1 - len(cycles)] + [x for f in cycles for x in (-1 - len(f), *f)],
                                          dtype=np.int64))
                   for rows, nodes, cycles, type_id in mesh.blocks()
-                  if kind_of_type[ids.index(type_id)] == VTK_CELL["polyhedron"] and len(rows)]
+                  if type_id is not None and kind_of_type[ids.index(type_id)] == VTK_CELL["polyhedron"]
+                  and len(rows)]
         for rows, _, template in blocks:
             stream[rows] = len(template)
         cells = order[polyhedral[order]]  # the polyhedra in cell order
@@ -432,7 +438,7 @@ def write_pvtu(path: str | Path, pieces: list[Path]) -> None:
     def arrays(section: str) -> list[str]:
         return [f'<PDataArray type="{kind}"' + (f" Name={name}" if section != "Points" else "")
                 + (f' NumberOfComponents="{components}"' if components else "") + "/>"
-                for kind, name, components in declared.get(section, [])]
+                for kind, name, components in (declared or {}).get(section, [])]
 
     xml = ['<?xml version="1.0"?>',
            '<VTKFile type="PUnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">',
@@ -469,7 +475,10 @@ def write_faces_vtu(mesh: Mesh, faces: RegionFaces, path: str | Path, origin: Se
     coordinates = mesh.vertices[ids] * (np.array(mesh.box.to_float()) / mesh.grid)
     if origin is not None:
         coordinates = coordinates + np.array([float(x) for x in origin])
-    device = mesh.regions.layout.device
+    layout = mesh.regions.layout if mesh.regions is not None else None
+    if layout is None:
+        raise ValueError("write_faces_vtu: the mesh of a device (regions with their layout) has the faces")
+    device = layout.device
     fields = {"contact_names": text_array("\n".join(c.name for c in device.contacts)),
               "interface_names": text_array("\n".join(faces.interface_names)),
               "grid_intervals": np.array([mesh.grid], dtype=np.int64)}
@@ -481,4 +490,5 @@ def write_faces_vtu(mesh: Mesh, faces: RegionFaces, path: str | Path, origin: Se
 def _padded(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two -1 padded arrays of rows brought to one width."""
     width = max(a.shape[1], b.shape[1], 1)
-    return tuple(np.pad(x, ((0, 0), (0, width - x.shape[1])), constant_values=-1) for x in (a, b))
+    return (np.pad(a, ((0, 0), (0, width - a.shape[1])), constant_values=-1),
+            np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1))

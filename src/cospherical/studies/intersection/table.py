@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Callable, Iterator
+from typing import Callable, Iterator, TypedDict
 
 import numpy as np
 
@@ -83,7 +83,7 @@ def cell_texts(cells: list[tuple[int, int, int]], kept: dict[str, list[str]]) ->
     for mask, _, owner in cells:
         points, poly = cell_polyhedron(mask, owner)
         element = Element.from_polyhedron(poly)
-        pieces = [(element,)]
+        pieces: list[tuple[Element, ...]] = [(element,)]
         for criterion, types in kept_sets.items():
             if element.type.id in types:
                 pieces.append((element,))
@@ -129,6 +129,14 @@ def _finished_chunk(codes, cells: Mapping[tuple[int, int], CellText], criteria: 
     return finish(table_entries(codes, cells, criteria), *args)
 
 
+class _Backend(TypedDict):
+    """Where the table's work runs (:func:`~cospherical.execution.backends.completed`'s keywords)."""
+
+    jobs: int
+    scheduler: str | None
+    dask_workers: int | None
+
+
 class TableRun:
     """The three passes of an intersection pattern table for a study's ``summary`` (its kept sets).
 
@@ -146,7 +154,7 @@ class TableRun:
         self.criteria = ["optimal", *self.kept]
         self.chunk = chunk
         self._report = progress or (lambda stage, n: None)
-        self._backend = dict(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
+        self._backend = _Backend(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
         self._held: dict[int, list[tuple[int, int]]] | None = None
         self._texts: dict[tuple[int, int], CellText] = {}
 
@@ -179,6 +187,8 @@ class TableRun:
         """Pass 3 (after :meth:`cells`): ``finish(entries, *args)`` of every chunk, in code order, whatever
         order the workers finish in.  ``finish`` is a module-level function: workers import it by name."""
         reps, chunk, held = self.reps, self.chunk, self._held
+        if held is None:
+            raise RuntimeError("TableRun.chunks: run cells() first (it finds the cells the chunks use)")
         tasks = {s: (reps[s:s + chunk], {pair: self._texts[pair] for pair in held.pop(s)}, self.criteria, finish, *args)
                  for s in range(0, len(reps), chunk)}
         waiting, next_start = {}, 0
