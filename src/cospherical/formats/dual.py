@@ -666,9 +666,13 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
         return int(np.flatnonzero(where)[0])
 
     def different(ours: np.ndarray, our_denominator: int, theirs: np.ndarray, their_denominator: int) -> np.ndarray:
-        # a / d == b / e  <=>  a e == b d: Python integers, no overflow
-        left = ours.astype(object) * their_denominator
-        right = theirs.astype(object) * our_denominator
+        # a / d == b / e  <=>  a e == b d: Python integers, no overflow; over one denominator (the file's
+        # are what a recomputation gives, unless altered) int64 numerators are compared as they are
+        if our_denominator == their_denominator and ours.dtype == theirs.dtype == np.int64:
+            left, right = ours, theirs
+        else:
+            left = ours.astype(object) * their_denominator
+            right = theirs.astype(object) * our_denominator
         unequal: np.ndarray = np.asarray(np.asarray(left != right).reshape(len(ours), -1).any(axis=1))
         return unequal
 
