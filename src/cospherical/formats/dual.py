@@ -81,8 +81,8 @@ volume and boundary area with the file's, exactly, and every float with the one 
 exact value gives.  A change that keeps the sums (one coefficient ``+k``, another
 ``-k``) is refused with the first edge it changed.  The cost is that of computing
 the dual from its elements (their shapes found by sorting, each shape measured once):
-0.7 CPU-s in all, the proof below included, for the 50,912 elements of the 21,512-leaf
-example of the results page, 4.9 CPU-s for the 799,984 of the README's level-8 tree.
+0.5 CPU-s in all, reading and the proof below included, for the 50,912 elements of the
+21,512-leaf example of the results page, 4.6 CPU-s for the 799,984 of the README's level-8 tree.
 Sums cannot see elements that
 overlap and leave a hole of the same volume, so the elements are also proved a mesh
 of the domain: every face shared by exactly two elements in opposite orientations, or
