@@ -501,3 +501,22 @@ def test_distinct_elements_are_proved_distinct_even_when_every_hash_collides(dua
     good = dual_run / "a" / "dual.npz"
     monkeypatch.setattr(shapes, "_ROW_HASH", np.zeros_like(shapes._ROW_HASH))
     assert len(read_dual(good).element_sizes) > 1
+
+
+def test_exact_values_wider_than_the_text_column_are_written_whole(tmp_path, capsys):
+    """Lengths of 37-digit fractions make coefficients of about 220 digits: they were cut to 200 characters
+    without a word, and check refused the mesher's own file.  Written whole, the file reads back as the dual
+    it was made from and check recomputes every value."""
+    from cospherical.cli import main
+    from cospherical.formats.dual import read_dual
+
+    lengths = ["1234567890123456789012345678901234567/9876543210987654321098765432109876543",
+               "9876543210987654321098765432109876541/1234567890123456789012345678901234569",
+               "1357913579135791357913579135791357913/2468024680246802468024680246802468029"]
+    out = tmp_path / "wide"
+    assert main(["mesh", "--domain", *lengths, "--levels", "1", "--refine", "point:0.1,0.1,0.1", "--dual",
+                 "--no-uniform", "--out", str(out)]) == 0
+    dual = read_dual(out / "dual.npz")
+    assert dual.coefficient_exact.dtype == object and max(len(str(v)) for v in dual.coefficient_exact) > 200
+    capsys.readouterr()
+    assert main(["check", str(out / "dual.npz")]) == 0, capsys.readouterr().err

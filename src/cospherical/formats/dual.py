@@ -157,11 +157,13 @@ _MAX_ELEMENT_NODES = 64
 _TRIPLES_ALLOWED = 1_000_000
 _TRIPLES_PER_ELEMENT = 100
 _STAMP = (1980, 1, 1, 0, 0, 0)
-_MAX_DIGITS = 200
+# Exact integers too wide for int64 are written as decimal text, at least this wide (a wider column only
+# where a value needs it: the files of earlier versions keep their bytes)
+_TEXT_WIDTH = 200
 # the manifest's exact numbers as written: plain integers and fractions of bounded length, so that a
 # hostile text such as "1e999999999" never reaches Fraction (which would compute 10**999999999)
-_INTEGER = re.compile(r"-?[0-9]{1,%d}" % _MAX_DIGITS)
-_MAX_TEXT_DIGITS = 1000  # the manifest's exact numbers, written as text
+_MAX_TEXT_DIGITS = 1000  # the manifest's exact numbers, and the members' written as text
+_INTEGER = re.compile(r"-?[0-9]{1,%d}" % _MAX_TEXT_DIGITS)
 _POSITIVE = re.compile(r"[1-9][0-9]{0,%d}" % (_MAX_TEXT_DIGITS - 1))
 _POSITIVE_FRACTION = re.compile(r"[1-9][0-9]{0,%d}(/[1-9][0-9]{0,%d})?" % (_MAX_TEXT_DIGITS - 1, _MAX_TEXT_DIGITS - 1))
 _MAX_GRID = 1 << 40
@@ -185,8 +187,14 @@ def _npy(array: np.ndarray) -> bytearray:
 def _exact(array: np.ndarray) -> np.ndarray:
     if array.dtype != object:
         return array
-    # Python integers as decimal text (str of each, in one cast)
-    return array.astype(f"U{_MAX_DIGITS}")
+    # Python integers as decimal text (str of each, in one cast), never cut: a cast to a narrower text
+    # column drops the last digits without a word (lengths of 37-digit fractions need 220)
+    text = array.astype(str)
+    width = text.dtype.itemsize // np.dtype("U1").itemsize
+    if width > _MAX_TEXT_DIGITS:
+        raise InputError(f"the dual's exact values need {width} digits, more than dual.npz holds "
+                         f"({_MAX_TEXT_DIGITS}): give the domain's lengths with fewer digits")
+    return text.astype(f"U{max(width, _TEXT_WIDTH)}")
 
 
 def write_dual(dual: Dual, path: str | Path) -> None:
@@ -374,7 +382,7 @@ def _integers(array: np.ndarray, name: str, path: Path) -> np.ndarray:
         return array.astype(np.int64)
     text = array.astype(str).reshape(-1).tolist()
     if any(not _INTEGER.fullmatch(x) for x in text):
-        raise FormatError(f"{path}: member {name}: not integers of at most {_MAX_DIGITS} digits")
+        raise FormatError(f"{path}: member {name}: not integers of at most {_MAX_TEXT_DIGITS} digits")
     return np.array([int(x) for x in text], dtype=object).reshape(array.shape)
 
 
