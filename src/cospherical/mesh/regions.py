@@ -366,9 +366,11 @@ def region_parts(box: Box, grid: int, vertices: np.ndarray, dual: Dual, element_
     cden: list[int] = []
     for r in range(len(names)):
         rows = np.flatnonzero(element_region == r)
+        whole = len(rows) == len(element_region)  # one region holds every element: no copy of the arrays
+        nodes = dual.element_nodes if whole else dual.element_nodes[rows]
         part = region_duals[r] if region_duals is not None else \
-            mesh_dual(mesh, (dual.element_nodes[rows], dual.element_sizes[rows]))
-        used = np.flatnonzero(np.asarray(part.volume_exact != 0) | _used(dual.element_nodes[rows], len(vertices)))
+            mesh_dual(mesh, (nodes, dual.element_sizes if whole else dual.element_sizes[rows]))
+        used = np.flatnonzero(np.asarray(part.volume_exact != 0) | _used(nodes, len(vertices)))
         vv.append(used)
         vr.append(np.full(len(used), r, dtype=np.int32))
         ve.append(part.volume_exact[used])
@@ -555,8 +557,13 @@ def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> d
     device = layout.device
     lengths = [high - low for low, high in device.bounds]
     box_volume = lengths[0] * lengths[1] * lengths[2]
-    conn, _ = mesh.connectivity()
     volumes = region_volumes(mesh)
+    # per region its elements and the vertices they use, block by block (no whole connectivity table)
+    count = len(device.regions)
+    elements = np.bincount(element_region, minlength=count)
+    used = np.zeros((count, len(mesh.vertices)), dtype=bool)
+    for element_rows, nodes, _, _ in mesh.blocks():
+        used[np.repeat(element_region[element_rows], nodes.shape[1]), nodes.reshape(-1)] = True
     negative = None
     parts = dual.regions if dual is not None else None
     if dual is not None and parts is not None:
@@ -571,9 +578,8 @@ def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> d
                     for r in range(len(device.regions))]
     regions = []
     for r, region in enumerate(device.regions):
-        rows = conn[element_region == r]
-        entry: dict[str, Any] = {"name": region.name, "material": region.material, "elements": int(len(rows)),
-                 "nodes": int(np.count_nonzero(np.bincount(rows[rows >= 0], minlength=1))), "volume": str(volumes[r] * box_volume),
+        entry: dict[str, Any] = {"name": region.name, "material": region.material, "elements": int(elements[r]),
+                 "nodes": int(used[r].sum()), "volume": str(volumes[r] * box_volume),
                  "volume_ok": volumes[r] * box_volume == layout.region_volumes[r]}
         if negative is not None and parts is not None:
             entry["negative_coefficients"] = negative[r]
