@@ -20,6 +20,7 @@ Fraction(1, 1)
 
 from __future__ import annotations
 
+import os
 import re
 import time
 from dataclasses import dataclass
@@ -43,9 +44,13 @@ from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode
                              tree_from_device, tree_from_leaves, tree_from_octree, tree_from_refine)
 from ..mesh.report import MeshReport
 
-if TYPE_CHECKING:  # the dual's modules are imported when a dual is made
+if TYPE_CHECKING:  # the dual's modules are imported when a dual is made, a table's reader when one is read
     from ..adapters.devsim import MeshWithDual
+    from ..formats.patterns import PatternTable
     from ..mesh.dual import Dual
+
+    # a pattern table: a path to its file, or a table cospherical.load_patterns read
+    PatternSource = PatternTable | str | os.PathLike[str]
 
 __all__ = ["Elements", "ExactVertices", "OctreeMesh", "build_mesh", "default_cut", "device_cut_axis", "from_treemesh",
            "mesh_writes", "output_names",
@@ -134,7 +139,7 @@ def tree_source(box: Box, levels: int | None = None, refine: Sequence[str | Shap
     return tree_from_leaves(box, rows[:, 0].astype(np.int64), rows[:, 1:].astype(np.int64))
 
 
-def pattern_lookup(patterns: Any, criterion: str, box: Box) -> tuple[Lookup | None, str | None]:
+def pattern_lookup(patterns: PatternSource | None, criterion: str, box: Box) -> tuple[Lookup | None, str | None]:
     """The lookup of a pattern table (a path, or a table :func:`cospherical.load_patterns` read) and its name for the report."""
     if patterns is None:
         return None, None
@@ -447,7 +452,7 @@ def device_cut_axis(device: Device) -> int:
 def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = None,
                refine: Sequence[str | Shape] | str | None = None, *,
                leaves: str | Path | Sequence[Sequence[int]] | np.ndarray | None = None, tree: Octree | None = None,
-               patterns: Any = None, criterion: str = "optimal", delaunay: str | None = None,
+               patterns: PatternSource | None = None, criterion: str = "optimal", delaunay: str | None = None,
                balance: str | None = None, dual: bool = False, tetrahedral_counts: bool = False,
                device: str | Path | Device | None = None, max_leaves: int | None = None,
                check_delaunay: bool = True, uniform: bool = True, progress: Progress | None = None,
