@@ -1,8 +1,16 @@
+import os
 import sys
 from collections.abc import Mapping
 from pathlib import Path
 
 import pytest
+
+# One BLAS thread per process: the suite runs on as many workers as cores (-n 2 on 2), and OpenBLAS's
+# threads spin while they wait, burning CPU the workers need (DEVSIM's diode: 15 CPU-s with numpy's
+# default threads at load 5, 5 with one). Set before numpy is first imported, here and in every command
+# the tests start (they inherit it); a value the user set stays.
+for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
 
 # The shared test helpers (oracle.py, strategies.py, commands.py, examples.py) live here, above the
 # test folders (tests/<package>/, one per package of src/cospherical): imported as top-level modules.
