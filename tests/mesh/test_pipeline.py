@@ -86,3 +86,18 @@ def test_a_contradiction_is_refused():
         delaunay_mode("internal_edges_and_faces", "global")
     with pytest.raises(InputError, match="write global or leaf"):
         delaunay_mode("optimal", "both")
+
+
+def test_a_tree_given_keeps_its_vertex_balance_only_where_its_leaves_bear_it_out():
+    """The Delaunay check bounds where vertices lie by the tree's vertex balance: a tree a caller brings keeps
+    that claim when it holds, and loses it when its leaves are only balanced across faces and edges (the
+    check then searches every sphere, and finds what it must)."""
+    from dataclasses import replace
+
+    shapes = [parse_shape("point:0.1,0.1,0.1"), parse_shape("point:0.55,0.55,0.55")]
+    balanced = build_octree(BOX, 4, shapes)
+    assert tree_from_octree(balanced).tree.vertex_balanced
+    edges_only = build_octree(BOX, 4, shapes, "edge")
+    assert len(edges_only) < len(balanced)  # some leaves meet at a corner two levels apart
+    claimed = tree_from_octree(replace(edges_only, vertex_balanced=True)).tree
+    assert not claimed.vertex_balanced and np.array_equal(claimed.levels, edges_only.levels)

@@ -111,8 +111,33 @@ def tree_from_device(device: Device, max_leaves: int | None = None) -> TreeSourc
 
 
 def tree_from_octree(tree: Octree) -> TreeSource:
-    """A tree already built (by :func:`~cospherical.mesh.octree.build_octree` or :func:`~cospherical.mesh.octree.leaves_octree`)."""
+    """A tree already built (by :func:`~cospherical.mesh.octree.build_octree` or :func:`~cospherical.mesh.octree.leaves_octree`).
+
+    Its :attr:`~cospherical.mesh.octree.Octree.vertex_balanced` claim, on which the Delaunay
+    check's bound rests, is kept only where the leaves bear it out: a tree from a caller may
+    have been edited (``dataclasses.replace`` keeps the flag) or built by hand.
+    """
+    if tree.vertex_balanced and not _balanced_at_corners(tree):
+        tree = replace(tree, vertex_balanced=False)
     return TreeSource(tree, {"source": "leaves", "depth": tree.depth})
+
+
+def _balanced_at_corners(tree: Octree) -> bool:
+    """Whether every cell touching a split cell across a face, an edge or a corner exists (its parent is split):
+    leaves touching anywhere are then at most one level apart, as ``build_octree(balance="vertex")`` makes them."""
+    from .tree import cells_of, distinct, keys_of, neighbour_offsets, neighbours
+
+    levels = tree.levels.astype(np.int64)
+    positions = tree.positions.astype(np.int64)
+    offsets = neighbour_offsets("vertex")
+    split = [distinct(np.concatenate([keys_of(level, positions[levels == deeper] >> (deeper - level))
+                                      for deeper in range(level + 1, tree.depth + 1)]))
+             for level in range(tree.depth)]
+    for level in range(1, tree.depth):
+        need = neighbours(level, cells_of(level, split[level]), offsets)
+        if not np.isin(keys_of(level - 1, cells_of(level, need) // 2), split[level - 1]).all():
+            return False
+    return True
 
 
 def delaunay_mode(criterion: str, delaunay: str | None) -> DelaunayMode:
