@@ -161,7 +161,7 @@ class ExactVertices(NamedTuple):
     sides).  :meth:`fractions` gives each coordinate as a fraction of its side.
     """
 
-    coordinates: np.ndarray
+    coordinates: NDArray[np.int64]
     intervals: int
     box: Box
 
@@ -188,19 +188,19 @@ class Elements:
     type_ids: tuple[str, ...]
     type_names: tuple[str, ...]
     vtk_cells: tuple[str | None, ...]
-    types: np.ndarray
-    connectivity: np.ndarray
-    offsets: np.ndarray
-    leaf: np.ndarray
+    types: NDArray[np.int32]
+    connectivity: NDArray[np.int64]
+    offsets: NDArray[np.int64]
+    leaf: NDArray[np.int64]
 
     def __len__(self) -> int:
         return len(self.types)
 
-    def nodes(self, element: int) -> np.ndarray:
+    def nodes(self, element: int) -> NDArray[np.int64]:
         """The vertex ids of one element."""
         return self.connectivity[self.offsets[element]:self.offsets[element + 1]]
 
-    def sizes(self) -> np.ndarray:
+    def sizes(self) -> NDArray[np.int64]:
         """Vertices per element."""
         return np.diff(self.offsets)
 
@@ -248,7 +248,7 @@ class OctreeMesh:
         return self._result.report
 
     @cached_property
-    def vertices(self) -> np.ndarray:
+    def vertices(self) -> NDArray[np.float64]:
         """(n, 3) float64: the vertices' coordinates, ``origin`` added (``mesh.vtu``'s points start at 0)."""
         points = self.assembled.points()
         return points + np.array(self.origin) if any(self.origin) else points
@@ -281,7 +281,7 @@ class OctreeMesh:
         return self._dual
 
     @property
-    def violating(self) -> np.ndarray | None:
+    def violating(self) -> NDArray[np.int64] | None:
         """The elements whose circumsphere strictly holds a vertex (``None``: the check was skipped)."""
         return self._result.violating
 

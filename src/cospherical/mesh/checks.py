@@ -563,9 +563,9 @@ class DelaunayCheck:
     violating_leaves: int
     ties: int
     exact_tests: int
-    violating_leaf_ids: np.ndarray
-    violating_elements: np.ndarray
-    not_cells: np.ndarray
+    violating_leaf_ids: NDArray[np.int64]
+    violating_elements: NDArray[np.int64]
+    not_cells: NDArray[np.int64]
     bounded: int = 0
     searched: int = 0
 

@@ -165,7 +165,7 @@ class PipelineResult:
     mesh: Mesh
     report: MeshReport
     dual: Dual | None = field(default=None, repr=False)
-    violating: np.ndarray | None = field(default=None, repr=False)
+    violating: NDArray[np.int64] | None = field(default=None, repr=False)
     faces: RegionFaces | None = field(default=None, repr=False)
 
 

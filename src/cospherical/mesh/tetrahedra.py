@@ -49,7 +49,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import TYPE_CHECKING, Any, Iterable, Protocol, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Protocol, Sequence, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -75,9 +75,9 @@ class Tetrahedra:
     region).
     """
 
-    nodes: np.ndarray
-    parent: np.ndarray
-    region: np.ndarray
+    nodes: NDArray[np.int64]
+    parent: NDArray[np.int64]
+    region: NDArray[np.int32]
 
     def __len__(self) -> int:
         return len(self.nodes)
@@ -92,18 +92,20 @@ class BoundaryTriangles:
     + (0 at the low end, 1 at the high end)``, in the order of :data:`SIDES`.
     """
 
-    nodes: np.ndarray
-    parent: np.ndarray
-    side: np.ndarray
+    nodes: NDArray[np.int64]
+    parent: NDArray[np.int64]
+    side: NDArray[np.int8]
 
     def __len__(self) -> int:
         return len(self.nodes)
 
 
+_Id = TypeVar("_Id", bound=np.integer[Any])  # vertex ids keep their dtype through fan_triangles
+
 SIDES = ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax")
 
 
-def fan_triangles(face: np.ndarray) -> np.ndarray:
+def fan_triangles(face: NDArray[_Id]) -> NDArray[_Id]:
     """Triangles of polygons (rows of global ids, in cycle order) fanned from each row's smallest id.
 
     Returns (rows x (k - 2) x 3), each triangle in the cycle's orientation.
@@ -211,9 +213,11 @@ def boundary_triangles(mesh: Mesh | Dual, blocks: Iterable[ElementBlock] | None 
         if not isinstance(mesh, Mesh):
             raise TypeError("boundary_triangles: a Dual's elements are given as blocks (element_blocks)")
         blocks = mesh.blocks()
-    parts, parents, sides = [], [], []
-    for rows, nodes, faces, _ in blocks:
-        nodes = np.asarray(nodes, dtype=np.int64)
+    parts: list[NDArray[np.int64]] = []
+    parents: list[NDArray[np.int64]] = []
+    sides: list[NDArray[np.int8]] = []
+    for rows, block_nodes, faces, _ in blocks:
+        nodes = np.asarray(block_nodes, dtype=np.int64)
         for cycle in faces:
             face = nodes[:, list(cycle)]
             coords = vertices[face]  # rows x k x 3
@@ -229,9 +233,9 @@ def boundary_triangles(mesh: Mesh | Dual, blocks: Iterable[ElementBlock] | None 
     if not parts:
         return BoundaryTriangles(np.zeros((0, 3), dtype=np.int64), np.zeros(0, dtype=np.int64),
                                  np.zeros(0, dtype=np.int8))
-    nodes, parent, side = np.concatenate(parts), np.concatenate(parents), np.concatenate(sides)
+    corners, parent, side = np.concatenate(parts), np.concatenate(parents), np.concatenate(sides)
     order = np.lexsort((parent, side))  # side by side, element by element: deterministic
-    return BoundaryTriangles(nodes[order], parent[order], side[order])
+    return BoundaryTriangles(corners[order], parent[order], side[order])
 
 
 @dataclass(frozen=True)
@@ -246,12 +250,12 @@ class SimplexMesh:
     surfaces (:data:`SIDES`), where a solver puts its boundary conditions.
     """
 
-    points: np.ndarray
-    tetrahedra: np.ndarray
-    volume: np.ndarray
+    points: NDArray[np.float64]
+    tetrahedra: NDArray[np.int64]
+    volume: NDArray[np.int32]
     volumes: tuple[str, ...]
-    triangles: np.ndarray
-    surface: np.ndarray
+    triangles: NDArray[np.int64]
+    surface: NDArray[np.int32]
     surfaces: tuple[str, ...]
 
 
