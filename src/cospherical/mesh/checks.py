@@ -322,21 +322,22 @@ def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArr
         parts.clear()
         # the faces are convex polygons (hulls): the same vertices are the same polygon, so a face is paired by
         # its sorted ids (a tenth of the time of turning every cycle; the few shown or left open are turned)
-        sorted_ids = np.sort(rows, axis=1)
         # the orientation: whether the cycle goes on from its smallest id to the larger of that id's neighbours
         # (column by column: numpy's reductions along rows of three or four are slow)
+        smallest = rows[:, 0].copy()
+        for column in range(1, size):
+            np.minimum(smallest, rows[:, column], out=smallest)
         after = np.empty(len(rows), dtype=rows.dtype)
         before = np.empty(len(rows), dtype=rows.dtype)
         for column in range(size):
-            here = rows[:, column] == sorted_ids[:, 0]
+            here = rows[:, column] == smallest
             after[here] = rows[here, (column + 1) % size]
             before[here] = rows[here, column - 1]
         flipped = after > before
-        del after, before, here
-        sorted_ids, flipped, ok, pairs, single, order = _paired(sorted_ids, flipped)
+        del smallest, after, before, here
+        order, flipped, ok, pairs, single = _paired(np.sort(rows, axis=1), flipped)
         interior += pairs
-        on_boundary = on_domain_boundary(vertices[sorted_ids[single]], grid, layout)
-        del sorted_ids
+        on_boundary = on_domain_boundary(vertices[rows[order[single]]], grid, layout)
         ok[single[on_boundary]] = True
         boundary += int(on_boundary.sum())
         if open_faces:
@@ -380,28 +381,32 @@ def _turned(rows: NDArray[np.integer[Any]]) -> NDArray[np.integer[Any]]:
     return turned
 
 
-def _paired(turned: NDArray[np.integer[Any]], flipped: NDArray[np.bool_]) -> tuple[
-        NDArray[np.integer[Any]], NDArray[np.bool_], NDArray[np.bool_], int, NDArray[np.intp], NDArray[np.intp]]:
+def _paired(faces: NDArray[np.integer[Any]], flipped: NDArray[np.bool_]) -> tuple[
+        NDArray[np.intp], NDArray[np.bool_], NDArray[np.bool_], int, NDArray[np.intp]]:
     """Sort faces (each in one canonical form: turned, or its ids sorted); mark those met exactly twice in
     opposite orientations.
 
-    Returns the sorted faces and orientations, the mask of faces so paired, how many
-    pairs, the indices of the faces met once, and the order that sorted them.
+    Returns the order that sorts them, their orientations in that order, the mask (in that order) of
+    faces so paired, how many pairs, and the positions (in that order) of the faces met once.  The
+    faces themselves are not copied in order: ``faces[order[i]]`` is the ``i``-th.
     """
-    order, keys = _row_order(turned, max(1, int(turned.max()).bit_length() if turned.size else 1))
-    turned, flipped = turned[order], flipped[order]
-    new = np.ones(len(turned), dtype=bool)
+    count = len(faces)
+    order, keys = _row_order(faces, max(1, int(faces.max()).bit_length() if faces.size else 1))
+    del faces  # the keys say all that is compared (a caller's temporary is freed here)
+    flipped = flipped[order]
+    new = np.ones(count, dtype=bool)
     new[1:] = False
     for key in keys:  # neighbours in the order differ where a packed key does
         key = key[order]
         new[1:] |= key[1:] != key[:-1]
+    del keys, key
     starts = np.flatnonzero(new)
-    counts = np.diff(np.r_[starts, len(turned)])
-    ok = np.zeros(len(turned), dtype=bool)
+    counts = np.diff(np.r_[starts, count])
+    ok = np.zeros(count, dtype=bool)
     pairs = starts[counts == 2]
     good_pairs = pairs[flipped[pairs] != flipped[pairs + 1]]
     ok[good_pairs] = ok[good_pairs + 1] = True
-    return turned, flipped, ok, len(good_pairs), starts[counts == 1], order
+    return order, flipped, ok, len(good_pairs), starts[counts == 1]
 
 
 def match_seams(seams: Iterable[OpenFaces], vertices: Callable[[NDArray[np.int64]], NDArray[np.int64]], grid: int,
@@ -428,13 +433,13 @@ def match_seams(seams: Iterable[OpenFaces], vertices: Callable[[NDArray[np.int64
     shown: list[list[list[float]]] = []
     for size in sorted({seam.size for seam in seams}):
         parts = [seam for seam in seams if seam.size == size]
-        turned, _, ok, pairs, _, _ = _paired(np.concatenate([seam.faces for seam in parts]),
-                                          np.concatenate([seam.flipped for seam in parts]))
+        turned = np.concatenate([seam.faces for seam in parts])
+        order, _, ok, pairs, _ = _paired(turned, np.concatenate([seam.flipped for seam in parts]))
         interior += pairs
         bad = np.flatnonzero(~ok)
         bad_total += len(bad)
         for row in bad[:max(0, examples - len(shown))]:
-            shown.append((vertices(turned[row]) / grid).tolist())
+            shown.append((vertices(turned[order[row]]) / grid).tolist())
     return ConformityCheck(int(bad_total), int(interior), 0, shown)
 
 
