@@ -390,19 +390,19 @@ def region_parts(box: Box, grid: int, vertices: np.ndarray, dual: Dual, element_
     if contact_face_nodes is None or contact_face_contact is None:
         contact_face_nodes = np.zeros((0, 3), dtype=np.int32)
         contact_face_contact = np.zeros(0, dtype=np.int32)
-    shares = _contact_shares(vertices, grid, contact_face_nodes, contact_face_contact,
-                             [c[3] for c in contacts], lengths)
-    pairs = sorted(shares)
-    contact_denominator = math.lcm(1, *(q.denominator for q in shares.values()))
+    share_vertex, share_contact, shares, common = _contact_shares(vertices, grid, contact_face_nodes,
+                                                                  contact_face_contact, [c[3] for c in contacts],
+                                                                  lengths)
+    # the smallest denominator of all the shares: what the totals over ``common`` have in common divides out
+    contact_denominator = common // math.gcd(common, *shares.tolist())
     return RegionParts(
         tuple(names), tuple(materials), element_region.astype(np.int32), volume_vertex[order].astype(np.int64),
         volume_region[order], volume_exact[order], volume_denominator, coupling_edge[corder].astype(np.int64),
         coupling_region[corder],
         coupling_exact[corder], coupling_denominator, tuple(c[0] for c in contacts), tuple(c[1] for c in contacts),
         tuple(tuple(c[2]) for c in contacts), contact_face_nodes.astype(np.int32),
-        contact_face_contact.astype(np.int32), np.array([v for v, _ in pairs], dtype=np.int64).reshape(-1),
-        np.array([c for _, c in pairs], dtype=np.int32).reshape(-1),
-        _narrow([int(shares[p] * contact_denominator) for p in pairs]), contact_denominator, dual.volume_factor,
+        contact_face_contact.astype(np.int32), share_vertex, share_contact,
+        _narrow_array(shares // (common // contact_denominator)), contact_denominator, dual.volume_factor,
         tuple(str(x) for x in origin), boxes)
 
 
@@ -410,6 +410,13 @@ def _used(nodes: np.ndarray, count: int) -> np.ndarray:
     used = np.zeros(count, dtype=bool)
     used[nodes[nodes >= 0]] = True
     return used
+
+
+def _narrow_array(values: np.ndarray) -> np.ndarray:
+    """What :func:`_narrow` makes of int64 values, without a Python list."""
+    if len(values) and int(np.abs(values).max()) >= 2**62 // len(values):
+        return np.array(values.tolist(), dtype=object).reshape(-1)
+    return values.astype(np.int64).reshape(-1)
 
 
 def _narrow(values: list[int]) -> np.ndarray:
@@ -433,15 +440,18 @@ def _common(parts: list[np.ndarray], denominators: list[int], common: int) -> np
 
 
 def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: np.ndarray, axes: list[int],
-                    lengths: Sequence[Fraction] | None) -> dict[tuple[int, int], Fraction]:
+                    lengths: Sequence[Fraction] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """Per (vertex, contact), its part of the contact's faces' area, exactly (device units).
+
+    Returns the pairs' vertices (int64) and contacts (int32), sorted by vertex then contact,
+    and their shares as int64 numerators over the returned common denominator.
 
     A co-circular face gives each vertex the triangles between it, the midpoints of
     its two edges and the face's circle centre (signed: they add up to the face's
     area whatever the shape); computed once per face shape up to translation.
     """
     if not len(faces):
-        return {}
+        return np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int64), 1
     if lengths is None:
         raise InputError("contact faces need the bounding box's lengths")
     n, width = faces.shape
@@ -472,7 +482,7 @@ def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: n
     starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
     totals = np.add.reduceat(value, starts)
     base = int(which.max()) + 1
-    return {divmod(int(k), base): Fraction(int(t), common) for k, t in zip(key[starts].tolist(), totals.tolist())}
+    return key[starts] // base, (key[starts] % base).astype(np.int32), totals.astype(np.int64), common
 
 
 def _polygon_shares(p: list[tuple[Fraction, Fraction]]) -> list[Fraction]:
