@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from hypothesis import HealthCheck, given, settings
+from sampling import examples
 from strategies import configurations
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.too_slow])  # 100; --full 150
 @given(configurations())
 def test_compiled_and_python_walks_give_the_same_cells(cfg):
     from cospherical.core.delaunay import delaunay_cells

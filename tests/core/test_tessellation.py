@@ -9,6 +9,7 @@ from fractions import Fraction
 import networkx as nx
 import pytest
 from hypothesis import HealthCheck, given, settings
+from sampling import examples
 from strategies import configurations
 
 from cospherical import Configuration, tessellate
@@ -50,7 +51,8 @@ def test_fvm_closed_and_open_box():
     assert plain.fvm_adequate and plain.fvm_adequate_open
 
 
-SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# 100 random configurations a run (each run draws new ones), 150 with --full
+SETTINGS = settings(max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
 def squared_distance(p, q, squared_lengths) -> Fraction:
