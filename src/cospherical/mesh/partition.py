@@ -204,7 +204,7 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: LookupRecipe | None, crite
             # As in one process, the spheres counted are those of the final check, the fresh cells': the leaf
             # elements kept were proven by the leaf mesh's check, whose spheres the one process does not count
             for k in set(range(pieces)) - set(again):
-                results[k]["figures"].update(delaunay_spheres_bounded=0, delaunay_spheres_searched=0)
+                results[k]["figures"]["delaunay_spheres_bounded"] = 0
     seams = [seam for k in range(pieces) for seam in results[k]["seams"]]
     n = np.int64(grid + 1)
 
