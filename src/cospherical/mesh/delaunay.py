@@ -118,8 +118,10 @@ domain).  Steps 2-4 hold for a cluster U_r exactly when every cell of D that mee
 interior of U_r lies in the domain: such a cell has its interior disjoint from the kept
 elements (cells of D), hence lies in U (the union of the closed clusters, which are
 disjoint) and, being connected, in U_r; so U_r is tiled by cells of D and the rest of
-the proof follows word for word.  Otherwise no set of cells of D tiles U_r, and the
-checks of 5 fail with any proposal, the exact engine's included:
+the proof follows word for word.  Otherwise no set of cells of D tiles U_r: the cells
+made pass the checks of 5 only if their volumes happen to sum to U_r's with one of them
+outside the domain, an element that the caller's exact conformity check then finds
+(:func:`~cospherical.mesh.regions.device_mesh` falls back to the leaf mesh); else they fail:
 
 8. With ``convex=False``, a cluster whose exact engine's cells still fail the checks of 5
    keeps its leaf elements (each leaf's own exact Delaunay subdivision), listed as
