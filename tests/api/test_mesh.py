@@ -137,9 +137,14 @@ def test_a_devices_dual_asked_later_has_its_region_parts():
     later = cospherical.build_mesh(device="examples/devices/mos-capacitor.yaml", uniform=False)
     now = cospherical.build_mesh(device="examples/devices/mos-capacitor.yaml", uniform=False, dual=True)
     assert later.report.dual is None and later.dual.regions is not None
-    for item in dataclasses.fields(now.dual.regions):
-        ours, theirs = getattr(later.dual.regions, item.name), getattr(now.dual.regions, item.name)
-        assert np.array_equal(ours, theirs) if isinstance(ours, np.ndarray) else ours == theirs, item.name
+    for a, b in ((later.dual.regions, now.dual.regions), (later.dual.regions.interfaces, now.dual.regions.interfaces)):
+        for item in dataclasses.fields(b):
+            ours, theirs = getattr(a, item.name), getattr(b, item.name)
+            if item.name != "interfaces":
+                assert np.array_equal(ours, theirs) if isinstance(ours, np.ndarray) else ours == theirs, item.name
+    for name in ("boundary", "boundary_area_exact", "boundary_edge"):  # the domain's boundary, not the box's
+        assert np.array_equal(getattr(later.dual, name), getattr(now.dual, name)), name
+    assert later.dual.boundary_area_denominator == now.dual.boundary_area_denominator
 
 
 def test_the_cli_writes_the_tetrahedra_and_gmsh_file_that_write_writes(tmp_path, capsys):

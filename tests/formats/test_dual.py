@@ -144,7 +144,7 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
     assert err.count("\n") == 1 and "Traceback" not in err and len(err) < 400, err
     assert time.monotonic() - start < 30  # 10**999999999 would take far longer
     assert case != "manifest with a repeated key" or "repeated key 'version'" in err, err
-    assert not case.startswith("version") or "dual format version 2; this reads 3 and 4 (write it again with " \
+    assert not case.startswith("version") or "dual format version 2; this reads 3, 4 and 5 (write it again with " \
         "cospherical mesh --dual)" in err, err
 
 
@@ -520,3 +520,43 @@ def test_exact_values_wider_than_the_text_column_are_written_whole(tmp_path, cap
     assert dual.coefficient_exact.dtype == object and max(len(str(v)) for v in dual.coefficient_exact) > 200
     capsys.readouterr()
     assert main(["check", str(out / "dual.npz")]) == 0, capsys.readouterr().err
+
+
+def test_a_version_4_device_dual_is_still_read_and_checked(tmp_path, capsys):
+    """Version 4 (before interfaces) counted a device's boundary in its bounding box's sides only: such a file
+    is still read (no interfaces) and checked by that rule, and the version 5 file of the same L-shaped device
+    holds its interfaces and the notch in its boundary."""
+    from dataclasses import replace
+    from fractions import Fraction as F
+
+    from cospherical.api.mesh import build_mesh
+    from cospherical.cli import main
+    from cospherical.formats.dual import _Vertices, read_dual, write_dual
+    from cospherical.mesh.device import Device, Region
+    from cospherical.mesh.dual import mesh_dual
+
+    def box(*values):
+        return tuple(F(v) for v in values)
+
+    device = Device("l", (Region("a", "Si", (box(0, 0, 0, 2, 1, 1),)), Region("b", "Ox", (box(0, 1, 0, 1, 2, 1),))),
+                    (), (), 1)
+    write_dual(build_mesh(device=device, uniform=False, dual=True).dual, tmp_path / "v5.npz")
+    dual = read_dual(tmp_path / "v5.npz")
+    assert dual.regions.interfaces.names == ("a|b",) and dual.regions.interfaces.areas() == [1]
+    assert dual.boundary_area_sums() == (2, 2, F(3, 2))  # the notch's walls x = 1 and y = 1 too
+    sides = mesh_dual(_Vertices(dual.box, dual.grid, dual.grid_vertices), (dual.element_nodes, dual.element_sizes))
+    old = replace(dual, boundary=sides.boundary, boundary_area=sides.boundary_area,
+                  boundary_area_exact=sides.boundary_area_exact,
+                  boundary_area_denominator=sides.boundary_area_denominator,
+                  regions=replace(dual.regions, interfaces=None))
+    write_dual(old, tmp_path / "v4.npz")
+    with np.load(tmp_path / "v4.npz") as archive:
+        assert json.loads(archive["manifest"].tobytes())["version"] == 4 and "interface_part" not in archive.files
+    again = read_dual(tmp_path / "v4.npz")
+    assert again.regions.interfaces is None and again.boundary_area_sums() == (F(3, 2), F(3, 2), F(3, 2))
+    capsys.readouterr()
+    assert main(["check", str(tmp_path / "v4.npz")]) == 0 and main(["check", str(tmp_path / "v5.npz")]) == 0
+    # a version 4 file with the union's boundary: not what version 4 means
+    write_dual(replace(dual, regions=replace(dual.regions, interfaces=None)), tmp_path / "mixed.npz")
+    assert main(["check", str(tmp_path / "mixed.npz")]) == 2
+    assert "the boundary areas sum to 2, 2, 3/2" in capsys.readouterr().err

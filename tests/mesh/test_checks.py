@@ -125,3 +125,27 @@ def test_only_vertex_balance_claims_the_structure():
     """The check's bound on where vertices lie holds for trees balanced across corners too, not across edges only."""
     shapes = [parse_shape("point:0.1,0.1,2")]
     assert build_octree(BRICK, 3, shapes).vertex_balanced and not build_octree(BRICK, 3, shapes, "edge").vertex_balanced
+
+
+def test_a_point_is_in_the_closed_union_of_boxes_exactly():
+    """Where a device's circumcentres may lie: an L's notch is outside, its walls and re-entrant edge inside
+    (against the boxes, in Fractions)."""
+    from fractions import Fraction
+
+    from cospherical.mesh.checks import in_closed_domain
+    from cospherical.mesh.device import Device, Region, device_layout
+
+    def box(*values):
+        return tuple(Fraction(v) for v in values)
+
+    layout = device_layout(Device("l", (Region("a", "Si", (box(0, 0, 0, 2, 1, 1), box(0, 1, 0, 1, 2, 1))),), (),
+                                  (), 1))
+    grid = 8  # grid units: the L is the boxes (0, 0, 0)-(8, 4, 8) and (0, 4, 0)-(4, 8, 8)
+    boxes = [(0, 0, 0, 8, 4, 8), (0, 4, 0, 4, 8, 8)]
+    third = Fraction(1, 3)
+    points = [(5, 5, 1), (4, 5, 1), (5, 4, 1), (4, 4, 8), (4 + third, 4 + third, 1), (8, 4, 0), (8 + third, 1, 1),
+              (1, 8, 8), (4 - third, 8, third), (4 + third, 8, 1), (2, 2, -third)]
+    want = [any(all(b[a] <= p[a] <= b[a + 3] for a in range(3)) for b in boxes) for p in points]
+    num = np.array([[int(Fraction(x) * 3) for x in p] for p in points], dtype=np.int64)
+    assert in_closed_domain(num, np.full((len(num), 1), 3, dtype=np.int64), grid, layout).tolist() == want
+    assert sum(want) not in (0, len(want))

@@ -165,6 +165,51 @@ def _mesh_and_check(path: Path, folder: Path, dual: bool = False):
     return m
 
 
+def _surfaces(data: dict) -> tuple[list[Fraction], dict]:
+    """From the device file alone (Fractions): per axis the domain's boundary area normal to it, as a fraction
+    of the bounding box's side; per pair of regions (a < b) the area where their boxes touch."""
+    regions, _, low, length = _device_boxes(data)
+    planes = [sorted({b[a] for boxes in regions for b in boxes} | {b[a + 3] for boxes in regions for b in boxes})
+              for a in range(3)]
+
+    def owner(cell):  # the region of a cell of the planes' grid (its centre in a box), or -1
+        centre = [(planes[a][cell[a]] + planes[a][cell[a] + 1]) / 2 for a in range(3)]
+        return next((r for r, boxes in enumerate(regions) for b in boxes
+                     if all(b[a] < centre[a] < b[a + 3] for a in range(3))), -1)
+
+    shape = [len(p) - 1 for p in planes]
+    owners = {(i, j, k): owner((i, j, k)) for i in range(shape[0]) for j in range(shape[1]) for k in range(shape[2])}
+    sides, touching = [Fraction(0)] * 3, {}
+    for axis in range(3):
+        b, c = (axis + 1) % 3, (axis + 2) % 3
+        for cell in owners:
+            for step in (-1, 1):
+                beyond = list(cell)
+                beyond[axis] += step
+                other = owners.get(tuple(beyond), -1)
+                area = (planes[b][cell[b] + 1] - planes[b][cell[b]]) * (planes[c][cell[c] + 1] - planes[c][cell[c]])
+                here = owners[cell]
+                if here >= 0 and other < 0:
+                    sides[axis] += area / (length[b] * length[c])
+                elif 0 <= here < other:
+                    touching[here, other] = touching.get((here, other), Fraction(0)) + area
+    return sides, touching
+
+
+def _on_the_boundary(data: dict, points: np.ndarray, grid: int) -> np.ndarray:
+    """Which grid points have the domain on some sides and not on others (from the device file, exactly)."""
+    regions, _, low, length = _device_boxes(data)
+    boxes = np.array([[int((b[i] - low[i % 3]) / length[i % 3] * grid) for i in range(6)]
+                      for r in regions for b in r], dtype=np.int64)
+    held = []
+    for signs in np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T:  # the eight octants around
+        lo, hi, p = boxes[None, :, :3], boxes[None, :, 3:], points[:, None, :]
+        inside = np.where(signs > 0, (lo <= p) & (p < hi), (lo < p) & (p <= hi)).all(axis=2).any(axis=1)
+        held.append(inside)
+    held = np.array(held)
+    return held.any(axis=0) & ~held.all(axis=0)
+
+
 @pytest.mark.parametrize("example", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 def test_example_devices_pass_the_oracle(example, tmp_path, capsys):
     from cospherical.cli import main
@@ -172,6 +217,18 @@ def test_example_devices_pass_the_oracle(example, tmp_path, capsys):
     m = _mesh_and_check(example, tmp_path, dual=example.stem in ("fin", "l-shape"))
     if m.report.dual is not None:  # non-convex: check proves the elements a mesh of the union of boxes
         assert main(["check", str(tmp_path / "dual.npz")]) == 0, capsys.readouterr().err
+        # the dual's boundary is the union's (notches, the fin's walls), its interfaces where regions touch
+        data = yaml.safe_load(example.read_text())
+        sides, touching = _surfaces(data)
+        dual = m.dual
+        assert list(dual.boundary_area_sums()) == sides
+        assert np.array_equal(dual.boundary, _on_the_boundary(data, dual.grid_vertices, dual.grid))
+        interfaces = dual.regions.interfaces
+        assert [tuple(p) for p in interfaces.regions.tolist()] == sorted(touching)
+        assert interfaces.areas() == [touching[tuple(p)] for p in interfaces.regions.tolist()]
+        assert dual.negative_coefficients() == {
+            key: sum(r["negative_coefficients"][key] for r in m.report.device["regions"])
+            for key in ("interior", "boundary")}
     report = m.report
     assert report.volume_ok and report.nonconforming_faces == 0
     device = report.device
@@ -287,7 +344,7 @@ def test_check_proves_the_region_parts_and_refuses_altered_ones(mos_dual, tmp_pa
     parts = m.dual.regions
     scale = {"volume_part": parts.volume_factor / parts.volume_denominator,
              "coupling_part": parts.volume_factor / parts.coupling_denominator,
-             "contact_part": 1 / parts.contact_denominator}
+             "contact_part": 1 / parts.contact_denominator, "interface_part": 1 / parts.interfaces.denominator}
     with np.load(path) as archive:
         members = {name: archive[name + "_exact"] for name in scale}
     for name, values in members.items():
@@ -299,6 +356,19 @@ def test_check_proves_the_region_parts_and_refuses_altered_ones(mos_dual, tmp_pa
         assert main(["check", str(target)]) == 2
         err = capsys.readouterr().err
         assert len(err.strip().splitlines()) == 1 and name.rsplit("_", 1)[0] in err, err
+    # an interface face turned over (its normal into the substrate), or given to no interface: the faces are
+    # compared with its elements' as oriented sets
+    with np.load(path) as archive:
+        faces, which = archive["interface_face_nodes"], archive["interface_face_interface"]
+    turned = faces.copy()
+    size = int((turned[0] >= 0).sum())
+    turned[0, :size] = turned[0, :size][::-1]
+    fewer = {"interface_face_nodes": faces[1:], "interface_face_interface": which[1:]}
+    for name, members in (("turned", {"interface_face_nodes": turned}), ("fewer", fewer)):
+        _resigned(path, tmp_path / f"{name}.npz", members=members)
+        assert main(["check", str(tmp_path / f"{name}.npz")]) == 2
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1 and "member interface_face_nodes: not the faces between" in err, err
 
 
 _STACK = """device: stack

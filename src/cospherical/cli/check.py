@@ -60,8 +60,10 @@ def _check_dual(path: Path) -> None:
     from ..formats.dual import domain_sums, dual_layout, read_dual, verify_dual
 
     dual = read_dual(path)
-    layout = dual_layout(dual, path)  # a device's union of boxes (dual.npz version 4), else the box
-    volume, expected = domain_sums(layout) if layout is not None else (1, (2, 2, 2))
+    layout = dual_layout(dual, path)  # a device's union of boxes (dual.npz version 4 or 5), else the box
+    # version 5: the boundary is the union's; version 4 counted only the bounding box's sides
+    whole = dual.regions is not None and dual.regions.interfaces is not None
+    volume, expected = domain_sums(layout, whole) if layout is not None else (1, (2, 2, 2))
     total = dual.volume_sum()
     if total != volume:
         raise FormatError(f"{path}: the control volumes sum to {_cut(total)} of the domain's box, not {_cut(volume)}")

@@ -6,7 +6,7 @@ same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` element
 
 ===========================  ==========  ==================================================
 ``manifest``                 uint8       JSON text: ``format`` (``cospherical-dual``),
-                                         ``version`` (3; 4 for a device, below), ``domain`` (the box, exact
+                                         ``version`` (3; 5 for a device, below), ``domain`` (the box, exact
                                          texts), ``grid``, the exact denominators and
                                          factors (decimal texts), ``sha256`` of every
                                          other member
@@ -24,27 +24,30 @@ same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` element
                                          volume_factor_squared) / volume_denominator``
 ``boundary``                 bool n      the vertex is on the domain's boundary
 ``boundary_area``            f8 n        the boundary's area in its control volume
-``boundary_area_exact``      int64 n x3  per axis k, the part in the two sides normal
-                                         to k: ``boundary_area = sum over k of
+``boundary_area_exact``      int64 n x3  per axis k, the part in the boundary faces normal
+                                         to k (a box's two sides): ``boundary_area = sum over k of
                                          boundary_area_exact[:, k] * sqrt(
                                          boundary_factors_squared[k]) /
                                          boundary_area_denominator``, the factors
                                          ``(b^2 c^2, a^2 c^2, a^2 b^2)`` for a box
                                          ``a x b x c`` (decimal text, ``U``, when int64
-                                         is too narrow); each column sums to twice the
-                                         denominator
+                                         is too narrow); on a box each column sums to
+                                         twice the denominator
 ``element_circumcenter``     f8 e x 3    the real circumcenter of each element (mesh order)
 ``element_nodes``            int e x w   each element's global vertex ids (mesh order),
                                          padded with -1; ``4 <= w <= 64``
 ``element_sizes``            int e       each element's number of vertices
 ===========================  ==========  ==================================================
 
-A device's dual (``mesh --device ... --dual``) is version 4: the members above plus its
-parts per region and its contacts (manifest: ``region_names``, ``region_materials``,
+A device's dual (``mesh --device ... --dual``) is version 5: the members above, whose
+boundary is the domain's (the union of its boxes: every face met by one element, also
+in a notch or a hole inside the bounding box), plus its parts per region, its contacts
+and its interfaces (manifest: ``region_names``, ``region_materials``,
 ``contact_names``, ``contact_regions`` (region indices), ``contact_boxes`` (exact
 texts, device units), ``region_boxes`` (per region its boxes: the domain),
-``origin`` (the bounding box's low corner, where the grid starts) and the three part
-denominators)::
+``origin`` (the bounding box's low corner, where the grid starts),
+``interface_regions`` (per interface its two regions ``[a, b]``, ``a < b``; named
+``"a|b"``) and the four part denominators)::
 
     element_region                   int e     each element's region
     volume_part_vertex, _region      int p     one row per (vertex, region), sorted
@@ -60,13 +63,22 @@ denominators)::
     contact_part_vertex, _contact    int r     one row per (vertex, contact), sorted
     contact_part_exact, contact_part iU/f8 r   over contact_part_denominator (device
                                                units): its part of the contact's area
+    interface_face_nodes             int g x w each interface face (polygon, -1 padded,
+                                               counter-clockwise seen from region a)
+    interface_face_interface         int g     its interface
+    interface_part_vertex, _interface int s    one row per (vertex, interface), sorted
+    interface_part_exact,            iU/f8 s   over interface_part_denominator (device
+    interface_part                             units): its part of the interface's area
 
 The parts of a vertex or an edge sum to its total exactly, a region's volume parts
-to its volume, a contact's area parts to its rectangle's area.  A one-box mesh (one
-region) writes version 3, byte for byte as before; both versions are read, and
-:func:`verify_dual` computes a version 4 file's parts again from its elements, their
-regions and its contact faces, and proves the elements a mesh of the union of boxes
-(the faces met once lie in its boundary, which need not be the bounding box's).
+to its volume, a contact's area parts to its rectangle's area, an interface's to the
+area where its two regions touch.  A one-box mesh (one region) writes version 3, byte
+for byte as before.  Version 4 (a device's dual before version 5) lacks the interface
+members and counts the boundary in the bounding box's sides only; all three are read,
+and :func:`verify_dual` computes a version 4 or 5 file's parts again from its
+elements, their regions and its contact faces (version 5: its boundary and interfaces
+from the faces its elements meet once and those between two regions), and proves the
+elements a mesh of the union of boxes.
 
 The reader refuses, with one line, a file that is not such a zip, lacks or adds a
 member, has an array of the wrong kind or shape, fails a checksum (a truncated or
@@ -117,14 +129,16 @@ from ..errors import FormatError, InputError, shown
 from ..files.yamlio import atomic_write, machine_memory, parse_json
 from ..mesh.device import NAME
 from ..mesh.device import DeviceLayout
-from ..mesh.dual import Dual, RegionParts
+from ..mesh.dual import Dual, InterfaceParts, RegionParts
 
 __all__ = ["DUAL_FORMAT_VERSION", "domain_sums", "dual_layout", "read_dual", "verify_dual", "write_dual"]
 
-DUAL_FORMAT_VERSION = 4
-# Version 3 is version 4 without the region members: a one-box mesh (one region) still writes it,
-# byte for byte as before, and both are read.
-_VERSIONS = (3, 4)
+DUAL_FORMAT_VERSION = 5
+# Version 3 is version 5 without the region and interface members: a one-box mesh (one region) still
+# writes it, byte for byte as before.  Version 4 (a device's dual before version 5) has the region
+# members but no interfaces, and its boundary figures are the bounding box's sides; all three are read
+# (a version 4 dual read and written again stays version 4).
+_VERSIONS = (3, 4, 5)
 _MAX_DUAL_FILE = 16 * 1024**3
 # member -> (dtype kind, columns or None, which count: n vertices, m edges, e elements)
 _MEMBERS = {
@@ -134,7 +148,7 @@ _MEMBERS = {
     "boundary_area": ("f", None, "n"), "boundary_area_exact": ("iU", 3, "n"), "element_circumcenter": ("f", 3, "e"),
     "element_nodes": ("i", "w", "e"), "element_sizes": ("i", None, "e"),
 }
-# a device's members (version 4): p control-volume parts, q coupling parts, f contact faces, r contact area parts
+# a device's members (versions 4 and 5): p control-volume parts, q coupling parts, f contact faces, r contact area parts
 _REGION_MEMBERS = {
     "element_region": ("i", None, "e"),
     "volume_part_vertex": ("i", None, "p"), "volume_part_region": ("i", None, "p"),
@@ -144,6 +158,12 @@ _REGION_MEMBERS = {
     "contact_face_nodes": ("i", "w", "f"), "contact_face_contact": ("i", None, "f"),
     "contact_part_vertex": ("i", None, "r"), "contact_part_contact": ("i", None, "r"),
     "contact_part_exact": ("iU", None, "r"), "contact_part": ("f", None, "r"),
+}
+# a device's interfaces (version 5): g interface faces, s interface area parts
+_INTERFACE_MEMBERS = {
+    "interface_face_nodes": ("i", "w", "g"), "interface_face_interface": ("i", None, "g"),
+    "interface_part_vertex": ("i", None, "s"), "interface_part_interface": ("i", None, "s"),
+    "interface_part_exact": ("iU", None, "s"), "interface_part": ("f", None, "s"),
 }
 _MAX_NAMES = 64
 # the most vertices an element may list: a leaf's 26 points, or a cell of the global mode (co-spherical
@@ -224,9 +244,19 @@ def write_dual(dual: Dual, path: str | Path) -> None:
                  "contact_part_denominator": str(parts.contact_denominator),
                  "origin": [str(x) for x in parts.origin],
                  "region_boxes": [[list(box) for box in boxes] for boxes in parts.boxes]}
+    interfaces = parts.interfaces if parts is not None else None
+    if interfaces is not None:
+        arrays.update({
+            "interface_face_nodes": _face_rows(interfaces.face_nodes),
+            "interface_face_interface": interfaces.face_interface.astype(np.int32),
+            "interface_part_vertex": interfaces.vertex, "interface_part_interface": interfaces.interface.astype(np.int32),
+            "interface_part_exact": _exact(interfaces.exact), "interface_part": interfaces.part})
+        extra.update({"interface_regions": [[int(a), int(b)] for a, b in interfaces.regions.tolist()],
+                      "interface_part_denominator": str(interfaces.denominator)})
     blobs = {name: _npy(array) for name, array in arrays.items()}
+    version = 3 if parts is None else 4 if interfaces is None else DUAL_FORMAT_VERSION
     manifest = {
-        "format": "cospherical-dual", "version": DUAL_FORMAT_VERSION if parts is not None else 3, **extra,
+        "format": "cospherical-dual", "version": version, **extra,
         "domain": list(dual.box.texts),
         "grid": int(dual.grid), "coefficient_denominator": str(dual.coefficient_denominator),
         "volume_denominator": str(dual.volume_denominator), "volume_factor_squared": str(dual.volume_factor_squared),
@@ -305,7 +335,8 @@ def _check_headers(archive: zipfile.ZipFile, path: Path, members: dict[str, tupl
     counts = {"n": headers["grid_vertices"][1][:1], "m": headers["edges"][1][:1],
               "e": headers["element_circumcenter"][1][:1]}
     for name, count in (("volume_part_vertex", "p"), ("coupling_part_edge", "q"), ("contact_face_contact", "f"),
-                        ("contact_part_vertex", "r")):
+                        ("contact_part_vertex", "r"), ("interface_face_interface", "g"),
+                        ("interface_part_vertex", "s")):
         if name in headers:
             counts[count] = headers[name][1][:1]
     for name, (kinds, columns, count) in members.items():
@@ -329,7 +360,11 @@ def read_dual(path: str | Path) -> Dual:
     try:
         with zipfile.ZipFile(path) as archive:
             names = sorted(archive.namelist())
-            members = {**_MEMBERS, **_REGION_MEMBERS} if "element_region.npy" in names else _MEMBERS
+            members = _MEMBERS
+            if "element_region.npy" in names:
+                members = {**_MEMBERS, **_REGION_MEMBERS}
+                if "interface_face_nodes.npy" in names:
+                    members = {**members, **_INTERFACE_MEMBERS}
             expected = sorted(f"{name}.npy" for name in ("manifest", *members))
             if names != expected:
                 extra = sorted(set(names) ^ set(expected))
@@ -338,9 +373,13 @@ def read_dual(path: str | Path) -> Dual:
             limit = max(size * 1100, 1 << 20)  # deflate's best ratio is about 1000
             _, raw = _member(archive, "manifest", path, 1 << 20)
             manifest = _manifest(raw, path)
-            if (manifest["version"] == 4) != (members is not _MEMBERS):
-                raise FormatError(f"{path}: dual format version {manifest['version']} "
-                                  f"{'without' if manifest['version'] == 4 else 'with'} the region members")
+            expected_members = {3: len(_MEMBERS), 4: len(_MEMBERS) + len(_REGION_MEMBERS),
+                                5: len(_MEMBERS) + len(_REGION_MEMBERS) + len(_INTERFACE_MEMBERS)}
+            if expected_members[manifest["version"]] != len(members):
+                raise FormatError(f"{path}: dual format version {manifest['version']} with the members of "
+                                  f"another version ({'with' if 'element_region' in members else 'without'} the "
+                                  f"region members, {'with' if 'interface_face_nodes' in members else 'without'} "
+                                  "the interface members)")
             _check_headers(archive, path, members)
             arrays = {}
             for name in members:
@@ -368,7 +407,8 @@ def _manifest(raw: np.ndarray, path: Path) -> dict[str, Any]:
         raise FormatError(f"{path}: not a cospherical dual (its manifest names no format cospherical-dual)")
     if manifest.get("version") not in _VERSIONS:
         raise FormatError(f"{path}: dual format version {manifest.get('version')!r}; this reads "
-                          f"{' and '.join(map(str, _VERSIONS))} (write it again with cospherical mesh --dual)")
+                          f"{', '.join(map(str, _VERSIONS[:-1]))} and {_VERSIONS[-1]} (write it again with "
+                          "cospherical mesh --dual)")
     for key, kind in (("domain", list), ("grid", int), ("coefficient_denominator", str), ("volume_denominator", str),
                       ("volume_factor_squared", str), ("boundary_area_denominator", str),
                       ("boundary_factors_squared", list), ("sha256", dict)):
@@ -436,7 +476,7 @@ def _dual(arrays: dict[str, np.ndarray], manifest: dict[str, Any], path: Path) -
 
 def _region_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], n_vertices: int, n_edges: int, n_elements: int, path: Path,
                   factor: float, n_face_bound: int) -> RegionParts:
-    """A version 4 file's region members, checked: names, indices in range, denominators (before any geometry)."""
+    """A version 4 or 5 file's region members, checked: names, indices in range, denominators (before any geometry)."""
     # JSON values, their types checked below
     names: Any = manifest.get("region_names")
     materials: Any = manifest.get("region_materials")
@@ -498,14 +538,53 @@ def _region_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], n_ver
         arrays["contact_part_contact"].astype(np.int32),
         _integers(arrays["contact_part_exact"], "contact_part_exact", path), denominators[2], factor,
         tuple(origin), tuple(tuple(tuple(b) for b in boxes) for boxes in region_boxes))
-    for name in ("volume_part", "coupling_part", "contact_part"):  # the floats: what the exact values give
+    if "interface_face_nodes" in arrays:
+        parts.interfaces = _interface_parts(arrays, manifest, names, n_vertices, n_face_bound, path)
+    floats: list[tuple[str, RegionParts | InterfaceParts, str]] = [
+        (name, parts, name) for name in ("volume_part", "coupling_part", "contact_part")]
+    if parts.interfaces is not None:
+        floats.append(("interface_part", parts.interfaces, "part"))
+    for name, holder, attribute in floats:  # the floats: what the exact values give
         try:
-            given = getattr(parts, name)
+            given = getattr(holder, attribute)
         except OverflowError:  # a denominator of hundreds of digits: no float
             raise FormatError(f"{path}: manifest: {name}_denominator is too large for its parts to be floats") from None
         if not np.array_equal(arrays[name], given):
             raise FormatError(f"{path}: member {name}: not what the exact values give")
     return parts
+
+
+def _interface_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], names: list[str], n_vertices: int, n_face_bound: int,
+                     path: Path) -> InterfaceParts:
+    """A version 5 file's interface members, checked: region pairs, indices in range, faces of distinct
+    vertices, the denominator (before any geometry)."""
+    pairs = manifest.get("interface_regions")
+    if not isinstance(pairs, list) or len(pairs) > _MAX_NAMES * (_MAX_NAMES - 1) // 2 or not all(
+            isinstance(p, list) and len(p) == 2 and all(type(r) is int for r in p) and 0 <= p[0] < p[1] < len(names)
+            for p in pairs) or len({tuple(p) for p in pairs}) != len(pairs):
+        raise FormatError(f"{path}: manifest: interface_regions is not a list of distinct region pairs [a, b], a < b")
+    denominator = manifest.get("interface_part_denominator")
+    if not isinstance(denominator, str) or not _POSITIVE.fullmatch(denominator):
+        raise FormatError(f"{path}: manifest: interface_part_denominator is not a positive integer of at most 1000 "
+                          "digits")
+    for name, bound in (("interface_face_interface", len(pairs)), ("interface_part_vertex", n_vertices),
+                        ("interface_part_interface", len(pairs))):
+        values = arrays[name]
+        if len(values) and (values.min() < 0 or values.max() >= bound):
+            raise FormatError(f"{path}: member {name}: an index outside 0..{bound - 1}")
+    faces = arrays["interface_face_nodes"]
+    if np.any((faces < -1) | (faces >= n_vertices)) or np.any((faces[:, :3] < 0)):
+        raise FormatError(f"{path}: member interface_face_nodes: a face that names no vertex")
+    if len(faces) > n_face_bound:
+        raise FormatError(f"{path}: member interface_face_nodes: {len(faces):,} faces, more than its elements have "
+                          f"({n_face_bound:,})")
+    _distinct_rows(faces, faces >= 0, path, "interface_face_nodes", "face")
+    regions = np.array(pairs, dtype=np.int32).reshape(-1, 2)
+    return InterfaceParts(regions, tuple(f"{names[a]}|{names[b]}" for a, b in regions.tolist()), faces.astype(np.int32),
+                          arrays["interface_face_interface"].astype(np.int32),
+                          arrays["interface_part_vertex"].astype(np.int64),
+                          arrays["interface_part_interface"].astype(np.int32),
+                          _integers(arrays["interface_part_exact"], "interface_part_exact", path), int(denominator))
 
 
 def _distinct_faces(faces: np.ndarray, most: int, path: Path) -> None:
@@ -619,7 +698,8 @@ def _element_shapes(dual: Dual, path: str | Path) -> np.ndarray:
     return shape
 
 
-def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path, layout: DeviceLayout | None = None) -> None:
+def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path, layout: DeviceLayout | None = None,
+                element_region: np.ndarray | None = None) -> tuple[Any, ...] | None:
     """The elements are a mesh of the domain: every face met by exactly two elements, in opposite
     orientations, or by one in the domain's boundary
     (:func:`~cospherical.mesh.checks.pair_faces`, the mesher's own conformity rule).
@@ -630,14 +710,24 @@ def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path, layout: DeviceL
     the number of elements over a point, so that number is the same all over the domain, and
     the volumes make it one.  Volume sums alone cannot see elements that overlap and leave a
     hole of the same volume.
+
+    With ``element_region`` (a version 5 device), returns the faces paired by
+    :func:`~cospherical.mesh.regions.face_sets` (the boundary's and the interfaces'), else ``None``.
     """
     from ..mesh.checks import element_faces, pair_faces
+    from ..mesh.regions import face_sets
 
+    owners: dict[int, list[np.ndarray]] | None = {} if element_region is not None else None
     try:
         faces = element_faces(dual.grid_vertices, dual.element_nodes, dual.element_sizes, shape, dual.box.squared,
-                              machine_memory() // 2)
+                              machine_memory() // 2, owners=owners)
     except InputError as error:
         raise FormatError(f"{path}: member element_nodes: {error}") from None
+    sets = None
+    if owners is not None and element_region is not None:
+        sizes = list(faces)
+        sets = face_sets(np.concatenate([m for size in sizes for m in owners[size]]),
+                         [f for size in sizes for f in faces[size]], element_region)
     found = pair_faces(faces, dual.grid_vertices, dual.grid, examples=1, layout=layout)
     if found.nonconforming_faces:
         corners = [[round(x * dual.grid) for x in corner] for corner in found.nonconforming_examples[0]]
@@ -645,6 +735,7 @@ def _check_mesh(dual: Dual, shape: np.ndarray, path: str | Path, layout: DeviceL
                           "faces are neither shared by two elements in opposite orientations nor in the domain's "
                           f"boundary, e.g. the face of grid points {', '.join(map(str, corners[:6]))}"
                           f"{', ...' if len(corners) > 6 else ''}")
+    return sets
 
 
 def verify_dual(dual: Dual, path: str | Path) -> None:
@@ -654,17 +745,24 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
     float member that is not what its exact value gives.
     """
     from ..mesh.dual import as_floats, boundary_areas, mesh_dual
+    from ..mesh.surfaces import set_domain_boundary
 
     _distinct_vertices(dual.grid_vertices, path)
     shape = _element_shapes(dual, path)
+    layout = dual_layout(dual, path)
+    interfaces = dual.regions.interfaces if dual.regions is not None else None
+    if layout is not None and dual.regions is not None:
+        _check_element_regions(dual, dual.regions, layout, path)
+    sets = _check_mesh(dual, shape, path, layout,
+                       dual.regions.element_region if dual.regions is not None and interfaces is not None else None)
     try:
         again = mesh_dual(_Vertices(dual.box, dual.grid, dual.grid_vertices), (dual.element_nodes, dual.element_sizes))
     except InputError as error:  # an element that is flat or not co-spherical has no dual
         raise FormatError(f"{path}: member element_nodes: {error}") from None
-    layout = dual_layout(dual, path)
-    _check_mesh(dual, shape, path, layout)
-    if layout is not None and dual.regions is not None:
-        _check_element_regions(dual, dual.regions, layout, path)
+    if sets is not None:  # a version 5 device: its boundary is the faces met once (4: the bounding box's sides)
+        _verify_interfaces(dual, sets, path)
+        _, face, ones, _, _, _ = sets
+        set_domain_boundary(again, face[ones])
     if not np.array_equal(again.edges, dual.edges):
         raise FormatError(f"{path}: member edges: not the edges of its elements ({len(dual.edges)} edges, "
                           f"its elements have {len(again.edges)})")
@@ -719,6 +817,8 @@ def verify_dual(dual: Dual, path: str | Path) -> None:
             raise FormatError(f"{path}: member {name}: {what} is not what the exact values give")
     if dual.regions is not None:
         _verify_regions(dual, dual.regions, path)
+    if sets is not None:
+        dual.boundary_edge = again.boundary_edge  # verified: the edges in the boundary, which the file does not hold
 
 
 def _check_element_regions(dual: Dual, parts: RegionParts, layout: DeviceLayout, path: str | Path) -> None:
@@ -744,7 +844,7 @@ def _check_element_regions(dual: Dual, parts: RegionParts, layout: DeviceLayout,
 
 
 def dual_layout(dual: Dual, path: str | Path) -> DeviceLayout | None:
-    """A version 4 file's device geometry (its regions' boxes and its contacts) checked again and cut into
+    """A version 4 or 5 file's device geometry (its regions' boxes and its contacts) checked again and cut into
     blocks (:class:`~cospherical.mesh.device.DeviceLayout`), or ``None`` for a one-box dual; its bounding box
     must be the file's domain, its low corner the file's origin."""
     from ..mesh.device import Contact, Device, Region, device_layout
@@ -773,10 +873,10 @@ def _six(texts: tuple[str, ...]) -> tuple[Fraction, Fraction, Fraction, Fraction
     return x0, y0, z0, x1, y1, z1
 
 
-def domain_sums(layout: DeviceLayout) -> tuple[Fraction, tuple[Fraction, Fraction, Fraction]]:
+def domain_sums(layout: DeviceLayout, whole: bool = True) -> tuple[Fraction, tuple[Fraction, Fraction, Fraction]]:
     """What a device's control volumes and boundary areas sum to: its volume as a fraction of the bounding
-    box's, and per axis the area of its faces in the bounding box's two sides normal to it as a fraction
-    of one side's (the dual's boundary areas are counted in those sides)."""
+    box's, and per axis the area of its boundary normal to it as a fraction of one side of the bounding
+    box (``whole=False``: only the boundary in the bounding box's two sides, as a version 4 file counts it)."""
     steps = [np.diff(p) for p in layout.planes]
     inside = layout.owner >= 0
     volume = Fraction(int((inside * steps[0][:, None, None] * steps[1][None, :, None]
@@ -786,12 +886,17 @@ def domain_sums(layout: DeviceLayout) -> tuple[Fraction, tuple[Fraction, Fractio
         b, c = [a for a in range(3) if a != axis]
         area = np.outer(steps[b], steps[c])
         layers = np.moveaxis(inside, axis, 0)
-        sides.append(Fraction(int((layers[0] * area).sum() + (layers[-1] * area).sum()), layout.steps ** 2))
+        if whole:  # a block face with the domain on one side only, at every plane
+            padded = np.pad(layers, ((1, 1), (0, 0), (0, 0)))
+            faces = padded[1:] != padded[:-1]
+        else:
+            faces = np.stack([layers[0], layers[-1]])
+        sides.append(Fraction(int((faces * area).sum()), layout.steps ** 2))
     return volume, (sides[0], sides[1], sides[2])
 
 
 def _verify_regions(dual: Dual, parts: RegionParts, path: str | Path) -> None:
-    """A version 4 file's region parts computed again from its elements, their regions and its contact faces,
+    """A version 4 or 5 file's region parts computed again from its elements, their regions and its contact faces,
     and compared exactly; each contact's faces lie in its rectangle and cover its area exactly."""
     from ..mesh.regions import region_parts
 
@@ -813,9 +918,9 @@ def _verify_regions(dual: Dual, parts: RegionParts, path: str | Path) -> None:
         again = region_parts(dual.box, dual.grid, dual.grid_vertices, dual, parts.element_region, parts.names,
                              parts.materials, contacts, parts.contact_face_nodes, parts.contact_face_contact, lengths,
                              parts.origin)
-    except ZeroDivisionError:  # a face whose first three vertices are on one line in its contact's plane
-        raise FormatError(f"{path}: member contact_face_nodes: a contact face is no polygon in its contact's "
-                          "plane") from None
+    except InputError as error:  # a face off the coordinate planes, or whose first three vertices are on a line
+        raise FormatError(f"{path}: member contact_face_nodes: a contact face is no polygon in a coordinate "
+                          f"plane ({error})") from None
 
     def rows_differ(name: str, ours: tuple[tuple[np.ndarray, ...], np.ndarray, int],
                     theirs: tuple[tuple[np.ndarray, ...], np.ndarray, int]) -> None:
@@ -880,3 +985,52 @@ def _contact_faces_on_elements(dual: Dual, parts: RegionParts, path: str | Path)
                               f"{shown(parts.contact_names[c])} is no face of an element of its region "
                               f"{shown(parts.names[parts.contact_regions[c]])}")
 
+
+
+def _verify_interfaces(dual: Dual, sets: tuple[np.ndarray, ...], path: str | Path) -> None:
+    """A version 5 file's interfaces computed again from its elements and their regions and compared exactly:
+    the region pairs, the faces between elements of two regions (each oriented out of the lower region's
+    element), each face's interface, and every (vertex, interface) area part."""
+    from ..mesh.surfaces import interface_parts
+
+    _, face, _, pair, pairs, which = sets
+    parts = dual.regions
+    given = parts.interfaces if parts is not None else None
+    if parts is None or given is None:
+        raise ValueError("_verify_interfaces: a dual without interfaces")
+    try:
+        a, b, c = (Fraction(text) for text in dual.box.texts)
+    except ValueError:
+        raise FormatError(f"{path}: manifest: a device's domain lengths must be rational") from None
+    lengths = (a, b, c)
+    again = interface_parts(dual.grid_vertices, dual.grid, lengths, parts.names, pairs, face[pair[:, 0]], which)
+    if not np.array_equal(again.regions, given.regions):
+        raise FormatError(f"{path}: manifest: interface_regions {given.regions.tolist()[:8]} are not the region pairs "
+                          f"whose elements meet ({again.regions.tolist()[:8]})")
+    ours, theirs = _oriented(again.face_nodes, again.face_interface), _oriented(given.face_nodes, given.face_interface)
+    if ours.shape != theirs.shape or not np.array_equal(ours, theirs):
+        raise FormatError(f"{path}: member interface_face_nodes: not the faces between elements of two regions, "
+                          f"each oriented out of the lower region's ({len(theirs)} faces, its elements have "
+                          f"{len(ours)})")
+    if not (np.array_equal(again.vertex, given.vertex) and np.array_equal(again.interface, given.interface)):
+        raise FormatError(f"{path}: member interface_part_vertex: not the rows its interface faces give "
+                          f"({len(given.vertex)} rows, they give {len(again.vertex)})")
+    wrong = np.flatnonzero(np.asarray(again.exact.astype(object) * given.denominator
+                                      != given.exact.astype(object) * again.denominator).reshape(-1))
+    if len(wrong):
+        k = int(wrong[0])
+        raise FormatError(f"{path}: member interface_part_exact: row {k} (vertex {int(given.vertex[k])}, interface "
+                          f"{shown(given.names[given.interface[k]])}) is not the part its faces give")
+
+
+def _oriented(faces: np.ndarray, which: np.ndarray) -> np.ndarray:
+    """Polygons (-1 padded) each turned to start at its smallest vertex, orientation kept, with their set in the
+    last column, rows sorted: equal for the same oriented faces in any order and from any first corner."""
+    width = max(faces.shape[1] if faces.ndim == 2 else 0, 4)
+    rows = []
+    for polygon, w in zip(faces.tolist(), which.tolist()):
+        ids = [v for v in polygon if v >= 0]
+        k = ids.index(min(ids))
+        rows.append(ids[k:] + ids[:k] + [-1] * (width - len(ids)) + [w])
+    table = np.array(rows, dtype=np.int64).reshape(-1, width + 1)
+    return table[np.lexsort(table.T[::-1])] if len(table) else table

@@ -73,7 +73,7 @@ _PAIR_CHUNK = 1 << 22
 
 __all__ = ["CircumcenterCheck", "ConformityCheck", "DelaunayCheck", "OpenFaces", "VolumeCheck", "check_circumcenters",
            "check_conformity", "check_delaunay", "check_volume", "element_faces", "grid_weights", "match_seams",
-           "on_domain_boundary", "pair_faces"]
+           "in_closed_domain", "on_domain_boundary", "pair_faces"]
 
 
 @dataclass(frozen=True)
@@ -184,7 +184,9 @@ def _leaf_faces(tessellation: LocalTessellation) -> tuple[int, list[tuple[int, .
 
 def element_faces(vertices: NDArray[np.integer[Any]], nodes: NDArray[np.integer[Any]], sizes: NDArray[np.integer[Any]],
                   shape: NDArray[np.integer[Any]], squared: Sequence[Rational],
-                  most_bytes: int | None = None) -> dict[int, list[NDArray[np.integer[Any]]]]:
+                  most_bytes: int | None = None,
+                  owners: dict[int, list[NDArray[np.integer[Any]]]] | None = None
+                  ) -> dict[int, list[NDArray[np.integer[Any]]]]:
     """Every face of elements given by their vertices, as :func:`pair_faces` reads them: by size, rows of
     vertex ids counter-clockwise seen from outside.
 
@@ -195,7 +197,7 @@ def element_faces(vertices: NDArray[np.integer[Any]], nodes: NDArray[np.integer[
     of the box's squared lengths ``squared``), taken for all its elements at once.  A flat
     element raises :class:`~cospherical.errors.InputError`, and so do faces whose arrays (with
     what :func:`pair_faces` makes of them) would take more than ``most_bytes``, before they
-    are made.
+    are made.  ``owners``, a dict, gets the same lists of each face's element.
     """
     order = np.argsort(shape, kind="stable")
     _, starts = np.unique(shape[order], return_index=True)
@@ -219,6 +221,8 @@ def element_faces(vertices: NDArray[np.integer[Any]], nodes: NDArray[np.integer[
         rows = nodes[members]
         for cycle in cycles:
             faces.setdefault(len(cycle), []).append(rows[:, cycle])
+            if owners is not None:
+                owners.setdefault(len(cycle), []).append(members)
     return faces
 
 
@@ -511,8 +515,10 @@ def check_circumcenters(mesh: Mesh) -> CircumcenterCheck:
 
 
 def _outside_domain(mesh: Mesh) -> int:
-    """Elements whose circumcenter lies outside the closed domain, decided exactly in grid units."""
+    """Elements whose circumcenter lies outside the closed domain (a device's: its union of boxes), decided
+    exactly in grid units."""
     grid = mesh.grid
+    layout = mesh.regions.layout if mesh.regions is not None else None
     size = mesh.leaf_size()
     outside = 0
     for _, tessellation, leaves in mesh.groups():
@@ -527,11 +533,39 @@ def _outside_domain(mesh: Mesh) -> int:
             kind = np.int64 if grid * (max(denominators) + max(map(abs, numerators))) < 2**62 else object
             p, q = np.array(numerators, dtype=kind), np.array(denominators, dtype=kind)
             at = low.astype(kind) * q[None] + p[None] * size[leaves, None].astype(kind)
-            outside += int((~in_closed_box(at, q[None], 0, grid)).sum())
+            outside += int((~in_closed_domain(at, q[None], grid, layout)).sum())
     if mesh.cells is not None:
         num, den = mesh.cell_centers()
-        outside += int((~in_closed_box(num, den[:, None], 0, grid)).sum())
+        outside += int((~in_closed_domain(num, den[:, None], grid, layout)).sum())
     return outside
+
+
+def in_closed_domain(numerators: np.ndarray, denominators: np.ndarray, grid: int,
+                     layout: DeviceLayout | None = None) -> np.ndarray:
+    """Per rational point (``numerators`` (n x 3) over positive ``denominators``, broadcast per row or per
+    axis; grid units), whether it lies in the closed domain: the box of ``grid`` intervals per side, or a
+    device's union of boxes (``layout``: in the closed block of a region, decided in integers; a point on
+    a block plane lies in either block beside it)."""
+    inside = in_closed_box(numerators, denominators, 0, grid)
+    if layout is None or not len(numerators):
+        return inside
+    den = np.broadcast_to(denominators, numerators.shape)
+    factor = grid // layout.steps  # grid steps per step of the resolving level
+    ranges = []
+    for axis in range(3):
+        planes = (layout.planes[axis] * factor).astype(numerators.dtype)
+        scaled = planes[None, :] * den[:, axis, None]
+        point = numerators[:, axis, None]
+        blocks = len(planes) - 2
+        low = np.clip((scaled < point).sum(axis=1) - 1, 0, blocks)  # the blocks whose closed span holds it
+        high = np.clip((scaled <= point).sum(axis=1) - 1, 0, blocks)
+        ranges.append((low.astype(np.int64), high.astype(np.int64)))
+    held = np.zeros(len(numerators), dtype=bool)
+    for i in ranges[0]:
+        for j in ranges[1]:
+            for k in ranges[2]:
+                held |= layout.owner[i, j, k] >= 0
+    return inside & held
 
 
 @dataclass(frozen=True, eq=False)

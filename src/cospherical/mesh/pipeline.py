@@ -170,7 +170,7 @@ class PipelineResult:
 
 
 class _Clock:
-    """Seconds per stage, in the order the stages ran."""
+    """Seconds per stage, in the order the stages first ran (a stage entered again adds to its time)."""
 
     def __init__(self, timings: dict[str, float]) -> None:
         self.timings = timings
@@ -180,7 +180,7 @@ class _Clock:
     def stage(self, name: str | None) -> None:
         now = time.perf_counter()
         if self.current is not None:
-            self.timings[self.current] = now - self.start
+            self.timings[self.current] = self.timings.get(self.current, 0.0) + now - self.start
         self.current, self.start = name, now
 
 
@@ -253,24 +253,24 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
                                          conformity_progress=told("conformity", None))
     report = checked_report.report
     found = faces = None
-    if dual:
-        from .dual import dual_summary, mesh_dual
-
-        clock.stage("dual")
-        if progress is not None:
-            progress("dual", 1, 0)
-        found = mesh_dual(mesh)
-        if progress is not None:
-            progress("dual", 1, 1)
-        report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"],
-                                   tetrahedral=tetrahedral_counts))
     if source.device is not None:
         from .regions import device_report, region_faces
 
         clock.stage("regions")
         faces = region_faces(mesh)
-        if found is not None:
-            found = full_dual(mesh, faces, found)
+    if dual:
+        from .dual import dual_summary
+
+        clock.stage("dual")
+        if progress is not None:
+            progress("dual", 1, 0)
+        found = full_dual(mesh, faces)
+        if progress is not None:
+            progress("dual", 1, 1)
+        report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"],
+                                   tetrahedral=tetrahedral_counts))
+    if faces is not None:
+        clock.stage("regions")
         report["device"] = device_report(mesh, faces, found)
     clock.stage(None)
     return PipelineResult(source, mesh, MeshReport.from_dict(report, timings), found,
@@ -289,7 +289,14 @@ def full_dual(mesh: Mesh, faces: RegionFaces | None, dual: Dual | None = None) -
     if dual is None:
         dual = mesh_dual(mesh)
     if faces is not None and dual.regions is None:
-        from .regions import mesh_region_parts
+        from .regions import device_of, mesh_region_parts
+        from .surfaces import interface_parts, set_domain_boundary
 
+        set_domain_boundary(dual, faces.boundary_nodes)  # a union of boxes: its boundary, not the bounding box's
         dual.regions = mesh_region_parts(mesh, dual, faces)
+        regions, layout, _ = device_of(mesh)
+        (x0, x1), (y0, y1), (z0, z1) = layout.device.bounds
+        dual.regions.interfaces = interface_parts(
+            mesh.vertices, mesh.grid, (x1 - x0, y1 - y0, z1 - z0), regions.names,
+            faces.interfaces, faces.interface_nodes, faces.interface_face_interface)
     return dual

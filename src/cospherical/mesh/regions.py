@@ -48,8 +48,9 @@ from .delaunay import delaunay_mesh, with_cells
 from .dual import Dual, RegionParts, mesh_dual
 from .device import DeviceLayout, Regions
 from .octree import Octree
+from .surfaces import edge_keys, vertex_parts
 
-__all__ = ["RegionFaces", "contact_areas", "device_mesh", "device_report", "mesh_region_parts", "region_faces", "region_parts",
+__all__ = ["RegionFaces", "contact_areas", "device_mesh", "device_report", "face_sets", "mesh_region_parts", "region_faces", "region_parts",
            "region_volumes"]
 
 
@@ -200,6 +201,9 @@ class RegionFaces:
     of ``interface_element[:, 0]`` (the element of the lower region index) into
     ``interface_element[:, 1]``; ``interface_face_interface`` indexes ``interfaces``,
     the pairs of touching regions ``(a, b)``, ``a < b``, named ``"name_a|name_b"``.
+    ``boundary_nodes``: every face met by one element only (the domain's boundary, the
+    contacts' faces among them), as its element has it; ``boundary_edges``: the keys
+    ``i * V + j`` (``i < j``, ``V`` vertices) of those faces' edges.
     """
 
     contact_nodes: np.ndarray
@@ -211,6 +215,7 @@ class RegionFaces:
     interface_element: np.ndarray
     interface_face_interface: np.ndarray
     boundary_edges: np.ndarray
+    boundary_nodes: np.ndarray
 
     def contact_vertices(self, contact: int) -> np.ndarray:
         """The distinct vertices of a contact's faces, increasing."""
@@ -229,21 +234,54 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     """
     regions, layout, element_region = device_of(mesh)
     rows, polygons = [], []
-    width = 0
-    vertices = mesh.vertices.astype(np.int64)
-    planes = [plane * (mesh.grid // layout.steps) for plane in layout.planes]
     for element_rows, nodes, faces, _ in mesh.blocks():
         for cycle in faces:
-            polygon = nodes[:, list(cycle)]
-            on = _on_a_plane(vertices, polygon, planes)
-            rows.append(element_rows[on])
-            polygons.append(polygon[on])
-            width = max(width, len(cycle))
+            rows.append(element_rows)
+            polygons.append(nodes[:, list(cycle)])
     if not rows:
         empty = np.zeros((0, 0), dtype=np.int32)
         return RegionFaces(empty, np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros((0, 2), np.int32), (),
-                           empty, np.zeros((0, 2), np.int64), np.zeros(0, np.int32), np.zeros(0, np.int64))
-    element = np.concatenate(rows).astype(np.int64)
+                           empty, np.zeros((0, 2), np.int64), np.zeros(0, np.int32), np.zeros(0, np.int64), empty)
+    element, face, ones, interface_element, interfaces, which = face_sets(np.concatenate(rows), polygons,
+                                                                          element_region)
+    names = tuple(f"{regions.names[a]}|{regions.names[b]}" for a, b in interfaces.tolist())
+    # contacts: faces met once, flat in the contact's plane, inside its rectangle
+    points = mesh.vertices.astype(np.int64)[np.maximum(face[ones], 0)]
+    valid = face[ones] >= 0
+    factor = mesh.grid // layout.steps
+    contact_of = np.full(len(ones), -1, dtype=np.int64)
+    for c, (axis, value, (p0, p1), (q0, q1)) in enumerate(layout.contacts):
+        b, d = (axis + 1) % 3, (axis + 2) % 3
+        on = np.all(~valid | (points[:, :, axis] == value * factor), axis=1)
+        on &= np.all(~valid | ((points[:, :, b] >= p0 * factor) & (points[:, :, b] <= p1 * factor)
+                               & (points[:, :, d] >= q0 * factor) & (points[:, :, d] <= q1 * factor)), axis=1)
+        region = [r.name for r in layout.device.regions].index(layout.device.contacts[c].region)
+        on &= element_region[element[ones]] == region
+        contact_of[on & (contact_of < 0)] = c
+    hit = contact_of >= 0
+    outer = face[ones]
+    lower = interface_element[:, 0]
+    return RegionFaces(face[ones[hit]].astype(np.int32), element[ones[hit]], contact_of[hit].astype(np.int32),
+                       interfaces.astype(np.int32), names, face[lower].astype(np.int32),
+                       np.stack([element[lower], element[interface_element[:, 1]]], axis=1),
+                       which.astype(np.int32).reshape(-1), edge_keys(outer, len(mesh.vertices)),
+                       outer.astype(np.int32))
+
+
+def face_sets(element: np.ndarray, polygons: list[np.ndarray], element_region: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every element face paired by its vertices: the faces met once, and those between two regions.
+
+    ``element``: each face's element; ``polygons``: blocks of faces (rows of vertex ids,
+    counter-clockwise seen from outside their element; all blocks' rows in ``element``'s
+    order).  Returns the faces (-1 padded) and their elements, sorted by vertex set; the
+    indices into them of the faces met once; per interface face the indices of its two
+    occurrences (the lower region's first, as the face is oriented out of it: the interface
+    polygon); the interfaces (region pairs ``a < b``) and each interface face's interface.
+    The mesher's faces and check's (from a file's elements) are sorted by this one rule.
+    """
+    width = max(p.shape[1] for p in polygons)
+    element = np.asarray(element, dtype=np.int64)
     face = np.concatenate([np.pad(p, ((0, 0), (0, width - p.shape[1])), constant_values=-1) for p in polygons])
     key = np.sort(np.where(face < 0, np.iinfo(np.int32).max, face), axis=1)
     order = np.lexsort(key.T[::-1])
@@ -263,30 +301,8 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     pairs = np.stack([element_region[element[lower]], element_region[element[upper]]], axis=1)
     interfaces, which = (np.unique(pairs, axis=0, return_inverse=True) if len(pairs)
                          else (np.zeros((0, 2), np.int64), np.zeros(0, np.int64)))
-    names = tuple(f"{regions.names[a]}|{regions.names[b]}" for a, b in interfaces.tolist())
-    # contacts: faces met once, flat in the contact's plane, inside its rectangle
-    ones = np.flatnonzero(single)
-    points = mesh.vertices.astype(np.int64)[np.maximum(face[ones], 0)]
-    valid = face[ones] >= 0
-    factor = mesh.grid // layout.steps
-    contact_of = np.full(len(ones), -1, dtype=np.int64)
-    for c, (axis, value, (p0, p1), (q0, q1)) in enumerate(layout.contacts):
-        b, d = (axis + 1) % 3, (axis + 2) % 3
-        on = np.all(~valid | (points[:, :, axis] == value * factor), axis=1)
-        on &= np.all(~valid | ((points[:, :, b] >= p0 * factor) & (points[:, :, b] <= p1 * factor)
-                               & (points[:, :, d] >= q0 * factor) & (points[:, :, d] <= q1 * factor)), axis=1)
-        region = [r.name for r in layout.device.regions].index(layout.device.contacts[c].region)
-        on &= element_region[element[ones]] == region
-        contact_of[on & (contact_of < 0)] = c
-    hit = contact_of >= 0
-    outer = face[ones]
-    following = np.where(np.roll(outer, -1, axis=1) >= 0, np.roll(outer, -1, axis=1), outer[:, :1])
-    lo, hi = np.minimum(outer, following), np.maximum(outer, following)
-    keys = (lo.astype(np.int64) * len(mesh.vertices) + hi)[outer >= 0]
-    return RegionFaces(face[ones[hit]].astype(np.int32), element[ones[hit]], contact_of[hit].astype(np.int32),
-                       interfaces.astype(np.int32), names, face[lower].astype(np.int32),
-                       np.stack([element[lower], element[upper]], axis=1), which.astype(np.int32).reshape(-1),
-                       np.unique(keys))
+    return element, face, np.flatnonzero(single), np.stack([lower, upper], axis=1), interfaces, \
+        which.reshape(-1)
 
 
 def _on_a_plane(vertices: np.ndarray, polygon: np.ndarray, planes: list[np.ndarray]) -> np.ndarray:
@@ -390,19 +406,18 @@ def region_parts(box: Box, grid: int, vertices: np.ndarray, dual: Dual, element_
     if contact_face_nodes is None or contact_face_contact is None:
         contact_face_nodes = np.zeros((0, 3), dtype=np.int32)
         contact_face_contact = np.zeros(0, dtype=np.int32)
-    share_vertex, share_contact, shares, common = _contact_shares(vertices, grid, contact_face_nodes,
-                                                                  contact_face_contact, [c[3] for c in contacts],
-                                                                  lengths)
-    # the smallest denominator of all the shares: what the totals over ``common`` have in common divides out
-    contact_denominator = common // math.gcd(common, *shares.tolist())
+    contact_vertex, contact_contact, contact_exact, contact_denominator = vertex_parts(
+        vertices, contact_face_nodes, contact_face_contact, len(contacts), grid,
+        lengths or (Fraction(1), Fraction(1), Fraction(1)))
     return RegionParts(
         tuple(names), tuple(materials), element_region.astype(np.int32), volume_vertex[order].astype(np.int64),
         volume_region[order], volume_exact[order], volume_denominator, coupling_edge[corder].astype(np.int64),
         coupling_region[corder],
         coupling_exact[corder], coupling_denominator, tuple(c[0] for c in contacts), tuple(c[1] for c in contacts),
         tuple(tuple(c[2]) for c in contacts), contact_face_nodes.astype(np.int32),
-        contact_face_contact.astype(np.int32), share_vertex, share_contact,
-        _narrow_array(shares // (common // contact_denominator)), contact_denominator, dual.volume_factor,
+        contact_face_contact.astype(np.int32), contact_vertex.astype(np.int64), contact_contact.astype(np.int32),
+        _narrow_array(contact_exact) if contact_exact.dtype != object else _narrow(contact_exact.tolist()),
+        contact_denominator, dual.volume_factor,
         tuple(str(x) for x in origin), boxes)
 
 
@@ -437,72 +452,6 @@ def _common(parts: list[np.ndarray], denominators: list[int], common: int) -> np
         return np.concatenate([part.astype(np.int64) * np.int64(common // d) for part, d in zip(parts, denominators)]
                               + [np.zeros(0, dtype=np.int64)])
     return _narrow([int(x) * (common // d) for part, d in zip(parts, denominators) for x in part.tolist()])
-
-
-def _contact_shares(vertices: np.ndarray, grid: int, faces: np.ndarray, which: np.ndarray, axes: list[int],
-                    lengths: Sequence[Fraction] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """Per (vertex, contact), its part of the contact's faces' area, exactly (device units).
-
-    Returns the pairs' vertices (int64) and contacts (int32), sorted by vertex then contact,
-    and their shares as int64 numerators over the returned common denominator.
-
-    A co-circular face gives each vertex the triangles between it, the midpoints of
-    its two edges and the face's circle centre (signed: they add up to the face's
-    area whatever the shape); computed once per face shape up to translation.
-    """
-    if not len(faces):
-        return np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int64), 1
-    if lengths is None:
-        raise InputError("contact faces need the bounding box's lengths")
-    n, width = faces.shape
-    valid = faces >= 0
-    axis = np.asarray(axes, dtype=np.int64)[which]
-    points = vertices[np.maximum(faces, 0)].astype(np.int64)  # (faces, width, 3)
-    rows, columns = np.arange(n)[:, None], np.arange(width)[None]
-    # each face in its plane's two axes, from its first vertex: one shape per (axis, offsets)
-    u = np.where(valid, points[rows, columns, ((axis + 1) % 3)[:, None]], 0)
-    v = np.where(valid, points[rows, columns, ((axis + 2) % 3)[:, None]], 0)
-    u, v = np.where(valid, u - u[:, :1], -1), np.where(valid, v - v[:, :1], -1)
-    _, first, shape_of = np.unique(np.c_[axis, u, v], axis=0, return_index=True, return_inverse=True)
-    measured = []
-    for f in first.tolist():
-        a, size = int(axis[f]), int(valid[f].sum())
-        scale = (Fraction(lengths[(a + 1) % 3]) / grid, Fraction(lengths[(a + 2) % 3]) / grid)
-        measured.append(_polygon_shares([(int(x) * scale[0], int(y) * scale[1])
-                                         for x, y in zip(u[f, :size].tolist(), v[f, :size].tolist())]))
-    # every share over one denominator, as integers; a face's vertex gets its shape's share at its place
-    common = math.lcm(1, *(q.denominator for m in measured for q in m))
-    table = [[int(q * common) for q in m] + [0] * (width - len(m)) for m in measured]
-    if max(abs(x) for row in table for x in row) >= 2**62 // max(1, n * width):
-        raise InputError(f"contact face shares over {common:,} do not fit the integers this sums them in")
-    value = np.array(table, dtype=np.int64)[shape_of.reshape(-1)][valid]
-    key = faces[valid].astype(np.int64) * (int(which.max()) + 1) + np.broadcast_to(which[:, None], faces.shape)[valid]
-    order = np.argsort(key, kind="stable")
-    key, value = key[order], value[order]
-    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-    totals = np.add.reduceat(value, starts)
-    base = int(which.max()) + 1
-    return key[starts] // base, (key[starts] % base).astype(np.int32), totals.astype(np.int64), common
-
-
-def _polygon_shares(p: list[tuple[Fraction, Fraction]]) -> list[Fraction]:
-    """Each vertex's share of a co-circular polygon's area (circle centre, edge midpoints), exactly."""
-    (x0, y0), (x1, y1), (x2, y2) = p[:3]
-    # the circle's centre: equidistant from the first three points
-    a1, b1, c1 = 2 * (x1 - x0), 2 * (y1 - y0), x1 * x1 - x0 * x0 + y1 * y1 - y0 * y0
-    a2, b2, c2 = 2 * (x2 - x0), 2 * (y2 - y0), x2 * x2 - x0 * x0 + y2 * y2 - y0 * y0
-    det = a1 * b2 - a2 * b1
-    fx, fy = (c1 * b2 - c2 * b1) / det, (a1 * c2 - a2 * c1) / det
-    n = len(p)
-    twice = sum(p[i][0] * p[(i + 1) % n][1] - p[(i + 1) % n][0] * p[i][1] for i in range(n))
-    sign = 1 if twice > 0 else -1
-    shares = [Fraction(0)] * n
-    for i in range(n):
-        (ux, uy), (vx, vy) = p[i], p[(i + 1) % n]
-        half = sign * ((vx - ux) * (fy - uy) - (vy - uy) * (fx - ux)) / 4  # half the triangle (u, v, f)
-        shares[i] += half
-        shares[(i + 1) % n] += half
-    return shares
 
 
 def mesh_region_parts(mesh: Mesh, dual: Dual, faces: RegionFaces) -> RegionParts:

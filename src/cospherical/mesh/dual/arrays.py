@@ -21,7 +21,7 @@ from ...core.configuration import Box
 if TYPE_CHECKING:
     from scipy.sparse import csr_matrix
 
-__all__ = ["Dual", "ExactArray", "RegionParts", "as_floats", "boundary_areas"]
+__all__ = ["Dual", "ExactArray", "InterfaceParts", "RegionParts", "as_floats", "boundary_areas"]
 
 ExactArray = NDArray[Any]  # int64, or object (Python integers) where int64 could overflow
 
@@ -47,6 +47,13 @@ class Dual:
     and ``element_sizes``: the elements themselves (global vertex ids, padded with -1,
     as :meth:`~cospherical.mesh.assembly.Mesh.connectivity` gives them), from which the
     exact values can be computed again (``cospherical check`` does).
+
+    A device's domain is a union of boxes, its boundary the faces met by one element
+    (also inside the bounding box: a notch, a hole); there ``boundary``, the boundary
+    areas and ``boundary_edge`` (per edge: it is an edge of such a face; not in the file,
+    set where the faces are known: the mesher, ``cospherical check``) are the true
+    boundary's (:func:`~cospherical.mesh.surfaces.set_domain_boundary`).  Without
+    ``boundary_edge`` the boundary is the box's six sides.
     """
 
     box: Box
@@ -73,6 +80,7 @@ class Dual:
     element_nodes: np.ndarray = field(repr=False)
     element_sizes: np.ndarray = field(repr=False)
     regions: "RegionParts | None" = field(default=None, repr=False)
+    boundary_edge: NDArray[np.bool_] | None = field(default=None, repr=False)
 
     def laplacian(self) -> csr_matrix:
         """The box method's matrix: ``K[i, j] = -coefficient``, ``K[i, i]`` the row's sum (scipy.sparse CSR).
@@ -113,8 +121,13 @@ class Dual:
     def negative_coefficients(self) -> dict[str, int]:
         """Edges whose coefficient is negative (decided on the exact integers), interior and boundary apart.
 
-        A boundary edge lies in one of the domain's boundary planes.
+        A boundary edge is an edge of a face in the domain's boundary: ``boundary_edge``
+        when it is set, else an edge in one of the box's sides.
         """
+        if self.boundary_edge is not None:
+            below = self.coefficient_exact < 0
+            return {"interior": int((below & ~self.boundary_edge).sum()),
+                    "boundary": int((below & self.boundary_edge).sum())}
         negative = np.flatnonzero(self.coefficient_exact < 0)  # few: only their ends are looked at
         g = self.grid_vertices
         a, b = g[self.edges[negative, 0]], g[self.edges[negative, 1]]
@@ -142,6 +155,9 @@ class RegionParts:
     ``contact_denominator``, in device units (a device's lengths are rational).
     ``origin``: the device's bounding box's low corner (exact texts), where the grid starts;
     ``boxes``: per region its boxes (six exact texts each, device units): the domain.
+    ``interfaces``: the faces between regions and their area per vertex
+    (:class:`InterfaceParts`); ``None`` in a dual read from a version 4 file, whose
+    boundary figures are the bounding box's sides.
     """
 
     names: tuple[str, ...]
@@ -167,6 +183,7 @@ class RegionParts:
     volume_factor: float
     origin: tuple[str, ...] = ("0", "0", "0")
     boxes: tuple[tuple[tuple[str, ...], ...], ...] = ()
+    interfaces: "InterfaceParts | None" = None
 
     @property
     def volume_part(self) -> np.ndarray:
@@ -189,6 +206,39 @@ class RegionParts:
         """Each contact's area parts summed, exactly (device units)."""
         return [Fraction(int(np.sum(self.contact_exact[self.contact_contact == c].astype(object))),
                          self.contact_denominator) for c in range(len(self.contact_names))]
+
+
+@dataclass
+class InterfaceParts:
+    """A device's interfaces, each a named set of faces, and each face's area split among its vertices, exactly.
+
+    ``regions``: per interface its two touching regions ``(a, b)``, ``a < b`` (indices into
+    :attr:`RegionParts.names`), named ``"a|b"`` (``names``); the faces: ``face_nodes``
+    (polygons of vertex ids, -1 padded, counter-clockwise seen from region ``a``'s side:
+    their normal points into ``b``), ``face_interface``; the area parts, one row per
+    (vertex, interface), sorted: ``vertex``, ``interface``, ``exact`` over ``denominator``
+    in device units (``part`` as floats): the box method's boundary pieces, as a contact's
+    (the triangles between the vertex, its edges' midpoints and the face's circle centre).
+    A vertex's part is the interface's area in its control volume, seen from either region.
+    """
+
+    regions: NDArray[np.int32]
+    names: tuple[str, ...]
+    face_nodes: NDArray[np.int32]
+    face_interface: NDArray[np.int32]
+    vertex: NDArray[np.int64]
+    interface: NDArray[np.int32]
+    exact: ExactArray
+    denominator: int
+
+    @property
+    def part(self) -> NDArray[np.float64]:
+        return as_floats(self.exact, self.denominator, 1.0)
+
+    def areas(self) -> list[Fraction]:
+        """Each interface's area parts summed, exactly (device units)."""
+        return [Fraction(int(np.sum(self.exact[self.interface == i].astype(object))), self.denominator)
+                for i in range(len(self.regions))]
 
 
 def boundary_areas(exact: ExactArray, denominator: int, factors_squared: Sequence[Fraction]) -> NDArray[np.float64]:
