@@ -84,6 +84,14 @@ def test_a_device_gives_regions_interfaces_and_each_region_its_part_of_the_dual(
             for region, volume in (("substrate", 0.75), ("oxide", 0.25)):
                 volumes, couple, length = assembled_with(devsim, name, region)
                 assert abs(volumes.sum() - volume) < 1e-12 and abs((couple * length).sum() - 3 * volume) < 1e-12
+                # the interface's exact area per node, which DEVSIM's interface equations integrate over
+                # (region parameter surface_area_model), is its own SurfaceArea's in total and support
+                assert devsim.get_parameter(device=name, region=region, name="surface_area_model") == \
+                    "ExactSurfaceArea"
+                exact = np.array(devsim.get_node_model_values(device=name, region=region, name="ExactSurfaceArea"))
+                own = np.array(devsim.get_node_model_values(device=name, region=region, name="SurfaceArea"))
+                assert abs(exact.sum() - 1) < 1e-12 and abs(own.sum() - 1) < 1e-12
+                assert np.array_equal(exact > 0, own > 0)
         finally:
             drop(devsim, name)
 

@@ -20,7 +20,11 @@ tetrahedra (:mod:`cospherical.mesh.tetrahedra`) and installs the exact dual
 parameters ``node_volume_model`` and ``edge_couple_model`` that DEVSIM's equation
 assembly reads (``Equation.cc``: ``GetRegion().GetNodeVolumeModel()``,
 ``GetEdgeCoupleModel()``).  Every equation defined afterwards uses them; the
-diagonals that the split adds couple ``0``, exactly as in the mixed mesh.
+diagonals that the split adds couple ``0``, exactly as in the mixed mesh.  A device's
+interfaces get each node's exact part of the interface's area as ``ExactSurfaceArea``,
+selected by the region parameter ``surface_area_model`` that DEVSIM's interface equations
+read (``Interface::GetSurfaceAreaModel``; DEVSIM's own ``SurfaceArea`` holds the same
+total from its triangles).
 
 DEVSIM's own geometry stays available under its names (``NodeVolume``,
 ``EdgeCouple``) for comparison, and so do the element edge models
@@ -55,11 +59,12 @@ from ..mesh.assembly import Mesh
 from ..mesh.dual import Dual
 from ..mesh.tetrahedra import SimplexMesh
 
-__all__ = ["EXACT_EDGE_COUPLE", "EXACT_NODE_VOLUME", "MeshInput", "DevsimDevice", "MeshWithDual", "create_device",
+__all__ = ["EXACT_EDGE_COUPLE", "EXACT_NODE_VOLUME", "EXACT_SURFACE_AREA", "MeshInput", "DevsimDevice", "MeshWithDual", "create_device",
            "import_devsim"]
 
 EXACT_NODE_VOLUME = "ExactNodeVolume"
 EXACT_EDGE_COUPLE = "ExactEdgeCouple"
+EXACT_SURFACE_AREA = "ExactSurfaceArea"
 CONTACT_MATERIAL = "metal"
 
 
@@ -152,7 +157,7 @@ def _source(mesh: MeshInput) -> _Source:
         verify_dual(dual, path)
         simplices = dual_simplex_mesh(dual)
         if dual.regions is None:
-            return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area)}, {})
+            return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area, None)}, {})
         parts = dual.regions
         return _Source(simplices, dual, _region_geometry(dual, parts),
                        {name: parts.names[r] for name, r in zip(parts.contact_names, parts.contact_regions)},
@@ -168,7 +173,7 @@ def _source(mesh: MeshInput) -> _Source:
     regions = getattr(assembled, "regions", None)
     if regions is None or regions.layout is None:
         simplices = simplex_mesh(assembled)
-        return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area)}, {})
+        return _Source(simplices, dual, {"domain": (dual.control_volume, dual.area, None)}, {})
     from ..mesh.pipeline import full_dual
     from ..mesh.regions import region_faces
 
@@ -181,8 +186,11 @@ def _source(mesh: MeshInput) -> _Source:
 
 
 def _region_geometry(dual: Dual, parts) -> dict:
-    """Per region name: its node volume per vertex and its dual-face area per edge (0 where it has none)."""
+    """Per region name: its node volume per vertex, its dual-face area per edge (0 where it has none) and its
+    surface area per vertex: its part of the interfaces the region is on, what DEVSIM's ``SurfaceArea`` holds
+    (``None`` for a dual without interfaces: a version 4 file)."""
     geometry = {}
+    interfaces = parts.interfaces
     for r, name in enumerate(parts.names):
         volume = np.zeros(len(dual.vertices))
         rows = parts.volume_region == r
@@ -191,7 +199,13 @@ def _region_geometry(dual: Dual, parts) -> dict:
         rows = parts.coupling_region == r
         edges = parts.coupling_edge[rows]
         area[edges] = parts.coupling_part[rows] * dual.length[edges]
-        geometry[name] = (volume, area)
+        surface = None
+        if interfaces is not None:
+            surface = np.zeros(len(dual.vertices))
+            touching = np.flatnonzero((interfaces.regions == r).any(axis=1))
+            mine = np.isin(interfaces.interface, touching)
+            np.add.at(surface, interfaces.vertex[mine], interfaces.part[mine])
+        geometry[name] = (volume, area, surface)
     return geometry
 
 
@@ -201,15 +215,16 @@ def create_device(mesh: MeshInput, device: str = "device", contacts: Sequence[st
 
     ``mesh``: the API's mesh, an assembled :class:`~cospherical.mesh.assembly.Mesh`, or a
     mesh folder with ``dual.npz`` (``cospherical mesh --dual --out DIR``; a device's
-    ``dual.npz`` holds its parts per region and its contact faces, the interfaces are
-    where tetrahedra of two regions meet).
+    ``dual.npz`` holds its parts per region, its contact faces and its interfaces).
 
     A device's mesh (``build_mesh(device=...)``) gives one DEVSIM region per region,
     with its name and material, one contact per contact of the device (``contacts``:
     a subset of their names, default all) and one interface per pair of touching
     regions, named ``"a|b"``; each region's node volumes and edge couplings are its
     parts of the exact dual (an interface vertex's control volume and an interface
-    edge's dual face split between the regions).  Any other mesh gives the region
+    edge's dual face split between the regions), and each region's ``ExactSurfaceArea``
+    (its ``surface_area_model``) is each node's part of the region's interfaces (not
+    from a version 4 ``dual.npz``, which has none: DEVSIM's own then).  Any other mesh gives the region
     ``domain`` of ``material``, and ``contacts`` names which of the box's sides
     (``xmin`` ... ``zmax``) become contacts (default none).
 
@@ -292,8 +307,9 @@ def _pair(interface: str, regions) -> tuple[str, str]:
 
 def _install_dual(devsim, device: str, region: str, points: np.ndarray, dual, geometry, scale: float
                   ) -> tuple[np.ndarray, np.ndarray]:
-    """Set the region's exact node volumes and edge couplings and select them; DEVSIM's node and edge maps."""
-    volumes, areas = geometry
+    """Set the region's exact node volumes, edge couplings and (a device's) surface areas and select them;
+    DEVSIM's node and edge maps."""
+    volumes, areas, surface = geometry
     xyz = np.column_stack([devsim.get_node_model_values(device=device, region=region, name=axis)
                            for axis in ("x", "y", "z")])
     # DEVSIM keeps the coordinates it was given (doubles): exact equality finds each node's vertex id
@@ -321,6 +337,11 @@ def _install_dual(devsim, device: str, region: str, points: np.ndarray, dual, ge
     devsim.set_edge_values(device=device, region=region, name=EXACT_EDGE_COUPLE, values=area.tolist())
     devsim.set_parameter(device=device, region=region, name="node_volume_model", value=EXACT_NODE_VOLUME)
     devsim.set_parameter(device=device, region=region, name="edge_couple_model", value=EXACT_EDGE_COUPLE)
+    if surface is not None:  # what interface equations integrate their node terms over
+        devsim.node_solution(device=device, region=region, name=EXACT_SURFACE_AREA)
+        devsim.set_node_values(device=device, region=region, name=EXACT_SURFACE_AREA,
+                               values=(surface[nodes] * scale ** 2).tolist())
+        devsim.set_parameter(device=device, region=region, name="surface_area_model", value=EXACT_SURFACE_AREA)
     return nodes, edges
 
 
