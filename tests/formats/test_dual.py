@@ -417,7 +417,8 @@ def _with_contact_faces(good: Path, target: Path, faces: np.ndarray, which: np.n
                                   "1000 digits", "a contact face repeated", "a contact face naming a vertex twice",
                                   "a million contact faces", "a contact box along another axis",
                                   "one quad over a whole contact", "a contact on a region it does not touch",
-                                  "an element given the other region"])
+                                  "an element given the other region", "an interface of regions that do not exist",
+                                  "an interface face naming a vertex twice"])
 def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, capsys, case):
     # re-signed or consistently recomputed: a v4 file's names, contacts and parts are held to what the mesher
     # writes (names by the device file's rule; contact faces on elements of their region), never a traceback
@@ -433,15 +434,21 @@ def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, ca
                 "two contacts of one name": {"contact_names": ["c", "c"]},
                 "a region index true": {"contact_regions": [True, 1]},
                 "a part denominator of 1000 digits": {"coupling_part_denominator": "9" * 1000},
+                "an interface of regions that do not exist": {"interface_regions": [[0, 7]]},
                 "a contact box along another axis": {"contact_boxes": [["1/7"] * 3 + ["1/7", "1", "1"],
                                                                        list(parts.contact_boxes[1])]}}
     repeated = faces.copy()
     repeated[0, 1] = repeated[0, 0]
+    with np.load(device_dual) as archive:
+        interface = archive["interface_face_nodes"].copy()
+    interface[0, 1] = interface[0, 0]
     members = {"a contact face repeated": (np.concatenate([faces[:1], faces]), np.concatenate([which[:1], which])),
                "a contact face naming a vertex twice": (repeated, which),
                "a million contact faces": (np.repeat(faces[:1], 10**6, axis=0), np.repeat(which[:1], 10**6))}
     if case in manifest:
         _resigned(device_dual, target, lambda m: m.update(manifest[case]))
+    elif case == "an interface face naming a vertex twice":
+        _resigned(device_dual, target, members={"interface_face_nodes": interface})
     elif case in members:
         nodes, contact = members[case]
         _resigned(device_dual, target, members={"contact_face_nodes": nodes,
@@ -470,7 +477,8 @@ def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, ca
     assert main(["check", str(target)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err and err[:-1].isprintable() and len(err) < 400, err
-    assert "\x1b" not in err and ("contact_face_nodes" in err or "manifest" in err or "element_region" in err), err
+    assert "\x1b" not in err and ("contact_face_nodes" in err or "manifest" in err or "element_region" in err
+                                  or "interface_face_nodes" in err), err
     assert case != "one quad over a whole contact" or "is no face of an element of its region" in err, err
     assert case != "an element given the other region" or "member element_region" in err, err
     assert case != "a contact on a region it does not touch" or "is no face of an element of its region" in err \
