@@ -114,6 +114,15 @@ def _dask_completed(function: Callable, tasks: Mapping[_Key, tuple], scheduler: 
 
     scratch = None if scheduler else tempfile.mkdtemp(prefix="cospherical-dask-")
     cluster = client = None
+    # distributed's own log quiet for the run: a cluster shut down by Ctrl-C logs closed comms with
+    # their tracebacks, some from its event loop's thread after close() has returned (and after the
+    # cluster has put back the level its silence_logs changed). Put back only after a run that ended
+    # well: after an error or an interrupt those late lines would follow the command's one line.
+    # (its handlers', as silence_logs does: some of its loggers have levels of their own)
+    handlers = {handler: handler.level for handler in logging.getLogger("distributed").handlers}
+    for handler in handlers:
+        handler.setLevel(logging.CRITICAL)
+    ended_well = False
     try:
         if scratch is not None:
             # Ctrl-C reaches the whole process group, and a worker caught by it while it starts
@@ -151,6 +160,7 @@ def _dask_completed(function: Callable, tasks: Mapping[_Key, tuple], scheduler: 
             # dropped once yielded: a finished future keeps its result (chunks of a
             # pattern table hold megabytes each)
             yield futures.pop(future), future.result()
+        ended_well = True
     except BaseException:
         _kill_workers(cluster)  # an error, Ctrl-C or SIGTERM: no wait for the chunks still running
         raise
@@ -159,6 +169,9 @@ def _dask_completed(function: Callable, tasks: Mapping[_Key, tuple], scheduler: 
         _close_dask(client, cluster)
         if scratch is not None:
             shutil.rmtree(scratch, ignore_errors=True)
+        if ended_well:
+            for handler, level in handlers.items():
+                handler.setLevel(level)
 
 
 def _handshake(scheduler: str) -> None:

@@ -182,7 +182,9 @@ _STAMP = (1980, 1, 1, 0, 0, 0)
 _TEXT_WIDTH = 200
 # the manifest's exact numbers as written: plain integers and fractions of bounded length, so that a
 # hostile text such as "1e999999999" never reaches Fraction (which would compute 10**999999999)
-_MAX_TEXT_DIGITS = 1000  # the manifest's exact numbers, and the members' written as text
+# the manifest's exact numbers, and the members' written as text: under Python's own bound on decimal text
+# (sys.int_max_str_digits, 4300 by default); a 1e-12 x 1 x 3e9 box's coefficients need 1049 digits at level 4
+_MAX_TEXT_DIGITS = 4000
 _INTEGER = re.compile(r"-?[0-9]{1,%d}" % _MAX_TEXT_DIGITS)
 _POSITIVE = re.compile(r"[1-9][0-9]{0,%d}" % (_MAX_TEXT_DIGITS - 1))
 _POSITIVE_FRACTION = re.compile(r"[1-9][0-9]{0,%d}(/[1-9][0-9]{0,%d})?" % (_MAX_TEXT_DIGITS - 1, _MAX_TEXT_DIGITS - 1))
@@ -433,11 +435,11 @@ def _dual(arrays: dict[str, np.ndarray], manifest: dict[str, Any], path: Path) -
     factors = manifest["boundary_factors_squared"]
     if len(factors) != 3 or not all(isinstance(f, str) and _POSITIVE_FRACTION.fullmatch(f) for f in factors):
         raise FormatError(f"{path}: manifest: boundary_factors_squared is not three positive fractions of at most "
-                          "1000 digits")
+                          f"{_MAX_TEXT_DIGITS} digits")
     for key, pattern in (("coefficient_denominator", _POSITIVE), ("volume_denominator", _POSITIVE),
                          ("volume_factor_squared", _POSITIVE_FRACTION), ("boundary_area_denominator", _POSITIVE)):
         if not pattern.fullmatch(manifest[key]):
-            raise FormatError(f"{path}: manifest: {key} is not a positive integer or fraction of at most 1000 digits")
+            raise FormatError(f"{path}: manifest: {key} is not a positive integer or fraction of at most {_MAX_TEXT_DIGITS} digits")
     if not 0 < manifest["grid"] <= _MAX_GRID:
         raise FormatError(f"{path}: manifest: grid {shown(manifest['grid'])} is not in 1..{_MAX_GRID}")
     try:
@@ -502,7 +504,7 @@ def _region_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], n_ver
     denominators = []
     for key in ("volume_part_denominator", "coupling_part_denominator", "contact_part_denominator"):
         if not isinstance(manifest.get(key), str) or not _POSITIVE.fullmatch(manifest[key]):
-            raise FormatError(f"{path}: manifest: {key} is not a positive integer of at most 1000 digits")
+            raise FormatError(f"{path}: manifest: {key} is not a positive integer of at most {_MAX_TEXT_DIGITS} digits")
         denominators.append(int(manifest[key]))
     for name, bound in (("element_region", len(names)), ("volume_part_vertex", n_vertices),
                         ("volume_part_region", len(names)), ("coupling_part_edge", n_edges),
@@ -565,7 +567,7 @@ def _interface_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], na
         raise FormatError(f"{path}: manifest: interface_regions is not a list of distinct region pairs [a, b], a < b")
     denominator = manifest.get("interface_part_denominator")
     if not isinstance(denominator, str) or not _POSITIVE.fullmatch(denominator):
-        raise FormatError(f"{path}: manifest: interface_part_denominator is not a positive integer of at most 1000 "
+        raise FormatError(f"{path}: manifest: interface_part_denominator is not a positive integer of at most {_MAX_TEXT_DIGITS} "
                           "digits")
     for name, bound in (("interface_face_interface", len(pairs)), ("interface_part_vertex", n_vertices),
                         ("interface_part_interface", len(pairs))):
