@@ -13,6 +13,7 @@ import textwrap
 
 _GONE = """
 import os, time
+from concurrent.futures.process import BrokenProcessPool
 
 import pytest
 
@@ -46,10 +47,13 @@ def test_a_pool_left_by_an_error_kills_its_running_calls_at_once():
         with pytest.raises(RuntimeError), process_pool(1) as pool:
             worker = pool.submit(os.getpid).result()
             running = pool.submit(time.sleep, 120)  # a chunk of minutes: shutdown() alone would wait for it
+            while not running.running():  # handed to the worker (a call still queued is only cancelled)
+                time.sleep(0.01)
             raise RuntimeError("the command failed meanwhile")
         assert time.monotonic() - start < 30
         assert gone(worker)
-        assert running.done()
+        # failed once the pool's management thread has seen its worker die: bounded, not instant
+        assert isinstance(running.exception(timeout=10), BrokenProcessPool)
         """)
 
 
