@@ -25,7 +25,8 @@ from cospherical import build_mesh
 from cospherical.formats.vtu import write_grid
 from cospherical.mesh.tetrahedra import split_tetrahedra
 
-EXAMPLES = sorted((Path(__file__).parents[2] / "examples" / "devices").glob("*.yaml"))
+ROOT = Path(__file__).parents[2]
+EXAMPLES = sorted((ROOT / "examples" / "devices").glob("*.yaml"))
 
 pytestmark = [pytest.mark.oracle_meshio, pytest.mark.oracle_vtk]
 
@@ -152,8 +153,8 @@ def _faces_by_vtk(path: Path):
     return ids, polygons, which
 
 
-def _mesh_and_check(path: Path, folder: Path, dual: bool = False):
-    m = build_mesh(device=path, uniform=False, dual=dual)
+def _mesh_and_check(path: Path, folder: Path, dual: bool = False, uniform: bool = False):
+    m = build_mesh(device=path, uniform=uniform, dual=dual)
     m.write(folder)
     tets = split_tetrahedra(m.assembled)
     write_grid(folder / "tets.vtu", m.assembled.vertices.astype(np.float64), np.full(len(tets), 10, np.uint8),
@@ -214,8 +215,15 @@ def _on_the_boundary(data: dict, points: np.ndarray, grid: int) -> np.ndarray:
 def test_example_devices_pass_the_oracle(example, tmp_path, capsys):
     from cospherical.cli import main
 
-    m = _mesh_and_check(example, tmp_path, dual=example.stem in ("fin", "l-shape"))
-    if m.report.dual is not None:  # non-convex: check proves the elements a mesh of the union of boxes
+    # as the docs' command makes it (mesh --device FILE --dual: uniform statistics too), so its report can be
+    # held against the one the devices page shows
+    m = _mesh_and_check(example, tmp_path, dual=True, uniform=True)
+    committed = ROOT / "results" / "devices" / example.stem / "report.json"
+    assert (tmp_path / "report.json").read_bytes() == committed.read_bytes(), (
+        f"{committed.relative_to(ROOT)} is not what the code writes: make it again with "
+        f"cospherical mesh --device examples/devices/{example.name} --dual --out DIR, copy DIR's "
+        "report.json and mesh.png over (CONTRIBUTING.md)")
+    if example.stem in ("fin", "l-shape"):  # non-convex: check proves the elements a mesh of the union of boxes
         assert main(["check", str(tmp_path / "dual.npz")]) == 0, capsys.readouterr().err
         # the dual's boundary is the union's (notches, the fin's walls), its interfaces where regions touch
         data = yaml.safe_load(example.read_text())
