@@ -11,7 +11,7 @@ from cospherical.core.configuration import Box, Configuration
 from cospherical.mesh.assembly import PAPER_FINAL, assemble
 from cospherical.mesh.octree import build_octree, parse_shape
 from cospherical.mesh.statistics import (in_bisection_family, level_counts, mesh_statistics, occurrences,
-                                         statistics, uniform_study)
+                                         shipped_uniform, statistics, uniform_figures, uniform_study)
 
 CUBE = Box.parse(["1", "1", "1"])
 
@@ -24,7 +24,7 @@ def mesh():
 
 @pytest.fixture(scope="module")
 def uniform():
-    return uniform_study(CUBE, shipped_catalogue())
+    return uniform_study(CUBE, shipped_catalogue(), computed=True)
 
 
 def test_the_uniform_study_of_the_cube_is_the_papers_table_2(uniform):
@@ -34,6 +34,37 @@ def test_the_uniform_study_of_the_cube_is_the_papers_table_2(uniform):
     for type_id, count in uniform["counts"].items():
         by_class[uniform["types"][type_id]["paper_class"]] += count
     assert by_class["Cuboid"] == 195 and by_class["Tetrahedron"] == 18450
+
+
+def test_the_shipped_uniform_studies_are_the_computed_ones(uniform, full):
+    # The cube's figures (computed above, 0.2 s); with --full every shipped box's (about 2 s in all).
+    shipped = uniform_study(CUBE, shipped_catalogue())
+    assert shipped == uniform and list(shipped["counts"]) == list(uniform["counts"])  # the same order too
+    for box in (["1", "1", "1"], ["2", "2", "2"], ["3/2", "3", "6"], ["1", "1.4142", "1.4142"], ["7", "7*sqrt(2)", "7*sqrt(2)"]):
+        assert shipped_uniform(Box.parse(box)) is not None, box  # a box of a shipped shape, scaled or not
+    for box in (["1", "1", "3"], ["2", "1", "1"], ["1", "1.4143", "1.4142"]):
+        assert shipped_uniform(Box.parse(box)) is None, box  # computed: other proportions, or the same turned
+    if full:
+        import importlib.util
+        from pathlib import Path
+
+        script = Path(__file__).resolve().parents[2] / "scripts" / "uniform_studies.py"
+        spec = importlib.util.spec_from_file_location("uniform_studies", script)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        assert [uniform_figures(Box.parse(list(b))) for b in module.BOXES] == [
+            shipped_uniform(Box.parse(list(b))) for b in module.BOXES]
+
+
+def test_the_shipped_uniform_studies_cover_the_shipped_tables():
+    from pathlib import Path
+
+    import yaml
+
+    for path in sorted((Path(__file__).resolve().parents[2] / "patterns").glob("*.yaml")):
+        header = yaml.safe_load(path.read_text().split("\nconfigurations:\n")[0])
+        if header.get("element", "cuboid") == "cuboid":
+            assert shipped_uniform(Box.parse(header["box"])) is not None, path.name
 
 
 def test_occurrences_add_up_to_the_mesh(mesh):

@@ -41,6 +41,8 @@ _SEQUENCE_LINE = re.compile(r"- (\{[^\n]*\})")
 # A line that can be neither shape's (what a hostile or hand-written file is full of): found in one
 # scan, before the section is cut into lines (a 100 MB block-style table took 0.83 GB to be told
 # apart as lines; the YAML reader then refuses it by its size, at once).
+_MAPPING_LINES = re.compile(r"^  '([^'\n]*)': (\{[^\n]*\})$", re.M)
+_SEQUENCE_LINES = re.compile(r"^- (\{[^\n]*\})$", re.M)
 _STRAY_LINE = re.compile(r"\n(?!  '|- \{)")  # a newline and what follows: the regex engine finds newlines fast
 
 
@@ -118,26 +120,21 @@ def split_section(text: str, key: str) -> tuple[str, dict[str, str] | list[str]]
     last = end - 1 if end > body_start and text[end - 1] == "\n" else end  # the final newline starts no line
     if body_start < last and _STRAY_LINE.search(text, body_start - 1, last):  # from the newline before the section
         return None
-    lines = text[body_start:end].split("\n")
-    if lines and lines[-1] == "":
-        lines.pop()
-    if not lines:
+    section = text[body_start:end]
+    lines = section.count("\n") + (not section.endswith("\n"))  # the final newline starts no line
+    if not section:
         return None
     header = text[: start + 1] + text[end:]
-    if lines[0].startswith("- "):
-        items = []
-        for line in lines:
-            found = _SEQUENCE_LINE.fullmatch(line)
-            if found is None:
-                return None
-            items.append(found.group(1))
-        return header, items
-    entries: dict[str, str] = {}
-    for line in lines:
-        found = _MAPPING_LINE.fullmatch(line)
-        if found is None or found.group(1) in entries:
-            return None
-        entries[found.group(1)] = found.group(2)
+    # One scan of the section in C (a loop over its lines, a match each, took 0.1 s of a 9 MB table):
+    # a match lies within one line and at most one per line, so as many matches as lines is every
+    # line of the shape.
+    if section.startswith("- "):
+        items = _SEQUENCE_LINES.findall(section)
+        return (header, items) if len(items) == lines else None
+    pairs = _MAPPING_LINES.findall(section)
+    entries = dict(pairs)
+    if len(pairs) != lines or len(entries) != lines:  # a line of another shape, or a repeated key
+        return None
     return header, entries
 
 

@@ -223,7 +223,8 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     checks
         ``all``: the Delaunay check searches the vertices near every sphere with a k-d tree,
         none bounded by the tree's structure (the cross-check of that bound: see
-        :mod:`cospherical.mesh.checks`); ``default``: bounded where the tree allows.
+        :mod:`cospherical.mesh.checks`), and the uniform study is computed even where its
+        figures ship precomputed; ``default``: bounded where the tree allows.
     """
     mode = delaunay_mode(criterion, delaunay)
     if checks not in ("default", "all"):
@@ -250,7 +251,8 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     checked_report = checked_mesh_report(mesh, source.described, patterns, criterion, uniform=uniform,
                                          delaunay=check_delaunay, stage=clock.stage,
                                          progress=told("delaunay", len(mesh)), leaf_mesh=leaf_mesh, checked=checked,
-                                         conformity_progress=told("conformity", None))
+                                         conformity_progress=told("conformity", None),
+                                         uniform_computed=checks == "all")
     report = checked_report.report
     found = faces = None
     if source.device is not None:

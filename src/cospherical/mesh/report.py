@@ -120,7 +120,8 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]
                   leaf_mesh: Mapping[str, int] | None = None, cells: tuple[int, int] = (0, 0),
                   seams: Iterable[OpenFaces] | None = None,
                   vertex_points: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None = None, grid: int = 1, *,
-                  catalogue: Catalogue, domain_share: Fraction = Fraction(1)) -> dict[str, Any]:
+                  catalogue: Catalogue, domain_share: Fraction = Fraction(1),
+                  uniform_computed: bool = False) -> dict[str, Any]:
     """The report of a mesh from the :func:`mesh_figures` of its pieces (one piece: the whole mesh).
 
     ``catalogue``: the element catalogue the pieces were assembled with (it names the types).
@@ -128,7 +129,8 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]
     ``cells``: the clusters re-tessellated (the report keeps its keys ``regions_retessellated`` and ``largest_region_vertices``) and the largest one's vertices; ``seams``:
     the faces the pieces left open, paired here (``vertex_points(ids)`` gives their
     grid points, for the examples).  ``domain_share``: the domain's volume as a fraction of the
-    root box's (a device's boxes can leave part of their bounding box out).
+    root box's (a device's boxes can leave part of their bounding box out).  ``uniform_computed``: the uniform
+    study run even for a box whose figures ship precomputed (see :func:`~cospherical.mesh.statistics.uniform_study`).
     """
     summed = {key: sum(part[key] for part in parts) for key in _SUMMED if all(key in part for part in parts)}
     report: dict[str, Any] = {
@@ -195,7 +197,7 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]
     for part in parts:
         types.update(part["types"])
     report.update(statistics(type_counts, configurations, len(tree), types, catalogue,
-                             uniform_study(tree.box, catalogue) if uniform else None))
+                             uniform_study(tree.box, catalogue, uniform_computed) if uniform else None))
     report["checks"] = _checks_run(patterns is not None, delaunay, summed)
     return report
 
@@ -266,14 +268,16 @@ def checked_mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | Non
                         uniform: bool = True, delaunay: bool = True, stage: Callable[[str], None] | None = None,
                         progress: Callable[[int], None] | None = None, leaf_mesh: Mapping[str, int] | None = None,
                         checked: DelaunayCheck | None = None,
-                        conformity_progress: Callable[[int], None] | None = None) -> CheckedReport:
+                        conformity_progress: Callable[[int], None] | None = None,
+                        uniform_computed: bool = False) -> CheckedReport:
     """:func:`mesh_report` (the same arguments), and the global Delaunay check it ran or was given;
-    ``conformity_progress`` is told as faces are paired."""
+    ``conformity_progress`` is told as faces are paired; ``uniform_computed``: see :func:`merged_report`."""
     figures, found, _ = mesh_figures(mesh, delaunay, stage, progress, checked,
                                      conformity_progress=conformity_progress)
     cells = (mesh.cells.clusters, mesh.cells.largest_cluster) if mesh.cells is not None else (0, 0)
     report = merged_report(mesh.tree, len(mesh.vertices), [figures], tree, patterns, criterion, uniform, delaunay,
-                           leaf_mesh, cells, catalogue=mesh.catalogue, domain_share=mesh.domain_share)
+                           leaf_mesh, cells, catalogue=mesh.catalogue, domain_share=mesh.domain_share,
+                           uniform_computed=uniform_computed)
     return CheckedReport(report, found)
 
 

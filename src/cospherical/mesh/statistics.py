@@ -14,24 +14,70 @@ from typing import Any
 
 import numpy as np
 
+from ..caches import cached
 from ..catalogue import Catalogue
 from ..core.configuration import Box, Configuration
-from ..studies.engine import bisection_codes, run_study
+from ..files.data import data_path
 from .assembly import PAPER_FINAL, Mesh, type_info
 from .tree import Octree
 
-__all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "statistics", "uniform_study"]
+__all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "shipped_uniform", "statistics",
+           "uniform_figures", "uniform_study"]
 
 _BISECTION_CONFIGURATIONS = 4096
 
 
-def uniform_study(box: Box, catalogue: Catalogue) -> dict[str, Any]:
+def uniform_study(box: Box, catalogue: Catalogue, computed: bool = False) -> dict[str, Any]:
     """Element counts per type of the uniform-weight bisection study of ``box`` (octree policy, optimal),
-    the types named by ``catalogue``."""
+    the types named by ``catalogue``.
+
+    The study is a pure function of the box's proportions (every type id, count and
+    VTK cell is unchanged when the box is scaled).  It costs 0.2 s for a cube and
+    0.5-0.8 s for the other shapes of the shipped pattern tables, more than a
+    small mesh: those shapes' figures ship precomputed in ``data/uniform-studies.json``
+    (:func:`shipped_uniform`, written by ``scripts/uniform_studies.py`` from
+    :func:`uniform_figures`; the tests compute them again and compare), and any
+    other box is computed here.  ``computed=True`` computes it whatever the box
+    (``mesh --check all``).
+    """
+    figures = None if computed else shipped_uniform(box)
+    if figures is None:
+        figures = uniform_figures(box)
+    info = {type_id: type_info(type_id, None, catalogue) if type_id in catalogue else dict(own)
+            for type_id, own in figures["types"].items()}
+    return {"counts": dict(figures["counts"]), "types": info, "elements": figures["elements"]}
+
+
+def uniform_figures(box: Box) -> dict[str, Any]:
+    """The uniform bisection study of ``box`` as data no catalogue names: ``box`` (its texts), ``counts`` and
+    ``types`` (each type's own name, paper class, VTK cell, vertices and faces) per type id, ``elements``."""
+    from ..catalogue import Catalogue
+    from ..studies.engine import bisection_codes, run_study
+
     study = run_study("bisection", box, bisection_codes(), "octree", criteria=("optimal",))
-    counts = {tc.type.id: tc.count for tc in study.type_counts("optimal")}
-    info = {tc.type.id: type_info(tc.type.id, tc.type, catalogue) for tc in study.type_counts("optimal")}
-    return {"counts": counts, "types": info, "elements": study.total("optimal")}
+    nobody = Catalogue.empty(1)
+    return {"box": list(box.texts), "counts": {tc.type.id: tc.count for tc in study.type_counts("optimal")},
+            "types": {tc.type.id: type_info(tc.type.id, tc.type, nobody) for tc in study.type_counts("optimal")},
+            "elements": study.total("optimal")}
+
+
+def shipped_uniform(box: Box) -> dict[str, Any] | None:
+    """The shipped :func:`uniform_figures` of a box shaped like ``box`` (the same proportions), else ``None``."""
+    ours = box.squared
+    for figures in _shipped_uniform_studies():
+        theirs = Box.parse(figures["box"]).squared
+        if all(theirs[a] * ours[0] == ours[a] * theirs[0] for a in range(3)):
+            return figures
+    return None
+
+
+@cached(maxsize=1)
+def _shipped_uniform_studies() -> list[dict[str, Any]]:
+    """``data/uniform-studies.json``'s studies (package data, as trusted as the code that reads it)."""
+    import json
+
+    studies: list[dict[str, Any]] = json.loads(data_path("uniform-studies.json").read_text(encoding="utf-8"))["studies"]
+    return studies
 
 
 def _share(part: int, whole: int) -> float:
