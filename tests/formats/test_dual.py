@@ -26,6 +26,7 @@ def dual_run(tmp_path_factory):
 @pytest.mark.oracle_meshio
 def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
     import json
+    import zipfile
 
     import meshio
 
@@ -33,6 +34,9 @@ def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
 
     a, b = dual_run / "a", dual_run / "b"
     assert (a / "dual.npz").read_bytes() == (b / "dual.npz").read_bytes()
+    with zipfile.ZipFile(a / "dual.npz") as archive:  # no clock, no umask in the file; every member deflated
+        assert {(i.date_time, i.external_attr >> 16, i.compress_type) for i in archive.infolist()} == {
+            ((1980, 1, 1, 0, 0, 0), 0o644, zipfile.ZIP_DEFLATED)}
     report = json.loads((a / "report.json").read_text())
     dual = read_dual(a / "dual.npz")
     assert dual.volume_sum() == 1 and len(dual.edges) == report["dual"]["edges"]
@@ -50,6 +54,7 @@ def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
 
 
 def test_a_truncated_or_tampered_dual_npz_is_refused_with_one_line(dual_run, tmp_path, capsys):
+    import struct
     import zipfile
 
     from cospherical.cli import main
@@ -66,7 +71,11 @@ def test_a_truncated_or_tampered_dual_npz_is_refused_with_one_line(dual_run, tmp
                 data = data[:-8] + np.float64(1e9).tobytes()
             target.writestr(info, data)
     flipped = bytearray(good)
-    flipped[len(good) // 3] ^= 0xFF
+    with zipfile.ZipFile(dual_run / "a" / "dual.npz") as source:  # a byte in the middle of a member's deflated data
+        info = source.getinfo("edges.npy")
+        name_length, extra_length = struct.unpack("<HH", good[info.header_offset + 26:info.header_offset + 30])
+        start = info.header_offset + 30 + name_length + extra_length  # after its local header
+    flipped[start + info.compress_size // 2] ^= 0xFF
     (tmp_path / "flipped.npz").write_bytes(bytes(flipped))
     (tmp_path / "empty.npz").write_bytes(b"")
     capsys.readouterr()
@@ -486,8 +495,8 @@ def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, ca
 
 
 def test_each_member_is_what_numpy_save_writes():
-    """The writer makes each .npy itself (one copy of the data): its bytes are numpy.save's, for every kind of
-    member (ints, floats, bools, bytes, decimal text, empty, a non-contiguous view)."""
+    """The writer makes each .npy itself (its header, then the array's own bytes): its bytes are numpy.save's, for
+    every kind of member (ints, floats, bools, bytes, decimal text, empty, a non-contiguous view)."""
     import io
 
     from cospherical.formats.dual import _npy
@@ -497,7 +506,8 @@ def test_each_member_is_what_numpy_save_writes():
                   np.ones((4, 3), dtype=bool), np.arange(6, dtype=np.int32).reshape(3, 2)[:, :1]):
         saved = io.BytesIO()
         np.save(saved, array, allow_pickle=False)
-        assert bytes(_npy(array)) == saved.getvalue()
+        header, data = _npy(array)
+        assert header + bytes(data) == saved.getvalue()
 
 
 def test_distinct_elements_are_proved_distinct_even_when_every_hash_collides(dual_run, monkeypatch):
