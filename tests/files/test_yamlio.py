@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import os
 
@@ -99,3 +100,35 @@ def test_validation_names_the_file_the_schema_and_the_place():
     with pytest.raises(FormatError) as error:
         validate({"schema_version": 1, "version": "0123456789ab", "types": [{"id": 3}]}, "catalogue", "c.yaml")
     assert one_line(error).startswith("c.yaml: catalogue format: at types.0")
+
+
+def test_a_compiled_validator_is_kept_and_gives_fastjsonschemas_verdicts(tmp_path, monkeypatch):
+    import sys
+
+    import fastjsonschema
+
+    from cospherical.files.yamlio import _compiled_validator
+
+    schema = {"type": "object", "properties": {"n": {"type": "integer", "minimum": 2}}, "required": ["n"]}
+    text = json.dumps(schema)
+    fresh = fastjsonschema.compile(schema)
+    monkeypatch.setattr(sys, "dont_write_bytecode", True)  # PYTHONDONTWRITEBYTECODE: nothing kept
+    assert _compiled_validator("demo", text, tmp_path)({"n": 2}) == {"n": 2} and not any(tmp_path.iterdir())
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)
+    first = _compiled_validator("demo", text, tmp_path)
+    kept = list(tmp_path.glob("demo.*.marshal"))
+    assert len(kept) == 1  # kept for the next process
+    second = _compiled_validator("demo", text, tmp_path)  # read back, not compiled
+    for check in (fresh, first, second):
+        assert check({"n": 3}) == {"n": 3}
+        with pytest.raises(fastjsonschema.JsonSchemaValueException, match="data.n must be bigger than or equal to 2"):
+            check({"n": 1})
+    kept[0].write_bytes(b"\x00damaged")  # a damaged file is compiled again and replaced
+    assert _compiled_validator("demo", text, tmp_path)({"n": 2}) == {"n": 2}
+    assert kept[0].read_bytes() != b"\x00damaged"
+    other = json.dumps({**schema, "required": []})  # another text of the schema: its own file, the old one dropped
+    assert _compiled_validator("demo", other, tmp_path)({}) == {}
+    assert [p.name for p in tmp_path.glob("demo.*.marshal")] != [kept[0].name]
+    assert len(list(tmp_path.glob("demo.*"))) == 1
+    (tmp_path / "file").write_text("")  # a folder it cannot make (root writes anywhere else): compiled, no error
+    assert _compiled_validator("demo", text, tmp_path / "file" / "cache")({"n": 2}) == {"n": 2}

@@ -245,10 +245,59 @@ def parse_yaml(text: str, name: str):
 def _validator(name: str):
     # fastjsonschema compiles the schema to Python: a 4096-configuration pattern
     # table validates in a fraction of a second instead of seconds.
+    text = data_path(f"schemas/{name}.schema.json").read_text(encoding="utf-8")
+    return _compiled_validator(name, text, data_path("schemas") / "__pycache__")
+
+
+def _compiled_validator(name: str, text: str, folder: Path):
+    """fastjsonschema's validator of the schema ``text``, its bytecode kept as Python keeps a module's.
+
+    Generating and compiling a validator costs 15-40 ms a schema (the mesh report's is
+    180 kB of Python), paid by every command that reads or writes a file of that
+    schema; the code object is kept in ``folder`` (the schemas' ``__pycache__``) under a digest of
+    the schema, fastjsonschema's version and the interpreter's bytecode magic (any
+    change makes a new one), and loaded in about a millisecond.  The same function,
+    so the same verdicts and messages; a cache that cannot be read or written (a
+    read-only install, ``PYTHONDONTWRITEBYTECODE``) only costs the compile again.
+    """
+    import hashlib
+    import importlib.util
+    import marshal
+    import sys
+
     import fastjsonschema
 
-    schema = json.loads(data_path(f"schemas/{name}.schema.json").read_text(encoding="utf-8"))
-    return fastjsonschema.compile(schema)
+    key = hashlib.sha256("\0".join((fastjsonschema.VERSION, importlib.util.MAGIC_NUMBER.hex(), text)).encode())
+    path = folder / f"{name}.{key.hexdigest()[:16]}.marshal"
+    try:
+        function, code = marshal.loads(path.read_bytes())
+        if not isinstance(function, str) or not isinstance(code, type(_compiled_validator.__code__)):
+            raise ValueError("not a cached validator")
+    except (OSError, ValueError, EOFError, TypeError):
+        source = fastjsonschema.compile_to_code(json.loads(text))
+        found = re.search(r"^def (\w+)\(", source, re.M)  # the schema's own function comes first
+        if found is None:
+            raise ValueError(f"fastjsonschema gave no validator for the {name} schema") from None
+        function, code = found.group(1), compile(source, f"<{name} schema>", "exec")
+        if not sys.dont_write_bytecode:
+            _keep(folder, path, marshal.dumps((function, code)))
+    namespace: dict[str, Any] = {}
+    exec(code, namespace)
+    return namespace[function]
+
+
+def _keep(folder: Path, path: Path, data: bytes) -> None:
+    """Write a cached validator atomically beside the others, and drop those of the schema's earlier texts."""
+    try:
+        folder.mkdir(exist_ok=True)
+        temporary = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        temporary.write_bytes(data)
+        os.replace(temporary, path)
+        for old in folder.glob(path.name.split(".", 1)[0] + ".*.marshal"):
+            if old != path:
+                old.unlink(missing_ok=True)
+    except OSError:
+        pass  # a read-only install: compiled again next time
 
 
 def validate(data, schema: str, path: str | Path) -> None:
