@@ -524,8 +524,8 @@ def _outside_domain(mesh: Mesh) -> int:
     for _, tessellation, leaves in mesh.groups():
         low = mesh.tree.positions[leaves].astype(np.int64) * size[leaves, None]
         for element in tessellation.elements:
-            if element.center is None:
-                continue
+            if element.center is None or element.center_in_leaf:
+                continue  # a centre in its own closed leaf is in the closed domain: the leaf is
             # the centre in grid units is low + c * size, for c = p / q: compare q * low + p * size with 0 and q * grid,
             # in int64 when every term is below 2**62 (low and size are at most grid), else in Python integers
             numerators = [c.numerator for c in element.center]

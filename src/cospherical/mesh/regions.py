@@ -234,10 +234,15 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     """
     regions, layout, element_region = device_of(mesh)
     rows, polygons = [], []
+    vertices = mesh.vertices.astype(np.int64)
+    planes = [plane * (mesh.grid // layout.steps) for plane in layout.planes]
+    in_plane = np.stack([np.isin(vertices[:, axis], planes[axis]) for axis in range(3)], axis=1)
     for element_rows, nodes, faces, _ in mesh.blocks():
         for cycle in faces:
-            rows.append(element_rows)
-            polygons.append(nodes[:, list(cycle)])
+            polygon = nodes[:, list(cycle)]
+            on = _on_a_plane(vertices, polygon, in_plane)
+            rows.append(element_rows[on])
+            polygons.append(polygon[on])
     if not rows:
         empty = np.zeros((0, 0), dtype=np.int32)
         return RegionFaces(empty, np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros((0, 2), np.int32), (),
@@ -305,18 +310,21 @@ def face_sets(element: np.ndarray, polygons: list[np.ndarray], element_region: n
         which.reshape(-1)
 
 
-def _on_a_plane(vertices: np.ndarray, polygon: np.ndarray, planes: list[np.ndarray]) -> np.ndarray:
-    """Which faces (rows of vertex ids) lie flat in one of the device's block planes (grid units per axis).
+def _on_a_plane(vertices: np.ndarray, polygon: np.ndarray, in_plane: np.ndarray) -> np.ndarray:
+    """Which faces (rows of vertex ids) lie flat in one of the device's block planes.
 
-    Only those can be a contact or interface face or lie on the domain's boundary (every
-    box face lies in a block plane), and both copies of a shared face are kept: what is
-    paired among them is paired as among all faces, at a fraction of the sort.
+    ``in_plane[v, a]``: whether vertex ``v``'s coordinate along axis ``a`` is one of the
+    block planes normal to ``a``.  Only those faces can be a contact or interface face or
+    lie on the domain's boundary (every box face lies in a block plane), and both copies
+    of a shared face are kept: what is paired among them is paired as among all faces,
+    at a fraction of the sort.  A face whose first corner lies on no plane is out at once.
     """
-    first = vertices[polygon[:, 0]]
+    first = polygon[:, 0]
+    candidates = np.flatnonzero(in_plane[first].any(axis=1))
     on = np.zeros(len(polygon), dtype=bool)
     for axis in range(3):
-        rows = np.flatnonzero(np.isin(first[:, axis], planes[axis]))
-        flat = np.all(vertices[polygon[rows], axis] == first[rows, axis, None], axis=1)
+        rows = candidates[in_plane[first[candidates], axis]]
+        flat = np.all(vertices[polygon[rows], axis] == vertices[first[rows], axis, None], axis=1)
         on[rows[flat]] = True
     return on
 
@@ -391,7 +399,8 @@ def region_parts(box: Box, grid: int, vertices: np.ndarray, dual: Dual, element_
         vr.append(np.full(len(used), r, dtype=np.int32))
         ve.append(part.volume_exact[used])
         vden.append(part.volume_denominator)
-        edge = np.searchsorted(keys, part.edges[:, 0].astype(np.int64) * len(vertices) + part.edges[:, 1])
+        edge = np.arange(len(keys)) if part is dual else \
+            np.searchsorted(keys, part.edges[:, 0].astype(np.int64) * len(vertices) + part.edges[:, 1])
         ce.append(edge)
         cr.append(np.full(len(edge), r, dtype=np.int32))
         cx.append(part.coefficient_exact)
@@ -400,9 +409,10 @@ def region_parts(box: Box, grid: int, vertices: np.ndarray, dual: Dual, element_
     volume_exact = _common(ve, vden, volume_denominator)
     coupling_exact = _common(cx, cden, coupling_denominator)
     volume_vertex, volume_region = np.concatenate(vv), np.concatenate(vr)
-    order = np.lexsort((volume_region, volume_vertex))
     coupling_edge, coupling_region = np.concatenate(ce), np.concatenate(cr)
-    corder = np.lexsort((coupling_region, coupling_edge))
+    # one region's rows are sorted already (increasing vertices, increasing edges)
+    order = np.lexsort((volume_region, volume_vertex)) if len(names) > 1 else slice(None)
+    corder = np.lexsort((coupling_region, coupling_edge)) if len(names) > 1 else slice(None)
     if contact_face_nodes is None or contact_face_contact is None:
         contact_face_nodes = np.zeros((0, 3), dtype=np.int32)
         contact_face_contact = np.zeros(0, dtype=np.int32)

@@ -185,8 +185,13 @@ def set_domain_boundary(dual: Dual, faces: np.ndarray) -> None:
     dual.boundary_area_denominator = denominator * dual.grid ** 2  # squared grid steps over a side's
     dual.boundary_area = boundary_areas(exact, dual.boundary_area_denominator, dual.boundary_factors_squared)
     count = len(dual.grid_vertices)
-    keys = dual.edges[:, 0].astype(np.int64) * count + dual.edges[:, 1]
-    dual.boundary_edge = np.isin(keys, edge_keys(faces, count))
+    keys = dual.edges[:, 0].astype(np.int64) * count + dual.edges[:, 1]  # increasing: the edges are sorted
+    # the few boundary edges looked up among all the edges (np.isin would sort them all)
+    boundary = edge_keys(faces, count)
+    at = np.minimum(np.searchsorted(keys, boundary), max(len(keys) - 1, 0))
+    dual.boundary_edge = np.zeros(len(keys), dtype=bool)
+    if len(keys):
+        dual.boundary_edge[at[keys[at] == boundary]] = True
 
 
 def interface_parts(vertices: np.ndarray, grid: int, lengths: tuple[Fraction, Fraction, Fraction],
