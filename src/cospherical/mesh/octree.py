@@ -23,8 +23,8 @@ from ..core.configuration import Box
 from ..errors import CosphericalWarning, InputError, shown
 from .leaf_list import leaf_list_order, leaves_octree
 from .refinement import Shape, estimate_leaves, meets_shape, parse_shape
-from .tree import (BYTES_PER_LEAF, MAX_LEVEL, Octree, cells_of, check_leaf_count, children, distinct, keys_of,
-                   leaf_bound, leaves_from_splits, neighbour_offsets, neighbours)
+from .tree import (BYTES_PER_LEAF, MAX_LEVEL, Octree, cells_of, check_leaf_count, children, distinct, leaf_bound,
+                   leaves_from_splits, neighbour_offsets, neighbours, parents)
 
 __all__ = ["BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "Shape", "build_octree", "check_leaf_count", "distinct",
            "estimate_leaves", "leaf_bound", "leaf_list_order", "leaves_octree", "parse_shape"]
@@ -90,8 +90,7 @@ def build_octree(box: Box, levels: int, shapes: Sequence[Shape], balance: str = 
     for level in range(deepest - 1, 0, -1):
         # every neighbour of a split cell must exist: its parent must be split
         need = neighbours(level, cells_of(level, split[level]), offsets)
-        parents = distinct(keys_of(level - 1, cells_of(level, need) // 2))
-        split[level - 1] = np.union1d(split[level - 1], parents)
+        split[level - 1] = distinct(np.concatenate([split[level - 1], parents(level, need)]), runs=True)
     levels_, positions = leaves_from_splits(split)
     check_leaf_count(len(levels_), f"{name}: balanced, the tree has", max_leaves)
     return Octree(box, levels_, positions, vertex_balanced=balance == "vertex")

@@ -25,7 +25,7 @@ from ..errors import InputError
 from ..files.yamlio import machine_memory
 
 __all__ = ["BYTES_PER_LEAF", "MAX_LEVEL", "Octree", "cells_of", "check_leaf_count", "children", "distinct", "keys_of",
-           "leaf_bound", "leaves_from_splits", "neighbour_offsets", "neighbours"]
+           "leaf_bound", "leaves_from_splits", "neighbour_offsets", "neighbours", "parents"]
 
 MAX_LEVEL = 16  # keys (2**16)**3 and the half-spacing grid (2**17 + 1)**3 stay inside int64
 # Peak memory of `cospherical mesh` with every check, per leaf: 1.5 kB measured at 131,258
@@ -34,13 +34,16 @@ BYTES_PER_LEAF = 2048
 _Key = TypeVar("_Key", bound=np.integer[Any])  # an integer array keeps its dtype through distinct
 
 
-def distinct(keys: NDArray[_Key]) -> NDArray[_Key]:
+def distinct(keys: NDArray[_Key], runs: bool = False) -> NDArray[_Key]:
     """The distinct values of an integer array, increasing.
 
     Sort and keep firsts: numpy's hash-based ``unique`` is much slower on int64 keys
-    (4 million keys spread over 10**12: 5.5 s against 0.03 s CPU, numpy 2.4).
+    (4 million keys spread over 10**12: 5.5 s against 0.03 s CPU, numpy 2.4).  ``runs``:
+    the keys (read in C order) are a few increasing runs, which a stable sort (timsort)
+    merges instead of sorting afresh: the corners of 335,504 leaves laid out corner by
+    corner, 2.7 million keys in 64 runs, 0.02 s CPU against 0.16 s for numpy's default sort.
     """
-    keys = np.sort(keys, axis=None)
+    keys = np.sort(keys, axis=None, kind="stable" if runs else None)
     return keys[np.r_[True, keys[1:] != keys[:-1]]] if len(keys) else keys
 
 
@@ -66,18 +69,45 @@ def neighbour_offsets(balance: Balance) -> NDArray[np.int64]:
 
 
 def neighbours(level: int, cells: NDArray[np.integer[Any]], offsets: NDArray[np.int64]) -> NDArray[np.integer[Any]]:
-    """Positions of the cells (with the cells themselves) at ``offsets``, inside the domain, unique keys."""
+    """Keys of the cells (with the cells themselves) at ``offsets`` (steps of -1, 0, 1 per axis:
+    :func:`neighbour_offsets`), inside the domain, distinct and increasing.
+
+    Cells given in key order make one increasing run per offset, merged by a stable sort.
+    """
     n = 1 << level
-    near = (cells[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
-    near = near[np.all((near >= 0) & (near < n), axis=1)]
-    return distinct(keys_of(level, near))
+    cells = cells.astype(np.int64)
+    base = keys_of(level, cells)
+    # per axis, the cells with room below (offset -1) and above (+1) inside the domain
+    room = {(axis, step): cells[:, axis] > 0 if step < 0 else cells[:, axis] < n - 1
+            for axis in range(3) for step in (-1, 1)}
+    near = []
+    for offset in offsets.tolist():
+        inside = None
+        for axis, step in enumerate(offset):
+            if step:
+                inside = room[axis, step] if inside is None else inside & room[axis, step]
+        shift = (offset[0] * n + offset[1]) * n + offset[2]
+        near.append((base if inside is None else base[inside]) + shift)
+    return distinct(np.concatenate(near) if near else base[:0], runs=True)
 
 
 def children(level: int, keys: NDArray[np.integer[Any]]) -> NDArray[np.int64]:
     """Keys at ``level + 1`` of the eight children of cells at ``level``."""
     cells = cells_of(level, keys) * 2
-    kids = (cells[:, None, :] + np.array(list(product((0, 1), repeat=3)))[None]).reshape(-1, 3)
-    return np.sort(keys_of(level + 1, kids))
+    kids = (np.array(list(product((0, 1), repeat=3)))[:, None, :] + cells[None]).reshape(-1, 3)
+    return np.sort(keys_of(level + 1, kids), kind="stable")  # child by child: eight increasing runs when keys increase
+
+
+def parents(level: int, keys: NDArray[np.integer[Any]]) -> NDArray[np.int64]:
+    """Keys at ``level - 1`` of the parents of cells at ``level`` (``keys`` increasing), distinct and increasing.
+
+    Halving keeps the order of the cells alike in each coordinate's parity, so the cells
+    grouped by their eight parities (a stable sort of 3-bit numbers) make eight increasing
+    runs of parents, merged by a stable sort.
+    """
+    cells = cells_of(level, keys)
+    parity = ((cells[:, 0] & 1) << 2 | (cells[:, 1] & 1) << 1 | cells[:, 2] & 1).astype(np.uint8)
+    return distinct(keys_of(level - 1, cells[np.argsort(parity, kind="stable")] // 2), runs=True)
 
 
 @dataclass(frozen=True)
