@@ -439,23 +439,78 @@ def vertex_keys(tree: Octree) -> tuple[int, NDArray[np.int64]]:
     its index in the keys is its id in the mesh, so a mesh assembled from a part of the
     tree with these keys numbers its vertices as the whole tree's mesh does.
     """
-    levels = tree.levels.astype(np.int64)
-    grid = 1 << (tree.depth + 1)
-    size = grid >> levels
-    origin = tree.positions.astype(np.int64) * size[:, None]
-    return grid, distinct(_node_keys(origin, size // 2, grid, slice(None), slice(0, 8)))
+    grid, origin, half = _leaf_boxes(tree)
+    return grid, distinct(_node_keys(origin, half, grid, _CORNERS), runs=True)
 
 
-def _node_keys(origin: NDArray[np.int64], half: NDArray[np.int64], grid: int, part: slice,
-               nodes: slice) -> NDArray[np.int64]:
-    # A point's key (x * n + y) * n + z is linear in the point: a node's key is its leaf origin's key plus
-    # half the leaf times the key of the node's offset: one (leaves x nodes) temporary, not eight.
+_CORNERS = np.arange(8)
+
+
+def _leaf_boxes(tree: Octree, grid: int | None = None) -> tuple[int, NDArray[np.int64], NDArray[np.int64]]:
+    """The grid (intervals per domain side: the tree's own unless given), and each leaf's lowest corner and half
+    its side in grid units."""
+    grid = 1 << (tree.depth + 1) if grid is None else grid
+    size = grid >> tree.levels.astype(np.int64)
+    return grid, tree.positions.astype(np.int64) * size[:, None], size // 2
+
+
+def _node_keys(origin: NDArray[np.int64], half: NDArray[np.int64], grid: int,
+               nodes: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The keys of the leaves' ``nodes`` (node numbers 0..26), node by node: (nodes x leaves).
+
+    A point's key (x * n + y) * n + z is linear in the point: a node's key is its leaf origin's key plus
+    half the leaf times the key of the node's offset.  Leaves in key order (within a level) make
+    increasing runs, one per node and level.
+    """
     n = np.int64(grid + 1)
-    origin = origin[part]
     offsets = NODE_OFFSETS[nodes]
-    keys: NDArray[np.int64] = half[part, None] * ((offsets[:, 0] * n + offsets[:, 1]) * n + offsets[:, 2])[None]
-    keys += ((origin[:, 0] * n + origin[:, 1]) * n + origin[:, 2])[:, None]
+    keys: NDArray[np.int64] = ((offsets[:, 0] * n + offsets[:, 1]) * n + offsets[:, 2])[:, None] * half[None]
+    keys += ((origin[:, 0] * n + origin[:, 1]) * n + origin[:, 2])[None]
     return keys
+
+
+def _leaf_slots(tree: Octree, vertices: tuple[int, NDArray[np.int64]] | None = None
+               ) -> tuple[int, NDArray[np.int64], NDArray[np.int32]]:
+    """The tree's grid, vertex keys (:func:`vertex_keys`, or ``vertices`` when given) and each leaf's 27 slots.
+
+    ``slots[i, s]`` is the id of the vertex at node ``s`` of leaf ``i`` (its index in the
+    keys), -1 where there is none.  Every key asked for (each leaf's corners; the other
+    nodes of the leaves above the finest grid level) and the vertex keys are sorted together
+    once, stably: they are a few increasing runs (one per node and level), which timsort
+    merges; a key is a vertex where its run of equal keys holds a vertex key (a leaf corner,
+    or one of ``vertices``), and its id is that run's rank among such runs.  A leaf of the
+    grid's finest level (two grid steps a side) has no point at its edges' and faces'
+    midpoints or its centre: every vertex is a leaf corner, at even grid coordinates, and
+    those nodes are at odd ones.  The finest level is the grid's, not the tree's: a part of a
+    tree (a partition piece, a device's region) may stop levels above the whole.
+    """
+    grid, origin, half = _leaf_boxes(tree, None if vertices is None else vertices[0])
+    coarse = np.flatnonzero(half > 1)
+    corners = _node_keys(origin, half, grid, _CORNERS)
+    others = _node_keys(origin[coarse], half[coarse], grid, _OTHERS)
+    given = vertices[1] if vertices is not None else corners[:0, 0]
+    asked = np.concatenate([given, corners.reshape(-1), others.reshape(-1)])
+    order = np.argsort(asked, kind="stable")
+    ordered = asked[order]
+    first = np.empty(len(asked), dtype=bool)
+    first[:1] = True
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    run = np.cumsum(first) - 1
+    # the vertex keys: the given ones, else the corners
+    vertex_entry = order < len(given) if vertices is not None else order < len(given) + corners.size
+    is_vertex = np.zeros(int(run[-1]) + 1 if len(run) else 0, dtype=bool)
+    is_vertex[run[vertex_entry]] = True
+    ids = np.where(is_vertex, np.cumsum(is_vertex) - 1, -1).astype(np.int32)
+    found = np.empty(len(asked), dtype=np.int32)
+    found[order] = ids[run]
+    keys = given if vertices is not None else ordered[first][is_vertex]
+    slots = np.full((len(tree), 27), -1, dtype=np.int32)
+    slots[:, :8] = found[len(given):len(given) + corners.size].reshape(8, -1).T
+    slots[coarse, 8:] = found[len(given) + corners.size:].reshape(len(_OTHERS), -1).T
+    return grid, keys, slots
+
+
+_OTHERS = np.arange(8, 27)
 
 
 def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int], None] | None = None,
@@ -483,40 +538,17 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     """
     cache = {} if cache is None else cache
     catalogue = shipped_catalogue() if catalogue is None else catalogue
-    grid, keys_all = vertex_keys(tree) if vertices is None else vertices
-    size = grid >> tree.levels.astype(np.int64)  # leaf edge in grid units (even)
-    origin = tree.positions.astype(np.int64) * size[:, None]
-    half = size // 2
+    grid, keys_all, slots = _leaf_slots(tree, vertices)
     n = np.int64(grid + 1)
     points = np.stack([keys_all // (n * n), (keys_all // n) % n, keys_all % n], axis=1)
-    slots = np.empty((len(tree), 27), dtype=np.int32)
-    # A leaf of the finest level has no smaller neighbour, so no point on its edges' and faces' midpoints
-    # (any vertex there is a corner of a smaller leaf): only its corners and its centre are looked up.
-    # The finest level is the grid's (two grid steps a leaf), not this tree's: a part of a tree (a
-    # partition piece, a device's region) may stop levels above the whole, beside smaller leaves.
-    finest = size == 2
-    # bounded temporaries (14 MB): glibc then reuses their memory instead of mapping fresh pages each time
-    chunk = 1 << 16
-    for start in range(0, len(tree), chunk):
-        part = slice(start, start + chunk)
-        keys = _node_keys(origin, half, grid, part, slice(None))
-        wanted = np.ones(keys.shape, dtype=bool)
-        wanted[finest[part], 8:26] = False
-        found = np.full(keys.shape, -1, dtype=np.int32)
-        asked = keys[wanted]
-        where = np.minimum(np.searchsorted(keys_all, asked), len(keys_all) - 1)
-        found[wanted] = np.where(keys_all[where] == asked, where, -1)
-        slots[part] = found
-        if progress:
-            progress(min(chunk, len(tree) - start) // 2)
+    if progress:
+        progress(len(tree) // 2)
     if (slots[:, 26] >= 0).any():
         i = int(np.flatnonzero(slots[:, 26] >= 0)[0])
         raise InputError(f"leaf {i}: a vertex at its centre: the leaves do not form an octree")
-    present = slots >= 0
-    edges = (present[:, 8:20].astype(np.int64) << np.arange(12)).sum(axis=1)
-    faces = (present[:, 20:26].astype(np.int64) << np.arange(6)).sum(axis=1)
-    value = edges | faces << 12  # < 2**18: count instead of sorting
-    seen = np.bincount(value, minlength=1 << 18) > 0
+    # bit k: a point at edge k's midpoint (node 8 + k), bit 12 + f: at face f's centre (node 20 + f)
+    value = (slots[:, 8:26] >= 0).astype(np.int32) @ (np.int32(1) << np.arange(18, dtype=np.int32))
+    seen = np.bincount(value, minlength=1 << 18) > 0  # < 2**18: count instead of sorting
     distinct = np.flatnonzero(seen)
     leaf_tessellation = (np.cumsum(seen) - 1)[value]
     tessellations: list[LocalTessellation] = []
