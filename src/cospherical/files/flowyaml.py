@@ -43,6 +43,7 @@ _SEQUENCE_LINE = re.compile(r"- (\{[^\n]*\})")
 # apart as lines; the YAML reader then refuses it by its size, at once).
 _MAPPING_LINES = re.compile(r"^  '([^'\n]*)': (\{[^\n]*\})$", re.M)
 _SEQUENCE_LINES = re.compile(r"^- (\{[^\n]*\})$", re.M)
+_TOP_LEVEL_LINE = re.compile(r"\n[^ \-\n#]")
 _STRAY_LINE = re.compile(r"\n(?!  '|- \{)")  # a newline and what follows: the regex engine finds newlines fast
 
 
@@ -114,9 +115,10 @@ def split_section(text: str, key: str) -> tuple[str, dict[str, str] | list[str]]
             return None
         start = -1
     body_start = start + len(key) + 3
-    # The section ends at the first line that starts a new top-level key.
-    match = re.compile(r"^[^ \-\n#]", re.M).search(text, body_start)
-    end = match.start() if match else len(text)
+    # The section ends at the first line that starts a new top-level key (found from the newline before
+    # it: a search for a newline runs at memchr's speed, one for a line start with re.M 16 times slower).
+    match = _TOP_LEVEL_LINE.search(text, body_start - 1)
+    end = match.start() + 1 if match else len(text)
     last = end - 1 if end > body_start and text[end - 1] == "\n" else end  # the final newline starts no line
     if body_start < last and _STRAY_LINE.search(text, body_start - 1, last):  # from the newline before the section
         return None
