@@ -78,10 +78,12 @@ def piece_name(k: int) -> str:
 
 def mesh_writes(name: str) -> bool:
     """Whether a mesh run writes a file of this name: the only files of an earlier run its folder may remove."""
-    from ..mesh.partition import MAX_PARTITIONS
-
     piece = re.fullmatch(r"mesh-(0|[1-9][0-9]{0,9})\.vtu", name)
-    return name in (*output_names(True, True, True, True), "mesh.pvtu") or piece is not None and int(piece[1]) < MAX_PARTITIONS
+    if piece is None:
+        return name in (*output_names(True, True, True, True), "mesh.pvtu")
+    from ..mesh.partition import MAX_PARTITIONS  # imported for a piece's name only: a partitioned run wrote it
+
+    return int(piece[1]) < MAX_PARTITIONS
 
 
 def default_cut(shapes: Sequence[Shape], box: Box) -> float:

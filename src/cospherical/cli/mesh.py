@@ -207,16 +207,18 @@ def run(args) -> int:
 
 def _pieces(args) -> int | None:
     """``--partitions`` and its backend, checked before any work; ``None`` without it."""
-    from ..mesh.partition import MAX_PARTITIONS
-    from ..execution.backends import MAX_WORKERS, check_backend
-
-    pieces = _count(args.partitions, "--partitions", MAX_PARTITIONS)
     backend = [option for option, value in (("--jobs", args.jobs), ("--scheduler", args.scheduler),
                                             ("--dask-workers", args.dask_workers)) if value is not None]
-    if pieces is None:
+    if args.partitions is None:
         if backend:
             raise InputError(f"{backend[0]} runs the pieces of --partitions N: give that too")
         return None
+    # the partitioned mesher and its backends are imported only for a partitioned run
+    from ..execution.backends import MAX_WORKERS, check_backend
+    from ..mesh.partition import MAX_PARTITIONS
+
+    pieces = _count(args.partitions, "--partitions", MAX_PARTITIONS)
+    assert pieces is not None  # given: a count, or refused
     if args.dual:
         raise InputError("--dual needs the whole mesh in one process: not with --partitions")
     check_backend("cospherical mesh", args.scheduler, args.dask_workers, args.scheduler_timeout)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -54,6 +55,7 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
     low = mesh.tree.positions[:, axis].astype(np.int64) * mesh.leaf_size()
     near = (low < z0) & (low + mesh.leaf_size() > z0)
     vertices = mesh.vertices[:, list(across)]  # the picture's two axes, then the cut's
+    edge_ends: dict[Any, np.ndarray] = {}  # an element's edges (pairs of positions in its node list) per face list
     for element_rows, nodes, faces, type_id in mesh.blocks(near):
         if type_id is None:  # a mesh's blocks all have types: only an element list's have none
             raise ValueError("mesh_picture: an element without a type")
@@ -61,15 +63,17 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
         crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
         if not len(crossing):
             continue
-        edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in faces for i in range(len(c))})
-        ends = np.array(edges, dtype=np.intp).reshape(-1, 2)
+        ends = edge_ends.get(faces)
+        if ends is None:  # blocks of one configuration's element, or of one cell shape, share their faces
+            edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in faces for i in range(len(c))})
+            ends = edge_ends[faces] = np.array(edges, dtype=np.intp).reshape(-1, 2)
         a = nodes[np.ix_(crossing, ends[:, 0])]  # (crossing elements, edges): vertex ids
         b = nodes[np.ix_(crossing, ends[:, 1])]
         pa, pb = vertices[a].astype(float), vertices[b].astype(float)  # (elements, edges, 3)
         za, zb = pa[..., 2] - z0, pb[..., 2] - z0
         cut = za * zb < 0
-        masks = (cut.astype(np.int64) << np.arange(len(edges))).sum(axis=1)
-        for mask in np.unique(masks).tolist():
+        masks = (cut.astype(np.int64) << np.arange(len(ends))).sum(axis=1)
+        for mask in sorted(set(masks.tolist())):
             rows = np.flatnonzero(masks == mask)
             which = np.flatnonzero(cut[rows[0]])
             ra, rb = pa[rows][:, which], pb[rows][:, which]  # (rows, corners, 3)
