@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections import defaultdict
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -54,6 +55,31 @@ def test_a_device_tells_the_same_stages_with_their_own_totals():
     assert sum(n for _, n in told["conformity"]) == _faces(result.report)
     assert told["assembly"][0][0] == len(source.tree) == sum(n for _, n in told["assembly"])
     assert told["regions"][0][0] == result.report.leaf_mesh["elements"] == sum(n for _, n in told["regions"])
+
+
+def _far(x0: str, side: str, levels: int) -> str:
+    return (f"device: far\nregions:\n  - {{name: si, material: Si, boxes: [[{x0}, 0, 0, {x0} + {side}, 1, 1]]}}\n"
+            f"refine:\n  - point: [{Fraction(x0) + Fraction(side) / 3}, 0.4, 0.4]\nlevels: {levels}\n"
+            ).replace(f"{x0} + {side}", str(Fraction(x0) + Fraction(side)))
+
+
+@pytest.mark.parametrize("x0, side, levels", [
+    ("100000000000000000000", "1", 2),    # every vertex rounded onto x = 1e20
+    ("1000000000000", "1/1000", 3),        # a 1e-3 cube at 1e12: distinct floats, its volumes 2 % off
+    ("1000", "1", 8),                      # 1000 sides off
+    ("-7", "1/8", 6)])
+def test_a_device_is_refused_where_float_coordinates_cannot_hold_its_leaves(x0, side, levels):
+    # the premise from the floats themselves: every grid line's float, its step against the exact step
+    exact = [Fraction(x0) + Fraction(side) * k / 2 ** levels for k in range(2 ** levels + 1)]
+    steps = np.diff([float(x) for x in exact])
+    fits = bool(np.all(np.abs(steps - float(exact[1] - exact[0])) <= float(exact[1] - exact[0]) / 2 ** 26))
+    device = parse_device(_far(x0, side, levels))
+    if fits:
+        assert tree_from_device(device).tree.depth == levels
+    else:
+        with pytest.raises(InputError, match="float64 coordinates .* too coarse for its smallest leaves"):
+            tree_from_device(device)
+    assert fits == (x0 in ("1000", "-7"))
 
 
 def test_the_pipeline_in_leaf_mode_is_the_steps_by_hand():
