@@ -48,6 +48,7 @@ def test_what_is_written_reads_back_the_same(tmp_path_factory, data):
     ("a: [1, 2\n", "demo.yaml: line 2"),
     ("[" * 65 + "]" * 65, "nested too deeply"),
     ("{[1]: 2}\n", "not a plain value"),
+    ("a: " + "9" * 5000 + "\n", "demo.yaml: an integer of more than 4,300 digits"),  # not Python's advice
 ])
 def test_hostile_yaml_is_one_line_naming_the_file(text, needle):
     with pytest.raises(FormatError) as error:

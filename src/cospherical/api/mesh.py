@@ -534,11 +534,18 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         raise InputError("tetrahedral_counts=True counts beside the dual's figures: give dual=True too")
     clock = time.perf_counter()
     if device is not None:
+        named = None
         if not isinstance(device, Device):
             from ..formats.device_file import read_device
 
-            device = read_device(device)
-        source = tree_from_device(device, max_leaves)
+            named, device = device, read_device(device)
+        try:
+            source = tree_from_device(device, max_leaves)
+        except InputError as error:
+            if named is None:
+                raise
+            # what is found past the file's parsing names the file too, as its parse errors do
+            raise InputError(f"{named}: {error}") from None
         layout = source.device
         if layout is None:
             raise ValueError("tree_from_device gave no device layout")

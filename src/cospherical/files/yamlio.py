@@ -7,6 +7,7 @@ import json
 import os
 import re
 import stat
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -219,7 +220,8 @@ def load_document(text: str, name: str, loader: type) -> Any:
         problem = getattr(error, "problem", None) or "not valid YAML"
         raise FormatError(f"{name}:{where}: {problem}") from None
     except (ValueError, OverflowError, RecursionError) as error:
-        # e.g. an integer of more digits than Python converts (sys.get_int_max_str_digits)
+        if "integer string conversion" in str(error):  # Python's advice to a programmer is no user's message
+            raise FormatError(f"{name}: an integer of more than {sys.get_int_max_str_digits():,} digits") from None
         raise FormatError(f"{name}: a value cannot be read: {str(error).splitlines()[0][:120]}") from None
 
 
