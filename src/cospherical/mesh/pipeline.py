@@ -320,7 +320,8 @@ def full_dual(mesh: Mesh, faces: RegionFaces | None, dual: Dual | None = None) -
         from .regions import device_of, mesh_region_parts
         from .surfaces import interface_parts, set_domain_boundary
 
-        set_domain_boundary(dual, faces.boundary_nodes)  # a union of boxes: its boundary, not the bounding box's
+        # a union of boxes: its boundary, not the bounding box's
+        set_domain_boundary(dual, faces.boundary_nodes, faces.boundary_edges)
         dual.regions = mesh_region_parts(mesh, dual, faces)
         regions, layout, _ = device_of(mesh)
         (x0, x1), (y0, y1), (z0, z1) = layout.device.bounds

@@ -237,10 +237,11 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     vertices = mesh.vertices.astype(np.int64)
     planes = [plane * (mesh.grid // layout.steps) for plane in layout.planes]
     in_plane = np.stack([np.isin(vertices[:, axis], planes[axis]) for axis in range(3)], axis=1)
+    on_some_plane: np.ndarray = np.any(in_plane, axis=1)
     for element_rows, nodes, faces, _ in mesh.blocks():
         for cycle in faces:
             polygon = nodes[:, list(cycle)]
-            on = _on_a_plane(vertices, polygon, in_plane)
+            on = _on_a_plane(vertices, polygon, in_plane, on_some_plane)
             rows.append(element_rows[on])
             polygons.append(polygon[on])
     if not rows:
@@ -310,17 +311,18 @@ def face_sets(element: np.ndarray, polygons: list[np.ndarray], element_region: n
         which.reshape(-1)
 
 
-def _on_a_plane(vertices: np.ndarray, polygon: np.ndarray, in_plane: np.ndarray) -> np.ndarray:
+def _on_a_plane(vertices: np.ndarray, polygon: np.ndarray, in_plane: np.ndarray, on_some_plane: np.ndarray
+                ) -> np.ndarray:
     """Which faces (rows of vertex ids) lie flat in one of the device's block planes.
 
     ``in_plane[v, a]``: whether vertex ``v``'s coordinate along axis ``a`` is one of the
-    block planes normal to ``a``.  Only those faces can be a contact or interface face or
+    block planes normal to ``a`` (``on_some_plane``: along any axis).  Only those faces can be a contact or interface face or
     lie on the domain's boundary (every box face lies in a block plane), and both copies
     of a shared face are kept: what is paired among them is paired as among all faces,
     at a fraction of the sort.  A face whose first corner lies on no plane is out at once.
     """
     first = polygon[:, 0]
-    candidates = np.flatnonzero(in_plane[first].any(axis=1))
+    candidates = np.flatnonzero(on_some_plane[first])
     on = np.zeros(len(polygon), dtype=bool)
     for axis in range(3):
         rows = candidates[in_plane[first[candidates], axis]]
@@ -420,8 +422,9 @@ def region_parts(box: Box, grid: int, vertices: np.ndarray, dual: Dual, element_
         vertices, contact_face_nodes, contact_face_contact, len(contacts), grid,
         lengths or (Fraction(1), Fraction(1), Fraction(1)))
     return RegionParts(
-        tuple(names), tuple(materials), element_region.astype(np.int32), volume_vertex[order].astype(np.int64),
-        volume_region[order], volume_exact[order], volume_denominator, coupling_edge[corder].astype(np.int64),
+        tuple(names), tuple(materials), element_region.astype(np.int32, copy=False),
+        volume_vertex[order].astype(np.int64, copy=False), volume_region[order], volume_exact[order], volume_denominator,
+        coupling_edge[corder].astype(np.int64, copy=False),
         coupling_region[corder],
         coupling_exact[corder], coupling_denominator, tuple(c[0] for c in contacts), tuple(c[1] for c in contacts),
         tuple(tuple(c[2]) for c in contacts), contact_face_nodes.astype(np.int32),
@@ -459,6 +462,8 @@ def _common(parts: list[np.ndarray], denominators: list[int], common: int) -> np
     room = 2**62 // max(1, sum(len(part) for part in parts))
     if all(part.dtype != object and (not len(part) or int(np.abs(part).max()) * (common // d) < room)
            for part, d in zip(parts, denominators)):
+        if len(parts) == 1 and common == denominators[0]:  # one region's: the numerators as they are, no copy
+            return parts[0].astype(np.int64, copy=False)
         return np.concatenate([part.astype(np.int64) * np.int64(common // d) for part, d in zip(parts, denominators)]
                               + [np.zeros(0, dtype=np.int64)])
     return _narrow([int(x) * (common // d) for part, d in zip(parts, denominators) for x in part.tolist()])
@@ -537,10 +542,9 @@ def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> d
     parts = dual.regions if dual is not None else None
     if dual is not None and parts is not None:
         factor = _factor(dual)
-        keys = dual.edges[parts.coupling_edge, 0].astype(np.int64) * len(mesh.vertices) + \
-            dual.edges[parts.coupling_edge, 1]
-        at = np.minimum(np.searchsorted(faces.boundary_edges, keys), max(len(faces.boundary_edges) - 1, 0))
-        on_boundary = (faces.boundary_edges[at] == keys) if len(faces.boundary_edges) else np.zeros(len(keys), bool)
+        if dual.boundary_edge is None:
+            raise ValueError("device_report: a device's dual without its boundary edges (pipeline.full_dual sets them)")
+        on_boundary = dual.boundary_edge[parts.coupling_edge]
         below = np.asarray(parts.coupling_exact < 0)
         negative = [{"interior": int((below & ~on_boundary & (parts.coupling_region == r)).sum()),
                      "boundary": int((below & on_boundary & (parts.coupling_region == r)).sum())}

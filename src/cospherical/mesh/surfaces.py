@@ -172,12 +172,13 @@ def edge_keys(faces: np.ndarray, count: int) -> np.ndarray:
     return np.unique(keys[faces >= 0])
 
 
-def set_domain_boundary(dual: Dual, faces: np.ndarray) -> None:
+def set_domain_boundary(dual: Dual, faces: np.ndarray, edges: np.ndarray | None = None) -> None:
     """Make ``dual``'s boundary figures the true boundary's: ``faces`` (every face met by one element only).
 
     Sets ``boundary`` (the vertices of those faces), the boundary areas (exact per axis, as
     :class:`~cospherical.mesh.dual.Dual` holds them) and ``boundary_edge``.  On a box these
-    are the figures the dual computes element by element, exactly.
+    are the figures the dual computes element by element, exactly.  ``edges``: the faces'
+    :func:`edge_keys`, when the caller has them.
     """
     on, exact, denominator = boundary_parts(dual.grid_vertices, faces, [Fraction(x) for x in dual.box.squared])
     dual.boundary = on
@@ -187,7 +188,7 @@ def set_domain_boundary(dual: Dual, faces: np.ndarray) -> None:
     count = len(dual.grid_vertices)
     keys = dual.edges[:, 0].astype(np.int64) * count + dual.edges[:, 1]  # increasing: the edges are sorted
     # the few boundary edges looked up among all the edges (np.isin would sort them all)
-    boundary = edge_keys(faces, count)
+    boundary = edge_keys(faces, count) if edges is None else edges
     at = np.minimum(np.searchsorted(keys, boundary), max(len(keys) - 1, 0))
     dual.boundary_edge = np.zeros(len(keys), dtype=bool)
     if len(keys):
