@@ -322,39 +322,76 @@ def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArr
     shown: list[list[list[float]]] = []
     seams: list[OpenFaces] = []
     for size, parts in sorted(faces.items()):
-        rows = np.concatenate(parts)
-        parts.clear()
         # the faces are convex polygons (hulls): the same vertices are the same polygon, so a face is paired by
-        # its sorted ids (a tenth of the time of turning every cycle; the few shown or left open are turned)
-        # the orientation: whether the cycle goes on from its smallest id to the larger of that id's neighbours
-        # (column by column: numpy's reductions along rows of three or four are slow)
-        smallest = rows[:, 0].copy()
-        for column in range(1, size):
-            np.minimum(smallest, rows[:, column], out=smallest)
-        after = np.empty(len(rows), dtype=rows.dtype)
-        before = np.empty(len(rows), dtype=rows.dtype)
-        for column in range(size):
-            here = rows[:, column] == smallest
-            after[here] = rows[here, (column + 1) % size]
-            before[here] = rows[here, column - 1]
-        flipped = after > before
-        del smallest, after, before, here
-        order, flipped, ok, pairs, single = _paired(np.sort(rows, axis=1), flipped)
+        # its ids in increasing order; its orientation: whether the cycle goes on from its smallest id to the
+        # larger of that id's neighbours
+        blocks = [_ranked(part) for part in parts]
+        cycles = list(parts)  # the cycles themselves, for the few faces shown or left open
+        parts.clear()
+        ids = np.concatenate([block[0] for block in blocks])
+        flipped = np.concatenate([block[1] for block in blocks])
+        del blocks
+        starts = np.cumsum([0] + [len(part) for part in cycles])
+
+        def turned(rows: NDArray[np.intp]) -> NDArray[np.integer[Any]]:
+            """The faces at ``rows`` (of the concatenation) as cycles, turned (:func:`_turned`)."""
+            part = np.searchsorted(starts, rows, side="right") - 1
+            out = np.empty((len(rows), size), dtype=ids.dtype)
+            for p in np.unique(part).tolist():
+                here = part == p
+                out[here] = _turned(cycles[p][rows[here] - starts[p]])
+            return out
+
+        order, flipped, ok, pairs, single = _paired(ids, flipped)
         interior += pairs
-        on_boundary = on_domain_boundary(vertices[rows[order[single]]], grid, layout)
+        on_boundary = on_domain_boundary(vertices[ids[order[single]]], grid, layout)
         ok[single[on_boundary]] = True
         boundary += int(on_boundary.sum())
         if open_faces:
             seam = single[~on_boundary]
-            seams.append(OpenFaces(size, _turned(rows[order[seam]]), flipped[seam]))
+            seams.append(OpenFaces(size, turned(order[seam]), flipped[seam]))
             ok[seam] = True
         bad = np.flatnonzero(~ok)
         bad_total += len(bad)
-        for row in _turned(rows[order[bad[:max(0, examples - len(shown))]]]):
+        for row in turned(order[bad[:max(0, examples - len(shown))]]):
             shown.append((vertices[row] / grid).tolist())
+        del ids, cycles
         if progress:
-            progress(len(rows))
+            progress(len(order))
     return ConformityCheck(int(bad_total), int(interior), int(boundary), shown, tuple(seams))
+
+
+def _ranked(cycles: NDArray[np.integer[Any]]) -> tuple[NDArray[np.integer[Any]], NDArray[np.bool_]]:
+    """Faces given as cycles of vertex ids: their ids in increasing order, and their orientations (whether each
+    cycle goes on from its smallest id to the larger of that id's two neighbours).
+
+    The faces of one element of a configuration over its leaves (or of one cell shape over
+    its translates) rank their vertices alike in every row: ids are ranks of grid keys, and a
+    key's order is that of its point's coordinates, which translation and scaling keep.  So the
+    first row's column order sorts every row, and its orientation is every row's: one gather and
+    one comparison of the result instead of a sort of each row.  Rows that do not rank alike
+    (any other caller's faces) are sorted row by row.
+    """
+    size = cycles.shape[1]
+    if not len(cycles):
+        return cycles.copy(), np.zeros(0, dtype=bool)
+    columns = np.argsort(cycles[0], kind="stable")
+    ids = cycles[:, columns]
+    if bool((ids[:, 1:] > ids[:, :-1]).all()):
+        at = int(columns[0])
+        flips = bool(cycles[0, (at + 1) % size] > cycles[0, at - 1])
+        return ids, np.full(len(cycles), flips)
+    # row by row, column by column (numpy's reductions along rows of three or four are slow)
+    smallest = cycles[:, 0].copy()
+    for column in range(1, size):
+        np.minimum(smallest, cycles[:, column], out=smallest)
+    after = np.empty(len(cycles), dtype=cycles.dtype)
+    before = np.empty(len(cycles), dtype=cycles.dtype)
+    for column in range(size):
+        here = cycles[:, column] == smallest
+        after[here] = cycles[here, (column + 1) % size]
+        before[here] = cycles[here, column - 1]
+    return np.sort(cycles, axis=1), after > before
 
 
 def on_domain_boundary(points: np.ndarray, grid: int, layout: DeviceLayout | None = None) -> np.ndarray:
@@ -448,10 +485,13 @@ def match_seams(seams: Iterable[OpenFaces], vertices: Callable[[NDArray[np.int64
 
 
 def _row_order(rows: np.ndarray, bits: int) -> tuple[np.ndarray, list[np.ndarray]]:
-    """The lexicographic order of ``rows`` of ids below ``2**bits``, and the keys it sorts: ids packed into as
-    few int64 keys as hold them (two rows are equal when their keys are).
+    """The lexicographic order of ``rows`` of ids below ``2**bits`` (stable: equal rows in their order), and the
+    keys it sorts: ids packed into as few int64 keys as hold them (two rows are equal when their keys are).
 
-    Sorting one or two keys costs a fraction of a lexicographic sort of every column.
+    Sorting one or two keys costs a fraction of a lexicographic sort of every column.  The rows
+    are sorted by their first key alone, stably (timsort: faces gathered alike, leaf after leaf,
+    come in increasing runs); only the groups of equal first keys that hold rows differing in
+    another key (quadrilaterals sharing their three smallest ids, rare) are then sorted by the others.
     """
     per_key = max(1, 63 // bits)
     keys = []
@@ -461,7 +501,21 @@ def _row_order(rows: np.ndarray, bits: int) -> tuple[np.ndarray, list[np.ndarray
             key <<= bits
             key |= rows[:, column]
         keys.append(key)
-    return (np.argsort(keys[0], kind="stable") if len(keys) == 1 else np.lexsort(keys[::-1])), keys
+    order = np.argsort(keys[0], kind="stable")
+    if len(keys) > 1 and len(order) > 1:
+        head = keys[0][order]
+        tie = np.flatnonzero(head[1:] == head[:-1])  # order[tie] and order[tie + 1] share the first key
+        differ = np.zeros(len(tie), dtype=bool)
+        for key in keys[1:]:
+            differ |= key[order[tie]] != key[order[tie + 1]]
+        if differ.any():
+            group = np.cumsum(np.r_[True, head[1:] != head[:-1]]) - 1
+            mixed = np.zeros(int(group[-1]) + 1, dtype=bool)
+            mixed[group[tie[differ]]] = True
+            members = np.flatnonzero(mixed[group])
+            within = order[members]
+            order[members] = within[np.lexsort([key[within] for key in keys[:0:-1]] + [group[members]])]
+    return order, keys
 
 
 @dataclass(frozen=True)
