@@ -486,28 +486,35 @@ def _leaf_slots(tree: Octree, vertices: tuple[int, NDArray[np.int64]] | None = N
     """
     grid, origin, half = _leaf_boxes(tree, None if vertices is None else vertices[0])
     coarse = np.flatnonzero(half > 1)
-    corners = _node_keys(origin, half, grid, _CORNERS)
-    others = _node_keys(origin[coarse], half[coarse], grid, _OTHERS)
-    given = vertices[1] if vertices is not None else corners[:0, 0]
-    asked = np.concatenate([given, corners.reshape(-1), others.reshape(-1)])
+    given = vertices[1] if vertices is not None else np.zeros(0, dtype=np.int64)
+    # every key asked for in one array (int32 while the grid's keys fit: half the bytes to sort)
+    kind = np.int32 if (grid + 1) ** 3 < 2**31 else np.int64
+    corners = slice(len(given), len(given) + 8 * len(tree))
+    asked = np.empty(corners.stop + len(_OTHERS) * len(coarse), dtype=kind)
+    asked[:corners.start] = given
+    asked[corners] = _node_keys(origin, half, grid, _CORNERS).reshape(-1)
+    asked[corners.stop:] = _node_keys(origin[coarse], half[coarse], grid, _OTHERS).reshape(-1)
     order = np.argsort(asked, kind="stable")
     ordered = asked[order]
-    first = np.empty(len(asked), dtype=bool)
+    del asked
+    first = np.empty(len(ordered), dtype=bool)
     first[:1] = True
     np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
-    run = np.cumsum(first) - 1
-    # the vertex keys: the given ones, else the corners
-    vertex_entry = order < len(given) if vertices is not None else order < len(given) + corners.size
-    is_vertex = np.zeros(int(run[-1]) + 1 if len(run) else 0, dtype=bool)
-    is_vertex[run[vertex_entry]] = True
-    ids = np.where(is_vertex, np.cumsum(is_vertex) - 1, -1).astype(np.int32)
-    found = np.empty(len(asked), dtype=np.int32)
+    run = np.cumsum(first, dtype=np.int32)
+    run -= 1
+    keys = ordered[first]
+    del ordered, first
+    # the runs that hold a vertex key: a given one, else a corner
+    is_vertex = np.zeros(len(keys), dtype=bool)
+    is_vertex[run[order < (corners.start if vertices is not None else corners.stop)]] = True
+    ids = np.where(is_vertex, np.cumsum(is_vertex, dtype=np.int32) - 1, -1).astype(np.int32)
+    found = np.empty(len(order), dtype=np.int32)
     found[order] = ids[run]
-    keys = given if vertices is not None else ordered[first][is_vertex]
+    del order, run
     slots = np.full((len(tree), 27), -1, dtype=np.int32)
-    slots[:, :8] = found[len(given):len(given) + corners.size].reshape(8, -1).T
-    slots[coarse, 8:] = found[len(given) + corners.size:].reshape(len(_OTHERS), -1).T
-    return grid, keys, slots
+    slots[:, :8] = found[corners].reshape(8, -1).T
+    slots[coarse, 8:] = found[corners.stop:].reshape(len(_OTHERS), -1).T
+    return grid, given if vertices is not None else keys[is_vertex].astype(np.int64), slots
 
 
 _OTHERS = np.arange(8, 27)

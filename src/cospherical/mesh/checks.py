@@ -325,22 +325,13 @@ def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArr
         # the faces are convex polygons (hulls): the same vertices are the same polygon, so a face is paired by
         # its ids in increasing order; its orientation: whether the cycle goes on from its smallest id to the
         # larger of that id's neighbours
-        blocks = [_ranked(part) for part in parts]
-        cycles = list(parts)  # the cycles themselves, for the few faces shown or left open
+        ends = np.cumsum([len(part) for part in parts])
+        ids = np.empty((int(ends[-1]) if len(ends) else 0, size), dtype=np.result_type(*parts) if parts else np.int64)
+        flipped = np.empty(len(ids), dtype=bool)
+        # per part, the columns of its rows of ids that are its cycles, or the cycles themselves
+        cycles = [_ranked(part, ids[end - len(part):end], flipped[end - len(part):end])
+                  for part, end in zip(parts, ends.tolist())]
         parts.clear()
-        ids = np.concatenate([block[0] for block in blocks])
-        flipped = np.concatenate([block[1] for block in blocks])
-        del blocks
-        starts = np.cumsum([0] + [len(part) for part in cycles])
-
-        def turned(rows: NDArray[np.intp]) -> NDArray[np.integer[Any]]:
-            """The faces at ``rows`` (of the concatenation) as cycles, turned (:func:`_turned`)."""
-            part = np.searchsorted(starts, rows, side="right") - 1
-            out = np.empty((len(rows), size), dtype=ids.dtype)
-            for p in np.unique(part).tolist():
-                here = part == p
-                out[here] = _turned(cycles[p][rows[here] - starts[p]])
-            return out
 
         order, flipped, ok, pairs, single = _paired(ids, flipped)
         interior += pairs
@@ -349,21 +340,37 @@ def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArr
         boundary += int(on_boundary.sum())
         if open_faces:
             seam = single[~on_boundary]
-            seams.append(OpenFaces(size, turned(order[seam]), flipped[seam]))
+            seams.append(OpenFaces(size, _cycles_at(order[seam], ids, cycles, ends), flipped[seam]))
             ok[seam] = True
         bad = np.flatnonzero(~ok)
         bad_total += len(bad)
-        for row in turned(order[bad[:max(0, examples - len(shown))]]):
+        for row in _cycles_at(order[bad[:max(0, examples - len(shown))]], ids, cycles, ends):
             shown.append((vertices[row] / grid).tolist())
-        del ids, cycles
         if progress:
             progress(len(order))
     return ConformityCheck(int(bad_total), int(interior), int(boundary), shown, tuple(seams))
 
 
-def _ranked(cycles: NDArray[np.integer[Any]]) -> tuple[NDArray[np.integer[Any]], NDArray[np.bool_]]:
-    """Faces given as cycles of vertex ids: their ids in increasing order, and their orientations (whether each
-    cycle goes on from its smallest id to the larger of that id's two neighbours).
+def _cycles_at(rows: NDArray[np.intp], ids: NDArray[np.integer[Any]],
+               cycles: list[tuple[int, ...] | NDArray[np.integer[Any]]], ends: NDArray[np.int64]
+               ) -> NDArray[np.integer[Any]]:
+    """The faces at ``rows`` of ``ids`` as cycles, turned (:func:`_turned`): ``cycles[p]`` (what :func:`_ranked`
+    returned of part ``p``, which ends at row ``ends[p]``) gives them back."""
+    part = np.searchsorted(ends, rows, side="right")
+    out = np.empty((len(rows), ids.shape[1]), dtype=ids.dtype)
+    for p in np.unique(part).tolist():
+        here = part == p
+        cycle = cycles[p]
+        out[here] = _turned(ids[rows[here]][:, list(cycle)] if isinstance(cycle, tuple)
+                            else cycle[rows[here] - (int(ends[p]) - len(cycle))])
+    return out
+
+
+def _ranked(cycles: NDArray[np.integer[Any]], ids: NDArray[np.integer[Any]], flipped: NDArray[np.bool_]
+            ) -> tuple[int, ...] | NDArray[np.integer[Any]]:
+    """Faces given as cycles of vertex ids: their ids in increasing order into ``ids``, and their orientations
+    (whether each cycle goes on from its smallest id to the larger of that id's two neighbours) into
+    ``flipped``; returns the columns of ``ids`` that give the cycles back, else the cycles themselves.
 
     The faces of one element of a configuration over its leaves (or of one cell shape over
     its translates) rank their vertices alike in every row: ids are ranks of grid keys, and a
@@ -374,13 +381,13 @@ def _ranked(cycles: NDArray[np.integer[Any]]) -> tuple[NDArray[np.integer[Any]],
     """
     size = cycles.shape[1]
     if not len(cycles):
-        return cycles.copy(), np.zeros(0, dtype=bool)
+        return cycles
     columns = np.argsort(cycles[0], kind="stable")
-    ids = cycles[:, columns]
+    np.take(cycles, columns, axis=1, out=ids)
     if bool((ids[:, 1:] > ids[:, :-1]).all()):
         at = int(columns[0])
-        flips = bool(cycles[0, (at + 1) % size] > cycles[0, at - 1])
-        return ids, np.full(len(cycles), flips)
+        flipped[:] = bool(cycles[0, (at + 1) % size] > cycles[0, at - 1])
+        return tuple(np.argsort(columns).tolist())
     # row by row, column by column (numpy's reductions along rows of three or four are slow)
     smallest = cycles[:, 0].copy()
     for column in range(1, size):
@@ -391,7 +398,9 @@ def _ranked(cycles: NDArray[np.integer[Any]]) -> tuple[NDArray[np.integer[Any]],
         here = cycles[:, column] == smallest
         after[here] = cycles[here, (column + 1) % size]
         before[here] = cycles[here, column - 1]
-    return np.sort(cycles, axis=1), after > before
+    np.greater(after, before, out=flipped)
+    ids[:] = np.sort(cycles, axis=1)
+    return cycles
 
 
 def on_domain_boundary(points: np.ndarray, grid: int, layout: DeviceLayout | None = None) -> np.ndarray:
@@ -438,9 +447,8 @@ def _paired(faces: NDArray[np.integer[Any]], flipped: NDArray[np.bool_]) -> tupl
     new = np.ones(count, dtype=bool)
     new[1:] = False
     for key in keys:  # neighbours in the order differ where a packed key does
-        key = key[order]
         new[1:] |= key[1:] != key[:-1]
-    del keys, key
+    del keys
     starts = np.flatnonzero(new)
     counts = np.diff(np.r_[starts, count])
     ok = np.zeros(count, dtype=bool)
@@ -486,7 +494,8 @@ def match_seams(seams: Iterable[OpenFaces], vertices: Callable[[NDArray[np.int64
 
 def _row_order(rows: np.ndarray, bits: int) -> tuple[np.ndarray, list[np.ndarray]]:
     """The lexicographic order of ``rows`` of ids below ``2**bits`` (stable: equal rows in their order), and the
-    keys it sorts: ids packed into as few int64 keys as hold them (two rows are equal when their keys are).
+    keys it sorts, in that order: ids packed into as few int64 keys as hold them (two rows are equal when
+    their keys are).
 
     Sorting one or two keys costs a fraction of a lexicographic sort of every column.  The rows
     are sorted by their first key alone, stably (timsort: faces gathered alike, leaf after leaf,
@@ -502,20 +511,25 @@ def _row_order(rows: np.ndarray, bits: int) -> tuple[np.ndarray, list[np.ndarray
             key |= rows[:, column]
         keys.append(key)
     order = np.argsort(keys[0], kind="stable")
-    if len(keys) > 1 and len(order) > 1:
-        head = keys[0][order]
-        tie = np.flatnonzero(head[1:] == head[:-1])  # order[tie] and order[tie + 1] share the first key
-        differ = np.zeros(len(tie), dtype=bool)
-        for key in keys[1:]:
-            differ |= key[order[tie]] != key[order[tie + 1]]
+    ranked = []
+    while keys:  # each key in the order, the unordered one let go at once
+        ranked.append(keys.pop(0)[order])
+    if len(ranked) > 1 and len(order) > 1:
+        same = ranked[0][1:] == ranked[0][:-1]  # neighbours in the order that share the first key
+        differ = np.zeros(len(order) - 1, dtype=bool)
+        for key in ranked[1:]:
+            differ |= key[1:] != key[:-1]
+        differ &= same
         if differ.any():
-            group = np.cumsum(np.r_[True, head[1:] != head[:-1]]) - 1
+            group = np.cumsum(np.r_[True, ~same]) - 1
             mixed = np.zeros(int(group[-1]) + 1, dtype=bool)
-            mixed[group[tie[differ]]] = True
+            mixed[group[1:][differ]] = True
             members = np.flatnonzero(mixed[group])
-            within = order[members]
-            order[members] = within[np.lexsort([key[within] for key in keys[:0:-1]] + [group[members]])]
-    return order, keys
+            within = np.lexsort([key[members] for key in ranked[:0:-1]] + [group[members]])
+            order[members] = order[members][within]
+            for key in ranked:
+                key[members] = key[members][within]
+    return order, ranked
 
 
 @dataclass(frozen=True)
