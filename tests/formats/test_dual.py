@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -78,11 +79,19 @@ def test_a_truncated_or_tampered_dual_npz_is_refused_with_one_line(dual_run, tmp
     flipped[start + info.compress_size // 2] ^= 0xFF
     (tmp_path / "flipped.npz").write_bytes(bytes(flipped))
     (tmp_path / "empty.npz").write_bytes(b"")
+    with zipfile.ZipFile(dual_run / "a" / "dual.npz") as source, \
+            zipfile.ZipFile(tmp_path / "twice.npz", "w") as target, warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # zipfile's "Duplicate name"
+        edges = source.read("edges.npy")
+        for info in source.infolist():
+            target.writestr(info.filename, source.read(info))
+        target.writestr("edges.npy", edges)  # a reader takes one of the two: which?
     capsys.readouterr()
-    for name in ("truncated", "tampered", "flipped", "empty"):
+    for name in ("truncated", "tampered", "flipped", "empty", "twice"):
         assert main(["check", str(tmp_path / f"{name}.npz")]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and f"{name}.npz" in err and "Traceback" not in err
+    assert "member 'edges.npy' appears twice" in err
 
 
 def _resigned(good: Path, target: Path, manifest_edit=None, members: dict | None = None) -> None:
@@ -116,7 +125,8 @@ def _resigned(good: Path, target: Path, manifest_edit=None, members: dict | None
                                   "integers of 5000 digits", "boundary factors not the domain's",
                                   "manifest nested 100,000 deep", "manifest with a repeated key",
                                   "a grid vertex outside the grid", "version 2 (no elements)",
-                                  "volume denominator of 1000 digits", "boundary denominator of 1000 digits"])
+                                  "volume denominator of 1000 digits", "boundary denominator of 1000 digits",
+                                  "version 3.0", "version 10**400"])
 def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, tmp_path, capsys, case):
     from cospherical.cli import main
 
@@ -130,6 +140,8 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
              "manifest nested 100,000 deep": lambda m: "[" * 100_000 + "]" * 100_000,
              "manifest with a repeated key": lambda m: json.dumps(m)[:-1] + ', "version": 1}',
              "version 2 (no elements)": lambda m: m.update(version=2),
+             "version 3.0": lambda m: m.update(version=3.0),  # a float: not what the writer writes
+             "version 10**400": lambda m: m.update(version=10**400),
              # the sums they give are named, cut: not a line of a thousand digits
              "volume denominator of 1000 digits": lambda m: m.update(volume_denominator="9" * 1000),
              "boundary denominator of 1000 digits": lambda m: m.update(boundary_area_denominator="9" * 1000)}
@@ -153,8 +165,9 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
     assert err.count("\n") == 1 and "Traceback" not in err and len(err) < 400, err
     assert time.monotonic() - start < 30  # 10**999999999 would take far longer
     assert case != "manifest with a repeated key" or "repeated key 'version'" in err, err
-    assert not case.startswith("version") or "dual format version 2; this reads 3, 4 and 5 (write it again with " \
+    assert not case.startswith("version 2") or "dual format version 2; this reads 3, 4 and 5 (write it again with " \
         "cospherical mesh --dual)" in err, err
+    assert not case.startswith("version 3") or "dual format version 3.0; this reads" in err, err
 
 
 def _edited(good: Path, target: Path, edit) -> None:

@@ -375,6 +375,9 @@ def read_dual(path: str | Path) -> Dual:
     try:
         with zipfile.ZipFile(path) as archive:
             names = sorted(archive.namelist())
+            twice = next((a for a, b in zip(names, names[1:]) if a == b), None)
+            if twice is not None:  # zipfile reads the last of them: which one a reader takes is not ours to guess
+                raise FormatError(f"{path}: not a cospherical dual: member {shown(twice)} appears twice")
             members = _MEMBERS
             if "element_region.npy" in names:
                 members = {**_MEMBERS, **_REGION_MEMBERS}
@@ -422,8 +425,9 @@ def _manifest(raw: np.ndarray, path: Path) -> dict[str, Any]:
     manifest = parse_json(text, f"{path}: member manifest", max_digits=_MAX_TEXT_DIGITS)
     if not isinstance(manifest, dict) or manifest.get("format") != "cospherical-dual":
         raise FormatError(f"{path}: not a cospherical dual (its manifest names no format cospherical-dual)")
-    if manifest.get("version") not in _VERSIONS:
-        raise FormatError(f"{path}: dual format version {manifest.get('version')!r}; this reads "
+    version = manifest.get("version")
+    if type(version) is not int or version not in _VERSIONS:  # 5.0 and True are not versions the writer writes
+        raise FormatError(f"{path}: dual format version {shown(version)}; this reads "
                           f"{', '.join(map(str, _VERSIONS[:-1]))} and {_VERSIONS[-1]} (write it again with "
                           "cospherical mesh --dual)")
     for key, kind in (("domain", list), ("grid", int), ("coefficient_denominator", str), ("volume_denominator", str),
