@@ -180,15 +180,18 @@ def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DType
         pieces = (offset + np.arange(count, dtype=np.int64)) << shift_bits
         for part in _chunks(len(rows), count):
             ids = rows[part, None]
-            a = source[ids, shape.edges[:, 0]].astype(np.int64)
-            b = source[ids, shape.edges[:, 1]].astype(np.int64)
-            key = (np.minimum(a, b) << vertex_bits) | np.maximum(a, b)
+            a = source[ids, shape.edges[:, 0]]
+            b = source[ids, shape.edges[:, 1]]
+            end = at + a.size
+            key = keys[at:end].reshape(a.shape)  # written in place: (min << vertex_bits | max), then the payload
+            np.left_shift(np.minimum(a, b), vertex_bits, out=key, dtype=np.int64)
+            key |= np.maximum(a, b)
             payload = pieces | shifts[part, None]
-            end = at + key.size
             if packed:
-                keys[at:end] = ((key << payload_bits) | payload).reshape(-1)
+                key <<= payload_bits
+                key |= payload
             else:
-                keys[at:end], payloads[at:end] = key.reshape(-1), payload.reshape(-1)
+                payloads[at:end] = payload.reshape(-1)
             at = end
     key_shift = payload_bits if packed else 0
     if packed:
@@ -209,13 +212,20 @@ def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DType
     np.bitwise_and(unique, (1 << vertex_bits) - 1, out=edges[:, 1])
     del unique
     numerators = np.array(table, dtype=dtype)
-    powers = np.array([1 << k for k in range(max_shift + 1)], dtype=dtype)
+    # each payload's value, its piece's numerator times its member's size, from one table indexed by the payload
+    # while that table is small (no member is larger than 2**max_shift: the columns past it are never read)
+    values = None
+    if len(table) << shift_bits <= _CHUNK:
+        powers = np.zeros(1 << shift_bits, dtype=dtype)
+        powers[:max_shift + 1] = [1 << k for k in range(max_shift + 1)]
+        values = (numerators[:, None] * powers[None, :]).reshape(-1)
     sums: ExactArray = np.empty(len(first), dtype=dtype)
     # blocks of whole runs, so that each run is summed within one block
     bounds = np.unique(np.r_[np.searchsorted(first, np.arange(0, total, _CHUNK)), len(first)])
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         start, stop = first[lo], first[hi] if hi < len(first) else total
         payload = payloads[start:stop] & ((1 << payload_bits) - 1)
-        parts = numerators[payload >> shift_bits] * powers[payload & ((1 << shift_bits) - 1)]
+        parts = values[payload] if values is not None else \
+            numerators[payload >> shift_bits] << (payload & ((1 << shift_bits) - 1)).astype(dtype)
         sums[lo:hi] = np.add.reduceat(parts, first[lo:hi] - start)
     return edges, sums
