@@ -50,6 +50,15 @@ def test_output_folder_moves_files_in_only_when_the_run_succeeds(tmp_path):
     assert (out / "a.txt").read_text() == "new" and sorted(listing(out)) == [MANIFEST, "a.txt"]
 
 
+def test_an_output_folder_whose_name_a_file_takes_says_so_and_leaves_the_file(tmp_path):
+    taken = tmp_path / "out"
+    taken.write_text("the user's")
+    with pytest.raises(InputError, match="the output is a folder, and this name is taken by something else"):
+        with OutputFolder(taken, "test"):
+            pass
+    assert taken.read_text() == "the user's"
+
+
 TEX = re.compile(r"[a-z]+\.tex").fullmatch
 RENDER_WRITES = _RENDERED.fullmatch
 

@@ -432,6 +432,9 @@ class FolderLock:
             self._created = not self.folder.exists()
             self.folder.mkdir(parents=True, exist_ok=True)
             self._fd = os.open(self.folder, os.O_RDONLY | os.O_DIRECTORY)
+        except FileExistsError:  # mkdir's word for a file in the way says neither what is wanted nor what to do
+            raise InputError(f"{self.folder}: cannot write: the output is a folder, and this name is taken by "
+                             "something else (a file): remove it or choose another name") from None
         except OSError as error:
             raise _output_error(self.folder, error) from None
         try:
