@@ -392,6 +392,9 @@ for (const table of article.querySelectorAll("table")) {
     faults.push(`a table ${Math.round(width)} px wide in a ${Math.round(column)} px column: ` +
                 table.rows[0].innerText.replace(/\s+/g, " ").slice(0, 60));
 }
+for (const name of article.querySelectorAll("td:first-child code"))
+  if (!/\s/.test(name.textContent) && name.getClientRects().length > 1)
+    faults.push(`a name broken across lines: ${name.textContent.slice(0, 60)}`);
 for (const math of article.querySelectorAll(".arithmatex"))
   if (!math.querySelector(".katex") || math.querySelector(".katex-error"))
     faults.push(`a formula not typeset: ${math.textContent.slice(0, 60)}`);
@@ -426,10 +429,12 @@ def test_the_browser_checks_see_each_fault(browser, tmp_path):
     page = tmp_path / "bad.html"
     page.write_text("""<html><head><style>body { margin: 0 } table { width: 2000px }</style></head><body>
         <article><p>\\(x^2\\) left as text</p><table><tr><td>wide</td></tr></table>
+        <table style="width: 60px"><tr><td><code style="word-break: break-all">control_volume_exact</code></td></tr></table>
         <span class="arithmatex">\\(y\\)</span><img src="missing.png"></article>
         <script>console.error("boom"); notDefined();</script></body></html>""")
     faults = "\n".join(_faults(browser, page.as_uri()))
-    for fault in ("the page is", "a table 2000 px wide", "a formula not typeset", "TeX left as text",
+    for fault in ("the page is", "a table 2000 px wide", "a name broken across lines: control_volume_exact",
+                  "a formula not typeset", "TeX left as text",
                   "a picture that does not load", "boom", "notDefined"):
         assert fault in faults, (fault, faults)
 
