@@ -124,10 +124,7 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
     real = verts * (lengths / grid)
     factor = math.sqrt(factor_squared)
     coefficient = as_floats(coefficient_exact, cden * grid, factor)
-    length = np.empty(len(edges))
-    for part in _chunks(len(edges), 1):
-        edge_vectors = real[edges[part, 1]] - real[edges[part, 0]]
-        length[part] = np.sqrt((edge_vectors ** 2).sum(axis=1))
+    length = _lengths(real, edges)
     control_volume = as_floats(volume_exact, vden * grid ** 3, factor)
     plane_squared = (squared[1] * squared[2], squared[2] * squared[0], squared[0] * squared[1])
     return Dual(box=box, grid=grid, grid_vertices=verts, vertices=real, edges=edges, length=length,
@@ -138,6 +135,20 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
                 boundary_area_exact=boundary_exact, boundary_area_denominator=bden * grid ** 2,
                 boundary_factors_squared=plane_squared, element_circumcenter=centers,
                 element_nodes=elements[0], element_sizes=elements[1])
+
+
+def _lengths(real: NDArray[np.float64], edges: NDArray[np.int64]) -> NDArray[np.float64]:
+    """Each edge's length, one coordinate at a time: ``sqrt((dx*dx + dy*dy) + dz*dz)``, the order and so the
+    bits of numpy's sum over a row of three (a loop over the edges' 3-vectors took four times as long)."""
+    i, j = edges[:, 0], edges[:, 1]
+    total: NDArray[np.float64] = np.zeros(len(edges))
+    for axis in range(3):
+        column = np.ascontiguousarray(real[:, axis])
+        step = column[j] - column[i]
+        step *= step
+        total += step
+    np.sqrt(total, out=total)
+    return total
 
 
 def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DTypeLike
