@@ -104,7 +104,11 @@ def leaf_groups(mesh: Mesh, squared: Squared) -> tuple[list[Group], NDArray[np.f
         for j, element in enumerate(tessellation.elements):
             if element.center is None:
                 raise InputError(f"configuration {tessellation.code}: element {j} is not co-spherical: it has no dual")
-            centers[first + j] = _real_centers(low, element.center, size, lengths, mesh.grid)
+        # every element of every leaf at once (leaves x elements x 3), by the sums and products of _real_centers
+        offsets = np.array([[float(x) for x in element.center] for element in tessellation.elements if
+                            element.center is not None]).reshape(1, -1, 3)
+        centers[first[:, None] + np.arange(offsets.shape[1])] = (low[:, None, :] + offsets * size[:, :, None]) * (
+            lengths / mesh.grid)
         groups.append(Group(_tessellation_pieces(tessellation, squared), mesh.slots, leaves, sizes[leaves]))
     return groups, centers
 
