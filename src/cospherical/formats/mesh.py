@@ -243,7 +243,9 @@ def vtu_arrays(mesh: Mesh) -> dict:
 
     Cells are sorted by VTK cell type (stable: in element order within a type), so a
     reader that groups cells into blocks of one type (meshio) meets few blocks;
-    ``order[c]`` is the element written as cell ``c``.
+    ``order[c]`` is the element written as cell ``c``.  Each block's vertex ids are
+    gathered once and written straight to their cells' places in ``connectivity`` (and,
+    for polyhedra, in the face streams): no padded table of every element's ids.
     """
     from .vtu import VTK_CELL
 
@@ -252,35 +254,39 @@ def vtu_arrays(mesh: Mesh) -> dict:
                             dtype=np.uint8)
     kinds = kind_of_type[element_type] if len(ids) else np.zeros(0, dtype=np.uint8)
     order = np.argsort(kinds, kind="stable")
-    conn, sizes = mesh.connectivity()
-    conn = conn[order]
-    connectivity = conn[conn >= 0].astype(np.int64)  # row by row: each cell's points in turn
-    offsets = np.cumsum(sizes[order], dtype=np.int64)
-    # polyhedra: a face stream per element (faces, then per face its size and points), laid out per configuration
     polyhedral = kinds == VTK_CELL["polyhedron"]
+    blocks = [block for block in mesh.blocks() if len(block.rows)]
+    # per block of polyhedra, a face stream template: counts as -1 - count, else node columns
+    templates = [np.array([-1 - len(block.faces)] + [x for f in block.faces for x in (-1 - len(f), *f)], dtype=np.int64)
+                 if block.type_id is not None and kind_of_type[ids.index(block.type_id)] == VTK_CELL["polyhedron"]
+                 else None for block in blocks]
+    sizes = np.zeros(len(mesh), dtype=np.int64)
     stream = np.zeros(len(mesh), dtype=np.int64)
+    for block, template in zip(blocks, templates):
+        sizes[block.rows] = block.nodes.shape[1]
+        if template is not None:
+            stream[block.rows] = len(template)
+    offsets = np.cumsum(sizes[order])
+    start = np.empty(len(mesh), dtype=np.int64)
+    start[order] = offsets - sizes[order]  # where each element's ids begin in connectivity
+    connectivity = np.empty(int(offsets[-1]) if len(offsets) else 0,
+                            dtype=np.int32 if len(mesh.vertices) < 2**31 else np.int64)
     faces = faceoffsets = None
     if polyhedral.any():
-        # per block of alike elements, a face stream template: counts as -1 - count, else node columns
-        blocks = [(rows, nodes, np.array([-1 - len(cycles)] + [x for f in cycles for x in (-1 - len(f), *f)],
-                                         dtype=np.int64))
-                  for rows, nodes, cycles, type_id in mesh.blocks()
-                  if type_id is not None and kind_of_type[ids.index(type_id)] == VTK_CELL["polyhedron"]
-                  and len(rows)]
-        for rows, _, template in blocks:
-            stream[rows] = len(template)
         cells = order[polyhedral[order]]  # the polyhedra in cell order
         ends = np.cumsum(stream[cells])
-        start = np.zeros(len(mesh), dtype=np.int64)
-        start[cells] = ends - stream[cells]
-        faces = np.empty(int(ends[-1]), dtype=np.int64)
-        for rows, nodes, template in blocks:
+        stream_start = np.zeros(len(mesh), dtype=np.int64)
+        stream_start[cells] = ends - stream[cells]
+        faces = np.empty(int(ends[-1]), dtype=connectivity.dtype)
+        faceoffsets = np.full(len(mesh), -1, dtype=np.int64)
+        faceoffsets[polyhedral[order]] = ends
+    for (rows, nodes, _, _), template in zip(blocks, templates):
+        connectivity[start[rows][:, None] + np.arange(nodes.shape[1])] = nodes
+        if template is not None and faces is not None:
             columns = template >= 0
             values = np.broadcast_to(np.where(columns, 0, -1 - template), (len(rows), len(template))).copy()
             values[:, columns] = nodes[:, template[columns]]
-            faces[start[rows][:, None] + np.arange(len(template))] = values
-        faceoffsets = np.full(len(mesh), -1, dtype=np.int64)
-        faceoffsets[polyhedral[order]] = ends
+            faces[stream_start[rows][:, None] + np.arange(len(template))] = values
     return {"ids": ids, "order": order, "types": kinds[order], "connectivity": connectivity, "offsets": offsets,
             "faces": faces, "faceoffsets": faceoffsets, "element_type": element_type}
 
