@@ -62,6 +62,22 @@ _API: dict[str, str | tuple[str, str]] = {
     "OctreeMesh": "cospherical.api.mesh",
     "from_treemesh": "cospherical.api.mesh",
     "MeshReport": "cospherical.mesh.report",
+    "ChecksSummary": "cospherical.mesh.report",
+    "ConfigurationFrequency": "cospherical.mesh.report",
+    "ContactSummary": "cospherical.mesh.report",
+    "DelaunaySpheres": "cospherical.mesh.report",
+    "DeviceSummary": "cospherical.mesh.report",
+    "DualSummary": "cospherical.mesh.report",
+    "InterfaceSummary": "cospherical.mesh.report",
+    "LeafMeshSummary": "cospherical.mesh.report",
+    "MixedCounts": "cospherical.mesh.report",
+    "NegativeCoefficients": "cospherical.mesh.report",
+    "OutsideType": "cospherical.mesh.report",
+    "RegionSummary": "cospherical.mesh.report",
+    "TetrahedralCounts": "cospherical.mesh.report",
+    "TreeSummary": "cospherical.mesh.report",
+    "TypeFrequency": "cospherical.mesh.report",
+    "UniformSummary": "cospherical.mesh.report",
 }
 
 if TYPE_CHECKING:  # a type checker sees the names _API loads on first use (X as X: re-exported)
@@ -78,6 +94,12 @@ if TYPE_CHECKING:  # a type checker sees the names _API loads on first use (X as
     load_patterns = _patterns.load  # a name of its own here: an assignment, which a checker sees exported
     from .api.mesh import build_mesh as build_mesh, OctreeMesh as OctreeMesh, from_treemesh as from_treemesh
     from .mesh.report import MeshReport as MeshReport
+    from .mesh.report import ChecksSummary as ChecksSummary, ConfigurationFrequency as ConfigurationFrequency, ContactSummary as ContactSummary
+    from .mesh.report import DelaunaySpheres as DelaunaySpheres, DeviceSummary as DeviceSummary, DualSummary as DualSummary
+    from .mesh.report import InterfaceSummary as InterfaceSummary, LeafMeshSummary as LeafMeshSummary, MixedCounts as MixedCounts
+    from .mesh.report import NegativeCoefficients as NegativeCoefficients, OutsideType as OutsideType, RegionSummary as RegionSummary
+    from .mesh.report import TetrahedralCounts as TetrahedralCounts, TreeSummary as TreeSummary, TypeFrequency as TypeFrequency
+    from .mesh.report import UniformSummary as UniformSummary
 
 __all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "__version__", *_API]
 

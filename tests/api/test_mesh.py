@@ -30,7 +30,7 @@ def test_the_snippet_runs_as_written():
     assert np.array_equal(m.vertices, exact.coordinates * (np.array([1.0, 2.0, 4.0]) / exact.intervals))
     assert len(m.elements) == r.elements and len(m.elements.offsets) == r.elements + 1
     assert m.elements.sizes().min() >= 4 and m.elements.connectivity.max() == r.vertices - 1
-    assert sorted(m.elements.type_ids) == sorted(t["id"] for t in r.type_frequencies if t["count"])
+    assert sorted(m.elements.type_ids) == sorted(t.id for t in r.type_frequencies if t.count)
     # the dual, computed on first use: control volumes tile the domain exactly, a linear function is harmonic
     dual = m.dual
     assert dual.volume_sum() == 1
@@ -47,7 +47,7 @@ def test_report_round_trip_and_schema():
     assert MeshReport.from_dict(data) == m.report
     assert MeshReport.from_dict(json.loads(json.dumps(data))).to_dict() == data
     assert "timings" not in data and {"assembly", "volume", "dual"} <= set(m.report.timings)
-    assert m.report.dual["tetrahedral"] is None  # the outside mesher runs only when asked (tetrahedral_counts)
+    assert m.report.dual.tetrahedral is None  # the outside mesher runs only when asked (tetrahedral_counts)
     data["leaves"] = -1  # a copy: the report does not change
     assert m.report.leaves == 15
     with pytest.raises(AttributeError):
@@ -83,7 +83,7 @@ def test_a_leaf_list_in_memory_is_numbered_as_listed():
     for e in range(len(m.elements)):
         points = m.vertices[m.elements.nodes(e)]
         assert np.all(points >= low[e] - 1e-12) and np.all(points <= low[e] + 0.5 + 1e-12)
-    assert m.report.tree == {"source": "leaves", "depth": 1}
+    assert m.report.tree == cospherical.TreeSummary("leaves", depth=1)
 
 
 @pytest.mark.parametrize("kwargs, needle", [
@@ -235,7 +235,7 @@ def test_the_report_says_which_checks_ran_and_how():
     assert searched["checks"]["delaunay_spheres"] == {"bounded_by_the_tree": 0}
     assert {k: v for k, v in bounded.items() if k != "checks"} == {k: v for k, v in searched.items() if k != "checks"}
     skipped = cospherical.build_mesh(**common, check_delaunay=False).report.checks
-    assert "delaunay" not in skipped["run"] and "--no-delaunay" in skipped["not_run"]["delaunay"]
+    assert "delaunay" not in skipped.run and "--no-delaunay" in skipped.not_run["delaunay"]
     validate(bounded, "mesh-report", "report")
 
 

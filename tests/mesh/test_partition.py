@@ -238,10 +238,12 @@ def test_bad_partitions_are_one_line(more, needle, tmp_path, capsys):
 def test_progress_is_told_as_each_piece_finishes():
     # the CLI's bars (cli/mesh.py) draw these: every piece, then the second round of the brick's seams
     from cospherical.mesh.partition import mesh_in_pieces
+    from cospherical.mesh.report import TreeSummary
 
     told = []
     box = Box.parse(BRICK[1:4])
-    mesh_in_pieces(build_octree(box, int(BRICK[5]), [parse_shape(BRICK[7])]), 2, None, "optimal", "global", {}, None,
+    mesh_in_pieces(build_octree(box, int(BRICK[5]), [parse_shape(BRICK[7])]), 2, None, "optimal", "global",
+                   TreeSummary("refine"), None,
                    uniform=False, progress=lambda *call: told.append(call))
     first = [call for call in told if call[0] == "pieces"]
     assert first == [("pieces", 2, 0), ("pieces", 2, 1), ("pieces", 2, 1)]

@@ -15,7 +15,7 @@ from cospherical.mesh.octree import build_octree, parse_shape
 from cospherical.formats.device_file import parse_device
 from cospherical.mesh.pipeline import (delaunay_mode, run_pipeline, tree_from_device, tree_from_leaves,
                                        tree_from_octree, tree_from_refine)
-from cospherical.mesh.report import MeshReport, mesh_report
+from cospherical.mesh.report import MeshReport, TreeSummary, mesh_report
 
 BOX = Box.parse([1, 2, 4])
 
@@ -36,11 +36,11 @@ def test_progress_adds_up_to_each_stage_total_and_timings_follow_the_stages():
         totals = {total for total, _ in calls}
         assert len(totals) == 1 and sum(n for _, n in calls) == (totals.pop() or _faces(result.report)), stage
     assert told["assembly"][0][0] == len(source.tree)
-    assert told["regions"][0][0] == result.report.leaf_mesh["elements"]
+    assert told["regions"][0][0] == result.report.leaf_mesh.elements
     assert list(result.report.timings) == ["assembly", "global Delaunay", "volume", "conformity", "circumcenters",
                                            "delaunay", "statistics", "dual"]
     assert all(seconds >= 0 for seconds in result.report.timings.values())
-    assert result.dual is not None and result.report.dual["edges"] == len(result.dual.edges)
+    assert result.dual is not None and result.report.dual.edges == len(result.dual.edges)
 
 
 def test_a_device_tells_the_same_stages_with_their_own_totals():
@@ -54,7 +54,7 @@ def test_a_device_tells_the_same_stages_with_their_own_totals():
     assert set(told) == {"assembly", "regions", "conformity"}
     assert sum(n for _, n in told["conformity"]) == _faces(result.report)
     assert told["assembly"][0][0] == len(source.tree) == sum(n for _, n in told["assembly"])
-    assert told["regions"][0][0] == result.report.leaf_mesh["elements"] == sum(n for _, n in told["regions"])
+    assert told["regions"][0][0] == result.report.leaf_mesh.elements == sum(n for _, n in told["regions"])
 
 
 def _far(x0: str, side: str, levels: int) -> str:
@@ -84,12 +84,12 @@ def test_a_device_is_refused_where_float_coordinates_cannot_hold_its_leaves(x0, 
 
 def test_the_pipeline_in_leaf_mode_is_the_steps_by_hand():
     tree = build_octree(BOX, 3, [parse_shape("point:0.2,0.3,0.4")])  # 22 leaves, 5 elements not Delaunay
-    by_hand = mesh_report(assemble(tree), {"source": "leaves", "depth": tree.depth}, None, uniform=False)
+    by_hand = mesh_report(assemble(tree), TreeSummary("leaves", depth=tree.depth), None, uniform=False)
     told = defaultdict(int)
     result = run_pipeline(tree_from_octree(tree), delaunay="leaf", uniform=False,
                           progress=lambda stage, total, n: told.__setitem__(stage, told[stage] + n))
-    assert isinstance(result.report, MeshReport) and result.report.to_dict() == by_hand
-    assert by_hand["delaunay_violations"] > 0 and len(result.violating) == by_hand["delaunay_violations"]
+    assert isinstance(result.report, MeshReport) and result.report == by_hand
+    assert by_hand.delaunay_violations > 0 and len(result.violating) == by_hand.delaunay_violations
     assert dict(told) == {"assembly": len(tree), "delaunay": len(result.mesh), "conformity": _faces(result.report)}
 
 
@@ -98,7 +98,7 @@ def test_a_leaf_list_keeps_its_numbering():
     shuffled = np.random.default_rng(3).permutation(len(tree))
     source = tree_from_leaves(BOX, tree.levels[shuffled], tree.positions[shuffled], file="mine.txt")
     assert np.array_equal(shuffled[source.leaf_order], np.arange(len(tree)))  # tree's leaf i is listed at leaf_order[i]
-    assert source.described == {"source": "leaves", "file": "mine.txt", "depth": 2}
+    assert source.described.to_dict() == {"source": "leaves", "file": "mine.txt", "depth": 2}
 
 
 @pytest.mark.parametrize("criterion, delaunay, expected", [

@@ -235,12 +235,12 @@ def test_example_devices_pass_the_oracle(example, tmp_path, capsys):
         assert [tuple(p) for p in interfaces.regions.tolist()] == sorted(touching)
         assert interfaces.areas() == [touching[tuple(p)] for p in interfaces.regions.tolist()]
         assert dual.negative_coefficients() == {
-            key: sum(r["negative_coefficients"][key] for r in m.report.device["regions"])
+            key: sum(getattr(r.negative_coefficients, key) for r in m.report.device.regions)
             for key in ("interior", "boundary")}
     report = m.report
     assert report.volume_ok and report.nonconforming_faces == 0
     device = report.device
-    assert all(r["volume_ok"] for r in device["regions"]) and all(c["area_ok"] for c in device["contacts"])
+    assert all(r.volume_ok for r in device.regions) and all(c.area_ok for c in device.contacts)
     # mesh.vtu read by VTK: each cell's region, the names in field data
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
@@ -336,7 +336,7 @@ def test_the_dual_splits_exactly_per_region(mos_dual):
     assert parts.contact_areas() == [Fraction(1), Fraction(1, 4)]
     # an interface vertex has a part in each region
     both = np.bincount(parts.volume_vertex, minlength=len(dual.vertices)) == 2
-    assert both.sum() == m.report.device["interfaces"][0]["nodes"]
+    assert both.sum() == m.report.device.interfaces[0].nodes
 
 
 def test_check_proves_the_region_parts_and_refuses_altered_ones(mos_dual, tmp_path, capsys):
@@ -487,7 +487,7 @@ def _negatives_per_region_are_the_duals(m) -> None:
             boundary |= {(a, b) for a in key for b in key if a < b}
     negative = [tuple(edge) for edge, c in zip(dual.edges.tolist(), dual.coefficient_exact.tolist()) if c < 0]
     interior = sum(1 for a, b in negative if (min(a, b), max(a, b)) not in boundary)
-    assert m.report.device["regions"][0]["negative_coefficients"]["interior"] == interior
+    assert m.report.device.regions[0].negative_coefficients.interior == interior
 
 
 def _circumcentre(p: list[list[int]]) -> list[Fraction]:

@@ -347,7 +347,7 @@ class OctreeMesh:
         write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=source.leaf_order)
         wrote()
         at = default_cut(source.shapes, self.box) if cut is None else cut
-        shapes = ", ".join(source.described.get("refine", [])) or source.described.get("file", "")
+        shapes = ", ".join(source.described.refine or ()) or source.described.file or ""
         cut_png(mesh, path("mesh.png"), at=at,
                 title=f"{' x '.join(self.box.texts)}: {shapes}; {report.leaves:,} leaves, {report.elements:,} "
                       f"elements, {report.types} types (cut at z = {at * float(self.box.c):.4g})")

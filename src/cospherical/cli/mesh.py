@@ -8,6 +8,7 @@ import time
 from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -23,6 +24,9 @@ from ..mesh.octree import BYTES_PER_LEAF, MAX_LEVEL, parse_shape
 from ..mesh.pipeline import TreeSource, delaunay_mode
 from .progress import stage_bars
 from .output import path_argument
+
+if TYPE_CHECKING:  # the report's types, for annotations only (the report module loads with the mesher)
+    from ..mesh.report import ChecksSummary, DeviceSummary, MeshReport
 
 
 __all__ = ["DESCRIPTION", "HELP", "add_arguments", "run"]  # what cli/__init__ builds the command from
@@ -255,15 +259,15 @@ def _run(args, out: OutputFolder | None) -> int:
         if out is not None:
             mesh.write_files(out.path, at, args.gmsh, args.gmsh_binary, args.tets, progress=progress)
     timings = {**mesh.report.timings, "outputs": time.perf_counter() - clock}
-    report = mesh.report.to_dict()
+    report = mesh.report
     _print(args, report)
-    if args.dual and args.format != "json":
-        negative = report["negative_coefficients"]
-        sys.stdout.write(f"dual_edges: {report['dual']['edges']:,}\n"
-                         f"negative_coefficients: {negative['interior']:,} interior, {negative['boundary']:,} "
+    if report.dual is not None and report.negative_coefficients is not None and args.format != "json":
+        negative = report.negative_coefficients
+        sys.stdout.write(f"dual_edges: {report.dual.edges:,}\n"
+                         f"negative_coefficients: {negative.interior:,} interior, {negative.boundary:,} "
                          "boundary\n")
-    if report.get("device") is not None and args.format != "json":
-        _print_device(report["device"])
+    if report.device is not None and args.format != "json":
+        _print_device(report.device)
     if sys.stderr.isatty():
         print("cospherical mesh: seconds " + ", ".join(f"{k} {v:.2f}" for k, v in timings.items()), file=sys.stderr)
     return 0
@@ -296,38 +300,40 @@ def _bars():
         yield progress
 
 
-def _print(args, report: dict) -> None:
+def _print(args, report: MeshReport) -> None:
+    data = report.to_dict()
     if args.format == "json":
-        sys.stdout.write(report_json(report))
+        sys.stdout.write(report_json(data))
     else:
-        sys.stdout.write("".join(f"{key}: {_text(report[key])}\n" for key in _SUMMARY_KEYS) + _checks_line(report))
+        sys.stdout.write("".join(f"{key}: {_text(data[key])}\n" for key in _SUMMARY_KEYS) + _checks_line(report.checks))
 
 
-def _checks_line(report: dict) -> str:
+def _checks_line(checks: ChecksSummary | None) -> str:
     """The summary's line of the checks that ran (and how the Delaunay check found each sphere's vertices)."""
-    checks = report["checks"]
-    spheres = checks.get("delaunay_spheres")
-    line = "checks: " + ", ".join(checks["run"])
-    if spheres is not None:
-        line += f" (Delaunay: {spheres['bounded_by_the_tree']:,} spheres bounded by the tree's structure, the rest searched)"
-    for name, why in checks.get("not_run", {}).items():
+    if checks is None:
+        return ""
+    line = "checks: " + ", ".join(checks.run)
+    if checks.delaunay_spheres is not None:
+        line += (f" (Delaunay: {checks.delaunay_spheres.bounded_by_the_tree:,} spheres bounded by the tree's "
+                 "structure, the rest searched)")
+    for name, why in (checks.not_run or {}).items():
         line += f"; not run: {name}, {why}"
     return line + "\n"
 
 
-def _print_device(device: dict) -> None:
+def _print_device(device: DeviceSummary) -> None:
     """A device's regions and contacts, one line each (names are data: printed as their repr)."""
-    lines = [f"resolving_level: {device['resolving_level']}, depth: {device['depth']}\n"]
-    for region in device["regions"]:
-        negative = region.get("negative_coefficients")
-        lines.append(f"region {region['name']!r} ({region['material']!r}): {region['elements']:,} elements, "
-                     f"{region['nodes']:,} nodes, volume {region['volume']} ({_text(region['volume_ok'])})"
-                     + (f", negative coefficients {negative['interior']:,} interior" if negative else "") + "\n")
-    for contact in device["contacts"]:
-        lines.append(f"contact {contact['name']!r} on {contact['region']!r}: {contact['faces']:,} faces, "
-                     f"{contact['nodes']:,} nodes, area {contact['area']} ({_text(contact['area_ok'])})\n")
-    for interface in device["interfaces"]:
-        lines.append(f"interface {interface['name']!r}: {interface['faces']:,} faces, {interface['nodes']:,} nodes\n")
+    lines = [f"resolving_level: {device.resolving_level}, depth: {device.depth}\n"]
+    for region in device.regions:
+        negative = region.negative_coefficients
+        lines.append(f"region {region.name!r} ({region.material!r}): {region.elements:,} elements, "
+                     f"{region.nodes:,} nodes, volume {region.volume} ({_text(region.volume_ok)})"
+                     + (f", negative coefficients {negative.interior:,} interior" if negative else "") + "\n")
+    for contact in device.contacts:
+        lines.append(f"contact {contact.name!r} on {contact.region!r}: {contact.faces:,} faces, "
+                     f"{contact.nodes:,} nodes, area {contact.area} ({_text(contact.area_ok)})\n")
+    for interface in device.interfaces:
+        lines.append(f"interface {interface.name!r}: {interface.faces:,} faces, {interface.nodes:,} nodes\n")
     sys.stdout.write("".join(lines))
 
 
@@ -373,6 +379,6 @@ def _in_pieces(args, source: TreeSource, out: OutputFolder | None) -> int:
                                 scheduler=args.scheduler, dask_workers=args.dask_workers, progress=progress)
     if out is not None and paths is not None:
         write_pvtu(out.path("mesh.pvtu"), [Path(p) for p in paths])
-        write_report(report, out.path("report.json"))
+        write_report(report.to_dict(), out.path("report.json"))
     _print(args, report)
     return 0

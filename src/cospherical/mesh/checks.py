@@ -62,6 +62,7 @@ from ..core.polyhedron import measure
 from ..errors import InputError
 from .assembly import NODE_OFFSETS, LocalTessellation, Mesh
 from .device import DeviceLayout, domain_boundary
+from .report_sections import LeafMeshSummary
 from .tree import distinct
 
 # Vertices found near spheres and tested exactly, at most: each test is a few microseconds of
@@ -682,10 +683,9 @@ class DelaunayCheck:
                 "delaunay_violating_leaves": self.violating_leaves, "delaunay_ties": self.ties,
                 "delaunay_exact_tests": self.exact_tests}
 
-    def leaf_mesh(self, elements: int) -> dict[str, int]:
+    def leaf_mesh(self, elements: int) -> LeafMeshSummary:
         """The report's ``leaf_mesh`` figures of a leaf mesh of ``elements`` elements that this check found."""
-        return {"elements": elements, "delaunay_violations": self.violations, "delaunay_ties": self.ties,
-                "elements_replaced": int(len(self.not_cells))}
+        return LeafMeshSummary(elements, self.violations, self.ties, int(len(self.not_cells)))
 
 
 def check_delaunay(mesh: Mesh, workers: int = 2, progress: Callable[[int], None] | None = None) -> DelaunayCheck:

@@ -146,6 +146,7 @@ from .assembly import Cells, Mesh, distinct
 from .checks import DelaunayCheck, check_delaunay, grid_weights
 from .merged_cells import Locator, NotOneCell, cell_members, classified_cells, inside_cluster, same_sphere
 from .proposal import Proposal, cluster_tetrahedra
+from .report_sections import LeafMeshSummary
 
 __all__ = ["delaunay_mesh", "global_delaunay", "retessellate", "with_cells"]
 
@@ -367,7 +368,7 @@ def _clusters(nodes: np.ndarray, vertices: int) -> tuple[np.ndarray, int]:
 
 def delaunay_mesh(mesh: Mesh, mode: DelaunayMode = "global", progress: Callable[[int], None] | None = None,
                   convex: bool = True
-                  ) -> tuple[Mesh, dict[str, int] | None, DelaunayCheck | None]:
+                  ) -> tuple[Mesh, LeafMeshSummary | None, DelaunayCheck | None]:
     """The mesh a user asked for: ``leaf`` (the leaf mesh as assembled) or ``global`` (its exact Delaunay subdivision).
 
     Returns the mesh; in ``global`` mode what the exact check found on the leaf mesh

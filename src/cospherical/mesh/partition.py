@@ -39,10 +39,11 @@ Why a piece is the whole mesh's restriction, element for element:
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
-from typing import Any, TypeVar
+from dataclasses import dataclass, replace
+from typing import Any, Mapping, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..catalogue import Catalogue, shipped_catalogue
 from ..core.configuration import Box
@@ -50,12 +51,13 @@ from ..core.morton import morton_codes
 from ..errors import InputError
 from ..execution.backends import completed
 from .assembly import Cells, assemble, vertex_keys
-from .checks import check_delaunay
+from .checks import OpenFaces, check_delaunay
 from .delaunay import retessellate, with_cells
 from .octree import Octree, distinct
-from .report import merged_report, mesh_figures
+from .report import MeshReport, merged_report, mesh_figures
+from .report_sections import LeafMeshSummary, TreeSummary
 
-__all__ = ["MAX_PARTITIONS", "Piece", "mesh_in_pieces", "mesh_piece", "morton_pieces"]
+__all__ = ["MAX_PARTITIONS", "Piece", "PieceResult", "mesh_in_pieces", "mesh_piece", "morton_pieces"]
 
 # The pattern lookup as it travels to a worker (a closure does not): a factory and its arguments.
 LookupRecipe = tuple[Callable[..., Any], tuple[Any, ...]]
@@ -113,7 +115,36 @@ class Piece:
     vertex_balanced: bool = False  # the whole tree's (Octree.vertex_balanced): the piece's vertices are its
 
 
-def mesh_piece(piece: Piece, keys: np.ndarray, lookup: LookupRecipe | None, catalogue: Catalogue) -> dict[str, Any]:
+@dataclass(frozen=True)
+class PieceResult:
+    """What a task found on its piece (:func:`mesh_piece`).
+
+    Attributes
+    ----------
+    index : int
+        The piece's number.
+    leaf_mesh : LeafMeshSummary or None
+        In the first round of ``global`` mode: what the exact check found on the piece's leaf mesh.
+    marked : ndarray or None
+        Then, if some of its elements are not cells of the Delaunay subdivision: those
+        leaves (whole-tree indices); the piece is not meshed further in this round.
+    failing : tuple of two ndarrays or None
+        With ``marked``: those elements, as (whole-tree leaf, index in the leaf).
+    figures : Mapping or None
+        Else the piece's :func:`~cospherical.mesh.report.mesh_figures` figures, which add up.
+    seams : tuple of OpenFaces
+        With ``figures``: the faces it leaves open at its seams.
+    """
+
+    index: int
+    leaf_mesh: LeafMeshSummary | None = None
+    marked: NDArray[np.integer[Any]] | None = None
+    failing: tuple[NDArray[np.integer[Any]], NDArray[np.integer[Any]]] | None = None
+    figures: Mapping[str, Any] | None = None
+    seams: tuple[OpenFaces, ...] = ()
+
+
+def mesh_piece(piece: Piece, keys: np.ndarray, lookup: LookupRecipe | None, catalogue: Catalogue) -> PieceResult:
     """Mesh, check and write one piece (run in a worker); see the module for why it equals its part of the whole.
 
     ``keys``: the whole tree's vertex keys; ``lookup``: ``(factory, arguments)`` that make
@@ -121,41 +152,37 @@ def mesh_piece(piece: Piece, keys: np.ndarray, lookup: LookupRecipe | None, cata
     the same for every piece: on Dask they reach each worker once; so does ``catalogue``,
     the element catalogue every piece is assembled with.
 
-    Returns ``index``; in the first round of ``global`` mode, ``leaf_mesh`` (what the
-    exact check found on the piece's leaf mesh) and, if some of its elements are not
-    cells of the Delaunay subdivision, ``marked`` (those leaves, whole-tree indices)
-    and nothing more; else ``figures`` (:func:`~cospherical.mesh.report.mesh_figures`)
-    and ``seams`` (the faces it leaves open).
+    Returns a :class:`PieceResult`: in the first round of ``global`` mode ``leaf_mesh`` and, if
+    some of its elements are not cells of the Delaunay subdivision, ``marked`` and ``failing``
+    and nothing more; else ``figures`` and ``seams``.
     """
     tree = Octree(piece.box, piece.levels, piece.positions, piece.vertex_balanced)
     mesh = assemble(tree, lookup[0](*lookup[1]) if lookup is not None else None, criterion=piece.criterion,
                     vertices=(piece.grid, keys), catalogue=catalogue)
-    result: dict[str, Any] = {"index": piece.index}
+    leaf_mesh = None
     checked = None
     if piece.cells is not None:
         replaced = piece.replaced if piece.replaced is not None else np.zeros(len(tree), dtype=bool)
         mesh = with_cells(mesh, replaced, piece.cells, {**mesh.types, **(piece.types or {})})
     elif piece.mode == "global":
         found = check_delaunay(mesh)
-        result["leaf_mesh"] = found.leaf_mesh(len(mesh))
+        leaf_mesh = found.leaf_mesh(len(mesh))
         failing = found.not_cells
         if len(failing):
-            result["marked"] = piece.leaves[distinct(mesh.element_leaf[failing])]
-            result["failing"] = (piece.leaves[mesh.element_leaf[failing]], mesh.element_local[failing])
-            return result
+            return PieceResult(piece.index, leaf_mesh, piece.leaves[distinct(mesh.element_leaf[failing])],
+                               (piece.leaves[mesh.element_leaf[failing]], mesh.element_local[failing]))
         checked = found
     figures, _, open_faces = mesh_figures(mesh, piece.delaunay, checked=checked, open_faces=True)
-    result.update(figures=figures, seams=open_faces)
     if piece.write is not None:
         piece.write(mesh, piece.path, piece.leaves)
-    return result
+    return PieceResult(piece.index, leaf_mesh, figures=figures, seams=open_faces)
 
 
 def mesh_in_pieces(tree: Octree, pieces: int, lookup: LookupRecipe | None, criterion: str, mode: str,
-                   described: dict[str, Any], patterns: str | None, uniform: bool = True, delaunay: bool = True,
+                   described: TreeSummary, patterns: str | None, uniform: bool = True, delaunay: bool = True,
                    write: Callable[..., None] | None = None, path: Callable[[int], str] | None = None, jobs: int = 1,
                    scheduler: str | None = None, dask_workers: int | None = None, catalogue: Catalogue | None = None,
-                   progress: Callable[[str, int, int], None] | None = None) -> dict[str, Any]:
+                   progress: Callable[[str, int, int], None] | None = None) -> MeshReport:
     """Mesh ``tree`` in ``pieces`` tasks (each writing ``path(k)`` with ``write``); return the whole mesh's report.
 
     ``lookup``: ``(factory, arguments)`` of the pattern lookup (``None``: every
@@ -184,17 +211,16 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: LookupRecipe | None, crite
                 progress(stage, total, 1)
             yield item
 
-    results = dict(told("pieces", pieces, completed(mesh_piece, {k: task(k) for k in range(pieces)}, jobs, scheduler,
+    results: dict[int, PieceResult] = dict(told("pieces", pieces, completed(mesh_piece, {k: task(k) for k in range(pieces)}, jobs, scheduler,
                                                     dask_workers, common=(keys, lookup, catalogue))))
     leaf_mesh = None
     regions = (0, 0)
     if mode == "global":
-        leaf_mesh = {key: sum(results[k]["leaf_mesh"][key] for k in range(pieces))
-                     for key in ("elements", "delaunay_violations", "delaunay_ties", "elements_replaced")}
-        marked = np.sort(np.concatenate([results[k].get("marked", np.zeros(0, dtype=np.int64))
-                                         for k in range(pieces)]))
+        leaf_meshes = [f for f in (results[k].leaf_mesh for k in range(pieces)) if f is not None]  # every piece's
+        leaf_mesh = sum(leaf_meshes[1:], leaf_meshes[0])
+        marked = np.sort(np.concatenate([_marked(results[k]) for k in range(pieces)]))
         if len(marked):
-            found = [results[k]["failing"] for k in range(pieces) if "failing" in results[k]]
+            found = [f for f in (results[k].failing for k in range(pieces)) if f is not None]
             failing = (np.concatenate([f[0] for f in found]), np.concatenate([f[1] for f in found]))
             again, regions = _cells_by_piece(tree, parts, marked, failing, grid, keys, lookup, criterion,
                                                      catalogue)
@@ -204,15 +230,27 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: LookupRecipe | None, crite
             # As in one process, the spheres counted are those of the final check, the fresh cells': the leaf
             # elements kept were proven by the leaf mesh's check, whose spheres the one process does not count
             for k in set(range(pieces)) - set(again):
-                results[k]["figures"]["delaunay_spheres_bounded"] = 0
-    seams = [seam for k in range(pieces) for seam in results[k]["seams"]]
+                results[k] = replace(results[k], figures={**_figures(results[k]), "delaunay_spheres_bounded": 0})
+    seams = [seam for k in range(pieces) for seam in results[k].seams]
     n = np.int64(grid + 1)
 
     def points(ids: np.ndarray) -> np.ndarray:
         return np.stack([keys[ids] // (n * n), (keys[ids] // n) % n, keys[ids] % n], axis=-1)
 
-    return merged_report(tree, len(keys), [results[k]["figures"] for k in range(pieces)], described, patterns,
+    return merged_report(tree, len(keys), [_figures(results[k]) for k in range(pieces)], described, patterns,
                          criterion, uniform, delaunay, leaf_mesh, regions, seams, points, grid, catalogue=catalogue)
+
+
+def _marked(result: PieceResult) -> NDArray[np.integer[Any]]:
+    """A piece's leaves marked for re-tessellation (none when it holds only Delaunay cells)."""
+    return result.marked if result.marked is not None else np.zeros(0, dtype=np.int64)
+
+
+def _figures(result: PieceResult) -> Mapping[str, Any]:
+    """A piece's figures, which every piece has once meshed (the first round's marked pieces are meshed again)."""
+    if result.figures is None:
+        raise ValueError(f"mesh_in_pieces: piece {result.index} was not meshed")
+    return result.figures
 
 
 def _cells_by_piece(tree: Octree, parts: list[np.ndarray], marked: np.ndarray,

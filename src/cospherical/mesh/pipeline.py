@@ -46,6 +46,7 @@ from .delaunay import delaunay_mesh
 from .device import Device, DeviceLayout, device_layout, device_octree
 from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape
 from .report import MeshReport, checked_mesh_report
+from .report_sections import TreeSummary
 
 if TYPE_CHECKING:  # the dual's and a device's regions' modules are imported when they are asked for
     from .dual import Dual
@@ -62,8 +63,8 @@ Progress = Callable[[str, "int | None", int], None]
 class TreeSource:
     """The octree to mesh and where it came from.
 
-    ``described`` is the report's ``tree`` object (``source``: ``refine`` or
-    ``leaves``, with the levels, shapes and balance, or the leaf file's name, and
+    ``described`` is the report's ``tree`` section (``source``: ``refine``, ``leaves``
+    or ``device``, with the levels, shapes and balance, or the leaf file's name, and
     the depth); ``leaf_order`` numbers the leaves as the user listed them (the
     ``leaf`` cell data of ``mesh.vtu``), ``None`` for the tree's own order;
     ``shapes`` the refinement shapes (the picture cuts through the first one);
@@ -72,7 +73,7 @@ class TreeSource:
     """
 
     tree: Octree
-    described: dict[str, Any]
+    described: TreeSummary
     leaf_order: NDArray[np.int64] | None = None
     shapes: tuple[Shape, ...] = ()
     device: DeviceLayout | None = None
@@ -84,8 +85,8 @@ def tree_from_refine(box: Box, levels: int, refine: Sequence[str | Shape], balan
     """The tree refined at ``refine`` (shape texts such as ``sphere:0.5,0.5,0.5,0.3``, or :class:`Shape`) down to ``levels``."""
     shapes = tuple(s if isinstance(s, Shape) else parse_shape(s) for s in refine)
     tree = build_octree(box, levels, shapes, balance, max_leaves)
-    return TreeSource(tree, {"source": "refine", "levels": levels, "refine": [s.text for s in shapes],
-                             "balance": balance, "depth": tree.depth}, None, shapes)
+    return TreeSource(tree, TreeSummary("refine", levels=levels, refine=tuple(s.text for s in shapes),
+                                        balance=balance, depth=tree.depth), None, shapes)
 
 
 def tree_from_leaves(box: Box, levels: Sequence[int] | np.ndarray, positions: Sequence[Sequence[int]] | np.ndarray,
@@ -95,8 +96,7 @@ def tree_from_leaves(box: Box, levels: Sequence[int] | np.ndarray, positions: Se
     The mesh numbers the leaves as the list does; ``file`` (the list's file name) goes in the report.
     """
     tree = leaves_octree(box, levels, positions, where=where)
-    described = {"source": "leaves", **({"file": file} if file is not None else {}), "depth": tree.depth}
-    return TreeSource(tree, described, leaf_list_order(levels, positions))
+    return TreeSource(tree, TreeSummary("leaves", file=file, depth=tree.depth), leaf_list_order(levels, positions))
 
 
 def tree_from_device(device: Device, max_leaves: int | None = None) -> TreeSource:
@@ -106,9 +106,9 @@ def tree_from_device(device: Device, max_leaves: int | None = None) -> TreeSourc
     device = layout.device  # checked: exact coordinates, shapes parsed
     tree, leaf_region = device_octree(layout, max_leaves)
     _coordinates_fit_floats(device, tree.depth)
-    described = {"source": "device", "device": device.name, "levels": device.levels,
-                 "refine": [s.text for s in device.refine], "balance": device.balance,
-                 "resolving_level": layout.resolving_level, "depth": tree.depth}
+    described = TreeSummary("device", device=device.name, levels=device.levels,
+                            refine=tuple(s.text for s in device.refine), balance=device.balance,
+                            resolving_level=layout.resolving_level, depth=tree.depth)
     return TreeSource(tree, described, None, device.refine, layout, leaf_region)
 
 
@@ -145,7 +145,7 @@ def tree_from_octree(tree: Octree) -> TreeSource:
     """
     if tree.vertex_balanced and not _balanced_at_corners(tree):
         tree = replace(tree, vertex_balanced=False)
-    return TreeSource(tree, {"source": "leaves", "depth": tree.depth})
+    return TreeSource(tree, TreeSummary("leaves", depth=tree.depth))
 
 
 def _balanced_at_corners(tree: Octree) -> bool:
@@ -295,13 +295,14 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         found = full_dual(mesh, faces)
         if progress is not None:
             progress("dual", 1, 1)
-        report.update(dual_summary(found, len(mesh), report["interior_faces"] + report["boundary_faces"],
-                                   tetrahedral=tetrahedral_counts))
+        figures = dual_summary(found, len(mesh), report.interior_faces + report.boundary_faces,
+                               tetrahedral=tetrahedral_counts)
+        report = replace(report, negative_coefficients=figures.negative_coefficients, dual=figures.dual)
     if faces is not None:
         clock.stage("regions")
-        report["device"] = device_report(mesh, faces, found)
+        report = replace(report, device=device_report(mesh, faces, found))
     clock.stage(None)
-    return PipelineResult(source, mesh, MeshReport.from_dict(report, timings), found,
+    return PipelineResult(source, mesh, report.with_timings(timings), found,
                           checked_report.delaunay.violating_elements if checked_report.delaunay is not None else None,
                           faces)
 

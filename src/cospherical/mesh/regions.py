@@ -31,7 +31,7 @@ one-box domain.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from collections.abc import Sequence
 from typing import Any, Callable
@@ -48,6 +48,8 @@ from .delaunay import delaunay_mesh, with_cells
 from .dual import Dual, RegionParts, mesh_dual
 from .device import DeviceLayout, Regions
 from .octree import Octree
+from .report_sections import (ContactSummary, DeviceSummary, InterfaceSummary, LeafMeshSummary, NegativeCoefficients,
+                              RegionSummary)
 from .surfaces import edge_keys, vertex_parts
 
 __all__ = ["RegionFaces", "contact_areas", "device_mesh", "device_report", "face_sets", "mesh_region_parts", "region_faces", "region_parts",
@@ -57,7 +59,7 @@ __all__ = ["RegionFaces", "contact_areas", "device_mesh", "device_report", "face
 def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, lookup: Lookup | None = None,
                 criterion: str = "optimal", mode: DelaunayMode = "global",
                 progress: Callable[[str, int | None, int], None] | None = None,
-                cache: dict[Any, Any] | None = None) -> tuple[Mesh, dict[str, Any] | None, DelaunayCheck | None]:
+                cache: dict[Any, Any] | None = None) -> tuple[Mesh, LeafMeshSummary | None, DelaunayCheck | None]:
     """Mesh a device's tree: the leaf mesh, then in ``global`` mode the exact Delaunay subdivision region by region.
 
     Returns what :func:`~cospherical.mesh.delaunay.delaunay_mesh` returns: the mesh,
@@ -87,7 +89,7 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
     first_box = np.cumsum([0] + [len(r.boxes) for r in device.regions])
     done: list[tuple[np.ndarray, Mesh, DelaunayCheck | None]] = []
     parts: list[Cells] = []
-    found: list[dict[str, int]] = []
+    found: list[LeafMeshSummary] = []
     types = dict(mesh.types)
     bad = np.zeros(len(tree), dtype=bool)
     for r in range(count):
@@ -101,7 +103,8 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
                        cache=cache,
                        criterion=criterion, vertices=(grid, keys[ids]), catalogue=mesh.catalogue)
         result, figures, checked = delaunay_mesh(sub, "global", convex=layout.convex(r))
-        found.append(figures or {})
+        if figures is not None:  # always, in global mode
+            found.append(figures)
         done.append((leaves, result, checked))
         if result.cells is None:
             continue
@@ -111,11 +114,11 @@ def device_mesh(layout: DeviceLayout, tree: Octree, leaf_region: np.ndarray, loo
         nodes = np.where(cells.nodes >= 0, ids[np.maximum(cells.nodes, 0)], -1).astype(np.int32)
         parts.append(Cells(cells.shapes, cells.shape, cells.anchor, nodes, leaves[cells.leaf], cells.spanning,
                            cells.proven, cells.clusters, cells.largest_cluster))
-    leaf: dict[str, Any] = {key: sum(f[key] for f in found) for key in found[0]}
+    leaf = sum(found[1:], found[0])
     result = with_cells(mesh, bad, _merged(parts), types) if parts else mesh
     if parts and check_conformity(result, examples=0).nonconforming_faces:
         # the regions' subdivisions do not meet face to face: the leaf mesh, conforming by construction
-        return mesh, dict(leaf, fallback="leaf elements: the regions' Delaunay subdivisions do not meet face to face"), \
+        return mesh, replace(leaf, fallback="leaf elements: the regions' Delaunay subdivisions do not meet face to face"), \
             None
     return result, leaf, _summed_checks(result, done)
 
@@ -523,7 +526,7 @@ def region_volumes(mesh: Mesh) -> list[Fraction]:
     return volumes
 
 
-def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> dict[str, Any]:
+def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> DeviceSummary:
     """The report's ``device`` section: per region its elements, nodes, volume (exact) and, with the dual
     (its parts per region computed), its negative coefficients (interior: off the domain's boundary) and
     control volume sum; per contact its faces, nodes, area; per interface its faces and nodes."""
@@ -546,18 +549,17 @@ def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> d
             raise ValueError("device_report: a device's dual without its boundary edges (pipeline.full_dual sets them)")
         on_boundary = dual.boundary_edge[parts.coupling_edge]
         below = np.asarray(parts.coupling_exact < 0)
-        negative = [{"interior": int((below & ~on_boundary & (parts.coupling_region == r)).sum()),
-                     "boundary": int((below & on_boundary & (parts.coupling_region == r)).sum())}
+        negative = [NegativeCoefficients(int((below & ~on_boundary & (parts.coupling_region == r)).sum()),
+                                         int((below & on_boundary & (parts.coupling_region == r)).sum()))
                     for r in range(len(device.regions))]
     regions = []
     for r, region in enumerate(device.regions):
-        entry: dict[str, Any] = {"name": region.name, "material": region.material, "elements": int(elements[r]),
-                 "nodes": int(used[r].sum()), "volume": str(volumes[r] * box_volume),
-                 "volume_ok": volumes[r] * box_volume == layout.region_volumes[r]}
-        if negative is not None and parts is not None:
-            entry["negative_coefficients"] = negative[r]
-            entry["control_volume_sum"] = str(parts.region_volumes()[r] * factor)
-        regions.append(entry)
+        with_dual = negative is not None and parts is not None  # the region's dual figures
+        regions.append(RegionSummary(
+            region.name, region.material, int(elements[r]), int(used[r].sum()), str(volumes[r] * box_volume),
+            volumes[r] * box_volume == layout.region_volumes[r],
+            negative[r] if with_dual and negative is not None else None,
+            str(parts.region_volumes()[r] * factor) if with_dual and parts is not None else None))
     areas = contact_areas(mesh, faces)
     contacts = []
     for c, contact in enumerate(device.contacts):
@@ -565,19 +567,17 @@ def device_report(mesh: Mesh, faces: RegionFaces, dual: Dual | None = None) -> d
         axis = contact.axis
         b, d = (axis + 1) % 3, (axis + 2) % 3
         expected = (box[b + 3] - box[b]) * (box[d + 3] - box[d])
-        entry = {"name": contact.name, "region": contact.region,
-                 "faces": int((faces.contact_face_contact == c).sum()),
-                 "nodes": int(len(faces.contact_vertices(c))), "area": str(areas[c]), "area_ok": areas[c] == expected}
-        if parts is not None:
-            entry["area_parts_sum"] = str(parts.contact_areas()[c])
-        contacts.append(entry)
+        contacts.append(ContactSummary(
+            contact.name, contact.region, int((faces.contact_face_contact == c).sum()),
+            int(len(faces.contact_vertices(c))), str(areas[c]), areas[c] == expected,
+            str(parts.contact_areas()[c]) if parts is not None else None))
     interfaces = []
     for i, name in enumerate(faces.interface_names):
         nodes = faces.interface_nodes[faces.interface_face_interface == i]
-        interfaces.append({"name": name, "faces": int(len(nodes)), "nodes": int(len(np.unique(nodes[nodes >= 0])))})
-    return {"name": device.name, "resolving_level": layout.resolving_level, "depth": mesh.tree.depth,
-            "origin": [str(x) for x in device.origin], "regions": regions, "contacts": contacts,
-            "interfaces": interfaces}
+        interfaces.append(InterfaceSummary(name, int(len(nodes)), int(len(np.unique(nodes[nodes >= 0])))))
+    x, y, z = (str(v) for v in device.origin)
+    return DeviceSummary(device.name, layout.resolving_level, mesh.tree.depth, (x, y, z), tuple(regions),
+                         tuple(contacts), tuple(interfaces))
 
 
 def _factor(dual: Dual) -> Fraction:

@@ -8,10 +8,10 @@ mesh in one piece goes the same way (:func:`mesh_report`), so the two cannot dri
 
 from __future__ import annotations
 
-import copy
 from collections import Counter
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from fractions import Fraction
+from types import MappingProxyType
 from typing import Any, Callable, Iterable, Mapping, NamedTuple, Sequence
 
 import numpy as np
@@ -22,11 +22,21 @@ from ..version import __version__
 from .assembly import Mesh
 from .checks import (DelaunayCheck, OpenFaces, check_circumcenters, check_conformity, check_delaunay, check_volume,
                      match_seams)
+from .report_sections import (ChecksSummary, ConfigurationFrequency, ContactSummary, DelaunaySpheres, DeviceSummary,
+                              DualSummary, InterfaceSummary, LeafMeshSummary, MixedCounts, NegativeCoefficients,
+                              OutsideType, RegionSummary, TetrahedralCounts, TreeSummary, TypeFrequency, UniformSummary,
+                              plain, read_only)
+from .statistics import ConfigurationOccurrence, level_counts, occurrences, statistics, uniform_study
 from .tree import Octree
-from .statistics import level_counts, occurrences, statistics, uniform_study
 
-__all__ = ["CheckedReport", "MeshFigures", "MeshReport", "checked_mesh_report", "merged_report", "mesh_figures", "mesh_report",
+__all__ = ["CheckedReport", "ChecksSummary", "ConfigurationFrequency", "ContactSummary", "DelaunaySpheres",
+           "DeviceSummary", "DualSummary", "InterfaceSummary", "LeafMeshSummary", "MeshFigures", "MeshReport",
+           "MixedCounts", "NegativeCoefficients", "OutsideType", "RegionSummary", "TetrahedralCounts", "TreeSummary",
+           "TypeFrequency", "UniformSummary", "checked_mesh_report", "merged_report", "mesh_figures", "mesh_report",
            "outside_catalogue"]
+
+# A nonconforming face: its vertices, each three fractions of the domain's sides (floats)
+Example = tuple[tuple[float, ...], ...]
 
 # Figures of the pieces that the whole's report adds up.
 _SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_faces", "circumcenters_outside_leaf",
@@ -36,25 +46,28 @@ _SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_f
            "cells_spanning_leaves", "delaunay_spheres_bounded")
 
 
-def outside_catalogue(mesh: Mesh) -> list[dict[str, Any]]:
+def outside_catalogue(mesh: Mesh) -> tuple[OutsideType, ...]:
     """The element types of the mesh its catalogue (:attr:`Mesh.catalogue`) does not name: id, systematic name, count, one example.
 
     The example is one element's vertices in domain units (exact fractions of the
     domain's sides, as text).  Nothing is added to the catalogue.
     """
     known = mesh.catalogue
-    found: dict[str, dict[str, Any]] = {}
+    found: dict[str, OutsideType] = {}
     if all(type_id in known for _, type_id in mesh.block_types()):  # the common case: no vertex ids gathered
-        return []
+        return ()
     for rows, nodes, _, type_id in mesh.blocks():
         if type_id is None or type_id in known or not len(rows):  # a mesh's blocks all have types
             continue
-        entry = found.setdefault(type_id, {"id": type_id, "name": mesh.types.get(type_id, {}).get("name", type_id),
-                                           "count": 0, "example": None})
-        entry["count"] += int(len(rows))
-        if entry["example"] is None:
-            entry["example"] = [[str(Fraction(int(x), mesh.grid)) for x in mesh.vertices[v]] for v in nodes[0]]
-    return sorted(found.values(), key=lambda e: (-e["count"], e["id"]))
+        if type_id not in found:
+            example = tuple(tuple(str(Fraction(int(x), mesh.grid)) for x in mesh.vertices[v]) for v in nodes[0])
+            found[type_id] = OutsideType(type_id, mesh.types.get(type_id, {}).get("name", type_id), 0, example)
+        found[type_id] = replace(found[type_id], count=found[type_id].count + int(len(rows)))
+    return _by_count(found.values())
+
+
+def _by_count(types: Iterable[OutsideType]) -> tuple[OutsideType, ...]:
+    return tuple(sorted(types, key=lambda e: (-e.count, e.id)))
 
 
 class MeshFigures(NamedTuple):
@@ -115,13 +128,13 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
     return MeshFigures(figures, found, conformity.open_faces)
 
 
-def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]], described: Mapping[str, Any],
+def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]], described: TreeSummary,
                   patterns: str | None, criterion: str = "optimal", uniform: bool = True, delaunay: bool = True,
-                  leaf_mesh: Mapping[str, int] | None = None, cells: tuple[int, int] = (0, 0),
+                  leaf_mesh: LeafMeshSummary | None = None, cells: tuple[int, int] = (0, 0),
                   seams: Iterable[OpenFaces] | None = None,
                   vertex_points: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None = None, grid: int = 1, *,
                   catalogue: Catalogue, domain_share: Fraction = Fraction(1),
-                  uniform_computed: bool = False) -> dict[str, Any]:
+                  uniform_computed: bool = False) -> MeshReport:
     """The report of a mesh from the :func:`mesh_figures` of its pieces (one piece: the whole mesh).
 
     ``catalogue``: the element catalogue the pieces were assembled with (it names the types).
@@ -133,36 +146,13 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]
     study run even for a box whose figures ship precomputed (see :func:`~cospherical.mesh.statistics.uniform_study`).
     """
     summed = {key: sum(part[key] for part in parts) for key in _SUMMED if all(key in part for part in parts)}
-    report: dict[str, Any] = {
-        "schema_version": 1,
-        "generator": f"cospherical {__version__}",
-        "domain": list(tree.box.texts),
-        "tree": described,
-        "patterns": patterns,
-        "criterion": criterion,
-        "leaves": len(tree),
-        "leaves_per_level": level_counts(tree),
-        "vertices": int(vertices),
-        "elements": sum(part["elements"] for part in parts),
-    }
     type_counts: Counter[str] = sum((Counter(part["type_counts"]) for part in parts), Counter())
-    outside: dict[str, dict[str, Any]] = {}
+    outside: dict[str, OutsideType] = {}
     for part in parts:
         for entry in part["types_outside_catalogue"]:
-            mine = outside.setdefault(entry["id"], {**entry, "count": 0})
-            mine["count"] += entry["count"]
-    report.update({
-        "types": len(type_counts),
-        "delaunay_mode": "leaf" if leaf_mesh is None else "global",
-        "leaf_mesh": leaf_mesh,
-        "cells_spanning_leaves": summed["cells_spanning_leaves"],
-        "regions_retessellated": cells[0],
-        "largest_region_vertices": cells[1],
-        "types_outside_catalogue": sorted(outside.values(), key=lambda e: (-e["count"], e["id"])),
-    })
+            mine = outside.get(entry.id)
+            outside[entry.id] = entry if mine is None else replace(mine, count=mine.count + entry.count)
     volume = sum((part["volume"] for part in parts), Fraction(0))
-    report.update({"volume_ok": volume == domain_share and summed["flat_elements"] == 0, "volume": str(volume),
-                   "flat_elements": summed["flat_elements"]})
     examples = [e for part in parts for e in part["nonconforming_examples"]]
     conformity = {key: summed[key] for key in ("nonconforming_faces", "interior_faces", "boundary_faces")}
     if seams is not None:
@@ -172,48 +162,62 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]
         conformity["nonconforming_faces"] += matched.nonconforming_faces
         conformity["interior_faces"] += matched.interior_faces
         examples += matched.nonconforming_examples
-    report.update(conformity, nonconforming_examples=examples[:5])
-    report.update({key: summed[key] for key in ("circumcenters_outside_leaf", "leaves_not_fvm_adequate",
-                                                "elements_not_cospherical", "boundary_circumcenters_outside")})
-    if delaunay:
-        report.update({key: summed[key] for key in ("delaunay_violations", "delaunay_violating_pairs",
-                                                    "delaunay_violating_leaves", "delaunay_ties",
-                                                    "delaunay_exact_tests", "delaunay_violating_fvm_leaves")})
-    else:
-        report["delaunay_violations"] = None
-    configurations: dict[str, dict[str, Any]] = {}
+    configurations: dict[str, ConfigurationOccurrence] = {}
     for part in parts:
         for code, entry in part["configurations"].items():
-            mine = configurations.setdefault(code, {**entry, "leaves": 0})
-            mine["leaves"] += entry["leaves"]
-    on_the_fly = sum(c["tessellated_on_the_fly"] for c in configurations.values())
+            met = configurations.get(code)
+            configurations[code] = entry if met is None else replace(met, leaves=met.leaves + entry.leaves)
+    on_the_fly = sum(c.tessellated_on_the_fly for c in configurations.values())
     mapped = len({code for part in parts for code in part["mapped"]})
-    report["configurations"] = len(configurations)
-    report["configurations_from_table"] = len(configurations) - on_the_fly - mapped
-    report["configurations_mapped"] = mapped
-    report["tessellated_on_the_fly"] = on_the_fly
-    report["leaves_tessellated_on_the_fly"] = summed["leaves_tessellated_on_the_fly"]
     types: dict[str, dict[str, Any]] = {}
     for part in parts:
         types.update(part["types"])
-    report.update(statistics(type_counts, configurations, len(tree), types, catalogue,
-                             uniform_study(tree.box, catalogue, uniform_computed) if uniform else None))
-    report["checks"] = _checks_run(patterns is not None, delaunay, summed)
-    return report
+    frequencies = statistics(type_counts, configurations, len(tree), types, catalogue,
+                             uniform_study(tree.box, catalogue, uniform_computed) if uniform else None)
+
+    def delaunay_figure(key: str) -> int | None:
+        return int(summed[key]) if delaunay else None
+
+    x, y, z = tree.box.texts
+    return MeshReport(
+        schema_version=1, generator=f"cospherical {__version__}", domain=(x, y, z), tree=described,
+        patterns=patterns, criterion=criterion, leaves=len(tree), leaves_per_level=level_counts(tree),
+        vertices=int(vertices), elements=sum(part["elements"] for part in parts), types=len(type_counts),
+        delaunay_mode="leaf" if leaf_mesh is None else "global", leaf_mesh=leaf_mesh,
+        cells_spanning_leaves=summed["cells_spanning_leaves"], regions_retessellated=cells[0],
+        largest_region_vertices=cells[1], types_outside_catalogue=_by_count(outside.values()),
+        volume_ok=volume == domain_share and summed["flat_elements"] == 0, volume=str(volume),
+        flat_elements=summed["flat_elements"], nonconforming_faces=conformity["nonconforming_faces"],
+        interior_faces=conformity["interior_faces"], boundary_faces=conformity["boundary_faces"],
+        nonconforming_examples=tuple(tuple(tuple(point) for point in face) for face in examples[:5]),
+        circumcenters_outside_leaf=summed["circumcenters_outside_leaf"],
+        leaves_not_fvm_adequate=summed["leaves_not_fvm_adequate"],
+        elements_not_cospherical=summed["elements_not_cospherical"],
+        boundary_circumcenters_outside=summed["boundary_circumcenters_outside"],
+        delaunay_violations=delaunay_figure("delaunay_violations"),
+        delaunay_violating_pairs=delaunay_figure("delaunay_violating_pairs"),
+        delaunay_violating_leaves=delaunay_figure("delaunay_violating_leaves"),
+        delaunay_ties=delaunay_figure("delaunay_ties"), delaunay_exact_tests=delaunay_figure("delaunay_exact_tests"),
+        delaunay_violating_fvm_leaves=delaunay_figure("delaunay_violating_fvm_leaves"),
+        configurations=len(configurations), configurations_from_table=len(configurations) - on_the_fly - mapped,
+        configurations_mapped=mapped, tessellated_on_the_fly=on_the_fly,
+        leaves_tessellated_on_the_fly=summed["leaves_tessellated_on_the_fly"],
+        paper_final_share=frequencies.paper_final_share,
+        leaves_in_bisection_family=frequencies.leaves_in_bisection_family,
+        type_frequencies=frequencies.type_frequencies, configuration_frequencies=frequencies.configuration_frequencies,
+        uniform=frequencies.uniform, checks=_checks_run(patterns is not None, delaunay, summed))
 
 
-def _checks_run(table: bool, delaunay: bool, summed: Mapping[str, int]) -> dict[str, Any]:
+def _checks_run(table: bool, delaunay: bool, summed: Mapping[str, int]) -> ChecksSummary:
     """The report's ``checks``: which exact checks ran, which did not and why, and how the Delaunay check
     found the vertices near each sphere (bounded by the tree's structure; the others searched)."""
-    checks: dict[str, Any] = {"run": (["table_entries"] if table else [])
-                              + ["volume", "conformity", "circumcenters"] + (["delaunay"] if delaunay else [])}
+    run = (("table_entries",) if table else ()) + ("volume", "conformity", "circumcenters") \
+        + (("delaunay",) if delaunay else ())
     if delaunay:
         # the others are searched (a piece searches its share of the cells and their surroundings: not a
         # figure that adds up to the whole's)
-        checks["delaunay_spheres"] = {"bounded_by_the_tree": summed.get("delaunay_spheres_bounded", 0)}
-    else:
-        checks["not_run"] = {"delaunay": "not asked for (--no-delaunay): delaunay_violations is null"}
-    return checks
+        return ChecksSummary(run, DelaunaySpheres(summed.get("delaunay_spheres_bounded", 0)))
+    return ChecksSummary(run, not_run=read_only({"delaunay": "not asked for (--no-delaunay): delaunay_violations is null"}))
 
 
 @dataclass(frozen=True)
@@ -222,22 +226,22 @@ class CheckedReport:
 
     Attributes
     ----------
-    report : dict
-        The report (the keys of ``schemas/mesh-report.schema.json``, as :func:`mesh_report` gives it).
+    report : MeshReport
+        The report, as :func:`mesh_report` gives it.
     delaunay : DelaunayCheck or None
         What the exact global Delaunay check found (its elements give the ``delaunay_ok`` cell
         data); ``None`` when the check was skipped.
     """
 
-    report: dict[str, Any]
+    report: MeshReport
     delaunay: DelaunayCheck | None
 
 
-def mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | None, criterion: str = "optimal",
+def mesh_report(mesh: Mesh, tree: TreeSummary, patterns: str | None, criterion: str = "optimal",
                 uniform: bool = True, delaunay: bool = True, stage: Callable[[str], None] | None = None,
                 progress: Callable[[int], None] | None = None,
-                leaf_mesh: Mapping[str, int] | None = None, checked: DelaunayCheck | None = None) -> dict[str, Any]:
-    """Run every check on ``mesh`` and gather the report (the keys of ``schemas/mesh-report.schema.json``).
+                leaf_mesh: LeafMeshSummary | None = None, checked: DelaunayCheck | None = None) -> MeshReport:
+    """Run every check on ``mesh`` and gather the report (:class:`MeshReport`: ``to_dict()`` gives ``report.json``).
 
     ``tree`` describes where the octree came from; ``patterns`` names the table read
     (``None``: every configuration tessellated); ``uniform`` adds the uniform-weight
@@ -256,17 +260,17 @@ def mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | None, crite
     >>> from cospherical.mesh.assembly import assemble
     >>> from cospherical.mesh.octree import build_octree, parse_shape
     >>> tree = build_octree(Box.parse([1, 1, 1]), 2, [parse_shape("point:0.1,0.1,0.1")])
-    >>> report = mesh_report(assemble(tree), {"source": "refine"}, None, uniform=False)
-    >>> [report[k] for k in ("leaves", "elements", "volume_ok", "nonconforming_faces", "delaunay_violations")]
-    [15, 48, True, 0, 0]
+    >>> report = mesh_report(assemble(tree), TreeSummary("refine"), None, uniform=False)
+    >>> report.leaves, report.elements, report.volume_ok, report.nonconforming_faces, report.delaunay_violations
+    (15, 48, True, 0, 0)
     """
     return checked_mesh_report(mesh, tree, patterns, criterion, uniform, delaunay, stage, progress, leaf_mesh,
                                checked).report
 
 
-def checked_mesh_report(mesh: Mesh, tree: Mapping[str, Any], patterns: str | None, criterion: str = "optimal",
+def checked_mesh_report(mesh: Mesh, tree: TreeSummary, patterns: str | None, criterion: str = "optimal",
                         uniform: bool = True, delaunay: bool = True, stage: Callable[[str], None] | None = None,
-                        progress: Callable[[int], None] | None = None, leaf_mesh: Mapping[str, int] | None = None,
+                        progress: Callable[[int], None] | None = None, leaf_mesh: LeafMeshSummary | None = None,
                         checked: DelaunayCheck | None = None,
                         conformity_progress: Callable[[int], None] | None = None,
                         uniform_computed: bool = False) -> CheckedReport:
@@ -296,8 +300,11 @@ class MeshReport:
     The fields are the keys of ``schemas/mesh-report.schema.json``, in the order
     ``report.json`` writes them; :meth:`to_dict` gives that JSON object exactly and
     :meth:`from_dict` reads it back (``MeshReport.from_dict(r.to_dict()) == r``).
-    Counts are ``int``; the nested figures (``tree``, ``leaf_mesh``, the frequency
-    tables, ``dual``) are the report's own JSON values, read-only by convention.
+    Counts are ``int``; the nested sections are frozen dataclasses of their own
+    (:mod:`cospherical.mesh.report_sections`: ``tree`` a :class:`TreeSummary`,
+    ``dual`` a :class:`DualSummary`, ``device`` a :class:`DeviceSummary`, ...), lists
+    are tuples, and the two open-ended mappings (``leaves_per_level``, keyed by level;
+    ``timings``, keyed by stage) are read-only: a report cannot be changed once made.
     ``delaunay_violations`` is ``None`` when the global Delaunay check was skipped;
     the fields that default to ``None`` are absent from the JSON when not computed.
     ``timings``: seconds per stage of the run (``tree``, ``assembly``, ``volume``, ...,
@@ -307,7 +314,7 @@ class MeshReport:
     schema_version: int
     generator: str
     domain: tuple[str, str, str]
-    tree: Mapping[str, Any]
+    tree: TreeSummary
     patterns: str | None
     criterion: str
     leaves: int
@@ -316,18 +323,18 @@ class MeshReport:
     elements: int
     types: int
     delaunay_mode: str
-    leaf_mesh: Mapping[str, Any] | None
+    leaf_mesh: LeafMeshSummary | None
     cells_spanning_leaves: int
     regions_retessellated: int
     largest_region_vertices: int
-    types_outside_catalogue: list[dict[str, Any]]
+    types_outside_catalogue: tuple[OutsideType, ...]
     volume_ok: bool
     volume: str
     flat_elements: int
     nonconforming_faces: int
     interior_faces: int
     boundary_faces: int
-    nonconforming_examples: list[list[list[float]]]
+    nonconforming_examples: tuple[Example, ...]
     circumcenters_outside_leaf: int
     leaves_not_fvm_adequate: int
     elements_not_cospherical: int
@@ -345,28 +352,53 @@ class MeshReport:
     leaves_tessellated_on_the_fly: int = 0
     paper_final_share: float = 0.0
     leaves_in_bisection_family: int = 0
-    type_frequencies: list[dict[str, Any]] = field(default_factory=list)
-    configuration_frequencies: list[dict[str, Any]] = field(default_factory=list)
-    uniform: Mapping[str, Any] | None = None
-    negative_coefficients: Mapping[str, int] | None = None
-    dual: Mapping[str, Any] | None = None
-    device: Mapping[str, Any] | None = None
-    checks: Mapping[str, Any] | None = None
-    timings: Mapping[str, float] = field(default_factory=dict, compare=False)
+    type_frequencies: tuple[TypeFrequency, ...] = ()
+    configuration_frequencies: tuple[ConfigurationFrequency, ...] = ()
+    uniform: UniformSummary | None = None
+    negative_coefficients: NegativeCoefficients | None = None
+    dual: DualSummary | None = None
+    device: DeviceSummary | None = None
+    checks: ChecksSummary | None = None
+    timings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}), compare=False)
 
     def to_dict(self) -> dict[str, Any]:
-        """The report as ``report.json`` holds it (a new dict, deep-copied: changing it changes nothing here)."""
+        """The report as ``report.json`` holds it (a new object of plain dicts and lists: changing it changes nothing here)."""
         result: dict[str, Any] = {}
         for item in fields(self):
             value = getattr(self, item.name)
             if item.name == "timings" or (value is None and item.name in _ABSENT_WHEN_NONE):
                 continue
-            result[item.name] = list(value) if item.name == "domain" else copy.deepcopy(value)
+            result[item.name] = plain(value)
         return result
 
     @classmethod
-    def from_dict(cls, report: Mapping[str, Any], timings: Mapping[str, float] | None = None) -> "MeshReport":
-        """The report of a ``report.json`` object (or :func:`mesh_report`'s dict); an unknown key raises ``TypeError``."""
-        values = {key: value for key, value in report.items()}
-        values["domain"] = tuple(values["domain"])
-        return cls(**values, timings=dict(timings or {}))
+    def from_dict(cls, report: Mapping[str, Any], timings: Mapping[str, float] | None = None) -> MeshReport:
+        """The report of a ``report.json`` object; an unknown key raises ``TypeError``."""
+        values = dict(report)
+        x, y, z = (str(v) for v in values["domain"])
+        values["domain"] = (x, y, z)
+        values["tree"] = TreeSummary.from_dict(values["tree"])
+        values["leaves_per_level"] = read_only(values["leaves_per_level"])
+        values["types_outside_catalogue"] = tuple(OutsideType.from_dict(t) for t in values["types_outside_catalogue"])
+        values["nonconforming_examples"] = tuple(tuple(tuple(point) for point in face)
+                                                 for face in values.get("nonconforming_examples", ()))
+        for key, section in _SECTIONS.items():
+            if values.get(key) is not None:
+                values[key] = section(values[key])
+        for key, entry in _ROWS.items():
+            if key in values:
+                values[key] = tuple(entry(row) for row in values[key])
+        return cls(**values, timings=read_only(timings or {}))
+
+    def with_timings(self, timings: Mapping[str, float]) -> MeshReport:
+        """The same report with ``timings`` (seconds per stage, kept read-only)."""
+        return replace(self, timings=read_only(timings))
+
+
+# The report's sections that are objects, and those that are lists of rows: how each is read from JSON
+_SECTIONS: dict[str, Callable[[Mapping[str, Any]], Any]] = {
+    "leaf_mesh": LeafMeshSummary.from_dict, "uniform": UniformSummary.from_dict,
+    "negative_coefficients": NegativeCoefficients.from_dict, "dual": DualSummary.from_dict,
+    "device": DeviceSummary.from_dict, "checks": ChecksSummary.from_dict}
+_ROWS: dict[str, Callable[[Mapping[str, Any]], Any]] = {
+    "type_frequencies": TypeFrequency.from_dict, "configuration_frequencies": ConfigurationFrequency.from_dict}

@@ -10,7 +10,8 @@ system), and the share of elements the paper's seven final elements cover.
 from __future__ import annotations
 
 from collections import Counter
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 
@@ -19,15 +20,80 @@ from ..catalogue import Catalogue
 from ..core.configuration import Box, Configuration
 from ..files.data import data_path
 from .assembly import PAPER_FINAL, Mesh, type_info
+from .report_sections import ConfigurationFrequency, TypeFrequency, UniformSummary, read_only
 from .tree import Octree
 
-__all__ = ["in_bisection_family", "level_counts", "mesh_statistics", "occurrences", "shipped_uniform", "statistics",
-           "uniform_figures", "uniform_study"]
+__all__ = ["ConfigurationOccurrence", "Frequencies", "UniformStudy", "in_bisection_family", "level_counts",
+           "mesh_statistics", "occurrences", "shipped_uniform", "statistics", "uniform_figures", "uniform_study"]
 
 _BISECTION_CONFIGURATIONS = 4096
 
 
-def uniform_study(box: Box, catalogue: Catalogue, computed: bool = False) -> dict[str, Any]:
+@dataclass(frozen=True)
+class UniformStudy:
+    """The uniform-weight bisection study of a box: its elements per type and what each type is.
+
+    Attributes
+    ----------
+    counts : Mapping of str to int
+        Elements per type id, by decreasing count (read-only; keyed by the types the study meets).
+    types : Mapping of str to Mapping
+        Per type id its name, paper class, VTK cell, vertices and faces (the catalogue's when it
+        names the type; read-only).
+    elements : int
+        The study's elements, all types together.
+    """
+
+    counts: Mapping[str, int]
+    types: Mapping[str, Mapping[str, Any]]
+    elements: int
+
+
+@dataclass(frozen=True)
+class ConfigurationOccurrence:
+    """A leaf configuration met in a mesh (or in a piece of it), and its leaves there.
+
+    Attributes
+    ----------
+    code : str
+        The configuration's whole point-set code.
+    leaves : int
+        Its leaves (replaced ones too); adds up over a partitioned mesh's pieces.
+    in_bisection_family : bool
+        Whether the paper's bisection study has its point set (:func:`in_bisection_family`).
+    elements_per_leaf : int
+        Its elements.
+    fvm_adequate : bool
+        Whether every circumcenter of its elements lies in the closed leaf.
+    tessellated_on_the_fly : bool
+        Whether the table lacked it.
+    """
+
+    code: str
+    leaves: int
+    in_bisection_family: bool
+    elements_per_leaf: int
+    fvm_adequate: bool
+    tessellated_on_the_fly: bool
+
+
+class Frequencies(NamedTuple):
+    """What :func:`statistics` found: the report's frequency figures, in its order.
+
+    ``paper_final_share``: the share of elements that are one of the paper's seven final
+    elements; ``leaves_in_bisection_family``: leaves whose configuration the bisection study
+    has; ``type_frequencies`` (by decreasing count), ``configuration_frequencies`` (by
+    decreasing leaves); ``uniform``: the uniform study's figures (``None`` without it).
+    """
+
+    paper_final_share: float
+    leaves_in_bisection_family: int
+    type_frequencies: tuple[TypeFrequency, ...]
+    configuration_frequencies: tuple[ConfigurationFrequency, ...]
+    uniform: UniformSummary | None
+
+
+def uniform_study(box: Box, catalogue: Catalogue, computed: bool = False) -> UniformStudy:
     """Element counts per type of the uniform-weight bisection study of ``box`` (octree policy, optimal),
     the types named by ``catalogue``.
 
@@ -45,7 +111,7 @@ def uniform_study(box: Box, catalogue: Catalogue, computed: bool = False) -> dic
         figures = uniform_figures(box)
     info = {type_id: type_info(type_id, None, catalogue) if type_id in catalogue else dict(own)
             for type_id, own in figures["types"].items()}
-    return {"counts": dict(figures["counts"]), "types": info, "elements": figures["elements"]}
+    return UniformStudy(read_only(figures["counts"]), read_only(info), figures["elements"])
 
 
 def uniform_figures(box: Box) -> dict[str, Any]:
@@ -99,10 +165,10 @@ def in_bisection_family(configuration: Configuration) -> bool:
     return Configuration.from_code(digits, configuration.box).point_set_code == configuration.point_set_code
 
 
-def mesh_statistics(mesh: Mesh, uniform: dict[str, Any] | None = None) -> dict[str, Any]:
+def mesh_statistics(mesh: Mesh, uniform: UniformStudy | None = None) -> Frequencies:
     """Per element type and per configuration, how often it occurs in the mesh, beside the uniform study.
 
-    Returns ``type_frequencies`` (by decreasing count), ``configuration_frequencies``
+    Returns :class:`Frequencies`: ``type_frequencies`` (by decreasing count), ``configuration_frequencies``
     (by decreasing leaf count), ``paper_final_share`` (elements whose paper class is
     one of the paper's seven final elements) and, with ``uniform``, its figures.
     """
@@ -110,7 +176,7 @@ def mesh_statistics(mesh: Mesh, uniform: dict[str, Any] | None = None) -> dict[s
     return statistics(type_counts, configurations, len(mesh.tree), mesh.types, mesh.catalogue, uniform)
 
 
-def occurrences(mesh: Mesh) -> tuple[Counter[str], dict[str, dict[str, Any]]]:
+def occurrences(mesh: Mesh) -> tuple[Counter[str], dict[str, ConfigurationOccurrence]]:
     """Elements per type id, and per configuration code its leaves (replaced ones too) and what it is.
 
     Both add up over the pieces of a partitioned mesh (leaves summed per code).
@@ -119,59 +185,49 @@ def occurrences(mesh: Mesh) -> tuple[Counter[str], dict[str, dict[str, Any]]]:
     for rows, type_id in mesh.block_types():
         if len(rows):
             type_counts[type_id] += len(rows)
-    configurations: dict[str, dict[str, Any]] = {}
+    configurations: dict[str, ConfigurationOccurrence] = {}
     for _, tessellation, leaves in mesh.groups(all_leaves=True):
-        configurations[tessellation.code] = {
-            "code": tessellation.code,
-            "leaves": int(len(leaves)),
-            "in_bisection_family": in_bisection_family(tessellation.configuration),
-            "elements_per_leaf": len(tessellation.elements),
-            "fvm_adequate": tessellation.fvm_adequate,
-            "tessellated_on_the_fly": tessellation.on_the_fly,
-        }
+        configurations[tessellation.code] = ConfigurationOccurrence(
+            tessellation.code, int(len(leaves)), in_bisection_family(tessellation.configuration),
+            len(tessellation.elements), tessellation.fvm_adequate, tessellation.on_the_fly)
     return type_counts, configurations
 
 
-def statistics(type_counts: Counter[str], configurations: dict[str, dict[str, Any]], total_leaves: int,
-               types: dict[str, dict[str, Any]], catalogue: Catalogue,
-               uniform: dict[str, Any] | None = None) -> dict[str, Any]:
+def statistics(type_counts: Counter[str], configurations: Mapping[str, ConfigurationOccurrence], total_leaves: int,
+               types: Mapping[str, Mapping[str, Any]], catalogue: Catalogue,
+               uniform: UniformStudy | None = None) -> Frequencies:
     """:func:`mesh_statistics` from the :func:`occurrences` of a mesh (or of all its pieces, added up);
     ``catalogue`` names the types met nowhere else."""
-    frequencies = sorted(({
-        "code": c["code"], "leaves": c["leaves"], "share": _share(c["leaves"], total_leaves),
-        "uniform_share": _share(1, _BISECTION_CONFIGURATIONS) if c["in_bisection_family"] else None,
-        "elements_per_leaf": c["elements_per_leaf"], "fvm_adequate": c["fvm_adequate"],
-        "tessellated_on_the_fly": c["tessellated_on_the_fly"]} for c in configurations.values()),
-        key=lambda c: (-c["leaves"], c["code"]))
+    frequencies = tuple(sorted((ConfigurationFrequency(
+        c.code, c.leaves, _share(c.leaves, total_leaves),
+        _share(1, _BISECTION_CONFIGURATIONS) if c.in_bisection_family else None,
+        c.elements_per_leaf, c.fvm_adequate, c.tessellated_on_the_fly) for c in configurations.values()),
+        key=lambda c: (-c.leaves, c.code)))
     total = sum(type_counts.values())
-    uniform_counts = uniform["counts"] if uniform else {}
-    uniform_total = uniform["elements"] if uniform else 0
-    info = dict(uniform["types"]) if uniform else {}
+    uniform_counts = uniform.counts if uniform is not None else {}
+    uniform_total = uniform.elements if uniform is not None else 0
+    info = dict(uniform.types) if uniform is not None else {}
     info.update(types)
     rows = []
     for type_id in sorted(set(type_counts) | set(uniform_counts), key=lambda t: (-type_counts[t], t)):
         entry = info.get(type_id) or type_info(type_id, None, catalogue)
-        rows.append({
-            "id": type_id, "name": entry["name"], "paper_class": entry["paper_class"], "vtk": entry["vtk"],
-            "count": int(type_counts[type_id]), "share": _share(type_counts[type_id], total),
-            "uniform_count": int(uniform_counts.get(type_id, 0)) if uniform else None,
-            "uniform_share": _share(uniform_counts.get(type_id, 0), uniform_total) if uniform else None,
-        })
-    final = sum(r["count"] for r in rows if r["paper_class"] in PAPER_FINAL)
-    result: dict[str, Any] = {
-        "paper_final_share": _share(final, total),
-        "leaves_in_bisection_family": int(sum(c["leaves"] for c in frequencies if c["uniform_share"] is not None)),
-        "type_frequencies": rows,
-        "configuration_frequencies": frequencies,
-    }
-    if uniform:
-        uniform_final = sum(r["uniform_count"] for r in rows if r["paper_class"] in PAPER_FINAL)
-        result["uniform"] = {"study": "bisection", "face_points": "octree", "configurations": _BISECTION_CONFIGURATIONS,
-                             "elements": int(uniform_total), "paper_final_share": _share(uniform_final, uniform_total)}
-    return result
+        rows.append(TypeFrequency(
+            type_id, entry["name"], entry["paper_class"], entry["vtk"], int(type_counts[type_id]),
+            _share(type_counts[type_id], total),
+            int(uniform_counts.get(type_id, 0)) if uniform is not None else None,
+            _share(uniform_counts.get(type_id, 0), uniform_total) if uniform is not None else None))
+    final = sum(r.count for r in rows if r.paper_class in PAPER_FINAL)
+    summary = None
+    if uniform is not None:
+        uniform_final = sum(r.uniform_count or 0 for r in rows if r.paper_class in PAPER_FINAL)
+        summary = UniformSummary("bisection", "octree", _BISECTION_CONFIGURATIONS, int(uniform_total),
+                                 _share(uniform_final, uniform_total))
+    return Frequencies(_share(final, total),
+                       int(sum(c.leaves for c in frequencies if c.uniform_share is not None)),
+                       tuple(rows), frequencies, summary)
 
 
-def level_counts(tree: Octree) -> dict[str, int]:
-    """Leaves per level of an octree (levels that occur)."""
+def level_counts(tree: Octree) -> Mapping[str, int]:
+    """Leaves per level of an octree (levels that occur, as text: the report's keys), read-only."""
     counts = np.bincount(tree.levels.astype(np.int64))
-    return {str(level): int(n) for level, n in enumerate(counts.tolist()) if n}
+    return read_only({str(level): int(n) for level, n in enumerate(counts.tolist()) if n})

@@ -35,9 +35,9 @@ from __future__ import annotations
 
 from .arrays import Dual, InterfaceParts, RegionParts, as_floats, boundary_areas
 from .pieces import ElementPieces, element_pieces
-from .summary import dual_summary
+from .summary import DualFigures, dual_summary
 from .sums import mesh_dual
 from .tetrahedral import TETRAHEDRAL_LIMIT, external_tetrahedra, tetrahedral_counts
 
-__all__ = ["Dual", "ElementPieces", "InterfaceParts", "RegionParts", "TETRAHEDRAL_LIMIT", "as_floats", "boundary_areas", "dual_summary",
+__all__ = ["Dual", "DualFigures", "ElementPieces", "InterfaceParts", "RegionParts", "TETRAHEDRAL_LIMIT", "as_floats", "boundary_areas", "dual_summary",
            "element_pieces", "external_tetrahedra", "mesh_dual", "tetrahedral_counts"]

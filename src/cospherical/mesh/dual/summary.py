@@ -2,15 +2,23 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import NamedTuple
 
+from ..report_sections import DualSummary, MixedCounts, NegativeCoefficients
 from .arrays import Dual
 from .tetrahedral import TETRAHEDRAL_LIMIT, tetrahedral_counts
 
-__all__ = ["dual_summary"]
+__all__ = ["DualFigures", "dual_summary"]
 
 
-def dual_summary(dual: Dual, elements: int, faces: int, tetrahedral: bool = False) -> dict[str, Any]:
+class DualFigures(NamedTuple):
+    """The report's figures of a dual: its ``negative_coefficients`` and its ``dual`` section."""
+
+    negative_coefficients: NegativeCoefficients
+    dual: DualSummary
+
+
+def dual_summary(dual: Dual, elements: int, faces: int, tetrahedral: bool = False) -> DualFigures:
     """The report's figures of a dual: negative coefficients, sums, and the mixed mesh beside a tetrahedral one.
 
     ``elements`` and ``faces`` are the mixed mesh's (faces: interior plus boundary).
@@ -19,11 +27,10 @@ def dual_summary(dual: Dual, elements: int, faces: int, tetrahedral: bool = Fals
     vertices, the tetrahedral side is ``None``.
     """
     negative = dual.negative_coefficients()
-    mixed = {"elements": int(elements), "edges": int(len(dual.edges)), "faces": int(faces),
-             "nonzeros": int(len(dual.vertices) + 2 * len(dual.edges))}
+    mixed = MixedCounts(int(elements), int(len(dual.edges)), int(faces), int(len(dual.vertices) + 2 * len(dual.edges)))
     tets = tetrahedral_counts(dual.grid_vertices) if tetrahedral and len(dual.vertices) <= TETRAHEDRAL_LIMIT else None
-    return {"negative_coefficients": negative, "dual": {
-        "edges": mixed["edges"], "volume_sum": str(dual.volume_sum()),
-        "coefficient_min": float(dual.coefficient.min()) if len(dual.edges) else None,
-        "coefficient_max": float(dual.coefficient.max()) if len(dual.edges) else None,
-        "boundary_vertices": int(dual.boundary.sum()), "mixed": mixed, "tetrahedral": tets}}
+    return DualFigures(NegativeCoefficients(negative["interior"], negative["boundary"]), DualSummary(
+        mixed.edges, str(dual.volume_sum()),
+        float(dual.coefficient.min()) if len(dual.edges) else None,
+        float(dual.coefficient.max()) if len(dual.edges) else None,
+        int(dual.boundary.sum()), mixed, tets))

@@ -4,13 +4,13 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ...core.geometry import six_volumes
 from ..octree import distinct
+from ..report_sections import TetrahedralCounts
 
 __all__ = ["TETRAHEDRAL_LIMIT", "external_tetrahedra", "tetrahedral_counts"]
 
@@ -50,7 +50,7 @@ def external_tetrahedra(grid_vertices: NDArray[np.integer]) -> tuple[NDArray[np.
     return tets[keep], "qhull", int((~keep).sum())
 
 
-def tetrahedral_counts(grid_vertices: NDArray[np.integer]) -> dict[str, Any]:
+def tetrahedral_counts(grid_vertices: NDArray[np.integer]) -> TetrahedralCounts:
     """Elements, edges, faces and matrix nonzeros of a tetrahedral Delaunay mesh of the same vertices.
 
     The paper's claim is that mixed elements need fewer of each; this is the
@@ -64,5 +64,5 @@ def tetrahedral_counts(grid_vertices: NDArray[np.integer]) -> dict[str, Any]:
     edges = distinct(np.concatenate([tets[:, a] * n + tets[:, b] for a, b in pairs]))
     triples = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
     faces = distinct(np.concatenate([(tets[:, a] * n + tets[:, b]) * n + tets[:, c] for a, b, c in triples]))
-    return {"tool": tool, "elements": int(len(tets)), "edges": int(len(edges)),
-            "faces": int(len(faces)), "nonzeros": int(len(points) + 2 * len(edges)), "flat": flat}
+    return TetrahedralCounts(tool, int(len(tets)), int(len(edges)), int(len(faces)),
+                             int(len(points) + 2 * len(edges)), flat)

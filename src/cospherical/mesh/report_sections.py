@@ -1,0 +1,575 @@
+"""The sections of a mesh's report, typed: what :class:`~cospherical.mesh.report.MeshReport` holds beside its counts.
+
+Each section is a frozen dataclass whose fields are the keys of its object in
+``report.json`` (``schemas/mesh-report.schema.json``), in the order the file writes
+them: ``to_dict()`` gives that object (a new one, plain lists and dicts), ``from_dict()``
+reads it back.  Sequences are tuples, so a report cannot be changed once made; the
+two sections keyed by open-ended names (a check not run and why; leaves per level)
+are read-only mappings (:class:`types.MappingProxyType`).
+
+The module imports nothing of the mesher, so the modules that measure a section
+(the checks, the statistics, the dual, a device's regions) make it typed and the
+report only gathers them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any, ClassVar, Mapping, cast
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+__all__ = ["ChecksSummary", "ConfigurationFrequency", "ContactSummary", "DelaunaySpheres", "DeviceSummary",
+           "DualSummary", "InterfaceSummary", "LeafMeshSummary", "MixedCounts", "NegativeCoefficients",
+           "OutsideType", "RegionSummary", "TetrahedralCounts", "TreeSummary", "TypeFrequency", "UniformSummary",
+           "plain", "read_only"]
+
+
+def plain(value: Any) -> Any:
+    """``value`` as JSON holds it: a section as its ``to_dict()``, tuples as lists, mappings as new dicts."""
+    if isinstance(value, _Section):
+        return value.to_dict()
+    if isinstance(value, (tuple, list)):
+        return [plain(item) for item in value]
+    if isinstance(value, Mapping):
+        return {key: plain(item) for key, item in value.items()}
+    return value
+
+
+def read_only(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
+    """A read-only copy of ``mapping`` (changing the original changes nothing in it)."""
+    return MappingProxyType(dict(mapping))
+
+
+class _Section:
+    """A report section's ``to_dict()``: its fields in order, those in ``_ABSENT_WHEN_NONE`` left out when ``None``."""
+
+    _ABSENT_WHEN_NONE: ClassVar[frozenset[str]] = frozenset()
+
+    def to_dict(self) -> dict[str, Any]:
+        """The section as ``report.json`` holds it (a new object: changing it changes nothing here)."""
+        result: dict[str, Any] = {}
+        for item in fields(cast("DataclassInstance", self)):
+            value = getattr(self, item.name)
+            if value is None and item.name in self._ABSENT_WHEN_NONE:
+                continue
+            result[item.name] = plain(value)
+        return result
+
+
+def _only_fields(section: type[_Section], data: Mapping[str, Any]) -> Mapping[str, Any]:
+    """``data``, refused (``TypeError``, as a constructor refuses an unknown keyword) if it has a key ``section`` lacks."""
+    known = {item.name for item in fields(cast("type[DataclassInstance]", section))}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise TypeError(f"{section.__name__}: unknown key {unknown[0]!r}")
+    return data
+
+
+def _strings(values: Any) -> tuple[str, ...]:
+    return tuple(str(v) for v in values)
+
+
+@dataclass(frozen=True)
+class TreeSummary(_Section):
+    """Where the octree came from (``report.json``'s ``tree``); the fields that do not apply are ``None`` (absent).
+
+    Attributes
+    ----------
+    source : str
+        ``refine`` (refined at shapes), ``leaves`` (a leaf list, or a tree given as it is) or ``device``.
+    device : str or None
+        The device's name (``source == "device"``).
+    file : str or None
+        The leaf list's file name, when it came from a file.
+    levels : int or None
+        The refinement's deepest level asked for.
+    refine : tuple of str or None
+        The refinement shapes, as text (``sphere:0.5,0.5,0.5,0.3``).
+    balance : str or None
+        ``vertex`` or ``edge``: which neighbours the 2:1 balance holds across.
+    resolving_level : int or None
+        A device's level at which every box boundary lies on leaf faces.
+    depth : int or None
+        The tree's deepest leaf level.
+    """
+
+    _ABSENT_WHEN_NONE: ClassVar[frozenset[str]] = frozenset({"device", "file", "levels", "refine", "balance",
+                                                             "resolving_level", "depth"})
+
+    source: str
+    device: str | None = None
+    file: str | None = None
+    levels: int | None = None
+    refine: tuple[str, ...] | None = None
+    balance: str | None = None
+    resolving_level: int | None = None
+    depth: int | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> TreeSummary:
+        """The section of a ``report.json`` ``tree`` object."""
+        return cls(**{**data, **({"refine": _strings(data["refine"])} if "refine" in data else {})})
+
+
+@dataclass(frozen=True)
+class LeafMeshSummary(_Section):
+    """What the exact check found on the leaf mesh before the global Delaunay step re-tessellated it (``leaf_mesh``).
+
+    Attributes
+    ----------
+    elements : int
+        The leaf mesh's elements.
+    delaunay_violations : int
+        Its elements whose circumsphere strictly holds a vertex.
+    delaunay_ties : int
+        Vertices found exactly on an element's circumsphere.
+    elements_replaced : int
+        Its elements that are not cells of the Delaunay subdivision (re-tessellated).
+    fallback : str or None
+        Why the leaf mesh was kept instead (a device whose regions' subdivisions do not meet
+        face to face); ``None`` (absent) when the subdivision was kept.
+    """
+
+    _ABSENT_WHEN_NONE: ClassVar[frozenset[str]] = frozenset({"fallback"})
+
+    elements: int
+    delaunay_violations: int
+    delaunay_ties: int
+    elements_replaced: int
+    fallback: str | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> LeafMeshSummary:
+        """The section of a ``report.json`` ``leaf_mesh`` object."""
+        return cls(**data)
+
+    def __add__(self, other: LeafMeshSummary) -> LeafMeshSummary:
+        """The figures of two pieces of a leaf mesh, added up (neither fell back)."""
+        return LeafMeshSummary(self.elements + other.elements, self.delaunay_violations + other.delaunay_violations,
+                               self.delaunay_ties + other.delaunay_ties, self.elements_replaced + other.elements_replaced)
+
+
+@dataclass(frozen=True)
+class OutsideType(_Section):
+    """An element type of the mesh its catalogue does not name (``types_outside_catalogue``).
+
+    Attributes
+    ----------
+    id : str
+        The type's id.
+    name : str
+        Its systematic name.
+    count : int
+        Its elements in the mesh.
+    example : tuple of tuple of str
+        One element's vertices, each three exact fractions of the domain's sides (text).
+    """
+
+    id: str
+    name: str
+    count: int
+    example: tuple[tuple[str, ...], ...]
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> OutsideType:
+        """The entry of a ``report.json`` ``types_outside_catalogue`` list."""
+        data = _only_fields(cls, data)
+        return cls(data["id"], data["name"], data["count"], tuple(_strings(point) for point in data["example"]))
+
+
+@dataclass(frozen=True)
+class TypeFrequency(_Section):
+    """How often an element type occurs in the mesh, beside the uniform bisection study (``type_frequencies``).
+
+    Attributes
+    ----------
+    id : str
+        The type's id.
+    name : str
+        Its name (the catalogue's, else the systematic one).
+    paper_class : str or None
+        The paper's class of the type, if it has one.
+    vtk : str or None
+        The VTK cell it is written as (``None``: a polyhedron).
+    count : int
+        Its elements in the mesh.
+    share : float
+        ``count`` over the mesh's elements (rounded to 6 digits).
+    uniform_count : int or None
+        Its elements in the uniform study (``None`` without the study).
+    uniform_share : float or None
+        Its share there (``None`` without the study).
+    """
+
+    id: str
+    name: str
+    paper_class: str | None
+    vtk: str | None
+    count: int
+    share: float
+    uniform_count: int | None
+    uniform_share: float | None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> TypeFrequency:
+        """The entry of a ``report.json`` ``type_frequencies`` list."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class ConfigurationFrequency(_Section):
+    """How often a leaf configuration occurs in the mesh (``configuration_frequencies``).
+
+    Attributes
+    ----------
+    code : str
+        The configuration's whole point-set code (edge digits, ``+f`` and its faces).
+    leaves : int
+        Its leaves in the mesh.
+    share : float
+        ``leaves`` over the tree's leaves (rounded to 6 digits).
+    uniform_share : float or None
+        Its weight in the uniform bisection study (one of 4,096), ``None`` outside that family.
+    elements_per_leaf : int
+        Its elements.
+    fvm_adequate : bool
+        Whether every circumcenter of its elements lies in the closed leaf.
+    tessellated_on_the_fly : bool
+        Whether the table lacked it and it was tessellated here.
+    """
+
+    code: str
+    leaves: int
+    share: float
+    uniform_share: float | None
+    elements_per_leaf: int
+    fvm_adequate: bool
+    tessellated_on_the_fly: bool
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ConfigurationFrequency:
+        """The entry of a ``report.json`` ``configuration_frequencies`` list."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class UniformSummary(_Section):
+    """The uniform-weight bisection study the frequencies are set beside (``uniform``).
+
+    Attributes
+    ----------
+    study : str
+        ``bisection``: every configuration of one bisected edge set weighs the same.
+    face_points : str
+        ``octree``: the face-point policy of the study.
+    configurations : int
+        The study's configurations (4,096).
+    elements : int
+        Its elements, all configurations together.
+    paper_final_share : float
+        The share of them that are one of the paper's seven final elements.
+    """
+
+    study: str
+    face_points: str
+    configurations: int
+    elements: int
+    paper_final_share: float
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> UniformSummary:
+        """The section of a ``report.json`` ``uniform`` object."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class NegativeCoefficients(_Section):
+    """Edges whose box-method coefficient is negative, decided exactly (``negative_coefficients``).
+
+    Attributes
+    ----------
+    interior : int
+        Off the domain's boundary (nonzero: the mesh is not Delaunay there).
+    boundary : int
+        In a boundary plane of the domain.
+    """
+
+    interior: int
+    boundary: int
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> NegativeCoefficients:
+        """The section of a ``report.json`` ``negative_coefficients`` object."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class MixedCounts(_Section):
+    """The mixed mesh's sizes beside a tetrahedral one's (``dual.mixed``).
+
+    Attributes
+    ----------
+    elements, edges, faces : int
+        The mesh's elements, edges and faces (interior and boundary).
+    nonzeros : int
+        The box-method matrix's nonzeros (vertices plus twice the edges).
+    """
+
+    elements: int
+    edges: int
+    faces: int
+    nonzeros: int
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> MixedCounts:
+        """The section of a ``report.json`` ``dual.mixed`` object."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class TetrahedralCounts(_Section):
+    """A tetrahedral Delaunay mesh of the same vertices by an outside mesher, its sizes (``dual.tetrahedral``).
+
+    Attributes
+    ----------
+    tool : str
+        ``tetgen``, else ``qhull``.
+    elements, edges, faces : int
+        Its tetrahedra, edges and faces.
+    nonzeros : int
+        Its box-method matrix's nonzeros (vertices plus twice the edges).
+    flat : int
+        Qhull's flat tetrahedra left out (0 with TetGen).
+    """
+
+    tool: str
+    elements: int
+    edges: int
+    faces: int
+    nonzeros: int
+    flat: int
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> TetrahedralCounts:
+        """The section of a ``report.json`` ``dual.tetrahedral`` object."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class DualSummary(_Section):
+    """The figures of the exact finite-volume dual (``dual``).
+
+    Attributes
+    ----------
+    edges : int
+        The dual's edges (the mesh's).
+    volume_sum : str
+        The control volumes' sum as an exact fraction of the domain.
+    coefficient_min, coefficient_max : float or None
+        The least and greatest box-method coefficients (``None``: no edge).
+    boundary_vertices : int
+        Vertices on the domain's boundary.
+    mixed : MixedCounts
+        The mixed mesh's sizes.
+    tetrahedral : TetrahedralCounts or None
+        A tetrahedral Delaunay mesh's, when asked for (and up to a million vertices).
+    """
+
+    edges: int
+    volume_sum: str
+    coefficient_min: float | None
+    coefficient_max: float | None
+    boundary_vertices: int
+    mixed: MixedCounts
+    tetrahedral: TetrahedralCounts | None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> DualSummary:
+        """The section of a ``report.json`` ``dual`` object."""
+        tetrahedral = _only_fields(cls, data)["tetrahedral"]
+        return cls(data["edges"], data["volume_sum"], data["coefficient_min"], data["coefficient_max"],
+                   data["boundary_vertices"], MixedCounts.from_dict(data["mixed"]),
+                   TetrahedralCounts.from_dict(tetrahedral) if tetrahedral is not None else None)
+
+
+@dataclass(frozen=True)
+class RegionSummary(_Section):
+    """A device region's figures (``device.regions``).
+
+    Attributes
+    ----------
+    name, material : str
+        The region's name and material.
+    elements, nodes : int
+        Its elements and the vertices they use.
+    volume : str
+        Its elements' volume, exact (the device's units).
+    volume_ok : bool
+        Whether it is exactly the region's boxes' volume.
+    negative_coefficients : NegativeCoefficients or None
+        With the dual: its edges' negative coefficients (``None``, absent, without).
+    control_volume_sum : str or None
+        With the dual: its control volumes' sum, exact (``None``, absent, without).
+    """
+
+    _ABSENT_WHEN_NONE: ClassVar[frozenset[str]] = frozenset({"negative_coefficients", "control_volume_sum"})
+
+    name: str
+    material: str
+    elements: int
+    nodes: int
+    volume: str
+    volume_ok: bool
+    negative_coefficients: NegativeCoefficients | None = None
+    control_volume_sum: str | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> RegionSummary:
+        """The entry of a ``report.json`` ``device.regions`` list."""
+        negative = data.get("negative_coefficients")
+        return cls(**{**data, "negative_coefficients":
+                      NegativeCoefficients.from_dict(negative) if negative is not None else None})
+
+
+@dataclass(frozen=True)
+class ContactSummary(_Section):
+    """A device contact's figures (``device.contacts``).
+
+    Attributes
+    ----------
+    name, region : str
+        The contact's name and the region it touches.
+    faces, nodes : int
+        Its mesh faces and their vertices.
+    area : str
+        Its faces' area, exact.
+    area_ok : bool
+        Whether it is exactly the contact's rectangle's area.
+    area_parts_sum : str or None
+        With the dual: its dual's boundary area parts summed, exact (``None``, absent, without).
+    """
+
+    _ABSENT_WHEN_NONE: ClassVar[frozenset[str]] = frozenset({"area_parts_sum"})
+
+    name: str
+    region: str
+    faces: int
+    nodes: int
+    area: str
+    area_ok: bool
+    area_parts_sum: str | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ContactSummary:
+        """The entry of a ``report.json`` ``device.contacts`` list."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class InterfaceSummary(_Section):
+    """An interface between two device regions (``device.interfaces``).
+
+    Attributes
+    ----------
+    name : str
+        The interface's name.
+    faces, nodes : int
+        Its mesh faces and their vertices.
+    """
+
+    name: str
+    faces: int
+    nodes: int
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> InterfaceSummary:
+        """The entry of a ``report.json`` ``device.interfaces`` list."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class DeviceSummary(_Section):
+    """A device's regions, contacts and interfaces (``device``).
+
+    Attributes
+    ----------
+    name : str
+        The device's name.
+    resolving_level : int
+        The level at which every box boundary lies on leaf faces.
+    depth : int
+        The tree's deepest level.
+    origin : tuple of str
+        The device's lowest corner, exact (text).
+    regions : tuple of RegionSummary
+    contacts : tuple of ContactSummary
+    interfaces : tuple of InterfaceSummary
+    """
+
+    name: str
+    resolving_level: int
+    depth: int
+    origin: tuple[str, str, str]
+    regions: tuple[RegionSummary, ...]
+    contacts: tuple[ContactSummary, ...]
+    interfaces: tuple[InterfaceSummary, ...]
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> DeviceSummary:
+        """The section of a ``report.json`` ``device`` object."""
+        x, y, z = _strings(_only_fields(cls, data)["origin"])
+        return cls(data["name"], data["resolving_level"], data["depth"], (x, y, z),
+                   tuple(RegionSummary.from_dict(r) for r in data["regions"]),
+                   tuple(ContactSummary.from_dict(c) for c in data["contacts"]),
+                   tuple(InterfaceSummary.from_dict(i) for i in data["interfaces"]))
+
+
+@dataclass(frozen=True)
+class DelaunaySpheres(_Section):
+    """How the Delaunay check found the vertices near each sphere (``checks.delaunay_spheres``).
+
+    Attributes
+    ----------
+    bounded_by_the_tree : int
+        Spheres whose nearby vertices the tree's structure bounded (the others were searched).
+    """
+
+    bounded_by_the_tree: int
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> DelaunaySpheres:
+        """The section of a ``report.json`` ``checks.delaunay_spheres`` object."""
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class ChecksSummary(_Section):
+    """Which exact checks ran and which did not (``checks``).
+
+    Attributes
+    ----------
+    run : tuple of str
+        The checks run, in order: ``table_entries`` (a pattern table was read), ``volume``,
+        ``conformity``, ``circumcenters``, ``delaunay``.
+    delaunay_spheres : DelaunaySpheres or None
+        With the Delaunay check: how it found each sphere's vertices (``None``, absent, without).
+    not_run : Mapping of str to str or None
+        The checks not run, each with why (open-ended: keyed by check name; read-only);
+        ``None`` (absent) when every check ran.
+    """
+
+    _ABSENT_WHEN_NONE: ClassVar[frozenset[str]] = frozenset({"delaunay_spheres", "not_run"})
+
+    run: tuple[str, ...]
+    delaunay_spheres: DelaunaySpheres | None = None
+    not_run: Mapping[str, str] | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ChecksSummary:
+        """The section of a ``report.json`` ``checks`` object."""
+        spheres, not_run = _only_fields(cls, data).get("delaunay_spheres"), data.get("not_run")
+        return cls(_strings(data["run"]), DelaunaySpheres.from_dict(spheres) if spheres is not None else None,
+                   read_only(not_run) if not_run is not None else None)
