@@ -215,13 +215,13 @@ def _on_the_boundary(data: dict, points: np.ndarray, grid: int) -> np.ndarray:
 def test_example_devices_pass_the_oracle(example, tmp_path, capsys):
     from cospherical.cli import main
 
-    # as the docs' command makes it (mesh --device FILE --dual: uniform statistics too), so its report can be
-    # held against the one the devices page shows
-    m = _mesh_and_check(example, tmp_path, dual=True, uniform=True)
+    # as the docs' command makes it (mesh --device FILE --dual --no-uniform), so its report can be held against
+    # the one the devices page shows
+    m = _mesh_and_check(example, tmp_path, dual=True)
     committed = ROOT / "results" / "devices" / example.stem / "report.json"
     assert (tmp_path / "report.json").read_bytes() == committed.read_bytes(), (
         f"{committed.relative_to(ROOT)} is not what the code writes: make it again with "
-        f"cospherical mesh --device examples/devices/{example.name} --dual --out DIR, copy DIR's "
+        f"cospherical mesh --device examples/devices/{example.name} --dual --no-uniform --out DIR, copy DIR's "
         "report.json and mesh.png over (CONTRIBUTING.md)")
     if example.stem in ("fin", "l-shape"):  # non-convex: check proves the elements a mesh of the union of boxes
         assert main(["check", str(tmp_path / "dual.npz")]) == 0, capsys.readouterr().err
