@@ -43,6 +43,18 @@ def test_the_grid_is_the_written_file_as_vtk_reads_it(graded, tmp_path):
     assert list(grid.field_data["type_ids"]) == list(graded.elements.type_ids)
 
 
+def test_a_devices_grid_is_its_written_file_regions_included(tmp_path):
+    # the regions a solver's materials hang on: in memory as in mesh.vtu (they were only in the file)
+    mos = cospherical.build_mesh(device="examples/devices/mos-capacitor.yaml", uniform=False)
+    mos.write(tmp_path)
+    read, grid = pyvista.read(tmp_path / "mesh.vtu"), mos.to_pyvista()
+    assert np.array_equal(read.points, grid.points)
+    assert np.array_equal(read.cell_data["region"], grid.cell_data["region"]) and set(grid.cell_data["region"]) == {0, 1}
+    for name in ("region_names", "region_materials", "origin"):
+        assert [str(x) for x in grid.field_data[name]] == bytes(read.field_data[name]).decode().split("\n"), name
+    assert list(grid.field_data["region_names"]) == ["substrate", "oxide"]
+
+
 def test_the_dual_travels_once_computed():
     m = cospherical.build_mesh(domain=(1, 1, 1), levels=2, refine=["point:0.1,0.1,0.1"], uniform=False)
     assert "control_volume" not in m.to_pyvista().point_data

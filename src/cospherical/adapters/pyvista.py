@@ -63,15 +63,15 @@ def legacy_cells(types: np.ndarray, connectivity: np.ndarray, offsets: np.ndarra
 
 
 def to_pyvista(mesh, point_data: dict | None = None, cell_data: dict | None = None, leaves: np.ndarray | None = None,
-               origin=(0.0, 0.0, 0.0)):
+               origin=(0.0, 0.0, 0.0), field_data: dict | None = None):
     """``mesh`` (an assembled :class:`~cospherical.mesh.assembly.Mesh`) as a ``pyvista.UnstructuredGrid``.
 
-    ``point_data``, ``cell_data`` (rows in vertex and element order) and ``leaves``
-    as :func:`~cospherical.formats.mesh.write_vtu` takes them; ``origin`` moves the
-    points (the mesh's own coordinates start at 0).
+    ``point_data``, ``cell_data`` (rows in vertex and element order), ``leaves`` and
+    ``field_data`` as :func:`~cospherical.formats.mesh.write_vtu` takes them; ``origin``
+    moves the points (the mesh's own coordinates start at 0).
     """
     pyvista = import_pyvista()
-    grid = vtu_grid(mesh, point_data, cell_data, leaves)
+    grid = vtu_grid(mesh, point_data, cell_data, leaves, field_data)
     cells = legacy_cells(grid.types, grid.connectivity, grid.offsets, grid.faces, grid.faceoffsets)
     result = pyvista.UnstructuredGrid(cells, grid.types, grid.points + np.asarray(origin, dtype=np.float64))
     for name, values in grid.point_data.items():

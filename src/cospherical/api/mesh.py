@@ -386,6 +386,20 @@ class OctreeMesh:
             cell_data["delaunay_ok"] = ok
         return point_data, cell_data
 
+    def _device_data(self) -> tuple[dict[str, NDArray[Any]], dict[str, NDArray[Any]]]:
+        """A device's cell data ``region`` and field data ``region_names``, ``region_materials`` and ``origin``:
+        what ``mesh.vtu`` and :meth:`to_pyvista` hold beyond a one-box mesh's (nothing for a one-box mesh)."""
+        from ..formats.vtu import text_array
+
+        mesh, layout = self.assembled, self._result.source.device
+        if layout is None or mesh.regions is None:
+            return {}, {}
+        regions = mesh.regions
+        return ({"region": regions.leaf_region[mesh.element_leaf].astype(np.int32)},
+                {"region_names": text_array("\n".join(regions.names)),
+                 "region_materials": text_array("\n".join(regions.materials)),
+                 "origin": text_array(" ".join(str(x) for x in layout.device.origin))})
+
     def to_pyvista(self) -> Any:  # a pyvista.UnstructuredGrid: the optional library stays out of the checker
         """The mesh as a ``pyvista.UnstructuredGrid``: ``mesh.vtu``'s grid in memory, polyhedra and data included.
 
@@ -394,13 +408,16 @@ class OctreeMesh:
         ``type`` (into field data ``type_ids``, ``type_names``), ``leaf`` and ``fvm``;
         point data ``grid_coordinates``; once the dual is computed (``dual=True``, or
         ``m.dual`` asked for) also ``control_volume``, ``boundary_area``,
-        ``circumcenter`` and ``delaunay_ok``.  Points are :attr:`vertices` (``origin``
+        ``circumcenter`` and ``delaunay_ok``; a device's cell data ``region`` and field data
+        ``region_names``, ``region_materials``, ``origin``.  Points are :attr:`vertices` (``origin``
         added).  Needs pyvista: ``pip install 'cospherical[pyvista]'``.
         """
         from ..adapters.pyvista import to_pyvista
 
         point_data, cell_data = self._vtu_data(self._dual is not None)
-        return to_pyvista(self.assembled, point_data, cell_data, self._result.source.leaf_order, self.origin)
+        regions, fields = self._device_data()
+        return to_pyvista(self.assembled, point_data, {**regions, **cell_data}, self._result.source.leaf_order,
+                          self.origin, fields)
 
     def to_meshio(self) -> Any:  # a meshio.Mesh (meshio has no type information)
         """The mesh split into tetrahedra as a ``meshio.Mesh`` (meshio holds standard cells, not mixed polyhedra).
@@ -419,7 +436,6 @@ class OctreeMesh:
         """A device's files: ``mesh.vtu`` with cell data ``region`` (names and materials in field data),
         ``contacts.vtu`` (its contact and interface faces, when it has any), ``mesh.png`` coloured by region, ``report.json``."""
         from ..formats.mesh import write_faces_vtu, write_report, write_vtu
-        from ..formats.vtu import text_array
         from ..outputs.mesh_picture import cut_png
 
         mesh, report, layout = self.assembled, self.report, self._result.source.device
@@ -427,12 +443,9 @@ class OctreeMesh:
         if layout is None or regions is None or faces is None:
             raise ValueError("_write_device: not a device's mesh (no layout, regions or faces)")
         device = layout.device
-        fields = {"region_names": text_array("\n".join(regions.names)),
-                  "region_materials": text_array("\n".join(regions.materials)),
-                  "origin": text_array(" ".join(str(x) for x in device.origin))}
-        write_vtu(mesh, path("mesh.vtu"), point_data=point_data,
-                  cell_data={"region": regions.leaf_region[mesh.element_leaf].astype(np.int32), **cell_data}, field_data=fields,
-                  origin=device.origin)
+        region_cells, fields = self._device_data()
+        write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data={**region_cells, **cell_data},
+                  field_data=fields, origin=device.origin)
         if device.has_faces:
             write_faces_vtu(mesh, faces, path("contacts.vtu"), origin=device.origin)
         axis = device_cut_axis(device)
@@ -534,18 +547,11 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         raise InputError("tetrahedral_counts=True counts beside the dual's figures: give dual=True too")
     clock = time.perf_counter()
     if device is not None:
-        named = None
         if not isinstance(device, Device):
             from ..formats.device_file import read_device
 
-            named, device = device, read_device(device)
-        try:
-            source = tree_from_device(device, max_leaves)
-        except InputError as error:
-            if named is None:
-                raise
-            # what is found past the file's parsing names the file too, as its parse errors do
-            raise InputError(f"{named}: {error}") from None
+            device = read_device(device)
+        source = tree_from_device(device, max_leaves)
         layout = source.device
         if layout is None:
             raise ValueError("tree_from_device gave no device layout")

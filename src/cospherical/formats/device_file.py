@@ -27,6 +27,7 @@ counts above) before anything is computed from it.
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -90,7 +91,8 @@ _ExactLoader.add_constructor("tag:yaml.org,2002:int", _decimal_integer)
 
 def read_device(path: str | Path) -> Device:
     """Read and check a device file (see the module); any fault raises one line naming the file and the place."""
-    return parse_device(read_text(path, MAX_DEVICE_BYTES), Path(path).name)
+    name = Path(path).name
+    return replace(parse_device(read_text(path, MAX_DEVICE_BYTES), name), source=name)
 
 
 def parse_device(text: str, name: str = "device file") -> Device:

@@ -34,7 +34,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
@@ -93,6 +93,8 @@ class Device:
     ``refine``: shapes in device coordinates (:class:`~cospherical.mesh.octree.Shape`);
     ``levels``: how deep the shapes refine (the region boundaries may need deeper
     leaves: the tree goes down to the resolving level whatever ``levels`` says).
+    ``source``: the file's name when read from one (:func:`~cospherical.formats.device_file.read_device`),
+    which the errors found past its parsing name too.
     """
 
     name: str
@@ -101,6 +103,7 @@ class Device:
     refine: tuple[Shape, ...]
     levels: int
     balance: Balance = "vertex"
+    source: str | None = field(default=None, compare=False)
 
     @property
     def bounds(self) -> tuple[tuple[Fraction, Fraction], ...]:

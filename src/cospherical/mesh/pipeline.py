@@ -102,10 +102,16 @@ def tree_from_leaves(box: Box, levels: Sequence[int] | np.ndarray, positions: Se
 def tree_from_device(device: Device, max_leaves: int | None = None) -> TreeSource:
     """The tree of a device (:mod:`cospherical.mesh.device`): checked, refined until its region boundaries and
     contact edges lie on leaf faces, balanced, the leaves outside every region dropped."""
-    layout = device_layout(device)
-    device = layout.device  # checked: exact coordinates, shapes parsed
-    tree, leaf_region = device_octree(layout, max_leaves)
-    _coordinates_fit_floats(device, tree.depth)
+    try:
+        layout = device_layout(device)
+        device = layout.device  # checked: exact coordinates, shapes parsed
+        tree, leaf_region = device_octree(layout, max_leaves)
+        _coordinates_fit_floats(device, tree.depth)
+    except InputError as error:
+        if device.source is None:
+            raise
+        # what is found past a file's parsing names the file too, as its parse errors do
+        raise InputError(f"{device.source}: {error}") from None
     described = TreeSummary("device", device=device.name, levels=device.levels,
                             refine=tuple(s.text for s in device.refine), balance=device.balance,
                             resolving_level=layout.resolving_level, depth=tree.depth)
