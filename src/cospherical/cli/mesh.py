@@ -113,8 +113,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check of the result")
     parser.add_argument("--check", choices=("default", "all"), default="default",
                         help="all: the Delaunay check searches the vertices near every element's sphere with a k-d "
-                        "tree, none bounded by the tree's structure (a cross-check of that bound); the report's "
-                        "checks says which checks ran and how")
+                        "tree, none bounded by the tree's structure (a cross-check of that bound), and the uniform "
+                        "study is run even where its figures ship with the package; the report's checks says which "
+                        "checks ran and how")
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
 
