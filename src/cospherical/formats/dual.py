@@ -368,7 +368,14 @@ def _check_headers(archive: zipfile.ZipFile, path: Path, members: dict[str, tupl
 
 
 def read_dual(path: str | Path) -> Dual:
-    """Read a ``dual.npz``; a malformed, truncated or tampered file raises :class:`FormatError` (one line)."""
+    """Read a ``dual.npz``; a malformed, truncated or tampered file raises :class:`FormatError` (one line).
+
+    Tampered: a member whose bytes its manifest's SHA-256 does not vouch for. What is read is
+    bounded and consistent in shape and index (no pickle, no index outside its array), but a
+    file forged and signed again can hold values its elements do not give (a float column
+    that is not its exact column, a coefficient moved between edges): :func:`verify_dual`
+    (``cospherical check``) computes the dual again from the elements and refuses those.
+    """
     path = Path(path)
     _regular(path)
     size = os.stat(path).st_size
