@@ -11,18 +11,10 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from types import SimpleNamespace
 
 import pytest
-from commands import cospherical, one_clean_line
+from commands import cospherical, in_process, one_clean_line
 
-from cospherical.cli import main
-
-
-def in_process(capsys, *argv) -> SimpleNamespace:
-    """``cospherical ARGV`` through ``main`` here: its exit status and stderr, as ``one_clean_line`` reads them."""
-    returncode = main([str(a) for a in argv])
-    return SimpleNamespace(returncode=returncode, stderr=capsys.readouterr().err)
 
 
 @pytest.mark.parametrize(

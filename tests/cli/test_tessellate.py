@@ -1,5 +1,8 @@
 """``cospherical tessellate``: its JSON and YAML, deterministic; its help's numbering; face points given on the
-command line; other elements and shape files; the VTU it writes."""
+command line; other elements and shape files; the VTU it writes.
+
+Most run the command's code in the test's process (commands.in_process: a process adds 0.4 CPU-s of start-up each);
+the JSON contract and the determinism across processes run real ``python -m cospherical`` processes."""
 
 from __future__ import annotations
 
@@ -8,29 +11,29 @@ import json
 import meshio
 import pytest
 import yaml
-from commands import cospherical
+from commands import cospherical, in_process
 
 from cospherical.cli import main
 
 
-def test_tessellate_with_faces_on_the_command_line():
-    by_flag = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--faces", "0", "4")
+def test_tessellate_with_faces_on_the_command_line(capsys):
+    by_flag = in_process(capsys, "tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--faces", "0", "4")
     assert by_flag.returncode == 0, by_flag.stderr
     data = json.loads(by_flag.stdout)
     assert data["code"] == "888888888888+f04" and data["face_points"] == "explicit"
     assert data["faces"] == [0, 4] and data["body_point"] is False and data["point_set_code"] == data["code"]
     assert set(data["nodes"]) == {str(i) for i in range(20)} | {"20", "24"}
-    by_code = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888+f04")
+    by_code = in_process(capsys, "tessellate", "--box", "1", "1", "1", "--code", "888888888888+f04")
     assert by_code.stdout == by_flag.stdout
-    by_steiner = cospherical("tessellate", "--box", "1", "1", "1", "--steiner", *(f"{k}:1/2" for k in range(12)),
-                             "--faces", "0", "4")
+    by_steiner = in_process(capsys, "tessellate", "--box", "1", "1", "1", "--steiner", *(f"{k}:1/2" for k in range(12)),
+                            "--faces", "0", "4")
     assert json.loads(by_steiner.stdout)["elements"] == data["elements"]
 
 
-def test_no_faces_given_explicitly_is_policy_none():
-    explicit = json.loads(cospherical("tessellate", "--box", "1", "2", "4", "--code", "888888888888", "--faces").stdout)
-    none = json.loads(cospherical("tessellate", "--box", "1", "2", "4", "--code", "888888888888",
-                                  "--face-points", "none").stdout)
+def test_no_faces_given_explicitly_is_policy_none(capsys):
+    args = ("tessellate", "--box", "1", "2", "4", "--code", "888888888888")
+    explicit = json.loads(in_process(capsys, *args, "--faces").stdout)
+    none = json.loads(in_process(capsys, *args, "--face-points", "none").stdout)
     assert explicit["code"] == "888888888888+f" and none["code"] == "888888888888"
     assert explicit["point_set_code"] == none["point_set_code"] == "888888888888+f"
     assert explicit["elements"] == none["elements"] and explicit["nodes"] == none["nodes"]
@@ -65,9 +68,9 @@ def test_bad_face_points_on_the_command_line_exit_2_in_one_line(args, needle, ca
 
 
 @pytest.mark.oracle_meshio
-def test_tessellate_cli_writes_vtu(tmp_path):
+def test_tessellate_cli_writes_vtu(tmp_path, capsys):
     path = tmp_path / "out.vtu"
-    result = cospherical("tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--vtu", str(path))
+    result = in_process(capsys, "tessellate", "--box", "1", "1", "1", "--code", "888888888888", "--vtu", str(path))
     assert result.returncode == 0, result.stderr
     mesh = meshio.read(path)
     assert [block.type for block in mesh.cells] == ["hexahedron"] and len(mesh.cells[0].data) == 8
@@ -89,10 +92,10 @@ def test_tessellate_json_contract():
 
 
 @pytest.mark.oracle_pyyaml
-def test_tessellate_steiner_and_yaml_agree_with_code():
-    by_code = json.loads(cospherical("tessellate", "--box", "1", "sqrt(2)", "1.4142", "--code", "800080000008").stdout)
-    result = cospherical("tessellate", "--box", "1", "sqrt(2)", "1.4142", "--steiner", "0:1/2", "4:0.5", "11:8/16",
-                         "--format", "yaml")
+def test_tessellate_steiner_and_yaml_agree_with_code(capsys):
+    box = ("tessellate", "--box", "1", "sqrt(2)", "1.4142")
+    by_code = json.loads(in_process(capsys, *box, "--code", "800080000008").stdout)
+    result = in_process(capsys, *box, "--steiner", "0:1/2", "4:0.5", "11:8/16", "--format", "yaml")
     assert result.returncode == 0, result.stderr
     assert yaml.safe_load(result.stdout) == by_code
 
@@ -109,10 +112,10 @@ def test_tessellate_help_shows_the_numbering(capsys):
     assert "0 (0,0,0)" in out and "(0,1) (1,2)" in out and "20-25" in out
 
 
-def test_cli_element_and_shape_file(tmp_path):
+def test_cli_element_and_shape_file(tmp_path, capsys):
     import json
 
-    result = cospherical("tessellate", "--element", "pyramid", "--box", "1", "1", "1", "--code", "88880000")
+    result = in_process(capsys, "tessellate", "--element", "pyramid", "--box", "1", "1", "1", "--code", "88880000")
     data = json.loads(result.stdout)
     assert data["element"] == "pyramid" and data["faces"] == [0] and "13" in data["nodes"]
     assert [e["name"] for e in data["elements"]] == ["Rectangular Pyramid"] * 4
@@ -122,5 +125,5 @@ def test_cli_element_and_shape_file(tmp_path):
                    "faces: [[0,1,3,2],[0,1,4],[1,2,4],[2,3,4],[3,0,4]]\n")
     for args in (["--shape", str(bad)], ["--element", "prism", "--code", "88888888"],
                  ["--element", "tetrahedron", "--steiner", "6:1/2"], ["--element", "prism", "--faces", "0"]):
-        result = cospherical("tessellate", "--box", "1", "1", "1", *args)
+        result = in_process(capsys, "tessellate", "--box", "1", "1", "1", *args)
         assert result.returncode == 2 and result.stdout == "" and len(result.stderr.strip().splitlines()) == 1, args

@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 import pytest
-from commands import cospherical, one_clean_line
+from commands import cospherical, in_process, one_clean_line
 
 from cospherical import Box
 from cospherical.catalogue import catalogue_path, load_catalogue, shipped_catalogue
@@ -60,6 +60,7 @@ def write(tmp_path, name, data) -> str:
 
 
 def test_good_files_pass_the_deep_check(tmp_path, small_table):
+    # a real process, as a user runs it; the refusals below run the command's code in the test's process
     result = cospherical("check", str(ROOT / "catalogue" / "catalogue.yaml"), write(tmp_path, "good.yaml", small_table))
     assert result.returncode == 0, result.stderr
     assert "ok, catalogue of" in result.stdout and "ok, pattern table of 4 configurations" in result.stdout
@@ -81,20 +82,20 @@ def test_good_files_pass_the_deep_check(tmp_path, small_table):
         (lambda d: d.update(schema_version=2), "schema_version"),
     ],
 )
-def test_bad_pattern_tables_are_refused(tmp_path, small_table, edit, needle):
+def test_bad_pattern_tables_are_refused(tmp_path, capsys, small_table, edit, needle):
     data = copy.deepcopy(small_table)
     edit(data)
-    one_clean_line(cospherical("check", write(tmp_path, "bad.yaml", data)), needle)
+    one_clean_line(in_process(capsys, "check", write(tmp_path, "bad.yaml", data)), needle)
 
 
-def test_repeated_configuration_codes_are_refused(tmp_path, small_table):
+def test_repeated_configuration_codes_are_refused(tmp_path, capsys, small_table):
     text = Path(write(tmp_path, "good.yaml", small_table)).read_text().splitlines()
     start = text.index("configurations:") + 1
     end = next(i for i in range(start + 1, len(text)) if text[i].startswith("  '"))
     duplicated = text[: end] + text[start:end] + text[end:]
     path = tmp_path / "twice.yaml"
     path.write_text("\n".join(duplicated[:200]) + "\n")
-    one_clean_line(cospherical("check", str(path)), "repeated key '000000000000'")
+    one_clean_line(in_process(capsys, "check", path), "repeated key '000000000000'")
 
 
 @pytest.mark.parametrize(
@@ -107,10 +108,10 @@ def test_repeated_configuration_codes_are_refused(tmp_path, small_table):
         (lambda d: d["types"][0].pop("code"), "code"),
     ],
 )
-def test_bad_catalogues_are_refused(tmp_path, edit, needle):
+def test_bad_catalogues_are_refused(tmp_path, capsys, edit, needle):
     data = load_yaml(ROOT / "catalogue" / "catalogue.yaml")
     edit(data)
-    one_clean_line(cospherical("check", write(tmp_path, "bad-catalogue.yaml", data)), needle)
+    one_clean_line(in_process(capsys, "check", write(tmp_path, "bad-catalogue.yaml", data)), needle)
 
 
 # Tables of the leaf family broken as the attacks broke them, and variants: each is refused by
