@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import pickle
 from collections import Counter
 from fractions import Fraction
 
@@ -126,6 +127,7 @@ def test_the_typed_report_cannot_be_changed(report):
         typed.leaves_per_level["0"] = 2  # read-only mappings
     with pytest.raises(TypeError):
         typed.timings["tree"] = 1.0
+    assert pickle.loads(pickle.dumps(typed)) == typed  # read-only, yet it travels between processes
 
 
 def test_every_section_reads_back_what_it_writes(report):

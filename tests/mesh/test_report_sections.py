@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import pickle
 
 import pytest
 
@@ -43,7 +44,7 @@ EXAMPLES = {
 
 
 def test_every_section_has_an_example():
-    assert set(EXAMPLES) == {name for name in sections.__all__ if name[0].isupper()}
+    assert set(EXAMPLES) == {name for name in sections.__all__ if name[0].isupper()} - {"ReadOnlyMapping"}
 
 
 @pytest.mark.parametrize("name", sorted(EXAMPLES))
@@ -53,6 +54,7 @@ def test_a_section_reads_back_what_it_writes_keys_in_order(name):
     typed = kind.from_dict(json.loads(json.dumps(data)))
     assert json.dumps(typed.to_dict()) == json.dumps(data)  # the same keys, in the same order, the same values
     assert kind.from_dict(typed.to_dict()) == typed
+    assert pickle.loads(pickle.dumps(typed)) == typed  # reports and pieces' figures travel between processes
     with pytest.raises(TypeError):
         kind.from_dict({**data, "unknown": 1})
     with pytest.raises(dataclasses.FrozenInstanceError):

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
-from typing import Any, Mapping, TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -54,7 +54,7 @@ from .assembly import Cells, assemble, vertex_keys
 from .checks import OpenFaces, check_delaunay
 from .delaunay import retessellate, with_cells
 from .octree import Octree, distinct
-from .report import MeshReport, merged_report, mesh_figures
+from .report import MeshReport, PieceFigures, merged_report, mesh_figures
 from .report_sections import LeafMeshSummary, TreeSummary
 
 __all__ = ["MAX_PARTITIONS", "Piece", "PieceResult", "mesh_in_pieces", "mesh_piece", "morton_pieces"]
@@ -130,8 +130,8 @@ class PieceResult:
         leaves (whole-tree indices); the piece is not meshed further in this round.
     failing : tuple of two ndarrays or None
         With ``marked``: those elements, as (whole-tree leaf, index in the leaf).
-    figures : Mapping or None
-        Else the piece's :func:`~cospherical.mesh.report.mesh_figures` figures, which add up.
+    figures : PieceFigures or None
+        Else the piece's figures (:func:`~cospherical.mesh.report.mesh_figures`), which add up.
     seams : tuple of OpenFaces
         With ``figures``: the faces it leaves open at its seams.
     """
@@ -140,7 +140,7 @@ class PieceResult:
     leaf_mesh: LeafMeshSummary | None = None
     marked: NDArray[np.integer[Any]] | None = None
     failing: tuple[NDArray[np.integer[Any]], NDArray[np.integer[Any]]] | None = None
-    figures: Mapping[str, Any] | None = None
+    figures: PieceFigures | None = None
     seams: tuple[OpenFaces, ...] = ()
 
 
@@ -230,7 +230,7 @@ def mesh_in_pieces(tree: Octree, pieces: int, lookup: LookupRecipe | None, crite
             # As in one process, the spheres counted are those of the final check, the fresh cells': the leaf
             # elements kept were proven by the leaf mesh's check, whose spheres the one process does not count
             for k in set(range(pieces)) - set(again):
-                results[k] = replace(results[k], figures={**_figures(results[k]), "delaunay_spheres_bounded": 0})
+                results[k] = replace(results[k], figures=replace(_figures(results[k]), delaunay_spheres_bounded=0))
     seams = [seam for k in range(pieces) for seam in results[k].seams]
     n = np.int64(grid + 1)
 
@@ -246,7 +246,7 @@ def _marked(result: PieceResult) -> NDArray[np.integer[Any]]:
     return result.marked if result.marked is not None else np.zeros(0, dtype=np.int64)
 
 
-def _figures(result: PieceResult) -> Mapping[str, Any]:
+def _figures(result: PieceResult) -> PieceFigures:
     """A piece's figures, which every piece has once meshed (the first round's marked pieces are meshed again)."""
     if result.figures is None:
         raise ValueError(f"mesh_in_pieces: piece {result.index} was not meshed")

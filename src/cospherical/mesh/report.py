@@ -11,7 +11,6 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass, field, fields, replace
 from fractions import Fraction
-from types import MappingProxyType
 from typing import Any, Callable, Iterable, Mapping, NamedTuple, Sequence
 
 import numpy as np
@@ -31,20 +30,13 @@ from .tree import Octree
 
 __all__ = ["CheckedReport", "ChecksSummary", "ConfigurationFrequency", "ContactSummary", "DelaunaySpheres",
            "DeviceSummary", "DualSummary", "InterfaceSummary", "LeafMeshSummary", "MeshFigures", "MeshReport",
+           "PieceFigures",
            "MixedCounts", "NegativeCoefficients", "OutsideType", "RegionSummary", "TetrahedralCounts", "TreeSummary",
            "TypeFrequency", "UniformSummary", "checked_mesh_report", "merged_report", "mesh_figures", "mesh_report",
            "outside_catalogue"]
 
 # A nonconforming face: its vertices, each three fractions of the domain's sides (floats)
 Example = tuple[tuple[float, ...], ...]
-
-# Figures of the pieces that the whole's report adds up.
-_SUMMED = ("flat_elements", "nonconforming_faces", "interior_faces", "boundary_faces", "circumcenters_outside_leaf",
-           "leaves_not_fvm_adequate", "elements_not_cospherical", "boundary_circumcenters_outside",
-           "delaunay_violations", "delaunay_violating_pairs", "delaunay_violating_leaves", "delaunay_ties",
-           "delaunay_exact_tests", "delaunay_violating_fvm_leaves", "leaves_tessellated_on_the_fly",
-           "cells_spanning_leaves", "delaunay_spheres_bounded")
-
 
 def outside_catalogue(mesh: Mesh) -> tuple[OutsideType, ...]:
     """The element types of the mesh its catalogue (:attr:`Mesh.catalogue`) does not name: id, systematic name, count, one example.
@@ -70,16 +62,82 @@ def _by_count(types: Iterable[OutsideType]) -> tuple[OutsideType, ...]:
     return tuple(sorted(types, key=lambda e: (-e.count, e.id)))
 
 
+@dataclass(frozen=True)
+class PieceFigures:
+    """Every count and check of a mesh, or of one piece of a partitioned mesh: figures that add up over pieces.
+
+    :func:`merged_report` adds the pieces' up into the report of the whole; the fields
+    named as the report's keys are those keys' figures for this piece.
+
+    Attributes
+    ----------
+    elements, cells_spanning_leaves, flat_elements : int
+        The piece's elements, its cells spanning several leaves, its flat elements.
+    types_outside_catalogue : tuple of OutsideType
+        Its element types the catalogue does not name.
+    volume : Fraction
+        Its elements' volume over the root box's.
+    nonconforming_faces, interior_faces, boundary_faces : int
+        Its faces (those left open at its seams, asked for, not counted).
+    nonconforming_examples : tuple
+        Up to five nonconforming faces, their vertices as fractions of the domain's sides.
+    circumcenters_outside_leaf, leaves_not_fvm_adequate, elements_not_cospherical, boundary_circumcenters_outside : int
+        What :func:`~cospherical.mesh.checks.check_circumcenters` counted.
+    delaunay_violations, delaunay_violating_pairs, delaunay_violating_leaves, delaunay_ties, delaunay_exact_tests : int or None
+        What the global Delaunay check counted (``None``: not run).
+    delaunay_violating_fvm_leaves : int or None
+        Violating leaves whose own circumcenters all lie in them.
+    delaunay_spheres_bounded : int or None
+        Spheres whose nearby vertices the tree's structure bounded (the others searched).
+    type_counts : Mapping of str to int
+        Elements per type id (read-only).
+    configurations : Mapping of str to ConfigurationOccurrence
+        Per configuration code its leaves and what it is (read-only).
+    mapped : tuple of str
+        The configurations carried back from a table's orbit representative.
+    leaves_tessellated_on_the_fly : int
+        Leaves whose configuration the table lacked.
+    types : Mapping of str to Mapping
+        What each type met is: name, paper class, VTK cell, vertices, faces (read-only).
+    """
+
+    elements: int
+    types_outside_catalogue: tuple[OutsideType, ...]
+    cells_spanning_leaves: int
+    volume: Fraction
+    flat_elements: int
+    nonconforming_faces: int
+    interior_faces: int
+    boundary_faces: int
+    nonconforming_examples: tuple[Example, ...]
+    circumcenters_outside_leaf: int
+    leaves_not_fvm_adequate: int
+    elements_not_cospherical: int
+    boundary_circumcenters_outside: int
+    type_counts: Mapping[str, int]
+    configurations: Mapping[str, ConfigurationOccurrence]
+    mapped: tuple[str, ...]
+    leaves_tessellated_on_the_fly: int
+    types: Mapping[str, Mapping[str, Any]]
+    delaunay_violations: int | None = None
+    delaunay_violating_pairs: int | None = None
+    delaunay_violating_leaves: int | None = None
+    delaunay_ties: int | None = None
+    delaunay_exact_tests: int | None = None
+    delaunay_violating_fvm_leaves: int | None = None
+    delaunay_spheres_bounded: int | None = None
+
+
 class MeshFigures(NamedTuple):
     """What :func:`mesh_figures` measured on a mesh (or on one piece of a partitioned mesh).
 
-    ``figures``: every count and check as the report names them, figures that add up over
-    pieces (:func:`merged_report` reads them); ``delaunay``: the global Delaunay check
-    (``None`` when skipped); ``open_faces``: the faces a piece leaves open at its seams, when
-    asked (see :func:`~cospherical.mesh.checks.check_conformity`).
+    ``figures``: every count and check, figures that add up over pieces (:func:`merged_report`
+    reads them); ``delaunay``: the global Delaunay check (``None`` when skipped);
+    ``open_faces``: the faces a piece leaves open at its seams, when asked (see
+    :func:`~cospherical.mesh.checks.check_conformity`).
     """
 
-    figures: dict[str, Any]
+    figures: PieceFigures
     delaunay: DelaunayCheck | None
     open_faces: tuple[OpenFaces, ...]
 
@@ -98,37 +156,60 @@ def mesh_figures(mesh: Mesh, delaunay: bool = True, stage: Callable[[str], None]
         if stage:
             stage(name)
 
-    figures = {"elements": len(mesh), "types_outside_catalogue": outside_catalogue(mesh),
-               "cells_spanning_leaves": int(mesh.cells.spanning.sum()) if mesh.cells is not None else 0}
+    outside = outside_catalogue(mesh)
     start("volume")
     volume = check_volume(mesh)
-    figures.update(volume=volume.volume, flat_elements=volume.flat_elements)
     start("conformity")
     conformity = check_conformity(mesh, open_faces=open_faces, progress=conformity_progress)
-    figures.update(conformity.figures())
     start("circumcenters")
-    figures.update(check_circumcenters(mesh).figures())
+    circumcenters = check_circumcenters(mesh)
     found = None
+    spheres: dict[str, int] = {}
     if delaunay:
         start("delaunay")
         found = checked if checked is not None else check_delaunay(mesh, progress=progress)
-        figures.update(found.figures())
         # the point of counting them: a leaf can be fvm_adequate on its own and still not globally Delaunay
         fvm = np.array([p.fvm_adequate for p in mesh.tessellations],
                        dtype=bool)[mesh.leaf_tessellation[found.violating_leaf_ids]]
-        figures["delaunay_violating_fvm_leaves"] = int(fvm.sum())
-        figures["delaunay_spheres_bounded"] = found.bounded
+        spheres = {"delaunay_violations": found.violations, "delaunay_violating_pairs": found.violating_pairs,
+                   "delaunay_violating_leaves": found.violating_leaves, "delaunay_ties": found.ties,
+                   "delaunay_exact_tests": found.exact_tests, "delaunay_violating_fvm_leaves": int(fvm.sum()),
+                   "delaunay_spheres_bounded": found.bounded}
     start("statistics")
-    figures["type_counts"], figures["configurations"] = occurrences(mesh)
+    type_counts, configurations = occurrences(mesh)
     kept = {p.code for _, p, _ in mesh.groups()}
-    figures["mapped"] = sorted(p.code for p in mesh.tessellations if p.mapped_from is not None and p.code in kept)
-    figures["leaves_tessellated_on_the_fly"] = int(sum(
-        len(leaves) for _, p, leaves in mesh.groups(all_leaves=True) if p.on_the_fly))
-    figures["types"] = dict(mesh.types)
+    figures = PieceFigures(
+        elements=len(mesh), types_outside_catalogue=outside,
+        cells_spanning_leaves=int(mesh.cells.spanning.sum()) if mesh.cells is not None else 0,
+        volume=volume.volume, flat_elements=volume.flat_elements,
+        nonconforming_faces=conformity.nonconforming_faces, interior_faces=conformity.interior_faces,
+        boundary_faces=conformity.boundary_faces, nonconforming_examples=_examples(conformity.nonconforming_examples),
+        circumcenters_outside_leaf=circumcenters.circumcenters_outside_leaf,
+        leaves_not_fvm_adequate=circumcenters.leaves_not_fvm_adequate,
+        elements_not_cospherical=circumcenters.elements_not_cospherical,
+        boundary_circumcenters_outside=circumcenters.boundary_circumcenters_outside,
+        type_counts=read_only(type_counts), configurations=read_only(configurations),
+        mapped=tuple(sorted(p.code for p in mesh.tessellations if p.mapped_from is not None and p.code in kept)),
+        leaves_tessellated_on_the_fly=int(sum(len(leaves) for _, p, leaves in mesh.groups(all_leaves=True)
+                                              if p.on_the_fly)),
+        types=read_only(mesh.types), **spheres)
     return MeshFigures(figures, found, conformity.open_faces)
 
 
-def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]], described: TreeSummary,
+def _examples(faces: Iterable[Iterable[Iterable[float]]]) -> tuple[Example, ...]:
+    """Nonconforming faces as tuples (each its vertices, each three fractions of the domain's sides)."""
+    return tuple(tuple(tuple(point) for point in face) for face in faces)
+
+
+def _total(parts: Sequence[PieceFigures], name: str) -> int:
+    """A count added up over the pieces (one the pieces all have)."""
+    values = [getattr(part, name) for part in parts]
+    if any(value is None for value in values):
+        raise ValueError(f"merged_report: a piece without {name}")
+    return int(sum(values))
+
+
+def merged_report(tree: Octree, vertices: int, parts: Sequence[PieceFigures], described: TreeSummary,
                   patterns: str | None, criterion: str = "optimal", uniform: bool = True, delaunay: bool = True,
                   leaf_mesh: LeafMeshSummary | None = None, cells: tuple[int, int] = (0, 0),
                   seams: Iterable[OpenFaces] | None = None,
@@ -145,55 +226,53 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]
     root box's (a device's boxes can leave part of their bounding box out).  ``uniform_computed``: the uniform
     study run even for a box whose figures ship precomputed (see :func:`~cospherical.mesh.statistics.uniform_study`).
     """
-    summed = {key: sum(part[key] for part in parts) for key in _SUMMED if all(key in part for part in parts)}
-    type_counts: Counter[str] = sum((Counter(part["type_counts"]) for part in parts), Counter())
+    type_counts: Counter[str] = sum((Counter(part.type_counts) for part in parts), Counter())
     outside: dict[str, OutsideType] = {}
     for part in parts:
-        for entry in part["types_outside_catalogue"]:
+        for entry in part.types_outside_catalogue:
             mine = outside.get(entry.id)
             outside[entry.id] = entry if mine is None else replace(mine, count=mine.count + entry.count)
-    volume = sum((part["volume"] for part in parts), Fraction(0))
-    examples = [e for part in parts for e in part["nonconforming_examples"]]
-    conformity = {key: summed[key] for key in ("nonconforming_faces", "interior_faces", "boundary_faces")}
+    volume = sum((part.volume for part in parts), Fraction(0))
+    examples = [e for part in parts for e in part.nonconforming_examples]
+    nonconforming, interior = _total(parts, "nonconforming_faces"), _total(parts, "interior_faces")
     if seams is not None:
         if vertex_points is None:
             raise ValueError("merged_report: seams without vertex_points, which places their faces")
         matched = match_seams(seams, vertex_points, grid)
-        conformity["nonconforming_faces"] += matched.nonconforming_faces
-        conformity["interior_faces"] += matched.interior_faces
-        examples += matched.nonconforming_examples
+        nonconforming += matched.nonconforming_faces
+        interior += matched.interior_faces
+        examples += _examples(matched.nonconforming_examples)
     configurations: dict[str, ConfigurationOccurrence] = {}
     for part in parts:
-        for code, entry in part["configurations"].items():
+        for code, occurrence in part.configurations.items():
             met = configurations.get(code)
-            configurations[code] = entry if met is None else replace(met, leaves=met.leaves + entry.leaves)
+            configurations[code] = occurrence if met is None else replace(met, leaves=met.leaves + occurrence.leaves)
     on_the_fly = sum(c.tessellated_on_the_fly for c in configurations.values())
-    mapped = len({code for part in parts for code in part["mapped"]})
-    types: dict[str, dict[str, Any]] = {}
+    mapped = len({code for part in parts for code in part.mapped})
+    types: dict[str, Mapping[str, Any]] = {}
     for part in parts:
-        types.update(part["types"])
+        types.update(part.types)
     frequencies = statistics(type_counts, configurations, len(tree), types, catalogue,
                              uniform_study(tree.box, catalogue, uniform_computed) if uniform else None)
 
     def delaunay_figure(key: str) -> int | None:
-        return int(summed[key]) if delaunay else None
+        return _total(parts, key) if delaunay else None
 
     x, y, z = tree.box.texts
     return MeshReport(
         schema_version=1, generator=f"cospherical {__version__}", domain=(x, y, z), tree=described,
         patterns=patterns, criterion=criterion, leaves=len(tree), leaves_per_level=level_counts(tree),
-        vertices=int(vertices), elements=sum(part["elements"] for part in parts), types=len(type_counts),
+        vertices=int(vertices), elements=_total(parts, "elements"), types=len(type_counts),
         delaunay_mode="leaf" if leaf_mesh is None else "global", leaf_mesh=leaf_mesh,
-        cells_spanning_leaves=summed["cells_spanning_leaves"], regions_retessellated=cells[0],
+        cells_spanning_leaves=_total(parts, "cells_spanning_leaves"), regions_retessellated=cells[0],
         largest_region_vertices=cells[1], types_outside_catalogue=_by_count(outside.values()),
-        volume_ok=volume == domain_share and summed["flat_elements"] == 0, volume=str(volume),
-        flat_elements=summed["flat_elements"], nonconforming_faces=conformity["nonconforming_faces"],
-        interior_faces=conformity["interior_faces"], boundary_faces=conformity["boundary_faces"],
-        nonconforming_examples=tuple(tuple(tuple(point) for point in face) for face in examples[:5]),
-        circumcenters_outside_leaf=summed["circumcenters_outside_leaf"],
-        leaves_not_fvm_adequate=summed["leaves_not_fvm_adequate"],
-        elements_not_cospherical=summed["elements_not_cospherical"],
-        boundary_circumcenters_outside=summed["boundary_circumcenters_outside"],
+        volume_ok=volume == domain_share and _total(parts, "flat_elements") == 0, volume=str(volume),
+        flat_elements=_total(parts, "flat_elements"), nonconforming_faces=nonconforming, interior_faces=interior,
+        boundary_faces=_total(parts, "boundary_faces"), nonconforming_examples=tuple(examples[:5]),
+        circumcenters_outside_leaf=_total(parts, "circumcenters_outside_leaf"),
+        leaves_not_fvm_adequate=_total(parts, "leaves_not_fvm_adequate"),
+        elements_not_cospherical=_total(parts, "elements_not_cospherical"),
+        boundary_circumcenters_outside=_total(parts, "boundary_circumcenters_outside"),
         delaunay_violations=delaunay_figure("delaunay_violations"),
         delaunay_violating_pairs=delaunay_figure("delaunay_violating_pairs"),
         delaunay_violating_leaves=delaunay_figure("delaunay_violating_leaves"),
@@ -201,14 +280,14 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[Mapping[str, Any]
         delaunay_violating_fvm_leaves=delaunay_figure("delaunay_violating_fvm_leaves"),
         configurations=len(configurations), configurations_from_table=len(configurations) - on_the_fly - mapped,
         configurations_mapped=mapped, tessellated_on_the_fly=on_the_fly,
-        leaves_tessellated_on_the_fly=summed["leaves_tessellated_on_the_fly"],
+        leaves_tessellated_on_the_fly=_total(parts, "leaves_tessellated_on_the_fly"),
         paper_final_share=frequencies.paper_final_share,
         leaves_in_bisection_family=frequencies.leaves_in_bisection_family,
         type_frequencies=frequencies.type_frequencies, configuration_frequencies=frequencies.configuration_frequencies,
-        uniform=frequencies.uniform, checks=_checks_run(patterns is not None, delaunay, summed))
+        uniform=frequencies.uniform, checks=_checks_run(patterns is not None, delaunay, parts))
 
 
-def _checks_run(table: bool, delaunay: bool, summed: Mapping[str, int]) -> ChecksSummary:
+def _checks_run(table: bool, delaunay: bool, parts: Sequence[PieceFigures]) -> ChecksSummary:
     """The report's ``checks``: which exact checks ran, which did not and why, and how the Delaunay check
     found the vertices near each sphere (bounded by the tree's structure; the others searched)."""
     run = (("table_entries",) if table else ()) + ("volume", "conformity", "circumcenters") \
@@ -216,7 +295,7 @@ def _checks_run(table: bool, delaunay: bool, summed: Mapping[str, int]) -> Check
     if delaunay:
         # the others are searched (a piece searches its share of the cells and their surroundings: not a
         # figure that adds up to the whole's)
-        return ChecksSummary(run, DelaunaySpheres(summed.get("delaunay_spheres_bounded", 0)))
+        return ChecksSummary(run, DelaunaySpheres(_total(parts, "delaunay_spheres_bounded")))
     return ChecksSummary(run, not_run=read_only({"delaunay": "not asked for (--no-delaunay): delaunay_violations is null"}))
 
 
@@ -359,7 +438,7 @@ class MeshReport:
     dual: DualSummary | None = None
     device: DeviceSummary | None = None
     checks: ChecksSummary | None = None
-    timings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}), compare=False)
+    timings: Mapping[str, float] = field(default_factory=lambda: read_only({}), compare=False)
 
     def to_dict(self) -> dict[str, Any]:
         """The report as ``report.json`` holds it (a new object of plain dicts and lists: changing it changes nothing here)."""

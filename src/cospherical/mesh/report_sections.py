@@ -3,9 +3,9 @@
 Each section is a frozen dataclass whose fields are the keys of its object in
 ``report.json`` (``schemas/mesh-report.schema.json``), in the order the file writes
 them: ``to_dict()`` gives that object (a new one, plain lists and dicts), ``from_dict()``
-reads it back.  Sequences are tuples, so a report cannot be changed once made; the
-two sections keyed by open-ended names (a check not run and why; leaves per level)
-are read-only mappings (:class:`types.MappingProxyType`).
+reads it back.  Sequences are tuples, so a report cannot be changed once made; what
+is keyed by open-ended names (a check not run and why; leaves per level; seconds per
+stage) is a read-only mapping (:class:`ReadOnlyMapping`).
 
 The module imports nothing of the mesher, so the modules that measure a section
 (the checks, the statistics, the dual, a device's regions) make it typed and the
@@ -15,16 +15,18 @@ report only gathers them.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
-from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, ClassVar, Mapping, cast
+from typing import TYPE_CHECKING, Any, ClassVar, Iterator, Mapping, TypeVar, cast
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
 
 __all__ = ["ChecksSummary", "ConfigurationFrequency", "ContactSummary", "DelaunaySpheres", "DeviceSummary",
            "DualSummary", "InterfaceSummary", "LeafMeshSummary", "MixedCounts", "NegativeCoefficients",
-           "OutsideType", "RegionSummary", "TetrahedralCounts", "TreeSummary", "TypeFrequency", "UniformSummary",
-           "plain", "read_only"]
+           "OutsideType", "ReadOnlyMapping", "RegionSummary", "TetrahedralCounts", "TreeSummary", "TypeFrequency",
+           "UniformSummary", "plain", "read_only"]
+
+K = TypeVar("K")
+V = TypeVar("V")
 
 
 def plain(value: Any) -> Any:
@@ -38,9 +40,38 @@ def plain(value: Any) -> Any:
     return value
 
 
-def read_only(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
+class ReadOnlyMapping(Mapping[K, V]):
+    """A mapping that cannot be changed: a copy of the one it was made from, in its order.
+
+    :class:`types.MappingProxyType` is read-only too but cannot be pickled, and reports and
+    a partitioned mesh's figures travel between processes.  Equal to any mapping of the
+    same items (a dict included).
+    """
+
+    __slots__ = ("_items",)
+
+    def __init__(self, items: Mapping[K, V]) -> None:
+        self._items = dict(items)
+
+    def __getitem__(self, key: K) -> V:
+        return self._items[key]
+
+    def __iter__(self) -> Iterator[K]:
+        return iter(self._items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __repr__(self) -> str:
+        return f"ReadOnlyMapping({self._items!r})"
+
+    def __reduce__(self) -> tuple[type[ReadOnlyMapping[K, V]], tuple[dict[K, V]]]:
+        return type(self), (self._items,)
+
+
+def read_only(mapping: Mapping[K, V]) -> ReadOnlyMapping[K, V]:
     """A read-only copy of ``mapping`` (changing the original changes nothing in it)."""
-    return MappingProxyType(dict(mapping))
+    return ReadOnlyMapping(mapping)
 
 
 class _Section:
