@@ -152,6 +152,11 @@ def _faces(mesh: Mesh, examples: int, progress: Callable[[int], None] | None = N
     return by_size, ConformityCheck(bad, pairs, 0, shown)
 
 
+# per node (0..26), the leaf's sides it lies in, as bits: 2 * axis + (0 at the low side, 1 at the high)
+_SIDES = tuple(sum(1 << (2 * axis + side) for axis in range(3) for side, at in enumerate((0, 2))
+                   if int(offset[axis]) == at) for offset in NODE_OFFSETS)
+
+
 def _leaf_faces(tessellation: LocalTessellation) -> tuple[int, list[tuple[int, ...]], list[tuple[int, ...]]]:
     """A configuration's element faces off its leaf's boundary, paired among themselves: how many pairs,
     and the occurrences that do not pair (cycles of node ids); and its faces in the leaf's boundary,
@@ -165,8 +170,10 @@ def _leaf_faces(tessellation: LocalTessellation) -> tuple[int, list[tuple[int, .
     outer: list[tuple[int, ...]] = []
     for element in tessellation.elements:
         for cycle in element.faces:
-            offsets = NODE_OFFSETS[list(cycle)]  # twice the unit coordinates: 0 and 2 on the leaf's sides
-            if any(offsets[0, axis] in (0, 2) and (offsets[:, axis] == offsets[0, axis]).all() for axis in range(3)):
+            sides = _SIDES[cycle[0]]
+            for node in cycle[1:]:
+                sides &= _SIDES[node]
+            if sides:  # every node in one of the leaf's sides
                 outer.append(cycle)
                 continue
             start = cycle.index(min(cycle))
@@ -774,29 +781,45 @@ def _leaf_suspects(tessellation: LocalTessellation, squared: tuple[Fraction, Fra
         return [x.numerator * (m // x.denominator) for x in point]
 
     whole = {s: scaled(point) for s, point in nodes.items()}
+    measured = [e for e in tessellation.elements if e.center is not None]
+    if not measured:
+        return [None] * len(tessellation.elements)
+    centers = [scaled(e.center) for e in measured if e.center is not None]
+    # int64 when every term is below 2**61 (the lattice reaches 7/4 of the leaf), else Python integers
+    reach = max(abs(x) for center in centers for x in center)
+    kind = np.int64 if max(weights) * (2 * m + reach) ** 2 < 2**61 else object
+    center_array = np.array(centers, dtype=kind)  # elements x 3
+    weight_array = np.array(weights, dtype=kind)
+
+    def squared_distances(points: np.ndarray) -> np.ndarray:
+        """elements x points: the squared distances of ``points`` (n x 3, scaled) from each element's centre."""
+        offsets = points[None, :, :] - center_array[:, None, :]
+        distances: np.ndarray = (offsets * offsets * weight_array).sum(axis=2)
+        return distances
+
+    slot_ids = list(whole)
+    to_slots = squared_distances(np.array([whole[n] for n in slot_ids], dtype=kind))
+    to_lattice = squared_distances(_HALF_A_LEAF_OUT.astype(kind) * (m // 4))
+    place = {n: i for i, n in enumerate(slot_ids)}
     found: list[_Suspects | None] = []
+    row = 0
     for element in tessellation.elements:
         if element.center is None:
             found.append(None)
             continue
-        center = scaled(element.center)
-
-        def squared_distance(point: list[int]) -> int:
-            return sum(w * (x - c) ** 2 for w, x, c in zip(weights, point, center))
-
-        radius2 = squared_distance(whole[element.nodes[0]])
+        center = centers[row]
+        radius2 = int(to_slots[row, place[element.nodes[0]]])
         # the sphere's extent on each axis, from its centre: strictly inside -3/4 .. 7/4 of the leaf
-        if not all(low > 0 and high > 0 and radius2 < w * low * low and radius2 < w * high * high
-                   for w, c in zip(weights, center) for low, high in [(c + 3 * m // 4, 7 * m // 4 - c)]):
+        inside = all(low > 0 and high > 0 and radius2 < w * low * low and radius2 < w * high * high
+                     for w, c in zip(weights, center) for low, high in [(c + 3 * m // 4, 7 * m // 4 - c)])
+        if inside:
+            own = set(element.nodes)
+            near = to_slots[row] <= radius2
+            found.append(_Suspects(tuple(n for n, i in place.items() if near[i] and n not in own),
+                                   _HALF_A_LEAF_OUT[np.flatnonzero(to_lattice[row] <= radius2)]))
+        else:
             found.append(None)
-            continue
-        own = set(element.nodes)
-        slots = tuple(s for s, point in whole.items() if s not in own and squared_distance(point) <= radius2)
-        # int64 when every term is below 2**61 (the lattice reaches 7/4 of the leaf), else Python integers
-        kind = np.int64 if max(weights) * (2 * m + max(map(abs, center))) ** 2 < 2**61 else object
-        offsets = _HALF_A_LEAF_OUT.astype(kind) * (m // 4) - np.array(center, dtype=kind)
-        distance = (offsets * offsets * np.array(weights, dtype=kind)).sum(axis=1)
-        found.append(_Suspects(slots, _HALF_A_LEAF_OUT[np.flatnonzero(distance <= radius2)]))
+        row += 1
     return found
 
 
