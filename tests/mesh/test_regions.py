@@ -303,6 +303,28 @@ def test_random_unions_of_boxes_pass_the_oracle(data, tmp_path_factory):
     _spheres_hold_what_the_mesh_says(m, data, strict=all(_convex(r["boxes"]) for r in data["regions"]))
 
 
+@pytest.mark.parametrize("side", ["substrate", "oxide"])
+def test_a_contact_on_an_interface_is_found_on_its_regions_side(side, tmp_path, capsys):
+    # a contact buried at the interface z = 3/4 (its region on one side, the other region on the other): its
+    # faces are interface faces, met twice, not faces of the domain's boundary (it had none, and check refused
+    # the dual: area 0 is not the rectangle's)
+    from cospherical.cli import main
+
+    data = {"device": "buried", "regions": [
+        {"name": "substrate", "material": "Si", "boxes": [[0, 0, 0, 1, 1, 0.75]]},
+        {"name": "oxide", "material": "SiO2", "boxes": [[0, 0, 0.75, 1, 1, 1]]}],
+        "contacts": [{"name": "buried", "region": side, "box": [0.25, 0.25, 0.75, 0.75, 0.75, 0.75]}], "levels": 2}
+    path = tmp_path / "device.yaml"
+    path.write_text(yaml.safe_dump(data))
+    m = _mesh_and_check(path, tmp_path / "out", dual=True)
+    contact = m.report.device.contacts[0]
+    assert contact.faces > 0 and contact.area_ok and contact.area_parts_sum == "1/4"
+    faces = m._result.faces
+    region = [r["name"] for r in data["regions"]].index(side)
+    assert (m.assembled.element_region[faces.contact_element] == region).all()
+    assert main(["check", str(tmp_path / "out" / "dual.npz")]) == 0, capsys.readouterr().err
+
+
 def _convex(boxes: list[list[int]]) -> bool:
     """Whether unit cubes (stretched alike) fill their bounding box: a convex region."""
     low = [min(b[a] for b in boxes) for a in range(3)]

@@ -230,10 +230,12 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     """The contact and interface faces of a device mesh (see :class:`RegionFaces`).
 
     Faces flat in a block plane (the only ones that can be) are paired by their sorted
-    global vertex ids; a face met once lies on a
-    contact when it is flat in the contact's plane and its vertices lie in the
-    contact's closed rectangle (a face of a conforming mesh lies in one leaf face,
-    which lies inside or outside the contact: the tree was refined so).
+    global vertex ids; a face met once (on the domain's boundary) or an interface face, as
+    the element of the contact's region has it, lies on a contact when it is flat in the
+    contact's plane and its vertices lie in the contact's closed rectangle (a face of a
+    conforming mesh lies in one leaf face, which lies inside or outside the contact: the
+    tree was refined so).  A contact lies on the outer boundary or on an interface: its
+    region is on one side only.
     """
     regions, layout, element_region = device_of(mesh)
     rows, polygons = [], []
@@ -254,23 +256,25 @@ def region_faces(mesh: Mesh) -> RegionFaces:
     element, face, ones, interface_element, interfaces, which = face_sets(np.concatenate(rows), polygons,
                                                                           element_region)
     names = tuple(f"{regions.names[a]}|{regions.names[b]}" for a, b in interfaces.tolist())
-    # contacts: faces met once, flat in the contact's plane, inside its rectangle
-    points = mesh.vertices.astype(np.int64)[np.maximum(face[ones], 0)]
-    valid = face[ones] >= 0
+    # contacts: faces met once or on an interface (either side's copy: the contact's region picks one), flat in
+    # the contact's plane, inside its rectangle
+    sides = np.sort(np.concatenate([ones, interface_element.reshape(-1)]))
+    points = vertices[np.maximum(face[sides], 0)]
+    valid = face[sides] >= 0
     factor = mesh.grid // layout.steps
-    contact_of = np.full(len(ones), -1, dtype=np.int64)
+    contact_of = np.full(len(sides), -1, dtype=np.int64)
     for c, (axis, value, (p0, p1), (q0, q1)) in enumerate(layout.contacts):
         b, d = (axis + 1) % 3, (axis + 2) % 3
         on = np.all(~valid | (points[:, :, axis] == value * factor), axis=1)
         on &= np.all(~valid | ((points[:, :, b] >= p0 * factor) & (points[:, :, b] <= p1 * factor)
                                & (points[:, :, d] >= q0 * factor) & (points[:, :, d] <= q1 * factor)), axis=1)
         region = [r.name for r in layout.device.regions].index(layout.device.contacts[c].region)
-        on &= element_region[element[ones]] == region
+        on &= element_region[element[sides]] == region
         contact_of[on & (contact_of < 0)] = c
     hit = contact_of >= 0
     outer = face[ones]
     lower = interface_element[:, 0]
-    return RegionFaces(face[ones[hit]].astype(np.int32), element[ones[hit]], contact_of[hit].astype(np.int32),
+    return RegionFaces(face[sides[hit]].astype(np.int32), element[sides[hit]], contact_of[hit].astype(np.int32),
                        interfaces.astype(np.int32), names, face[lower].astype(np.int32),
                        np.stack([element[lower], element[interface_element[:, 1]]], axis=1),
                        which.astype(np.int32).reshape(-1), edge_keys(outer, len(mesh.vertices)),
