@@ -45,7 +45,7 @@ def test_the_empty_box_is_one_cuboid():
 
 
 def _circumcenter(points: list[tuple[Fraction, ...]]) -> tuple[Fraction, ...]:
-    """The centre equidistant from the points, by Gaussian elimination in fractions (an oracle of our own hand)."""
+    """The center equidistant from the points, by Gaussian elimination in fractions (an oracle of our own hand)."""
     p0 = points[0]
     rows = [[2 * (a - b) for a, b in zip(p, p0)] + [sum(a * a for a in p) - sum(b * b for b in p0)] for p in points[1:]]
     system = []
@@ -69,7 +69,7 @@ SCALE = (1, 2, 4)
 
 @settings(max_examples=12, deadline=None)
 @given(st.lists(st.sampled_from("08"), min_size=12, max_size=12).map("".join))
-def test_cells_measured_against_qhull_and_a_hand_solved_centre(code):
+def test_cells_measured_against_qhull_and_a_hand_solved_center(code):
     configuration = Configuration.from_code(code, BOX)
     nodes = configuration.nodes()
     frame = Frame.build(nodes, BOX.squared)
@@ -98,11 +98,11 @@ def test_flat_or_scattered_nodes_have_no_volume_or_no_sphere():
     frame = Frame.build({0: (0, 0, 0), 1: (1, 0, 0), 2: (1, 1, 0), 3: (0, 1, 0), 4: (HALF, HALF, 1)}, (1, 1, 1))
     flat = measure(frame, [0, 1, 2, 3])
     assert flat.cycles == () and flat.unit_volume == 0 and flat.sphere is None and flat.center is None
-    # a square pyramid is co-spherical: z^2 + 1/2 = (1 - z)^2 puts the centre at height 1/4
+    # a square pyramid is co-spherical: z^2 + 1/2 = (1 - z)^2 puts the center at height 1/4
     pyramid = measure(frame, [0, 1, 2, 3, 4])
     assert pyramid.unit_volume == Fraction(1, 3) and len(pyramid.cycles) == 5
     assert pyramid.center == (HALF, HALF, Fraction(1, 4))
-    # a prism with one short edge: five corners on the sphere centred at (1/2, 1/2, 1/2), the sixth inside it
+    # a prism with one short edge: five corners on the sphere centered at (1/2, 1/2, 1/2), the sixth inside it
     prism = Frame.build({0: (0, 0, 0), 1: (1, 0, 0), 2: (0, 1, 0), 3: (0, 0, 1), 4: (1, 0, 1), 5: (0, 1, HALF)},
                         (1, 1, 1))
     scattered = measure(prism, range(6))

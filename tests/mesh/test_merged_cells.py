@@ -26,9 +26,9 @@ def test_the_locator_finds_the_leaf_whose_closed_box_holds_a_point():
     mesh = assemble(build_octree(Box.parse(["1", "1", "1"]), 2, [parse_shape("point:0.1,0.1,0.1")]))
     size = mesh.leaf_size()
     low = mesh.tree.positions.astype(np.int64) * size[:, None]
-    # each leaf's centre (4 x grid coordinates), and the points found there against the boxes by hand
-    centres = 4 * low + 2 * size[:, None]
-    found = Locator(mesh).leaf(centres)
+    # each leaf's center (4 x grid coordinates), and the points found there against the boxes by hand
+    centers = 4 * low + 2 * size[:, None]
+    found = Locator(mesh).leaf(centers)
     assert np.array_equal(found, np.arange(len(mesh.tree)))
     corner = Locator(mesh).leaf(np.array([[4 * mesh.grid] * 3]))  # the domain's far corner: in the closed domain
     assert np.all(4 * (low[corner] + size[corner, None]) == 4 * mesh.grid)

@@ -173,10 +173,10 @@ def _surfaces(data: dict) -> tuple[list[Fraction], dict]:
     planes = [sorted({b[a] for boxes in regions for b in boxes} | {b[a + 3] for boxes in regions for b in boxes})
               for a in range(3)]
 
-    def owner(cell):  # the region of a cell of the planes' grid (its centre in a box), or -1
-        centre = [(planes[a][cell[a]] + planes[a][cell[a] + 1]) / 2 for a in range(3)]
+    def owner(cell):  # the region of a cell of the planes' grid (its center in a box), or -1
+        center = [(planes[a][cell[a]] + planes[a][cell[a] + 1]) / 2 for a in range(3)]
         return next((r for r, boxes in enumerate(regions) for b in boxes
-                     if all(b[a] < centre[a] < b[a + 3] for a in range(3))), -1)
+                     if all(b[a] < center[a] < b[a + 3] for a in range(3))), -1)
 
     shape = [len(p) - 1 for p in planes]
     owners = {(i, j, k): owner((i, j, k)) for i in range(shape[0]) for j in range(shape[1]) for k in range(shape[2])}
@@ -478,14 +478,14 @@ def _spheres_hold_what_the_mesh_says(m, data: dict, strict: bool, face: tuple[in
         nodes = [v for v in nodes if v >= 0]
         region = int(element_region[e])
         p = [points[v] for v in nodes]
-        centre = _circumcentre(p)
-        radius = sum((x - c) ** 2 for x, c in zip(p[0], centre))
-        assert all(sum((x - c) ** 2 for x, c in zip(q, centre)) == radius for q in p)
+        center = _circumcenter(p)
+        radius = sum((x - c) ** 2 for x, c in zip(p[0], center))
+        assert all(sum((x - c) ** 2 for x, c in zip(q, center)) == radius for q in p)
         own = set(nodes)
         # floats only narrow the vertices down (a wide margin); each one near the sphere is decided exactly
-        near = members[region][((real[members[region]] - [float(c) for c in centre]) ** 2).sum(axis=1)
+        near = members[region][((real[members[region]] - [float(c) for c in center]) ** 2).sum(axis=1)
                                <= float(radius) * (1 + 1e-6) + 1e-9]
-        sides = [sum((x - c) ** 2 for x, c in zip(points[v], centre)) - radius for v in near.tolist() if v not in own]
+        sides = [sum((x - c) ** 2 for x, c in zip(points[v], center)) - radius for v in near.tolist() if v not in own]
         assert (e in violating) == any(side < 0 for side in sides)
         if strict:
             assert all(side > 0 for side in sides)
@@ -512,8 +512,8 @@ def _negatives_per_region_are_the_duals(m) -> None:
     assert m.report.device.regions[0].negative_coefficients.interior == interior
 
 
-def _circumcentre(p: list[list[int]]) -> list[Fraction]:
-    """The centre of the sphere through the first four affinely independent points (Cramer's rule, exact)."""
+def _circumcenter(p: list[list[int]]) -> list[Fraction]:
+    """The center of the sphere through the first four affinely independent points (Cramer's rule, exact)."""
     import itertools
 
     for i, j, k in itertools.combinations(range(1, len(p)), 3):

@@ -73,10 +73,10 @@ def test_faces_recounted_and_the_boundary_covers_the_box(mesh, report):
             corners = points[sorted(face)]
             assert any(np.all(corners[:, axis] == 0) or np.allclose(corners[:, axis], DOMAIN[axis])
                        for axis in range(3))
-            centre = corners.mean(axis=0)  # the face is convex: a fan from its centre, in any order of the corners
+            center = corners.mean(axis=0)  # the face is convex: a fan from its center, in any order of the corners
             normal_axis = next(a for a in range(3) if np.ptp(corners[:, a]) == 0)
             u, v = (a for a in range(3) if a != normal_axis)
-            angles = np.arctan2(corners[:, v] - centre[v], corners[:, u] - centre[u])
+            angles = np.arctan2(corners[:, v] - center[v], corners[:, u] - center[u])
             ring = corners[np.argsort(angles)]
             area += 0.5 * abs(np.sum(ring[:, u] * np.roll(ring[:, v], -1) - np.roll(ring[:, u], -1) * ring[:, v]))
     a, b, c = DOMAIN
