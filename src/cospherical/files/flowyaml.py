@@ -118,18 +118,20 @@ def split_section(text: str, key: str) -> tuple[str, dict[str, str] | list[str]]
     if end <= body_start:
         return None
     lines = text.count("\n", body_start, end) + (text[end - 1] != "\n")  # the final newline starts no line
-    header = text[: start + 1] + text[end:]
     # One scan of the section in C, in place (a loop over its lines, a match each, took 0.1 s of a 9 MB
     # table): a match lies within one line and there is at most one per line, so as many matches as
     # lines is every line of the shape, and the matches are all the memory a hostile file costs.
+    found: dict[str, str] | list[str]
     if text.startswith("- ", body_start):
-        items = _SEQUENCE_LINES.findall(text, body_start, end)
-        return (header, items) if len(items) == lines else None
-    pairs = _MAPPING_LINES.findall(text, body_start, end)
-    entries = dict(pairs)
-    if len(pairs) != lines or len(entries) != lines:  # a line of another shape, or a repeated key
-        return None
-    return header, entries
+        found = _SEQUENCE_LINES.findall(text, body_start, end)
+        if len(found) != lines:
+            return None
+    else:
+        pairs = _MAPPING_LINES.findall(text, body_start, end)
+        found = dict(pairs)
+        if len(pairs) != lines or len(found) != lines:  # a line of another shape, or a repeated key
+            return None
+    return text[: start + 1] + text[end:], found
 
 
 def _refuse_repeats(pairs):
