@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cospherical.core.configuration import Box
 from cospherical.mesh.assembly import assemble
@@ -49,3 +51,14 @@ def test_exact_numerators_become_the_same_floats_as_int64_or_python_integers():
     assert np.array_equal(as_floats(small.astype(object), 12, 1.0), small / 12.0)
     huge = np.array([10**400, -(10**400) * 3], dtype=object)
     assert as_floats(huge, 10**400, 0.5).tolist() == [0.5, -1.5]
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.integers(-2**62, 2**62), max_size=40), st.booleans())
+def test_exact_sums_are_pythons_sums(values, wide):
+    """The sums of exact numerators (volume sums, areas per axis, per region, contact and interface) equal Python's
+    sum of the integers, in int64 where that cannot overflow and past it (here: values near 2**62, object arrays)."""
+    from cospherical.mesh.dual.arrays import _exact_sum
+
+    array = np.array(values, dtype=object if wide else np.int64)
+    assert _exact_sum(array) == sum(values)

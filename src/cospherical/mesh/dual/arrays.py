@@ -110,11 +110,11 @@ class Dual:
 
     def volume_sum(self) -> Fraction:
         """The control volumes' sum as an exact fraction of the domain's volume."""
-        return Fraction(int(np.sum(self.volume_exact.astype(object))), self.volume_denominator)
+        return Fraction(_exact_sum(self.volume_exact), self.volume_denominator)
 
     def boundary_area_sums(self) -> tuple[Fraction, Fraction, Fraction]:
         """Per axis, the boundary areas' sum as an exact fraction of one side's area (2: both sides normal to it)."""
-        x, y, z = (Fraction(int(np.sum(self.boundary_area_exact[:, k].astype(object))), self.boundary_area_denominator)
+        x, y, z = (Fraction(_exact_sum(self.boundary_area_exact[:, k]), self.boundary_area_denominator)
                    for k in range(3))
         return x, y, z
 
@@ -199,12 +199,12 @@ class RegionParts:
 
     def region_volumes(self) -> list[Fraction]:
         """Each region's control-volume parts summed, as exact multiples of ``volume_factor``."""
-        return [Fraction(int(np.sum(self.volume_exact[self.volume_region == r].astype(object))),
+        return [Fraction(_exact_sum(self.volume_exact[self.volume_region == r]),
                          self.volume_denominator) for r in range(len(self.names))]
 
     def contact_areas(self) -> list[Fraction]:
         """Each contact's area parts summed, exactly (device units)."""
-        return [Fraction(int(np.sum(self.contact_exact[self.contact_contact == c].astype(object))),
+        return [Fraction(_exact_sum(self.contact_exact[self.contact_contact == c]),
                          self.contact_denominator) for c in range(len(self.contact_names))]
 
 
@@ -237,8 +237,18 @@ class InterfaceParts:
 
     def areas(self) -> list[Fraction]:
         """Each interface's area parts summed, exactly (device units)."""
-        return [Fraction(int(np.sum(self.exact[self.interface == i].astype(object))), self.denominator)
+        return [Fraction(_exact_sum(self.exact[self.interface == i]), self.denominator)
                 for i in range(len(self.regions))]
+
+
+def _exact_sum(values: ExactArray) -> int:
+    """The sum of exact integers: in int64 where no partial sum can leave it (their count times the largest
+    magnitude below 2**63), as Python integers otherwise (object arrays, or int64 that could overflow)."""
+    if values.dtype != object and len(values):
+        largest = max(int(values.max()), -int(values.min()))
+        if largest * len(values) < 2**63:
+            return int(values.sum(dtype=np.int64))
+    return int(np.sum(values.astype(object)))
 
 
 def boundary_areas(exact: ExactArray, denominator: int, factors_squared: Sequence[Fraction]) -> NDArray[np.float64]:
