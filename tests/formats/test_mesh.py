@@ -69,7 +69,7 @@ def test_vtk_reads_the_same_cells_node_orders_and_data(tmp_path):
     assert len(ids) == len(names) == len(mesh.types)
     expected = {"tetra": vtk.VTK_TETRA, "pyramid": vtk.VTK_PYRAMID, "wedge": vtk.VTK_WEDGE,
                 "hexahedron": vtk.VTK_HEXAHEDRON, None: vtk.VTK_POLYHEDRON}
-    assert [expected[mesh.types[ids[t]]["vtk"]] for t in cell_array(grid, "type")] == types.tolist()
+    assert [expected[mesh.types[ids[t]].vtk] for t in cell_array(grid, "type")] == types.tolist()
     conn, sizes = mesh.connectivity()
     stream = vtk.vtkIdList()
     for c in range(len(mesh)):
@@ -127,13 +127,13 @@ def test_meshio_reads_it(tmp_path):
     import meshio
 
     mesh = assemble(build_octree(CUBE, 3, [parse_shape("point:0.3,0.4,0.45")]))
-    assert all(info["vtk"] for info in mesh.types.values())
+    assert all(info.vtk for info in mesh.types.values())
     write_vtu(mesh, tmp_path / "mesh.vtu")
     back = meshio.read(tmp_path / "mesh.vtu")
     assert (back.points == mesh.vertices / mesh.grid).all()
     element = np.concatenate(back.cell_data["element"])
     assert sorted(element.tolist()) == list(range(len(mesh)))
-    assert len(back.cells) == len({info["vtk"] for info in mesh.types.values()})  # one block per cell type
+    assert len(back.cells) == len({info.vtk for info in mesh.types.values()})  # one block per cell type
     conn, _ = mesh.connectivity()
     ids = bytes(back.field_data["type_ids"]).decode().split("\n")
     types = np.concatenate(back.cell_data["type"])
@@ -141,7 +141,7 @@ def test_meshio_reads_it(tmp_path):
     for block in back.cells:
         rows = element[at:at + len(block.data)]
         assert (block.data == conn[rows, :block.data.shape[1]]).all()
-        assert {mesh.types[ids[t]]["vtk"] for t in types[at:at + len(block.data)]} == {block.type}
+        assert {mesh.types[ids[t]].vtk for t in types[at:at + len(block.data)]} == {block.type}
         at += len(block.data)
     assert (back.point_data["grid_coordinates"] == mesh.vertices).all()
 

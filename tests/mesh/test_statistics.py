@@ -33,7 +33,7 @@ def test_the_uniform_study_of_the_cube_is_the_papers_table_2(uniform):
     assert uniform.elements == 37259 == sum(uniform.counts.values())
     by_class = Counter()
     for type_id, count in uniform.counts.items():
-        by_class[uniform.types[type_id]["paper_class"]] += count
+        by_class[uniform.types[type_id].paper_class] += count
     assert by_class["Cuboid"] == 195 and by_class["Tetrahedron"] == 18450
 
 

@@ -270,8 +270,8 @@ class OctreeMesh:
         offsets = np.zeros(len(mesh) + 1, dtype=np.int64)
         np.cumsum(sizes, out=offsets[1:])
         order = self._result.source.leaf_order
-        return Elements(tuple(ids), tuple(mesh.types.get(t, {}).get("name") or t for t in ids),
-                        tuple(mesh.types.get(t, {}).get("vtk") for t in ids), element_type,
+        return Elements(tuple(ids), tuple(mesh.type_name(t) for t in ids), tuple(mesh.type_vtk(t) for t in ids),
+                        element_type,
                         conn[conn >= 0].astype(np.int64), offsets,
                         (mesh.element_leaf if order is None else order[mesh.element_leaf]).astype(np.int64))
 

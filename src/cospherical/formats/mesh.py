@@ -250,7 +250,7 @@ def vtu_arrays(mesh: Mesh) -> dict:
     from .vtu import VTK_CELL
 
     ids, element_type = mesh.element_types()
-    kind_of_type = np.array([VTK_CELL[mesh.types.get(t, {}).get("vtk") or "polyhedron"] for t in ids],
+    kind_of_type = np.array([VTK_CELL[mesh.type_vtk(t) or "polyhedron"] for t in ids],
                             dtype=np.uint8)
     kinds = kind_of_type[element_type] if len(ids) else np.zeros(0, dtype=np.uint8)
     order = np.argsort(kinds, kind="stable")
@@ -351,7 +351,7 @@ def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None 
     ids = arrays["ids"]
     fields = {
         "type_ids": text_array("\n".join(ids)),
-        "type_names": text_array("\n".join(mesh.types.get(t, {}).get("name") or t for t in ids)),
+        "type_names": text_array("\n".join(mesh.type_name(t) for t in ids)),
         "domain": text_array(" ".join(mesh.box.texts)),
         "domain_squared": text_array(" ".join(str(s) for s in mesh.box.squared)),
         "grid_intervals": np.array([mesh.grid], dtype=np.int64),

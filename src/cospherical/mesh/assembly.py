@@ -38,8 +38,8 @@ from ..paper import paper_class
 from .device import Regions
 from .tree import Octree, distinct
 
-__all__ = ["CellShape", "Cells", "ElementBlock", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "NODE_OFFSETS", "PAPER_FINAL",
-           "assemble", "distinct", "local_tessellation", "type_info", "vertex_keys"]
+__all__ = ["CellShape", "Cells", "ElementBlock", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "MeshType", "NODE_OFFSETS",
+           "PAPER_FINAL", "assemble", "distinct", "local_tessellation", "type_info", "vertex_keys"]
 
 # Twice the unit coordinates of the 27 nodes (corners, edge midpoints, face centres, body).
 NODE_OFFSETS = np.array(
@@ -222,7 +222,7 @@ class Mesh:
     element_offsets: NDArray[np.int64]
     element_leaf: NDArray[np.int32]
     element_local: NDArray[np.int16]
-    types: dict[str, dict[str, Any]] = field(default_factory=dict)
+    types: dict[str, MeshType] = field(default_factory=dict)
     replaced: NDArray[np.bool_] | None = None
     cells: Cells | None = None
     # names the types (assemble's catalogue; the shipped one when none is given)
@@ -373,6 +373,16 @@ class Mesh:
             flags[self.leaf_elements:] = self.cell_center_in_leaf()
         return flags
 
+    def type_name(self, type_id: str) -> str:
+        """The name of one of the mesh's types (its id when :attr:`types` does not hold it)."""
+        info = self.types.get(type_id)
+        return info.name if info is not None else type_id
+
+    def type_vtk(self, type_id: str) -> str | None:
+        """The standard VTK cell one of the mesh's types is written as (``None``: a polyhedron, or not known)."""
+        info = self.types.get(type_id)
+        return info.vtk if info is not None else None
+
     def required_cells(self) -> Cells:
         """The cells, for what only a mesh with re-tessellated cells has (a ``ValueError`` without them)."""
         if self.cells is None:
@@ -410,17 +420,38 @@ class Mesh:
         low = self.tree.positions[leaf].astype(num.dtype) * size[:, None]
         return in_closed_box(num, den[:, None], low, low + size[:, None]).astype(bool)
 
-def type_info(type_id: str, etype: ElementType | None, catalogue: Catalogue) -> dict[str, Any]:
+@dataclass(frozen=True)
+class MeshType:
+    """What an element type of a mesh is, as its files and its report name it.
+
+    Attributes
+    ----------
+    name : str
+        The catalogue's name of the type, else its systematic name (else its id).
+    paper_class : str or None
+        The paper's class of the type, if it has one.
+    vtk : str or None
+        The standard VTK cell it is written as (``None``: a polyhedron).
+    vertices, faces : int or None
+        Its vertices and faces (``None`` when known by its id alone).
+    """
+
+    name: str
+    paper_class: str | None
+    vtk: str | None
+    vertices: int | None
+    faces: int | None
+
+
+def type_info(type_id: str, etype: ElementType | None, catalogue: Catalogue) -> MeshType:
     """Name, paper class, VTK cell and size of a type: from the catalogue, else from the type itself."""
     entry = catalogue.get(type_id)
     if entry is not None:
-        return {"name": entry.name, "paper_class": entry.paper_class,
-                "vtk": entry.vtk, "vertices": entry.vertices, "faces": entry.faces}
+        return MeshType(entry.name, entry.paper_class, entry.vtk, entry.vertices, entry.faces)
     if etype is not None:
         cls = paper_class(etype)
-        return {"name": etype.name, "paper_class": cls["name"] if cls else None, "vtk": etype.vtk,
-                "vertices": etype.vertices, "faces": etype.faces}
-    return {"name": type_id, "paper_class": None, "vtk": None, "vertices": None, "faces": None}
+        return MeshType(etype.name, cls["name"] if cls else None, etype.vtk, etype.vertices, etype.faces)
+    return MeshType(type_id, None, None, None, None)
 
 
 def _leaf_code(edges: int, faces: int) -> str:
@@ -559,7 +590,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     distinct = np.flatnonzero(seen)
     leaf_tessellation = (np.cumsum(seen) - 1)[value]
     tessellations: list[LocalTessellation] = []
-    types: dict[str, dict[str, Any]] = {}
+    types: dict[str, MeshType] = {}
     for value in distinct.tolist():
         code = _leaf_code(value & 0xFFF, value >> 12)
         if (code, criterion) not in cache:
@@ -581,7 +612,7 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
                 element_leaf, element_local, types, catalogue=catalogue)
 
 
-def _leaf_tessellation(configuration: Configuration, lookup: Lookup | None, types: dict[str, dict[str, Any]],
+def _leaf_tessellation(configuration: Configuration, lookup: Lookup | None, types: dict[str, MeshType],
                        criterion: str, catalogue: Catalogue) -> LocalTessellation:
     elements = lookup(configuration) if lookup is not None else None
     if elements is not None:

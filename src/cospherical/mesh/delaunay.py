@@ -136,13 +136,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from fractions import Fraction
-from typing import Any
 
 import numpy as np
 
 from ..choices import ENGINES, MODES, DelaunayMode, Engine
 from ..errors import InputError
-from .assembly import Cells, Mesh, distinct
+from .assembly import Cells, Mesh, MeshType, distinct
 from .checks import DelaunayCheck, check_delaunay, grid_weights
 from .merged_cells import Locator, NotOneCell, cell_members, classified_cells, inside_cluster, same_sphere
 from .proposal import Proposal, cluster_tetrahedra
@@ -202,7 +201,7 @@ def _leaves_of(mesh: Mesh, elements: np.ndarray) -> np.ndarray:
     return bad
 
 
-def retessellate(mesh: Mesh, elements: np.ndarray, types: dict[str, dict[str, Any]], engine: Engine = "qhull",
+def retessellate(mesh: Mesh, elements: np.ndarray, types: dict[str, MeshType], engine: Engine = "qhull",
                  proposal: Proposal | None = None, convex: bool = True) -> tuple[Cells, DelaunayCheck]:
     """The cells of the Delaunay subdivision of ``mesh``'s vertices that replace the leaves holding ``elements``.
 
@@ -333,7 +332,7 @@ def _failing_clusters(mesh: Mesh, found: DelaunayCheck, vertex_cluster: np.ndarr
     return failing | {r for r, (v, w) in enumerate(zip(volumes, wanted)) if v != w}
 
 
-def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict[str, dict[str, Any]]) -> Mesh:
+def with_cells(mesh: Mesh, bad: np.ndarray, cells: Cells, types: dict[str, MeshType]) -> Mesh:
     """``mesh`` with the elements of the marked leaves replaced by ``cells`` (whose ``leaf`` indexes its leaves);
     ``types``: the element types of the result."""
     counts = np.array([len(p.elements) for p in mesh.tessellations], dtype=np.int64)[mesh.leaf_tessellation]

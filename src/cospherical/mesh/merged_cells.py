@@ -13,14 +13,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from fractions import Fraction
-from typing import Any
 
 import numpy as np
 
 from ..catalogue import Catalogue
 from ..core.geometry import Frame, area_vector, circumcenters
 from ..core.tessellation import tessellation_elements
-from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, distinct, type_info
+from .assembly import NODE_OFFSETS, CellShape, Cells, Mesh, MeshType, distinct, type_info
 
 __all__ = ["Locator", "NotOneCell", "cell_members", "cell_shape", "classified_cells", "element_planes",
            "inside_cluster", "row_classes", "same_sphere", "scaled_shape"]
@@ -138,7 +137,7 @@ def cell_members(cell_of_tet: np.ndarray, tets: np.ndarray, vertices: int) -> np
 
 
 def classified_cells(mesh: Mesh, merged: np.ndarray, proven: np.ndarray, located: Locator,
-                     types: dict[str, dict[str, Any]]) -> Cells:
+                     types: dict[str, MeshType]) -> Cells:
     """The cells (rows of vertex ids, -1 padded): the merged ones and the ``proven`` kept elements, classified and measured.
 
     Cells are listed in the order of their sorted vertex ids, so the result does not
@@ -206,7 +205,7 @@ def row_classes(rows: np.ndarray) -> np.ndarray:
 
 
 def cell_shape(offsets: list[tuple[int, int, int]], squared: tuple[Fraction, Fraction, Fraction],
-               types: dict[str, dict[str, Any]], catalogue: Catalogue) -> tuple[CellShape, list[int]]:
+               types: dict[str, MeshType], catalogue: Catalogue) -> tuple[CellShape, list[int]]:
     """Classify and measure one cell shape (vertex offsets from the anchor, grid units), exactly.
 
     Returns the shape and the order of ``offsets`` that is the type's reference order.

@@ -50,7 +50,7 @@ from ..core.configuration import Box
 from ..core.morton import morton_codes
 from ..errors import InputError
 from ..execution.backends import completed
-from .assembly import Cells, assemble, vertex_keys
+from .assembly import Cells, MeshType, assemble, vertex_keys
 from .checks import OpenFaces, check_delaunay
 from .delaunay import retessellate, with_cells
 from .octree import Octree, distinct
@@ -111,7 +111,7 @@ class Piece:
     path: str | None
     cells: Cells | None = None
     replaced: np.ndarray | None = None
-    types: dict[str, dict[str, Any]] | None = None
+    types: dict[str, MeshType] | None = None
     vertex_balanced: bool = False  # the whole tree's (Octree.vertex_balanced): the piece's vertices are its
 
 

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from ..catalogue import Catalogue
 from ..version import __version__
-from .assembly import Mesh
+from .assembly import Mesh, MeshType
 from .checks import (DelaunayCheck, OpenFaces, check_circumcenters, check_conformity, check_delaunay, check_volume,
                      match_seams)
 from .report_sections import (ChecksSummary, ConfigurationFrequency, ContactSummary, DelaunaySpheres, DeviceSummary,
@@ -53,7 +53,7 @@ def outside_catalogue(mesh: Mesh) -> tuple[OutsideType, ...]:
             continue
         if type_id not in found:
             example = tuple(tuple(str(Fraction(int(x), mesh.grid)) for x in mesh.vertices[v]) for v in nodes[0])
-            found[type_id] = OutsideType(type_id, mesh.types.get(type_id, {}).get("name", type_id), 0, example)
+            found[type_id] = OutsideType(type_id, mesh.type_name(type_id), 0, example)
         found[type_id] = replace(found[type_id], count=found[type_id].count + int(len(rows)))
     return _by_count(found.values())
 
@@ -97,7 +97,7 @@ class PieceFigures:
         The configurations carried back from a table's orbit representative.
     leaves_tessellated_on_the_fly : int
         Leaves whose configuration the table lacked.
-    types : Mapping of str to Mapping
+    types : Mapping of str to MeshType
         What each type met is: name, paper class, VTK cell, vertices, faces (read-only).
     """
 
@@ -118,7 +118,7 @@ class PieceFigures:
     configurations: Mapping[str, ConfigurationOccurrence]
     mapped: tuple[str, ...]
     leaves_tessellated_on_the_fly: int
-    types: Mapping[str, Mapping[str, Any]]
+    types: Mapping[str, MeshType]
     delaunay_violations: int | None = None
     delaunay_violating_pairs: int | None = None
     delaunay_violating_leaves: int | None = None
@@ -249,7 +249,7 @@ def merged_report(tree: Octree, vertices: int, parts: Sequence[PieceFigures], de
             configurations[code] = occurrence if met is None else replace(met, leaves=met.leaves + occurrence.leaves)
     on_the_fly = sum(c.tessellated_on_the_fly for c in configurations.values())
     mapped = len({code for part in parts for code in part.mapped})
-    types: dict[str, Mapping[str, Any]] = {}
+    types: dict[str, MeshType] = {}
     for part in parts:
         types.update(part.types)
     frequencies = statistics(type_counts, configurations, len(tree), types, catalogue,

@@ -10,7 +10,7 @@ system), and the share of elements the paper's seven final elements cover.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any, Mapping, NamedTuple
 
 import numpy as np
@@ -19,7 +19,7 @@ from ..caches import cached
 from ..catalogue import Catalogue
 from ..core.configuration import Box, Configuration
 from ..files.data import data_path
-from .assembly import PAPER_FINAL, Mesh, type_info
+from .assembly import PAPER_FINAL, Mesh, MeshType, type_info
 from .report_sections import ConfigurationFrequency, TypeFrequency, UniformSummary, read_only
 from .tree import Octree
 
@@ -37,7 +37,7 @@ class UniformStudy:
     ----------
     counts : Mapping of str to int
         Elements per type id, by decreasing count (read-only; keyed by the types the study meets).
-    types : Mapping of str to Mapping
+    types : Mapping of str to MeshType
         Per type id its name, paper class, VTK cell, vertices and faces (the catalogue's when it
         names the type; read-only).
     elements : int
@@ -45,7 +45,7 @@ class UniformStudy:
     """
 
     counts: Mapping[str, int]
-    types: Mapping[str, Mapping[str, Any]]
+    types: Mapping[str, MeshType]
     elements: int
 
 
@@ -109,7 +109,7 @@ def uniform_study(box: Box, catalogue: Catalogue, computed: bool = False) -> Uni
     figures = None if computed else shipped_uniform(box)
     if figures is None:
         figures = uniform_figures(box)
-    info = {type_id: type_info(type_id, None, catalogue) if type_id in catalogue else dict(own)
+    info = {type_id: type_info(type_id, None, catalogue) if type_id in catalogue else MeshType(**own)
             for type_id, own in figures["types"].items()}
     return UniformStudy(read_only(figures["counts"]), read_only(info), figures["elements"])
 
@@ -123,7 +123,7 @@ def uniform_figures(box: Box) -> dict[str, Any]:
     study = run_study("bisection", box, bisection_codes(), "octree", criteria=("optimal",))
     nobody = Catalogue.empty(1)
     return {"box": list(box.texts), "counts": {tc.type.id: tc.count for tc in study.type_counts("optimal")},
-            "types": {tc.type.id: type_info(tc.type.id, tc.type, nobody) for tc in study.type_counts("optimal")},
+            "types": {tc.type.id: asdict(type_info(tc.type.id, tc.type, nobody)) for tc in study.type_counts("optimal")},
             "elements": study.total("optimal")}
 
 
@@ -194,7 +194,7 @@ def occurrences(mesh: Mesh) -> tuple[Counter[str], dict[str, ConfigurationOccurr
 
 
 def statistics(type_counts: Counter[str], configurations: Mapping[str, ConfigurationOccurrence], total_leaves: int,
-               types: Mapping[str, Mapping[str, Any]], catalogue: Catalogue,
+               types: Mapping[str, MeshType], catalogue: Catalogue,
                uniform: UniformStudy | None = None) -> Frequencies:
     """:func:`mesh_statistics` from the :func:`occurrences` of a mesh (or of all its pieces, added up);
     ``catalogue`` names the types met nowhere else."""
@@ -212,7 +212,7 @@ def statistics(type_counts: Counter[str], configurations: Mapping[str, Configura
     for type_id in sorted(set(type_counts) | set(uniform_counts), key=lambda t: (-type_counts[t], t)):
         entry = info.get(type_id) or type_info(type_id, None, catalogue)
         rows.append(TypeFrequency(
-            type_id, entry["name"], entry["paper_class"], entry["vtk"], int(type_counts[type_id]),
+            type_id, entry.name, entry.paper_class, entry.vtk, int(type_counts[type_id]),
             _share(type_counts[type_id], total),
             int(uniform_counts.get(type_id, 0)) if uniform is not None else None,
             _share(uniform_counts.get(type_id, 0), uniform_total) if uniform is not None else None))

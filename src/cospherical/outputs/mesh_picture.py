@@ -146,7 +146,7 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
     if shown:
         font = ImageFont.load_default(13)
         heading = "region (sections)" if by_region else "element type (sections)"
-        rows = [heading] + [f"{t if by_region else mesh.types.get(t, {}).get('name', t)} ({counts[t]})" for t in shown]
+        rows = [heading] + [f"{t if by_region else mesh.type_name(t)} ({counts[t]})" for t in shown]
         box_width = 12 + 28 + 8 + max(int(font.getlength(r)) for r in rows) + 12
         lx, ly = x0 + w + 12, y0
         draw.rectangle((lx, ly, lx + box_width, ly + 10 + 20 * len(rows)), fill=WHITE, outline=GREY)
