@@ -478,6 +478,8 @@ def device_octree(layout: DeviceLayout, max_leaves: int | None = None) -> tuple[
                              f"{layout.resolving_level})")
     region = leaf_owner(layout, tree.levels, tree.positions)
     keep = region >= 0
+    if keep.all():  # the boxes fill their bounding box: every leaf stays, no copy of the tree
+        return tree, region.astype(np.int32)
     return (Octree(tree.box, tree.levels[keep], tree.positions[keep], tree.vertex_balanced),
             region[keep].astype(np.int32))
 
