@@ -1,6 +1,7 @@
 """The dual of bench_mesh.py's sphere octree, timed; the box method beside discretize's finite volumes.
 
     python benchmarks/bench_dual.py [--levels 9] [--radius 0.3] [--patterns patterns/leaves-1x1x1.yaml] [--baseline REV]
+    python benchmarks/bench_dual.py --files 6,7,8 [--radius 0.3] [--patterns ...]
     python benchmarks/bench_dual.py --poisson [--uniform 2 3 4 5 6] [--graded 4 5 6 7]
 
 Default: the sphere octree of about 1.3 million leaves (level 9), assembled from the
@@ -13,9 +14,16 @@ within 4 GB.  ``--baseline REV`` first runs the same in a process of its own wit
 ``mesh_dual`` as git revision ``REV`` had it (its ``mesh/dual.py``, or its package ``mesh/dual/``), so that
 before and after are measured in one run, under one load.
 
+``--files 6,7,8``: per level, the sphere tree's ``dual.npz`` as ``write_dual`` writes it
+(every member deflated at zlib's level 1): its bytes and the writer's CPU seconds, beside
+the same members deflated at zlib's default level 6 (what the writer did before
+2026-12-04: the file's size then, the same zip around them) and both levels' deflating
+time, measured in the same process on the same bytes.
+
 ``--poisson``: examples/poisson.py's table on larger trees (needs the ``compare``
-extra, discretize), with the solve times of both methods.  Both write
-results/benchmarks/bench_dual.json or bench_dual-poisson.json (benchmarks/record.py).
+extra, discretize), with the solve times of both methods.  They write
+results/benchmarks/bench_dual.json, bench_dual-files.json or bench_dual-poisson.json
+(benchmarks/record.py).
 """
 
 from __future__ import annotations
@@ -113,6 +121,51 @@ def big(args, record) -> None:
         record.add(f"peak memory {what}", f"{now[key]:.2f} GB{earlier}")
 
 
+def files(args, record) -> None:
+    """``dual.npz`` per level: as written (zlib level 1) beside its members deflated at level 6 (the writer before)."""
+    import time
+    import zipfile
+    import zlib
+
+    from bench_mesh import sphere_tree, timer
+
+    from cospherical.formats.dual import write_dual
+    from cospherical.mesh.dual import mesh_dual
+
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        for level in [int(x) for x in args.files.split(",")]:
+            args.levels = level
+            lookup, tree = sphere_tree(args, timer({}))
+            dual = mesh_dual(assemble(tree, lookup))
+            path = Path(folder) / f"L{level}.npz"
+            start = time.process_time()
+            write_dual(dual, path)
+            write = time.process_time() - start
+            deflate = {1: 0.0, 6: 0.0}
+            packed = {1: 0, 6: 0}
+            with zipfile.ZipFile(path) as archive:
+                infos = archive.infolist()
+                raw = sum(info.file_size for info in infos)
+                headers = path.stat().st_size - sum(info.compress_size for info in infos)  # the zip around them
+                for info in infos:
+                    blob = archive.read(info)
+                    for zlevel in (1, 6):
+                        start = time.process_time()
+                        compressor = zlib.compressobj(zlevel, zlib.DEFLATED, -15)
+                        packed[zlevel] += len(compressor.compress(blob)) + len(compressor.flush())
+                        deflate[zlevel] += time.process_time() - start
+            assert packed[1] + headers == path.stat().st_size  # level 1 is what the writer wrote
+            row = [f"{level}", f"{len(dual.vertices):,}", f"{raw / 1e6:.1f}", f"{(packed[6] + headers) / 1e6:.2f}",
+                   f"{path.stat().st_size / 1e6:.2f}", f"{path.stat().st_size / (packed[6] + headers):.2f}",
+                   f"{deflate[6]:.2f}", f"{deflate[1]:.2f}", f"{write:.2f}"]
+            print(" | ".join(row), flush=True)
+            rows.append(row)
+            path.unlink()
+    record.table(["level", "vertices", "members MB", "dual.npz MB at level 6 (before)", "at level 1 (now)",
+                  "size ratio", "deflate s, level 6", "level 1", "write_dual s"], rows)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -120,6 +173,7 @@ def main() -> None:
 
     tree_arguments(parser)
     parser.add_argument("--poisson", action="store_true", help="the Poisson comparison instead")
+    parser.add_argument("--files", metavar="LEVELS", help="dual.npz's size and writing per level (e.g. 6,7,8) instead")
     parser.add_argument("--baseline", metavar="REV", help="first time the dual of this git revision, the same way")
     parser.add_argument("--dual-module", help=argparse.SUPPRESS)  # a baseline's dual.py or dual/, in its own process
     parser.add_argument("--figures", help=argparse.SUPPRESS)  # where that process leaves its figures
@@ -131,6 +185,10 @@ def main() -> None:
     if args.dual_module:
         load_baseline(args.dual_module)
         Path(args.figures).write_text(json.dumps(measure(args)))
+        return
+    if args.files:
+        with recorded(__file__, name=f"{Path(__file__).stem}-files") as record:
+            files(args, record)
         return
     if not args.poisson:
         with recorded(__file__) as record:
