@@ -51,7 +51,7 @@ import itertools
 import math
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Callable, Iterable, NamedTuple, Sequence
+from typing import Any, Callable, Iterable, Mapping, NamedTuple, Sequence, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -128,11 +128,16 @@ def check_volume(mesh: Mesh) -> VolumeCheck:
     return VolumeCheck(share, int(flat), share == mesh.domain_share and flat == 0)
 
 
+Faces = Union[NDArray[np.integer[Any]], tuple[NDArray[np.integer[Any]], tuple[int, ...]]]
+"""Faces of alike elements for :func:`pair_faces`: rows of cycles, or ``(table, columns)``: the rows
+``table[:, columns]``."""
+
+
 def _faces(mesh: Mesh, examples: int, progress: Callable[[int], None] | None = None
-           ) -> tuple[dict[int, list[NDArray[np.integer[Any]]]], ConformityCheck]:
-    """The faces to pair across the mesh as rows of global vertex ids, by size; and what the faces inside the
-    leaves gave, paired once per configuration (see :func:`check_conformity`)."""
-    by_size: dict[int, list[NDArray[np.integer[Any]]]] = {}
+           ) -> tuple[dict[int, list[Faces]], ConformityCheck]:
+    """The faces to pair across the mesh as rows of global vertex ids, by size (as :func:`pair_faces` reads them);
+    and what the faces inside the leaves gave, paired once per configuration (see :func:`check_conformity`)."""
+    by_size: dict[int, list[Faces]] = {}
     pairs = bad = 0
     shown: list[list[list[float]]] = []
     for _, tessellation, leaves in mesh.groups():
@@ -144,11 +149,11 @@ def _faces(mesh: Mesh, examples: int, progress: Callable[[int], None] | None = N
             progress((2 * inner_pairs + len(inner_bad)) * len(leaves))
         for cycle in inner_bad[:max(0, examples - len(shown))]:
             shown.append((mesh.vertices[slots[0, list(cycle)]] / mesh.grid).tolist())
-        for cycle in outer:
-            by_size.setdefault(len(cycle), []).append(slots[:, list(cycle)])
+        for cycle in outer:  # gathered when paired, straight into their place (pair_faces)
+            by_size.setdefault(len(cycle), []).append((slots, cycle))
     for _, nodes, faces, _ in mesh.blocks(np.zeros(len(mesh.tree), dtype=bool)):  # the cells alone
         for face in faces:
-            by_size.setdefault(len(face), []).append(nodes[:, list(face)])
+            by_size.setdefault(len(face), []).append((nodes, face))
     return by_size, ConformityCheck(bad, pairs, 0, shown)
 
 
@@ -318,13 +323,14 @@ def check_conformity(mesh: Mesh, examples: int = 5, open_faces: bool = False,
                            (inside.nonconforming_examples + found.nonconforming_examples)[:examples], found.open_faces)
 
 
-def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArray[np.integer[Any]], grid: int,
+def pair_faces(faces: Mapping[int, Sequence[Faces]], vertices: NDArray[np.integer[Any]], grid: int,
                examples: int = 5, open_faces: bool = False, layout: DeviceLayout | None = None,
                progress: Callable[[int], None] | None = None) -> ConformityCheck:
     """:func:`check_conformity` on any elements' faces: ``faces``, by size, lists of arrays whose rows are
-    faces as cycles of vertex ids counter-clockwise seen from outside their element; ``vertices``
-    the grid points, ``grid`` intervals per side of the box, the domain (or its union of boxes,
-    ``layout``: see :func:`on_domain_boundary`).  The lists are emptied as they are read.
+    faces as cycles of vertex ids counter-clockwise seen from outside their element (or ``(table,
+    columns)``: the rows ``table[:, columns]``, gathered here); ``vertices`` the grid points, ``grid``
+    intervals per side of the box, the domain (or its union of boxes, ``layout``: see
+    :func:`on_domain_boundary`).  The lists are emptied as they are read.
     """
     bad_total, interior, boundary = 0, 0, 0
     shown: list[list[list[float]]] = []
@@ -333,13 +339,16 @@ def pair_faces(faces: dict[int, list[NDArray[np.integer[Any]]]], vertices: NDArr
         # the faces are convex polygons (hulls): the same vertices are the same polygon, so a face is paired by
         # its ids in increasing order; its orientation: whether the cycle goes on from its smallest id to the
         # larger of that id's neighbours
-        ends = np.cumsum([len(part) for part in parts])
-        ids = np.empty((int(ends[-1]) if len(ends) else 0, size), dtype=np.result_type(*parts) if parts else np.int64)
+        ends = np.cumsum([len(part[0] if isinstance(part, tuple) else part) for part in parts])
+        ids = np.empty((int(ends[-1]) if len(ends) else 0, size),
+                       dtype=np.result_type(*(part[0] if isinstance(part, tuple) else part for part in parts))
+                       if parts else np.int64)
         flipped = np.empty(len(ids), dtype=bool)
         # per part, the columns of its rows of ids that are its cycles, or the cycles themselves
-        cycles = [_ranked(part, ids[end - len(part):end], flipped[end - len(part):end])
-                  for part, end in zip(parts, ends.tolist())]
-        parts.clear()
+        cycles = [_ranked(part, ids[start:end], flipped[start:end])
+                  for part, start, end in zip(parts, [0, *ends[:-1].tolist()], ends.tolist())]
+        if isinstance(parts, list):
+            parts.clear()
 
         order, flipped, ok, pairs, single = _paired(ids, flipped)
         interior += pairs
@@ -374,9 +383,9 @@ def _cycles_at(rows: NDArray[np.intp], ids: NDArray[np.integer[Any]],
     return out
 
 
-def _ranked(cycles: NDArray[np.integer[Any]], ids: NDArray[np.integer[Any]], flipped: NDArray[np.bool_]
+def _ranked(part: Faces, ids: NDArray[np.integer[Any]], flipped: NDArray[np.bool_]
             ) -> tuple[int, ...] | NDArray[np.integer[Any]]:
-    """Faces given as cycles of vertex ids: their ids in increasing order into ``ids``, and their orientations
+    """Faces given as cycles of vertex ids (:data:`Faces`): their ids in increasing order into ``ids``, and their orientations
     (whether each cycle goes on from its smallest id to the larger of that id's two neighbours) into
     ``flipped``; returns the columns of ``ids`` that give the cycles back, else the cycles themselves.
 
@@ -387,15 +396,18 @@ def _ranked(cycles: NDArray[np.integer[Any]], ids: NDArray[np.integer[Any]], fli
     one comparison of the result instead of a sort of each row.  Rows that do not rank alike
     (any other caller's faces) are sorted row by row.
     """
-    size = cycles.shape[1]
-    if not len(cycles):
-        return cycles
-    columns = np.argsort(cycles[0], kind="stable")
-    np.take(cycles, columns, axis=1, out=ids)
+    table, cycle = part if isinstance(part, tuple) else (part, tuple(range(part.shape[1])))
+    size = len(cycle)
+    if not len(table):
+        return table[:, list(cycle)]
+    first = table[0, list(cycle)]
+    columns = np.argsort(first, kind="stable")
+    np.take(table, np.asarray(cycle)[columns], axis=1, out=ids)
     if bool((ids[:, 1:] > ids[:, :-1]).all()):
         at = int(columns[0])
-        flipped[:] = bool(cycles[0, (at + 1) % size] > cycles[0, at - 1])
+        flipped[:] = bool(first[(at + 1) % size] > first[at - 1])
         return tuple(np.argsort(columns).tolist())
+    cycles = table[:, list(cycle)] if isinstance(part, tuple) else table
     # row by row, column by column (numpy's reductions along rows of three or four are slow)
     smallest = cycles[:, 0].copy()
     for column in range(1, size):
