@@ -59,9 +59,12 @@ def measure(args) -> dict:
     stage("laplacian", dual.laplacian)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     negative = dual.negative_coefficients()
+    # a NegativeCoefficients; a dict from a --baseline revision older than it
+    interior, boundary = ((negative["interior"], negative["boundary"]) if isinstance(negative, dict)
+                          else (negative.interior, negative.boundary))
     print(f"leaves {len(tree):,}  vertices {len(mesh.vertices):,}  elements {len(mesh):,}  edges {len(dual.edges):,}  "
           f"configurations {len(mesh.tessellations)}  volume sum {dual.volume_sum()}  negative coefficients "
-          f"{negative['interior']} interior, {negative['boundary']} boundary")
+          f"{interior} interior, {boundary} boundary")
     for name, (wall, cpu) in clock.items():
         print(f"{name:42s} {wall:8.2f} s wall {cpu:8.2f} s cpu")
     print(f"peak {dual_peak:.2f} GB after the duals, {peak:.2f} GB after the laplacian", flush=True)

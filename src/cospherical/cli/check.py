@@ -76,8 +76,7 @@ def _check_dual(path: Path) -> None:
     say(f"{path}: ok, dual of {len(dual.vertices)} vertices and {len(dual.edges)} edges, every value equal to "
           f"its elements' exactly, its elements a mesh of the domain (every face shared by two in opposite "
           f"orientations or in the boundary), control volumes sum to the domain and boundary areas to its surface, "
-          f"{negative['interior']} interior and "
-          f"{negative['boundary']} boundary negative coefficients")
+          f"{negative.interior} interior and {negative.boundary} boundary negative coefficients")
 
 
 def _cut(value, most: int = 40) -> str:

@@ -21,8 +21,8 @@ def test_a_non_delaunay_mesh_shows_its_negative_coefficients():
                     cache=CACHES.setdefault(box.texts, {}))
     dual = mesh_dual(mesh)
     negative = dual.negative_coefficients()
-    assert negative["interior"] > 0
-    assert negative["interior"] + negative["boundary"] == int((dual.coefficient < 0).sum())
+    assert negative.interior > 0
+    assert negative.interior + negative.boundary == int((dual.coefficient < 0).sum())
     assert dual.volume_sum() == 1
 
 

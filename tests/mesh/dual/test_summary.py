@@ -19,7 +19,7 @@ def test_the_summary_counts_the_mixed_mesh_and_tetgens_of_the_same_vertices():
     dual = mesh_dual(mesh)
     summary = dual_summary(dual, len(mesh), 1234, tetrahedral=True)
     figures, mixed, tets = summary.dual, summary.dual.mixed, summary.dual.tetrahedral
-    assert summary.negative_coefficients.to_dict() == dual.negative_coefficients()
+    assert summary.negative_coefficients == dual.negative_coefficients()
     assert figures.volume_sum == "1" and figures.edges == len(dual.edges) == mixed.edges
     assert mixed.to_dict() == {"elements": len(mesh), "edges": len(dual.edges), "faces": 1234,
                                "nonzeros": len(dual.vertices) + 2 * len(dual.edges)}

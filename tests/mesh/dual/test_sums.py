@@ -71,7 +71,7 @@ def test_the_dual_of_tiny_and_huge_domains_is_exact(domain, tmp_path):
     dual = mesh_dual(assemble(build_octree(box, 2, [parse_shape("point:0,0,0")])))
     assert dual.volume_sum() == 1  # the control volumes fill the domain, as a fraction of its volume
     assert dual.boundary_area_sums() == (2, 2, 2)  # and the boundary areas its surface
-    assert dual.negative_coefficients()["interior"] == 0
+    assert dual.negative_coefficients().interior == 0
     write_dual(dual, tmp_path / "dual.npz")  # integers too wide for int64 go as decimal text, and come back
     again = read_dual(tmp_path / "dual.npz")
     for name in ("coefficient_exact", "volume_exact", "boundary_area_exact"):

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...core.configuration import Box
+from ..report_sections import NegativeCoefficients
 
 if TYPE_CHECKING:
     from scipy.sparse import csr_matrix
@@ -118,7 +119,7 @@ class Dual:
                    for k in range(3))
         return x, y, z
 
-    def negative_coefficients(self) -> dict[str, int]:
+    def negative_coefficients(self) -> NegativeCoefficients:
         """Edges whose coefficient is negative (decided on the exact integers), interior and boundary apart.
 
         A boundary edge is an edge of a face in the domain's boundary: ``boundary_edge``
@@ -126,8 +127,8 @@ class Dual:
         """
         if self.boundary_edge is not None:
             below = self.coefficient_exact < 0
-            return {"interior": int((below & ~self.boundary_edge).sum()),
-                    "boundary": int((below & self.boundary_edge).sum())}
+            return NegativeCoefficients(int((below & ~self.boundary_edge).sum()),
+                                        int((below & self.boundary_edge).sum()))
         negative = np.flatnonzero(self.coefficient_exact < 0)  # few: only their ends are looked at
         g = self.grid_vertices
         a, b = g[self.edges[negative, 0]], g[self.edges[negative, 1]]
@@ -135,7 +136,7 @@ class Dual:
         for side in (0, self.grid):
             on_plane |= np.any((a == side) & (b == side), axis=1)
         boundary = int(on_plane.sum())
-        return {"interior": len(negative) - boundary, "boundary": boundary}
+        return NegativeCoefficients(len(negative) - boundary, boundary)
 
 
 @dataclass

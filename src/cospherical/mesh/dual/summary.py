@@ -26,10 +26,9 @@ def dual_summary(dual: Dual, elements: int, faces: int, tetrahedral: bool = Fals
     vertices costs several times the dual); without it, or above :data:`TETRAHEDRAL_LIMIT`
     vertices, the tetrahedral side is ``None``.
     """
-    negative = dual.negative_coefficients()
     mixed = MixedCounts(int(elements), int(len(dual.edges)), int(faces), int(len(dual.vertices) + 2 * len(dual.edges)))
     tets = tetrahedral_counts(dual.grid_vertices) if tetrahedral and len(dual.vertices) <= TETRAHEDRAL_LIMIT else None
-    return DualFigures(NegativeCoefficients(negative["interior"], negative["boundary"]), DualSummary(
+    return DualFigures(dual.negative_coefficients(), DualSummary(
         mixed.edges, str(dual.volume_sum()),
         float(dual.coefficient.min()) if len(dual.edges) else None,
         float(dual.coefficient.max()) if len(dual.edges) else None,
