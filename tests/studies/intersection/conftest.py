@@ -8,13 +8,13 @@ from cospherical.studies.intersection import run_intersection
 
 
 @pytest.fixture(scope="session")
-def pool_run():
-    """The R = 4 study, run by a process pool of two workers."""
-    return run_intersection(4, jobs=2)
+def r4_run():
+    """The R = 4 study, run in this process (the pool and Dask are held to one process in test_run.py)."""
+    return run_intersection(4)
 
 
 @pytest.fixture(scope="session")
-def r4_table(pool_run, tmp_path_factory):
+def r4_table(r4_run, tmp_path_factory):
     """The R = 4 pattern table, as YAML and as an indexed store, made in this process.
 
     One process: a pool of two adds its workers' start-up (about 11 CPU-s against 9 at load 5). The
@@ -25,6 +25,6 @@ def r4_table(pool_run, tmp_path_factory):
     from cospherical.studies.intersection.table import TableRun
 
     folder = tmp_path_factory.mktemp("r4")
-    write_pattern_table(TableRun(pool_run, jobs=1), shipped_catalogue().version, yaml_path=folder / "r4.yaml",
+    write_pattern_table(TableRun(r4_run, jobs=1), shipped_catalogue().version, yaml_path=folder / "r4.yaml",
                         store=folder / "r4.sqlite")
     return folder / "r4.yaml", folder / "r4.sqlite"

@@ -33,17 +33,23 @@ def test_resolution_2_is_the_bisection_study(paper_studies):
     assert (ours["fvm_adequate"], ours["fvm_adequate_open"]) == (bisection["fvm_adequate"], bisection["fvm_adequate_open"])
 
 
-def test_process_pool_dask_and_brute_force_agree(pool_run, full, monkeypatch):
-    dask = run_intersection(4, dask_workers=2)
-    assert pool_run["configurations"] == 66**3 and pool_run["orbits"] == 32077
-    assert dask == pool_run
-    assert set(pool_run["criteria"]) == {"optimal", "internal_faces", "internal_edges_and_faces"}
+def test_process_pool_dask_and_brute_force_agree(r4_run, full, monkeypatch):
+    assert r4_run["configurations"] == 66**3 and r4_run["orbits"] == 32077
+    assert set(r4_run["criteria"]) == {"optimal", "internal_faces", "internal_edges_and_faces"}
+    # A pool of two and a Dask cluster of two give one process's summary, on a run cut into many chunks
+    # joined in whatever order they finish: R = 2 in 16 chunks of 40 orbits (R = 4's default chunks are
+    # 7 of 5,000: the same joining, 10 CPU-s more), and R = 4 too with --full.
+    one = run_intersection(2, chunk=40)
+    assert run_intersection(2, jobs=2, chunk=40) == one
+    assert run_intersection(2, dask_workers=2, chunk=40) == one
+    if full:
+        assert run_intersection(4, jobs=2) == r4_run and run_intersection(4, dask_workers=2) == r4_run
     # Every configuration tessellated against one per orbit counted as many times as its orbit
     # has members: the whole family with --full (its 287,496 configurations take 20 CPU-s), by
     # default a seeded 1 in 32 of the orbits, each with all its members (the statistics of a
     # set of whole orbits are the same either way).
     if full:
-        brute, by_orbits = run_intersection(4, jobs=2, brute_force=True), pool_run
+        brute, by_orbits = run_intersection(4, jobs=2, brute_force=True), r4_run
     else:
         brute, by_orbits = _sampled_orbits_both_ways(monkeypatch)
     assert brute["orbits"] == brute["configurations"] == by_orbits["configurations"]
@@ -65,7 +71,7 @@ def _sampled_orbits_both_ways(monkeypatch):
     assert len(members) == sizes[pick].sum() > len(pick)
     monkeypatch.setattr(run, "orbits", lambda resolution, order: (reps[pick], sizes[pick], len(members)))
     monkeypatch.setattr(run, "all_configurations", lambda resolution, order: members)
-    return run_intersection(4, brute_force=True), run_intersection(4)  # in this process: the pool ran above
+    return run_intersection(4, brute_force=True), run_intersection(4)  # in this process: the pool is held to it above
 
 
 def test_compiled_stage_agrees_with_the_python_walk_on_a_sample():
@@ -96,13 +102,13 @@ def test_compiled_stage_agrees_with_the_python_walk_on_a_sample():
     assert set(cells["poly_mask"][offsets[i]:offsets[i + 1]].tolist()) == masks
 
 
-def test_the_paper_figures_beside_ours(pool_run):
+def test_the_paper_figures_beside_ours(r4_run):
     from cospherical.paper import paper_comparison, paper_study_key
 
-    key, notes = paper_study_key(pool_run)
+    key, notes = paper_study_key(r4_run)
     assert key == "intersection_cube" and "insertion_order" in notes
-    table = paper_comparison(pool_run, key)
-    assert table["total"] == {"paper": 46491970, "ours": pool_run["criteria"]["optimal"]["total"]}
+    table = paper_comparison(r4_run, key)
+    assert table["total"] == {"paper": 46491970, "ours": r4_run["criteria"]["optimal"]["total"]}
 
 
 def test_an_interrupted_run_resumes_to_the_same_result(tmp_path):

@@ -7,7 +7,7 @@ from sampling import sampled_table
 
 
 
-def test_table_lines_joined_from_cells_are_those_of_each_tessellation(pool_run):
+def test_table_lines_joined_from_cells_are_those_of_each_tessellation(r4_run):
     # The table is joined from each distinct cell's text; the same lines, byte for byte,
     # come from tessellating every configuration and splitting it under each kept set.
     from cospherical import Configuration, tessellate
@@ -18,7 +18,7 @@ def test_table_lines_joined_from_cells_are_those_of_each_tessellation(pool_run):
     from cospherical.formats.patterns import configuration_line
     from cospherical.studies.intersection import orbits
 
-    kept = {c: data["kept"] for c, data in pool_run["criteria"].items() if c != "optimal"}
+    kept = {c: data["kept"] for c, data in r4_run["criteria"].items() if c != "optimal"}
     reps, _, _ = orbits(4)
     codes = reps[::40]
     cells = [tuple(row) for row in distinct_cells(codes).tolist()]
