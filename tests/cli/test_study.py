@@ -3,24 +3,20 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
-from commands import cospherical
+from commands import cospherical, in_process
 
 from cospherical.formats.patterns import load, pattern_name
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def test_study_cli_json_shape(tmp_path):
-    result = subprocess.run(
-        [sys.executable, "-m", "cospherical", "study", "bisection", "--box", "1", "2", "4", "--format", "json",
-         "--out", str(tmp_path), "--compare-paper"],
-        capture_output=True, text=True,
-    )
+def test_study_cli_json_shape(tmp_path, capsys):
+    # in this process (the study as a process, interrupted, is test_reliability.py's)
+    result = in_process(capsys, "study", "bisection", "--box", "1", "2", "4", "--format", "json",
+                        "--out", tmp_path, "--compare-paper")
     assert result.returncode == 0, result.stderr
     data = json.loads(result.stdout)
     assert data["study"] == "bisection" and data["box"] == ["1", "2", "4"] and data["configurations"] == 4096
