@@ -27,7 +27,8 @@ BOXES = (("1", "1", "1"), ("1", "2", "4"), ("1", "1.4142", "1.4142"), ("1", "sqr
 
 def uniform_studies_text() -> str:
     """The file's text (deterministic)."""
-    studies = [uniform_figures(Box.parse(list(box))) for box in BOXES]
+    studies = [{"box": list(Box.parse(list(box)).texts), **uniform_figures(Box.parse(list(box))).to_dict()}
+               for box in BOXES]
     return json.dumps({"comment": "the uniform bisection study (octree points, optimal) of each box: written by "
                        "scripts/uniform_studies.py, read by cospherical.mesh.statistics.uniform_study",
                        "studies": studies}, indent=1) + "\n"

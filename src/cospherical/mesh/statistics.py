@@ -10,7 +10,7 @@ system), and the share of elements the paper's seven final elements cover.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any, Mapping, NamedTuple
 
 import numpy as np
@@ -39,7 +39,7 @@ class UniformStudy:
         Elements per type id, by decreasing count (read-only; keyed by the types the study meets).
     types : Mapping of str to MeshType
         Per type id its name, paper class, VTK cell, vertices and faces (the catalogue's when it
-        names the type; read-only).
+        names the type, :func:`uniform_study`; the type's own, :func:`uniform_figures`; read-only).
     elements : int
         The study's elements, all types together.
     """
@@ -47,6 +47,17 @@ class UniformStudy:
     counts: Mapping[str, int]
     types: Mapping[str, MeshType]
     elements: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """The study as ``data/uniform-studies.json`` holds it (beside its box)."""
+        return {"counts": dict(self.counts), "types": {key: asdict(info) for key, info in self.types.items()},
+                "elements": self.elements}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> UniformStudy:
+        """A study of ``data/uniform-studies.json`` (its ``box`` is not the study's)."""
+        return cls(read_only(data["counts"]), read_only({key: MeshType(**info) for key, info in data["types"].items()}),
+                   data["elements"])
 
 
 @dataclass(frozen=True)
@@ -109,31 +120,32 @@ def uniform_study(box: Box, catalogue: Catalogue, computed: bool = False) -> Uni
     figures = None if computed else shipped_uniform(box)
     if figures is None:
         figures = uniform_figures(box)
-    info = {type_id: type_info(type_id, None, catalogue) if type_id in catalogue else MeshType(**own)
-            for type_id, own in figures["types"].items()}
-    return UniformStudy(read_only(figures["counts"]), read_only(info), figures["elements"])
+    info = {type_id: type_info(type_id, None, catalogue) if type_id in catalogue else own
+            for type_id, own in figures.types.items()}
+    return replace(figures, types=read_only(info))
 
 
-def uniform_figures(box: Box) -> dict[str, Any]:
-    """The uniform bisection study of ``box`` as data no catalogue names: ``box`` (its texts), ``counts`` and
-    ``types`` (each type's own name, paper class, VTK cell, vertices and faces) per type id, ``elements``."""
+def uniform_figures(box: Box) -> UniformStudy:
+    """The uniform bisection study of ``box`` as data no catalogue names: ``counts`` and ``types`` (each type's
+    own name, paper class, VTK cell, vertices and faces) per type id, ``elements``."""
     from ..catalogue import Catalogue
     from ..studies.engine import bisection_codes, run_study
 
     study = run_study("bisection", box, bisection_codes(), "octree", criteria=("optimal",))
     nobody = Catalogue.empty(1)
-    return {"box": list(box.texts), "counts": {tc.type.id: tc.count for tc in study.type_counts("optimal")},
-            "types": {tc.type.id: asdict(type_info(tc.type.id, tc.type, nobody)) for tc in study.type_counts("optimal")},
-            "elements": study.total("optimal")}
+    return UniformStudy(read_only({tc.type.id: tc.count for tc in study.type_counts("optimal")}),
+                        read_only({tc.type.id: type_info(tc.type.id, tc.type, nobody)
+                                   for tc in study.type_counts("optimal")}),
+                        study.total("optimal"))
 
 
-def shipped_uniform(box: Box) -> dict[str, Any] | None:
+def shipped_uniform(box: Box) -> UniformStudy | None:
     """The shipped :func:`uniform_figures` of a box shaped like ``box`` (the same proportions), else ``None``."""
     ours = box.squared
     for figures in _shipped_uniform_studies():
         theirs = Box.parse(figures["box"]).squared
         if all(theirs[a] * ours[0] == ours[a] * theirs[0] for a in range(3)):
-            return figures
+            return UniformStudy.from_dict(figures)
     return None
 
 
