@@ -141,17 +141,23 @@ def tree_source(box: Box, levels: int | None = None, refine: Sequence[str | Shap
     return tree_from_leaves(box, rows[:, 0].astype(np.int64), rows[:, 1:].astype(np.int64))
 
 
-def pattern_lookup(patterns: PatternSource | None, criterion: str, box: Box) -> tuple[Lookup | None, str | None]:
-    """The lookup of a pattern table (a path, or a table :func:`cospherical.load_patterns` read) and its name for the report."""
+def pattern_lookup(patterns: PatternSource | None, criterion: str, box: Box,
+                   every_criterion: bool = False) -> tuple[Lookup | None, str | None]:
+    """The lookup of a pattern table (a path, or a table :func:`cospherical.load_patterns` read) and its name for the report.
+
+    Each entry used is checked under ``criterion``, or under every criterion of the table with
+    ``every_criterion`` (see :func:`~cospherical.formats.mesh.table_lookup`).
+    """
     if patterns is None:
         return None, None
     from ..formats.mesh import table_lookup
     from ..formats.patterns import PatternTable, load
 
     if isinstance(patterns, PatternTable):  # read by the caller: named by its study, it has no file name here
-        return table_lookup(patterns, criterion, box), f"{patterns.header.get('study', 'pattern')} table"
+        return (table_lookup(patterns, criterion, box, every_criterion=every_criterion),
+                f"{patterns.header.get('study', 'pattern')} table")
     path = Path(patterns)
-    return table_lookup(load(path), criterion, box, str(path)), path.name
+    return table_lookup(load(path), criterion, box, str(path), every_criterion=every_criterion), path.name
 
 
 class ExactVertices(NamedTuple):
@@ -523,9 +529,11 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
     checks
         ``"all"``: the Delaunay check searches the vertices near every element's sphere,
         none bounded by the tree's structure (a cross-check; the report's ``checks`` says
-        which ran and how), and the uniform study is run even for a box whose figures ship
-        with the package (:func:`~cospherical.mesh.statistics.uniform_study`); ``"default"``:
-        bounded where the tree allows.
+        which ran and how), each table entry used is checked under every criterion of the
+        table (by default only ``criterion``'s elements, the ones that reach the mesh), and the
+        uniform study is run even for a box whose figures ship with the package
+        (:func:`~cospherical.mesh.statistics.uniform_study`); ``"default"``: bounded where the
+        tree allows.
 
     Examples
     --------
@@ -565,7 +573,7 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         origin = (0.0, 0.0, 0.0)
     timings = {"tree": time.perf_counter() - clock}
     clock = time.perf_counter()
-    lookup, name = pattern_lookup(patterns, criterion, source.tree.box)
+    lookup, name = pattern_lookup(patterns, criterion, source.tree.box, every_criterion=checks == "all")
     if patterns is not None:
         timings["table"] = time.perf_counter() - clock
     return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,

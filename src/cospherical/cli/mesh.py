@@ -113,9 +113,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--no-delaunay", action="store_true", help="skip the global Delaunay check of the result")
     parser.add_argument("--check", choices=("default", "all"), default="default",
                         help="all: the Delaunay check searches the vertices near every element's sphere with a k-d "
-                        "tree, none bounded by the tree's structure (a cross-check of that bound), and the uniform "
-                        "study is run even where its figures ship with the package; the report's checks says which "
-                        "checks ran and how")
+                        "tree, none bounded by the tree's structure (a cross-check of that bound), each table entry used "
+                        "is checked under every criterion of the table (not only --criterion's elements), and the "
+                        "uniform study is run even where its figures ship with the package; the report's checks says "
+                        "which checks ran and how")
     parser.add_argument("--no-uniform", action="store_true",
                         help="skip the uniform-weight bisection study beside the frequencies")
 
@@ -360,7 +361,8 @@ def _in_pieces(args, source: TreeSource, out: OutputFolder | None) -> int:
     if args.patterns is not None:
         from ..formats.patterns import load
 
-        table = (load(args.patterns), args.criterion, tree.box, str(args.patterns))
+        # table_lookup's arguments (the shipped catalogue; every criterion checked with --check all)
+        table = (load(args.patterns), args.criterion, tree.box, str(args.patterns), None, args.check == "all")
 
     write = write_piece if listed is None else partial(_write_listed_piece, listed)
 

@@ -129,10 +129,15 @@ class EntryCheck:
     An element (its type, mirror flag and points) recurs across a table's configurations
     and criteria: it is measured once (once across tables too, given one
     :class:`SharedChecks` for the checks of several tables against the same catalogue).
+
+    ``only``: the one criterion whose elements are checked (a mesher's: the other criteria's
+    elements never reach its mesh, and ``fvm_adequate``, which the mesher recomputes from the
+    elements it uses, is checked only when ``only`` is the table's first criterion, the one it
+    describes); ``None``: every criterion, as ``check`` does.
     """
 
     def __init__(self, header: dict, catalogue: Catalogue | None, name: str, geometry: bool = True,
-                 shared: SharedChecks | None = None):
+                 shared: SharedChecks | None = None, only: str | None = None):
         self._types = catalogue if catalogue is not None and len(catalogue) else None
         self._known = frozenset(t.id for t in self._types) if self._types is not None else None
         self._name = name
@@ -144,6 +149,9 @@ class EntryCheck:
         self._squared = box.squared
         self._scale = box.to_float()
         self._criteria = header["criteria"]
+        if only is not None and only not in self._criteria:
+            raise FormatError(f"{name}: no {only!r} elements (it has {', '.join(self._criteria)})")
+        self._only = only
         self._family = base_element(header.get("element", "cuboid"), box, header["face_points"])
         shape = self._family.shape
         self._shared = shared = SharedChecks() if shared is None else shared
@@ -154,7 +162,7 @@ class EntryCheck:
             (shape.name, shape.corners, shape.edges, shape.faces, header["face_points"]), {})
         # what an entry's verdict depends on besides its text and its points
         self._context = (self._squared, shape, self._scale, tuple(self._criteria), self._geometry,
-                         catalogue.version if catalogue is not None else None)
+                         catalogue.version if catalogue is not None else None, only)
         self._placed: dict[tuple, _Placed | str] = {}
         unit = shape.unit_volume
         self._unit_volume = (unit.numerator, unit.denominator)
@@ -208,6 +216,8 @@ class EntryCheck:
         checked: list = []
         inside = True
         for c, criterion in enumerate(self._criteria):
+            if self._only is not None and criterion != self._only:
+                continue
             elements = entry_elements(entry, criterion)
             if elements is None:  # the schema, checked first, gives every criterion its elements
                 raise FormatError(f"{where}/{criterion}: no elements")
@@ -217,7 +227,7 @@ class EntryCheck:
             all_inside = self._elements(elements, positions, shape, f"{where}/{criterion}")
             if c == 0:
                 inside = all_inside
-        if self._geometry:
+        if self._geometry and self._only in (None, self._criteria[0]):
             if entry["fvm_adequate"] != inside:
                 raise FormatError(f"{where}: fvm_adequate is {entry['fvm_adequate']}, recomputed {inside}")
         if text is not None:

@@ -122,7 +122,7 @@ def read_leaves(path: str | Path, max_leaves: int | None = None) -> tuple[np.nda
 
 
 def table_lookup(table, criterion: str, box: Box, name: str = "pattern table",
-                 catalogue: Catalogue | None = None) -> Lookup:
+                 catalogue: Catalogue | None = None, every_criterion: bool = False) -> Lookup:
     """A lookup for :func:`cospherical.mesh.assembly.assemble` reading a pattern table.
 
     The table is asked for the leaf's whole-point-set code (``800000000000+f``), and
@@ -135,7 +135,10 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table",
     the rules of ``cospherical check`` (:class:`~cospherical.formats.check.EntryCheck`:
     node order, recomputed types, tiling, faces met from both sides), so a damaged or
     forged entry raises :class:`FormatError` naming the table and the configuration
-    instead of giving inverted or overlapping cells.
+    instead of giving inverted or overlapping cells.  Its elements under ``criterion`` are
+    the ones checked (the others never reach the mesh: half the leaf table's entries have
+    split elements of their own, a third of the elements); ``every_criterion``: all of them,
+    as ``check`` does (``mesh --check all``).
     """
     if catalogue is None:
         from ..catalogue import shipped_catalogue
@@ -155,7 +158,7 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table",
             raise InputError(f"{name}: its box {' x '.join(header['box'])} is not shaped like the domain "
                              f"{' x '.join(box.texts)}: its tessellations are not the leaves'")
     policy = header.get("face_points", "octree")
-    check = EntryCheck(header, catalogue, name)
+    check = EntryCheck(header, catalogue, name, only=None if every_criterion else criterion)
     checked: set[str] = set()
 
     def elements(code: str):
