@@ -1,6 +1,6 @@
 """Devices: time and memory of the example devices, and a diode beside the one-box mesh of the same size.
 
-    python benchmarks/bench_devices.py [--levels 7] [--anode] [--pairs 3] [--devices GLOB]
+    python benchmarks/bench_devices.py [--levels 7] [--anode] [--pairs 3] [--warmup 1] [--devices GLOB]
 
 Whole processes, each measured by the kernel (``os.wait4``: user + system CPU, peak
 resident memory) and by the wall clock, every output written (``--dual --out``):
@@ -16,7 +16,8 @@ resident memory) and by the wall clock, every output written (``--dual --out``):
     about 2.6 M (minutes and GBs: run them on a quiet machine).  ``--anode`` refines both
     at the anode contact's plane z = 1 too (``plane:0,0,1,1``), half again the leaves:
     about 1 M elements at level 8.  The two run in turn, box then device, ``--pairs N`` times
-    (default 3); the ratios are taken pair by pair and their median is the figure (a shared
+    (default 3) after ``--warmup`` pairs not counted (default 1: a first run after a change of
+    the code also writes Python's and the schemas' caches); the ratios are taken pair by pair and their median is the figure (a shared
     machine's speed drifts between runs, much less within a pair).
 
 Writes results/benchmarks/bench_devices.json (benchmarks/record.py).
@@ -59,11 +60,14 @@ def main() -> None:
     parser.add_argument("--levels", type=int, default=7, help="the diode's level for the comparison (default 7)")
     parser.add_argument("--anode", action="store_true", help="refine the diode at its anode's plane z = 1 too")
     parser.add_argument("--pairs", type=int, default=3, help="box/device runs in turn (default 3)")
+    parser.add_argument("--warmup", type=int, default=1, help="runs not counted first (default 1)")
     parser.add_argument("--devices", default="*", metavar="GLOB", help="the example devices (1) meshes (default: all)")
     args = parser.parse_args()
     cospherical = [sys.executable, "-m", "cospherical", "mesh"]
     with recorded(__file__) as record, tempfile.TemporaryDirectory() as scratch:
         rows = []
+        for _ in range(args.warmup):  # not counted: the first process after a change of the code writes its caches
+            run_usage(cospherical + ["--device", str(EXAMPLES / "pn-diode.yaml"), "--out", str(Path(scratch) / "warm")])
         for path in sorted(EXAMPLES.glob(f"{args.devices}.yaml")):
             out = Path(scratch) / path.stem
             wall, cpu, peak = run_usage(cospherical + ["--device", str(path), "--dual", "--out", str(out)])
@@ -83,10 +87,13 @@ def main() -> None:
                     "diode device": ["--device", str(diode), "--no-uniform"]}
         runs: dict[str, list[tuple[float, float, float]]] = {name: [] for name in commands}
         elements = {}
-        for _ in range(args.pairs):
+        for counted in [False] * args.warmup + [True] * args.pairs:
             for name, command in commands.items():
                 out = Path(scratch) / name.replace(" ", "-")
-                runs[name].append(run_usage(cospherical + command + ["--dual", "--out", str(out)]))
+                usage = run_usage(cospherical + command + ["--dual", "--out", str(out)])
+                if not counted:
+                    continue
+                runs[name].append(usage)
                 elements[name] = json.loads((out / "report.json").read_text())["elements"]
                 wall, cpu, peak = runs[name][-1]
                 print(f"{name:14s} level {args.levels}: {elements[name]:,} elements  {cpu:6.2f} CPU-s  {wall:6.2f} s  "

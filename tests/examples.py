@@ -33,7 +33,7 @@ SMALLER = [
     (re.compile(r"^(python benchmarks/bench_mesh.py)"), r"\1 --levels 4"),
     (re.compile(r"^(python benchmarks/bench_regions.py)"), r"\1 --levels 4"),
     # every example device is meshed as shipped by mesh/test_regions.py (and mos-capacitor by the devices page)
-    (re.compile(r"^(python benchmarks/bench_devices.py).*"), r"\1 --levels 2 --pairs 1 --devices pn-diode"),
+    (re.compile(r"^(python benchmarks/bench_devices.py).*"), r"\1 --levels 2 --pairs 1 --warmup 0 --devices pn-diode"),
     (re.compile(r"^(python benchmarks/bench_scale.py)"), r"\1 --levels 2"),  # L 10 is two processes of minutes and GBs
     (re.compile(r"^(python benchmarks/bench_outputs.py)"), r"\1 --levels 2"),
     # CGAL's wheel is the script's own set-up, not the tests': the example runs with TetGen alone
