@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..catalogue import Catalogue
+from ..choices import DelaunayMode
 from ..version import __version__
 from .assembly import Mesh, MeshType
 from .checks import (DelaunayCheck, OpenFaces, check_circumcenters, check_conformity, check_delaunay, check_volume,
@@ -401,7 +402,7 @@ class MeshReport:
     vertices: int
     elements: int
     types: int
-    delaunay_mode: str
+    delaunay_mode: DelaunayMode
     leaf_mesh: LeafMeshSummary | None
     cells_spanning_leaves: int
     regions_retessellated: int
