@@ -52,11 +52,20 @@ def test_a_bad_store_is_refused_with_exit_2(small_store, tmp_path, damage):
 
 
 def _bomb(connection):
-    # a few kB that would unpack into a gigabyte
+    # 1 MB (just under the store's 1 MiB bound on an entry as stored) that unpacks into a gigabyte: a valid
+    # zlib stream with the store's dictionary, '{' and 1 GiB of spaces. After a full flush the compressor's
+    # history is empty, so each further 16 MiB of spaces compresses to the same bytes: they are repeated
+    # rather than compressed 64 times (3 CPU-s), and the checksum of the whole is put in the trailer.
     (dictionary,) = connection.execute("SELECT data FROM dictionary").fetchone()
     packer = zlib.compressobj(9, zdict=dictionary)
-    spaces = b" " * (1 << 20)
-    blob = packer.compress(b"{") + b"".join(packer.compress(spaces) for _ in range(1024)) + packer.flush()
+    spaces = b" " * (1 << 24)
+    head = packer.compress(b"{") + packer.compress(spaces) + packer.flush(zlib.Z_FULL_FLUSH)
+    again = packer.compress(spaces) + packer.flush(zlib.Z_FULL_FLUSH)
+    checksum = zlib.adler32(b"{")
+    for _ in range(64):
+        checksum = zlib.adler32(spaces, checksum)
+    blob = head + again * 63 + packer.flush()[:-4] + checksum.to_bytes(4, "big")
+    assert len(blob) < 1 << 20
     connection.execute("UPDATE entries SET entry = ? WHERE code = (SELECT min(code) FROM entries)", (blob,))
 
 
