@@ -127,7 +127,7 @@ import numpy as np
 
 from ..core.configuration import Box
 from ..errors import FormatError, InputError, shown
-from ..files.yamlio import atomic_write, machine_memory, parse_json
+from ..files.yamlio import atomic_open, machine_memory, parse_json
 from ..mesh.device import NAME
 from ..mesh.device import DeviceLayout
 from ..mesh.dual import Dual, InterfaceParts, RegionParts
@@ -270,10 +270,10 @@ def write_dual(dual: Dual, path: str | Path) -> None:
     }
     members = {"manifest": _npy(np.frombuffer(json.dumps(manifest, sort_keys=True).encode(), dtype=np.uint8)),
                **members}
-    buffer = io.BytesIO()
-    # a member named (not a ZipInfo) takes the archive's compression and level, and the zip's first date
-    # (1980-01-01 00:00): no clock in the file
-    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED, allowZip64=True, compresslevel=_DEFLATE_LEVEL) as archive:
+    # straight into the file (no copy of the zip in memory), in place only once whole; a member named (not a
+    # ZipInfo) takes the archive's compression and level, and the zip's first date (1980-01-01 00:00): no clock
+    with atomic_open(path, binary=True) as handle, \
+            zipfile.ZipFile(handle, "w", zipfile.ZIP_DEFLATED, allowZip64=True, compresslevel=_DEFLATE_LEVEL) as archive:
         for name, (header, data) in members.items():
             size = len(header) + data.nbytes
             # the header, then the array's bytes as they are (no copy): the same calls for the same dual, the same
@@ -282,7 +282,6 @@ def write_dual(dual: Dual, path: str | Path) -> None:
                 stream.write(header)
                 stream.write(data)
             archive.getinfo(f"{name}.npy").external_attr = 0o644 << 16  # rw-r--r-- when unpacked
-    atomic_write(path, buffer.getvalue())
 
 
 def _sha256(header: bytes, data: memoryview) -> str:
