@@ -38,6 +38,7 @@ SMALLER = [
     (re.compile(r"^(python benchmarks/bench_outputs.py)"), r"\1 --levels 2"),
     # CGAL's wheel is the script's own set-up, not the tests': the example runs with TetGen alone
     (re.compile(r"^(python benchmarks/bench_peers.py)"), r"\1 --levels 2 --runs 1 --peers tetgen"),
+    (re.compile(r"^(python benchmarks/bench_phases.py)"), r"\1 --levels 2 --runs 1"),
     (re.compile(r"^(python benchmarks/bench_startup.py)"), r"\1 --runs 1 --every 64 --tables 'bisection-tetra*'"),
     (re.compile(r"^(python benchmarks/bench_bisection.py)"), r"\1 --every 64"),
     (re.compile(r"^(cospherical sweep --ratios \S+):\d+ (\S+):\d+"), r"\1:2 \2:2"),  # 2 x 2 grid values
