@@ -45,8 +45,9 @@ def test_process_pool_dask_and_brute_force_agree(r4_run, full, monkeypatch):
         assert run_intersection(4, jobs=2) == r4_run and run_intersection(4, dask_workers=2) == r4_run
     # Every configuration tessellated against one per orbit counted as many times as its orbit
     # has members: the whole family with --full (its 287,496 configurations take 20 CPU-s), by
-    # default a seeded 1 in 32 of the orbits, each with all its members (the statistics of a
-    # set of whole orbits are the same either way).
+    # default a seeded 1 in 64 of the orbits (501 orbits, 4,386 configurations: 4 CPU-s brute force; 1 in 32: 6.6), each
+    # with all its members (the statistics of a set of whole orbits are the same either way). The orbits'
+    # members are held to Qhull member by member for the bisection family (core/test_delaunay.py).
     if full:
         brute, by_orbits = run_intersection(4, jobs=2, brute_force=True), r4_run
     else:
@@ -65,7 +66,7 @@ def _sampled_orbits_both_ways(monkeypatch):
     keys, _ = orbit_keys(digits, box_symmetries(Box.parse(["1", "1", "1"])), "compiled")  # each code's orbit
     codes = (digits.astype(np.int64) << (4 * np.arange(11, -1, -1))).sum(axis=1)
     reps, sizes, _ = orbits(4)
-    pick = np.sort(np.random.default_rng(4).choice(len(reps), len(reps) // 32, replace=False))
+    pick = np.sort(np.random.default_rng(4).choice(len(reps), len(reps) // 64, replace=False))
     members = np.sort(codes[np.isin(keys, reps[pick])])
     assert len(members) == sizes[pick].sum() > len(pick)
     monkeypatch.setattr(run, "orbits", lambda resolution, order: (reps[pick], sizes[pick], len(members)))
