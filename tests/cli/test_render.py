@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import pytest
-from commands import cospherical
+from commands import in_process
 
 from tests.outputs.test_latex import SUMMARIES
 
 
-def test_render_refuses_bad_summaries(tmp_path):
+def test_render_refuses_bad_summaries(tmp_path, capsys):
     bad = tmp_path / "bad.json"
     bad.write_text('{"study": "bisection"}')
-    result = cospherical("render", "--summary", str(bad), "--out", str(tmp_path / "out"))
+    result = in_process(capsys, "render", "--summary", bad, "--out", tmp_path / "out")
     assert result.returncode == 2 and "not a study summary" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1
 

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 import pytest
-from commands import cospherical, in_process
+from commands import in_process
 
 from cospherical.formats.patterns import load, pattern_name
 
@@ -68,16 +68,16 @@ def test_each_study_family_has_its_own_help(capsys):
     assert "option of the intersection study only" in capsys.readouterr().err
 
 
-def test_study_cli_element(tmp_path):
+def test_study_cli_element(tmp_path, capsys):
     import json
 
-    result = cospherical("study", "bisection", "--element", "tetrahedron", "--format", "json", "--out", str(tmp_path))
+    result = in_process(capsys, "study", "bisection", "--element", "tetrahedron", "--format", "json", "--out", tmp_path)
     data = json.loads(result.stdout)
     assert data["element"] == "tetrahedron" and data["configurations"] == 64
     optimal = data["criteria"]["optimal"]
     assert optimal["total"] == sum(t["count"] for t in optimal["types"].values())
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bisection-tetrahedron-1x1x1.json",
                                                           "bisection-tetrahedron-1x1x1.yaml"]
-    assert cospherical("check", str(tmp_path / "bisection-tetrahedron-1x1x1.yaml")).returncode == 0
-    result = cospherical("study", "leaves", "--element", "prism")
+    assert in_process(capsys, "check", tmp_path / "bisection-tetrahedron-1x1x1.yaml").returncode == 0
+    result = in_process(capsys, "study", "leaves", "--element", "prism")
     assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
