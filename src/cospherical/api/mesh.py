@@ -322,10 +322,7 @@ class OctreeMesh:
                     binary: bool = False, tets: bool = False, progress: Progress | None = None) -> None:
         """Write the outputs, each to ``path(name)`` (an :class:`~cospherical.files.outputs.OutputFolder`'s ``path``);
         ``progress("outputs", files, n)`` is told as files are written."""
-        from ..formats.mesh import write_report, write_vtu
-        from ..outputs.mesh_picture import cut_png
-
-        mesh, report, source = self.assembled, self.report, self._result.source
+        report, source = self.report, self._result.source
         if gmsh is not None and gmsh not in GMSH_VERSIONS:
             raise InputError(f"Gmsh version {gmsh!r}: write one of {', '.join(GMSH_VERSIONS)}")
         layout = source.device
@@ -339,16 +336,35 @@ class OctreeMesh:
         if gmsh is not None or tets:
             self._write_tetrahedra(path, gmsh, binary, tets)
             wrote((gmsh is not None) + tets)
-        with_dual = report.dual is not None
-        if with_dual:
-            from ..formats.dual import write_dual
+        others = files - (gmsh is not None) - tets  # mesh.vtu, mesh.png, report.json, a device's files, dual.npz
+        if report.dual is None:
+            self._write_mesh_files(path, cut, others, wrote)
+            return
+        from concurrent.futures import ThreadPoolExecutor
 
-            write_dual(self.dual, path("dual.npz"))
-            wrote()
+        from ..formats.dual import write_dual
+
+        # dual.npz is written beside the other files, in a thread of its own: its time is deflate's and the
+        # checksums', which leave the interpreter free for mesh.vtu and mesh.png (the same bytes either way);
+        # its error, if any, is raised here once the others are written
+        with ThreadPoolExecutor(1, thread_name_prefix="dual.npz") as pool:
+            written = pool.submit(write_dual, self.dual, path("dual.npz"))
+            self._write_mesh_files(path, cut, others - 1, wrote, with_dual=True)
+            written.result()
+        wrote()
+
+    def _write_mesh_files(self, path: Callable[[str], Path], cut: float | None, files: int,
+                          wrote: Callable[..., None], with_dual: bool = False) -> None:
+        """``mesh.vtu``, ``mesh.png`` and ``report.json`` (a device's own files in their place): what
+        :meth:`write_files` writes beside dual.npz and the tetrahedra, ``files`` of them."""
+        from ..formats.mesh import write_report, write_vtu
+        from ..outputs.mesh_picture import cut_png
+
+        mesh, report, source = self.assembled, self.report, self._result.source
         point_data, cell_data = self._vtu_data(with_dual)
         if source.device is not None:
             self._write_device(path, cut, point_data, cell_data)
-            wrote(files - (gmsh is not None) - tets - with_dual)
+            wrote(files)
             return
         write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=source.leaf_order)
         wrote()
