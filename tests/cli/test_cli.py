@@ -69,6 +69,39 @@ def test_main_freezes_the_collector_only_as_the_process_command(monkeypatch, cap
         gc.unfreeze()
 
 
+def test_main_as_the_process_command_starts_one_openblas_thread_unless_asked(monkeypatch, capsys):
+    # OpenBLAS starts a spinning thread per core as numpy loads (~0.05 s CPU of every run) for linear
+    # algebra no command calls: run as the process's command, main asks for one before numpy loads,
+    # unless the environment says otherwise; called with an argument list it leaves the environment alone.
+    import os
+    import subprocess
+
+    from cospherical.cli import main
+
+    command = ["tessellate", "--box", "1", "1", "1", "--code", "800000000000"]
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+    assert main(command) == 0, capsys.readouterr().err
+    assert "OPENBLAS_NUM_THREADS" not in os.environ
+    monkeypatch.setattr(sys, "argv", ["cospherical", *command])
+    try:
+        assert main() == 0, capsys.readouterr().err
+        assert os.environ["OPENBLAS_NUM_THREADS"] == "1"
+        monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")
+        assert main() == 0, capsys.readouterr().err
+        assert os.environ["OPENBLAS_NUM_THREADS"] == "3"
+    finally:
+        import gc
+
+        gc.unfreeze()
+    # in a fresh process: asked before numpy loads, OpenBLAS starts no thread (the process keeps its one)
+    script = ("import sys\nfrom cospherical.cli import main\nsys.argv = ['cospherical', '--version']\n"
+              "try:\n    main()\nexcept SystemExit:\n    pass\nimport os, numpy\n"
+              "print(len(os.listdir('/proc/self/task')))")
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
+    found = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
+    assert found.stdout.split()[-1] == "1", found
+
+
 def test_the_scheduler_option_says_it_must_be_a_scheduler_you_run(capsys):
     # Dask unpickles what the scheduler sends: connecting to one is trusting it with your account.
     # The help of each --scheduler says so, and the Dask how-to says why, in one place.

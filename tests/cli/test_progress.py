@@ -45,3 +45,13 @@ def test_stage_bars_open_when_their_stage_starts_and_close_at_the_end(monkeypatc
         assert bars == {"cells": (2, 4, "chunk"), "table": (9, None, "entry")}
         assert "table" in terminal.getvalue()
     assert not any(bar.desc in stages for bar in tqdm._instances)  # both closed
+
+
+def test_no_terminal_no_stage_bars(capsys, monkeypatch):
+    # a large tree's stages report progress; with stderr not a terminal nothing is drawn and tqdm
+    # (which imports multiprocessing and importlib.metadata: ~20 ms of a mesh run) stays unloaded
+    monkeypatch.delitem(sys.modules, "tqdm", raising=False)
+    with stage_bars({"assembly": (100, "assembling", "leaf")}) as advance:
+        advance("assembly", 60)
+        advance("assembly", 40)
+    assert capsys.readouterr().err == "" and "tqdm" not in sys.modules

@@ -27,6 +27,9 @@ def progress_bar(total: int, label: str):
 @contextmanager
 def stage_bars(stages: dict[str, tuple[int | None, str, str]]):
     """Yield ``advance(stage, n)``; one bar per stage (total or None, label, unit), opened when it starts."""
+    if not sys.stderr.isatty():  # as progress_bar: nothing drawn, tqdm (and the multiprocessing it imports) not imported
+        yield _quiet
+        return
     bars: dict = {}
 
     def advance(stage: str, n: int) -> None:
