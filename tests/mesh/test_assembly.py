@@ -159,3 +159,19 @@ def test_a_part_of_a_tree_sees_the_whole_trees_points_on_its_leaves():
     hanging = (whole.slots[part, 8:26] >= 0).any(axis=1) & (tree.levels[part] == 2)
     assert hanging.any()  # leaves at the part's finest level with points of smaller leaves on them
     assert np.array_equal(sub.slots, whole.slots[part])
+
+
+def test_configurations_sharing_an_element_measure_it_once():
+    # assemble measures each element at given node ids and points once for all the configurations
+    # that have it: every configuration's elements are what a measure of its own gives
+    from cospherical.mesh.assembly import local_tessellation
+
+    mesh = assemble(build_octree(CUBE, 3, [parse_shape("sphere:0.5,0.5,0.5,0.3")]))
+    measured: dict = {}
+    elements = 0
+    for tessellation in mesh.tessellations:
+        listed = [(e.type_id, e.nodes) for e in tessellation.elements]
+        shared = local_tessellation(tessellation.configuration, listed, on_the_fly=True, measured=measured)
+        assert shared == tessellation == local_tessellation(tessellation.configuration, listed, on_the_fly=True)
+        elements += len(listed)
+    assert len(mesh.tessellations) == 21 and len(measured) < elements  # some shared, each measured once

@@ -38,7 +38,8 @@ from ..paper import paper_class
 from .device import Regions
 from .tree import Octree, distinct
 
-__all__ = ["CellShape", "Cells", "ElementBlock", "LocalElement", "LocalTessellation", "Lookup", "Mesh", "MeshType", "NODE_OFFSETS",
+__all__ = ["CellShape", "Cells", "ElementBlock", "LocalElement", "LocalTessellation", "Lookup", "MeasureCache", "Mesh",
+           "MeshType", "NODE_OFFSETS",
            "PAPER_FINAL", "assemble", "distinct", "local_tessellation", "type_info", "vertex_keys"]
 
 # Twice the unit coordinates of the 27 nodes (corners, edge midpoints, face centres, body).
@@ -99,9 +100,23 @@ class LocalTessellation:
         return all(e.center_in_leaf for e in self.elements)
 
 
+# An element measured in a configuration's frame, by what the measure reads: the frame's scale and
+# weights, the element's node ids in its order, and their frame coordinates.  The hull's cycles (in
+# node ids), the volume, the sphere and its centre are functions of these alone (the hull reads the
+# nodes' order and their coordinates; frame indices rank as node ids do), so configurations that share
+# an element at the same points measure it once.
+MeasureCache = dict[tuple[int, tuple[int, int, int], tuple[int, ...], tuple[tuple[int, int, int], ...]],
+                    tuple[tuple[tuple[int, ...], ...], Fraction, Sphere | None,
+                          tuple[Fraction, Fraction, Fraction] | None]]
+
+
 def local_tessellation(configuration: Configuration, elements: Iterable[tuple[str, Iterable[int]]],
-                       on_the_fly: bool = False, mapped_from: str | None = None) -> LocalTessellation:
+                       on_the_fly: bool = False, mapped_from: str | None = None,
+                       measured: MeasureCache | None = None) -> LocalTessellation:
     """Measure a configuration's elements (type id, node ids) exactly, trusting nothing but the node lists.
+
+    ``measured``: elements measured before, in other configurations of the same mesh (see
+    :data:`MeasureCache`), taken as they are where their node ids and coordinates are the same.
 
     Examples
     --------
@@ -114,21 +129,26 @@ def local_tessellation(configuration: Configuration, elements: Iterable[tuple[st
     nodes = configuration.nodes()
     frame = Frame.build(nodes, configuration.box.squared)
     index = {node: i for i, node in enumerate(frame.ids)}
-    measured = []
+    cache: MeasureCache = {} if measured is None else measured
+    elements_measured = []
     for type_id, element_nodes in elements:
         element_nodes = tuple(int(n) for n in element_nodes)
         missing = [n for n in element_nodes if n not in index]
         if missing:
             raise InputError(f"pattern table: configuration {configuration.code}: an element ({type_id}) uses "
                              f"node {missing[0]}, which the leaf does not have")
-        # a flat element has no faces and no volume (the volume check reports it); one not co-spherical
-        # has no sphere (it is not a Delaunay element)
-        element = measure(frame, [index[n] for n in element_nodes])
-        measured.append(LocalElement(
-            type_id, element_nodes, tuple(tuple(frame.ids[i] for i in c) for c in element.cycles),
-            element.unit_volume, element.sphere, element.center))
-    return LocalTessellation(configuration.point_set_code or "", configuration, tuple(measured), frame.scale,
-                        frame.weights, on_the_fly, mapped_from)
+        members = [index[n] for n in element_nodes]
+        key = (frame.scale, frame.weights, element_nodes, tuple(frame.coords[i] for i in members))
+        found = cache.get(key)
+        if found is None:
+            # a flat element has no faces and no volume (the volume check reports it); one not co-spherical
+            # has no sphere (it is not a Delaunay element)
+            element = measure(frame, members)
+            found = cache[key] = (tuple(tuple(frame.ids[i] for i in c) for c in element.cycles),
+                                  element.unit_volume, element.sphere, element.center)
+        elements_measured.append(LocalElement(type_id, element_nodes, *found))
+    return LocalTessellation(configuration.point_set_code or "", configuration, tuple(elements_measured),
+                             frame.scale, frame.weights, on_the_fly, mapped_from)
 
 
 @dataclass(frozen=True)
@@ -591,11 +611,12 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
     leaf_tessellation = (np.cumsum(seen) - 1)[value]
     tessellations: list[LocalTessellation] = []
     types: dict[str, MeshType] = {}
+    measured: MeasureCache = {}
     for value in distinct.tolist():
         code = _leaf_code(value & 0xFFF, value >> 12)
         if (code, criterion) not in cache:
             cache[code, criterion] = _leaf_tessellation(Configuration.from_code(code, tree.box), lookup, types,
-                                                        criterion, catalogue)
+                                                        criterion, catalogue, measured)
         tessellations.append(cache[code, criterion])
     for tessellation in tessellations:
         for element in tessellation.elements:
@@ -613,12 +634,14 @@ def assemble(tree: Octree, lookup: Lookup | None = None, progress: Callable[[int
 
 
 def _leaf_tessellation(configuration: Configuration, lookup: Lookup | None, types: dict[str, MeshType],
-                       criterion: str, catalogue: Catalogue) -> LocalTessellation:
+                       criterion: str, catalogue: Catalogue, measured: MeasureCache) -> LocalTessellation:
     elements = lookup(configuration) if lookup is not None else None
     if elements is not None:
         return local_tessellation(configuration, [(e["type"], e["nodes"]) for e in elements],
-                                  mapped_from=next((e["mapped_from"] for e in elements if "mapped_from" in e), None))
+                                  mapped_from=next((e["mapped_from"] for e in elements if "mapped_from" in e), None),
+                                  measured=measured)
     tess = apply_catalogue_criterion(tessellate(configuration), criterion, catalogue)
     for element in tess.elements:
         types.setdefault(element.type.id, type_info(element.type.id, element.type, catalogue))
-    return local_tessellation(configuration, [(e.type.id, e.nodes) for e in tess.elements], on_the_fly=True)
+    return local_tessellation(configuration, [(e.type.id, e.nodes) for e in tess.elements], on_the_fly=True,
+                              measured=measured)
