@@ -42,18 +42,18 @@ def reference_sums(mesh):
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(octrees(), st.booleans(), st.booleans())
 def test_bulk_sums_equal_leaf_by_leaf_sums_exactly(mesh, packed, small_blocks):
-    """The sorted bulk sums (key and payload packed in one int64, or argsorted apart; in blocks of 2**21
+    """The sorted bulk sums (key and payload packed in one int64, or argsorted apart; in blocks of 2**17
     instances with each payload's value from one table, or in blocks of 16 with the numerators shifted by
     the sizes) are the leaf-by-leaf sums."""
     from cospherical.mesh.dual import sums as module
 
-    saved, chunk = module.PACKED_BITS, module._CHUNK
+    saved, chunk, values = module.PACKED_BITS, module._CHUNK, module._VALUES
     module.PACKED_BITS = saved if packed else 0  # 0: nothing fits, the argsort path
-    module._CHUNK = 16 if small_blocks else chunk  # 16: no payload table fits
+    module._CHUNK, module._VALUES = (16, 16) if small_blocks else (chunk, values)  # 16: no payload table fits
     try:
         dual = mesh_dual(mesh)
     finally:
-        module.PACKED_BITS, module._CHUNK = saved, chunk
+        module.PACKED_BITS, module._CHUNK, module._VALUES = saved, chunk, values
     coefficients, volumes = reference_sums(mesh)
     assert list(map(tuple, dual.edges.tolist())) == sorted(coefficients)
     grid = Fraction(dual.grid)
