@@ -53,9 +53,13 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     # The zip writer knows no file format of ours: the dual's writer builds on it, not the other way.
     deflated = tmp_path / "cospherical" / "formats" / "deflated.py"
     deflated.write_text(deflated.read_text() + "\nfrom .dual import write_dual  # wrong on purpose\n")
+    # One check reaching into another: the mesh's checks stand side by side.
+    volume = tmp_path / "cospherical" / "mesh" / "checks" / "volume.py"
+    volume.write_text(volume.read_text() + "\nfrom .conformity import pair_faces  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
-    assert "Contracts: 0 kept, 9 broken." in result.stdout
+    assert "Contracts: 0 kept, 10 broken." in result.stdout
+    assert "cospherical.mesh.checks.volume -> cospherical.mesh.checks.conformity" in result.stdout
     assert "cospherical.formats.deflated -> cospherical.formats.dual" in result.stdout
     assert "cospherical.mesh.merged_cells -> cospherical.mesh.delaunay" in result.stdout
     assert "cospherical.mesh.tree -> cospherical.mesh.octree" in result.stdout

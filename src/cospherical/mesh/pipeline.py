@@ -255,7 +255,7 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
     checks
         ``all``: the Delaunay check searches the vertices near every sphere with a k-d tree,
         none bounded by the tree's structure (the cross-check of that bound: see
-        :mod:`cospherical.mesh.checks`), and the uniform study is computed even where its
+        :mod:`cospherical.mesh.checks.empty_sphere`), and the uniform study is computed even where its
         figures ship precomputed; ``default``: bounded where the tree allows.
     """
     mode = delaunay_mode(criterion, delaunay)

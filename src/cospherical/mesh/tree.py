@@ -120,7 +120,7 @@ class Octree:
     whose leaves touch across a face, an edge or a corner only when at most one level apart
     (:func:`build_octree` with ``balance="vertex"``): all of them, or a part (a device keeps
     the leaves inside its boxes); the exact Delaunay check then bounds
-    where a vertex can lie near a leaf (:mod:`cospherical.mesh.checks`).  ``False``
+    where a vertex can lie near a leaf (:mod:`cospherical.mesh.checks.empty_sphere`).  ``False``
     claims nothing.
     """
 
