@@ -59,14 +59,18 @@ def test_main_freezes_the_collector_only_as_the_process_command(monkeypatch, cap
 
     command = ["tessellate", "--box", "1", "1", "1", "--code", "800000000000"]
     frozen = gc.get_freeze_count()
+    threshold = gc.get_threshold()
     assert main(command) == 0, capsys.readouterr().err
-    assert gc.get_freeze_count() == frozen
+    assert gc.get_freeze_count() == frozen and gc.get_threshold() == threshold
     monkeypatch.setattr(sys, "argv", ["cospherical", *command])
     try:
         assert main() == 0, capsys.readouterr().err
         assert gc.get_freeze_count() > frozen
+        # and the collector's first generation runs seldom: the command's objects hold almost no cycles
+        assert gc.get_threshold() == (50_000, *threshold[1:])
     finally:
         gc.unfreeze()
+        gc.set_threshold(*threshold)
 
 
 def test_main_as_the_process_command_starts_one_openblas_thread_unless_asked(monkeypatch, capsys):
@@ -78,7 +82,10 @@ def test_main_as_the_process_command_starts_one_openblas_thread_unless_asked(mon
 
     from cospherical.cli import main
 
+    import gc
+
     command = ["tessellate", "--box", "1", "1", "1", "--code", "800000000000"]
+    threshold = gc.get_threshold()
     monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
     assert main(command) == 0, capsys.readouterr().err
     assert "OPENBLAS_NUM_THREADS" not in os.environ
@@ -90,9 +97,8 @@ def test_main_as_the_process_command_starts_one_openblas_thread_unless_asked(mon
         assert main() == 0, capsys.readouterr().err
         assert os.environ["OPENBLAS_NUM_THREADS"] == "3"
     finally:
-        import gc
-
         gc.unfreeze()
+        gc.set_threshold(*threshold)
     # in a fresh process: asked before numpy loads, OpenBLAS starts no thread (the process keeps its one)
     script = ("import sys\nfrom cospherical.cli import main\nsys.argv = ['cospherical', '--version']\n"
               "try:\n    main()\nexcept SystemExit:\n    pass\nimport os, numpy\n"

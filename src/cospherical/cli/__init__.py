@@ -139,6 +139,10 @@ def main(argv: list[str] | None = None) -> int:
         # loads and they spin, ~0.05 s CPU of every run (0.11 -> 0.06 s for `import numpy`), for
         # linear algebra no command calls. One thread, unless the environment asks for more.
         os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+        # The cycle collector's first generation every 50,000 allocations instead of 700: a command's
+        # objects (arrays, tuples, Fractions, frozen dataclasses) hold almost no cycles, and at the
+        # default the collector ran ~160 times in a level-7 mesh run for 0.025 s CPU (0.008 s now).
+        gc.set_threshold(50_000, *gc.get_threshold()[1:])
     _closed_standard_streams()
     with warnings.catch_warnings():
         python_shows = warnings.showwarning
