@@ -51,3 +51,22 @@ def test_bare_element_lists_pair_as_the_mesh_on_any_octree(mesh):
     conn, sizes = mesh.connectivity()
     faces = element_faces(mesh.vertices, conn, sizes, _shapes(mesh.vertices, conn), mesh.box.squared)
     assert pair_faces(faces, mesh.vertices, mesh.grid) == check_conformity(mesh)
+
+
+def test_faces_given_as_columns_of_a_table_pair_as_the_same_faces_given_as_rows():
+    # A mesh hands its faces as columns of a leaf table (its rows rank alike: ranked together, from the
+    # first row); any other table's rows are ranked one by one. Either way the pairs, the faces met once
+    # and the examples are those of the same faces given as plain rows of ids.
+    rng = np.random.default_rng(5)
+    grid = 64
+    vertices = rng.integers(1, grid, (400, 3))  # off the box's boundary: a face met once is nonconforming
+    ranked_alike = np.sort(rng.permuted(np.tile(np.arange(400), (50, 1)), axis=1)[:, :4], axis=1)
+    shuffled = rng.permuted(ranked_alike, axis=1)
+    assert (np.diff(ranked_alike, axis=1) > 0).all() and not (np.diff(shuffled, axis=1) > 0).all()
+    cycles = [(0, 1, 2), (2, 1, 0), (0, 1, 3), (1, 2, 3), (3, 2, 1)]
+    for table in (ranked_alike, shuffled, ranked_alike[:1]):
+        as_columns = {3: [(table, cycle) for cycle in cycles]}
+        as_rows = {3: [table[:, list(cycle)] for cycle in cycles]}
+        found = pair_faces(as_columns, vertices, grid, examples=50)
+        assert found == pair_faces(as_rows, vertices, grid, examples=50)
+        assert found.interior_faces == 2 * len(table) and found.nonconforming_faces == 1 * len(table)
