@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from fractions import Fraction
+from functools import cached_property
 from typing import Any, Callable, Iterable, Iterator, NamedTuple
 
 import numpy as np
@@ -73,7 +74,7 @@ class LocalElement:
     sphere: Sphere | None
     center: tuple[Fraction, Fraction, Fraction] | None
 
-    @property
+    @cached_property  # read per element by several checks and writers: Fraction comparisons, made once
     def center_in_leaf(self) -> bool:
         return self.center is not None and all(0 <= x <= 1 for x in self.center)
 
@@ -94,7 +95,7 @@ class LocalTessellation:
     on_the_fly: bool
     mapped_from: str | None = None  # the table's orbit representative its elements were carried back from
 
-    @property
+    @cached_property
     def fvm_adequate(self) -> bool:
         """Every circumcenter in the closed leaf, decided exactly."""
         return all(e.center_in_leaf for e in self.elements)
