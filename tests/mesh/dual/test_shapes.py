@@ -32,18 +32,22 @@ def test_element_list_path_equals_the_configuration_path():
 
 
 def test_pieces_remembered_per_shape_are_each_elements_own():
-    """A configuration's pieces, its elements measured once per shape up to translation and moved back, are the
-    pieces of each element measured where it lies, exactly: boundary planes, node ids and all (a cube, whose
-    configurations repeat shapes at other corners, and a 1 x sqrt 2 x sqrt 2 box)."""
+    """A configuration's pieces, its elements measured once per class of shapes up to translation and the box's
+    symmetries and mapped and moved back, are the pieces of each element measured where it lies, exactly:
+    boundary planes, node ids and all (a cube, whose configurations repeat shapes at other corners and in
+    mirror images, a 1 x sqrt 2 x sqrt 2 box, whose last two axes may be swapped, and a 1 x 2 x 4 box, only
+    mirrored)."""
     from cospherical.mesh.dual import shapes
     from cospherical.mesh.dual.pieces import element_pieces
 
-    for texts, shape in ((["1", "1", "1"], "sphere:0.5,0.5,0.5,0.3"), (["1", "sqrt(2)", "sqrt(2)"], "point:0.3,0.4,0.5")):
+    for texts, shape in ((["1", "1", "1"], "sphere:0.5,0.5,0.5,0.3"), (["1", "sqrt(2)", "sqrt(2)"], "point:0.3,0.4,0.5"),
+                         (["1", "2", "4"], "point:1/3,1/5,1/7")):
         box = Box.parse(texts)
         mesh = assemble(build_octree(box, 3, [parse_shape(shape)]), cache=CACHES.setdefault(box.texts, {}))
         squared = tuple(Fraction(x) for x in box.squared)
         shapes._REMEMBERED.clear()
         shapes._SHAPES.clear()
+        shapes._CLASSES.clear()
         elements = 0
         for _, tessellation, _ in mesh.groups():
             points = tessellation.configuration.nodes()
@@ -55,6 +59,7 @@ def test_pieces_remembered_per_shape_are_each_elements_own():
             assert direct.volume_q == remembered.volume_q and direct.boundary == remembered.boundary
             elements += len(tessellation.elements)
         assert len(shapes._SHAPES) < elements or texts[1] != "1"  # the cube's shapes were met again
+        assert len(shapes._CLASSES) < len(shapes._SHAPES)  # and mapped: measured once per class
 
 
 def test_element_shapes_are_classed_exactly_even_when_their_hashes_collide(monkeypatch):
