@@ -119,12 +119,21 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
             np.add.at(volume_exact, ids, sizes[part, None].astype(dtype) ** 3 * q)
             if shape.boundary:
                 touching_parts.append(part.start + np.flatnonzero(boundary[ids].any(axis=1)))
-        touching = np.concatenate(touching_parts) if touching_parts else np.zeros(0, dtype=np.int64)
-        for (axis, _, node), share in shape.boundary:
-            ids = source[rows[touching], node].astype(np.int64)
-            on = (verts[ids, axis] == 0) | (verts[ids, axis] == grid)
+        if not touching_parts:
+            continue
+        touching = np.concatenate(touching_parts)
+        # every boundary share of every touching member at once: (member, share) tables of vertex ids and axes
+        axes = np.array([axis for (axis, _, _), _ in shape.boundary], dtype=np.int64)
+        nodes = np.array([node for (_, _, node), _ in shape.boundary], dtype=np.int64)
+        shares = np.array([_over(share, bden) for _, share in shape.boundary], dtype=object).astype(dtype)
+        for part in _chunks(len(touching), len(nodes)):
+            members = touching[part]
+            ids = source[rows[members, None], nodes].astype(np.int64)
+            coordinate = verts[ids, axes]
             # the face lies in the vertex's plane: on the boundary where that plane is a side of the domain
-            np.add.at(boundary_exact[:, axis], ids[on], sizes[touching][on].astype(dtype) ** 2 * _over(share, bden))
+            on = (coordinate == 0) | (coordinate == grid)
+            values = sizes[members, None].astype(dtype) ** 2 * shares
+            np.add.at(boundary_exact, (ids[on], np.broadcast_to(axes, ids.shape)[on]), values[on])
     lengths = np.array(box.to_float())
     real = verts * (lengths / grid)
     factor = math.sqrt(factor_squared)
