@@ -12,10 +12,14 @@ imported only by its caller: this module reads the object's attributes.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import InputError
+
+if TYPE_CHECKING:
+    import discretize
 
 __all__ = ["TreeMeshLeaves", "treemesh_leaves"]
 
@@ -30,7 +34,7 @@ class TreeMeshLeaves:
     positions: np.ndarray
 
 
-def treemesh_leaves(tree_mesh) -> TreeMeshLeaves:
+def treemesh_leaves(tree_mesh: discretize.TreeMesh) -> TreeMeshLeaves:
     """The leaves of ``tree_mesh`` (a 3-D ``discretize.TreeMesh``) and its domain.
 
     The sides are the sums of the base cell widths, written as the shortest decimal

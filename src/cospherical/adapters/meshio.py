@@ -7,15 +7,22 @@ the split keeps the exact dual, its added edges couple 0).  meshio is imported w
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..errors import InputError
 from ..mesh.tetrahedra import split_tetrahedra
 
+if TYPE_CHECKING:
+    import meshio
+
+    from ..mesh.assembly import Mesh
+
 __all__ = ["to_meshio"]
 
 
-def to_meshio(mesh, points: np.ndarray, leaves: np.ndarray | None = None):
+def to_meshio(mesh: Mesh, points: np.ndarray, leaves: np.ndarray | None = None) -> meshio.Mesh:
     """``mesh`` (an assembled :class:`~cospherical.mesh.assembly.Mesh`) split into tetrahedra, as a ``meshio.Mesh``.
 
     ``points``: the vertices' coordinates.  Cell data of the one ``tetra`` block:

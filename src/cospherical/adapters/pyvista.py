@@ -10,13 +10,20 @@ cells sorted by VTK cell type, cell data ``element`` (the element each cell is),
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import InputError
 from ..formats.mesh import vtu_grid
 from ..formats.vtu import VTK_CELL
+
+if TYPE_CHECKING:
+    import pyvista
+
+    from ..mesh.assembly import Mesh
 
 __all__ = ["import_pyvista", "legacy_cells", "to_pyvista"]
 
@@ -62,8 +69,9 @@ def legacy_cells(types: np.ndarray, connectivity: np.ndarray, offsets: np.ndarra
     return cells
 
 
-def to_pyvista(mesh, point_data: dict | None = None, cell_data: dict | None = None, leaves: np.ndarray | None = None,
-               origin=(0.0, 0.0, 0.0), field_data: dict | None = None):
+def to_pyvista(mesh: Mesh, point_data: dict[str, np.ndarray] | None = None, cell_data: dict[str, np.ndarray] | None = None,
+               leaves: np.ndarray | None = None, origin: Sequence[float] = (0.0, 0.0, 0.0),
+               field_data: dict[str, np.ndarray] | None = None) -> pyvista.UnstructuredGrid:
     """``mesh`` (an assembled :class:`~cospherical.mesh.assembly.Mesh`) as a ``pyvista.UnstructuredGrid``.
 
     ``point_data``, ``cell_data`` (rows in vertex and element order), ``leaves`` and

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import hashlib
 import json
-from typing import Sequence
+from typing import Any, Mapping, Protocol, Sequence
 from pathlib import Path
 
 from ..core.canonical import canonical_form
-from ..core.configuration import Configuration
+from ..core.configuration import Box, Configuration
 from ..core.delaunay import delaunay_cells
 from ..core.element_types import ElementType
 from ..core.geometry import Frame
@@ -27,10 +27,10 @@ from ..files.flowyaml import decode_entry, split_section
 from ..files.yamlio import read_text
 from ..version import __version__
 from .model import Catalogue
-from .criteria import option_types, split_options, split_positions
+from .criteria import Choice, option_types, split_options, split_positions
 from .names import SCHEMA_VERSION, type_names
 
-__all__ = ["build_catalogue", "intersection_examples"]
+__all__ = ["StudyResult", "build_catalogue", "intersection_examples"]
 
 
 def _chiral(element) -> bool:
@@ -39,7 +39,22 @@ def _chiral(element) -> bool:
     return canonical_form(mirror, element.polyhedron.face_kinds).mirrored != element.mirrored
 
 
-def _study_label(study) -> str:
+class StudyResult(Protocol):
+    """What the catalogue reads of a study: a :class:`cospherical.studies.engine.Study` (a layer above) is one."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def box(self) -> Box: ...
+    @property
+    def face_points(self) -> str: ...
+    @property
+    def element(self) -> str: ...
+    @property
+    def choices(self) -> Mapping[str, Choice]: ...
+
+
+def _study_label(study: StudyResult) -> str:
     element = "" if study.element == "cuboid" else f" {study.element}"
     return f"{study.name}{element} {'x'.join(study.box.texts)} {study.face_points}"
 
@@ -83,7 +98,7 @@ def intersection_examples(path: str | Path | None = None) -> list[dict]:
     return found
 
 
-def build_catalogue(studies, extra: Sequence[dict] = ()) -> Catalogue:
+def build_catalogue(studies: Sequence[StudyResult], extra: Sequence[dict[str, Any]] = ()) -> Catalogue:
     """The catalogue of every element type met in the studies (written by
     :func:`cospherical.formats.catalogue_file.write_catalogue`).
 

@@ -12,10 +12,12 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass, replace
-from typing import Sequence
+from typing import Literal, Sequence, overload
 
 from ..caches import cached
-from ..core.geometry import Frame
+from ..choices import SPLIT_CRITERIA
+from ..core.geometry import Frame, Rational
+from ..core.polyhedron import Polyhedron
 from ..core.split import subdivisions
 from ..core.tessellation import Element, Tessellation
 from .model import Catalogue
@@ -38,7 +40,8 @@ def element_options(tess: Tessellation, element: Element, criterion: str) -> tup
 
 # The same element (same node ids at the same places) recurs across configurations.
 @cached(maxsize=1 << 14)
-def split_options(points, squared, poly, criterion) -> tuple[tuple[Element, ...], ...]:
+def split_options(points: tuple[tuple[int, Sequence[Rational]], ...], squared: Sequence[Rational], poly: Polyhedron,
+                  criterion: str) -> tuple[tuple[Element, ...], ...]:
     """Every split of the polyhedron ``poly`` with ``points`` ((node, unit coordinates) pairs)
     under a criterion, the element itself first, pieces classified."""
     if criterion == "internal_faces":
@@ -49,9 +52,12 @@ def split_options(points, squared, poly, criterion) -> tuple[tuple[Element, ...]
         edges = set(poly.edges)
         return tuple(option for option in split_options(points, squared, poly, "internal_edges_and_faces")
                      if all(edge in edges for piece in option for edge in piece.polyhedron.edges))
+    split_criterion = next((c for c in SPLIT_CRITERIA if c == criterion), None)
+    if split_criterion is None:
+        raise ValueError(f"{criterion!r} is not a split criterion")
     frame = Frame.build(dict(points), squared)
     options = []
-    for split in subdivisions(frame, poly, criterion):
+    for split in subdivisions(frame, poly, split_criterion):
         options.append(tuple(Element.from_polyhedron(piece) for piece in split))
     # Fewest pieces, then the smallest multiset of piece types: a rule a symmetry cannot change,
     # so every member of an orbit is split alike (node lists only break the remaining ties).
@@ -107,7 +113,14 @@ class Choice:
     splits: dict[str, Counter]
 
 
-def split_tessellation(tess: Tessellation, kept: frozenset[str], criterion: str, strict: bool = True):
+@overload
+def split_tessellation(tess: Tessellation, kept: frozenset[str], criterion: str,
+                       strict: Literal[False]) -> tuple[Tessellation, list[tuple[Element, tuple[Element, ...]]]]: ...
+@overload
+def split_tessellation(tess: Tessellation, kept: frozenset[str], criterion: str,
+                       strict: bool = True) -> tuple[Tessellation, list[tuple[Element, tuple[Element, ...]]]] | None: ...
+def split_tessellation(tess: Tessellation, kept: frozenset[str], criterion: str,
+                       strict: bool = True) -> tuple[Tessellation, list[tuple[Element, tuple[Element, ...]]]] | None:
     """Split every element whose type is not kept into kept types, fewest pieces first.
 
     Returns ``(tessellation, used)`` with ``used`` the list of (element, pieces)
@@ -194,13 +207,15 @@ def choose(tessellations: dict[str, Tessellation], sizes: dict[str, int], criter
     split: dict[str, Tessellation] = {}
     splits: dict[str, Counter] = {}
     for rep, tess in tessellations.items():
-        split[rep], used = split_tessellation(tess, kept, criterion)
+        done = split_tessellation(tess, kept, criterion)
+        assert done is not None, "choose_kept's set splits every element into kept types"
+        split[rep], used = done
         for element, pieces in used:
             splits.setdefault(element.type.id, Counter())[split_positions(element, pieces)] += sizes[rep]
     return Choice(criterion, kept, split, splits)
 
 
-def split_positions(element: Element, pieces) -> tuple[tuple[str, tuple[int, ...]], ...]:
+def split_positions(element: Element, pieces: Sequence[Element]) -> tuple[tuple[str, tuple[int, ...]], ...]:
     """A split as the catalogue records it: (piece type, piece nodes as positions in the element's
     reference order), sorted."""
     position = {node: i for i, node in enumerate(element.nodes)}

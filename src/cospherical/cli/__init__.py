@@ -16,6 +16,7 @@ import signal
 import sys
 import threading
 import warnings
+from typing import NoReturn, TextIO
 
 from ..errors import CosphericalError, CosphericalWarning, UsageError, one_line
 from ..version import __version__
@@ -29,7 +30,7 @@ _SUBCOMMANDS = ("tessellate", "study", "reproduce", "render", "diff", "check", "
 
 class _Parser(argparse.ArgumentParser):
     # argparse prints the whole usage block; a usage error here is one line.
-    def error(self, message: str):
+    def error(self, message: str) -> NoReturn:
         raise UsageError(f"{self.prog}: error: {message}")
 
     # argparse drops a failed write of --help or --version (a closed stdout, /dev/full) and exits 0;
@@ -147,12 +148,13 @@ def main(argv: list[str] | None = None) -> int:
     with warnings.catch_warnings():
         python_shows = warnings.showwarning
 
-        def show(message, category, *where, **more) -> None:
+        def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                 file: TextIO | None = None, line: str | None = None) -> None:
             # the library's warnings about the input are one line, as its errors are; others as Python shows them
             if issubclass(category, CosphericalWarning):
                 _say(f"cospherical: warning: {message}")
             else:
-                python_shows(message, category, *where, **more)
+                python_shows(message, category, filename, lineno, file, line)
 
         warnings.showwarning = show
         return _main(argv)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 from ..catalogue import catalogue_path, load_catalogue
@@ -23,7 +24,7 @@ DESCRIPTION = ("Validate catalogues (schema, unique ids, consistent faces, known
                "Exit status 0 when every file is valid, 2 at the first problem.")
 
 
-def add_arguments(parser) -> None:
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("files", nargs="+", type=path_argument, metavar="FILE",
                         help="catalogues, pattern tables (YAML, or the SQLite store of study intersection --patterns) "
                         "and dual.npz files of mesh --dual, checked in order (about 1-2 s per 4096-configuration "
@@ -34,7 +35,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--no-tiling", action="store_true", help="skip the geometric tiling check (faster)")
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     catalogue = None
     shared = SharedChecks()  # what recurs across the tables is checked once (one catalogue for all of them)
     for path in args.files:

@@ -5,6 +5,7 @@ Exit status as diff(1): 0 no difference, 1 differences, 2 trouble.
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -23,7 +24,7 @@ DESCRIPTION = ("Compare two catalogues (types matched by canonical code) or two 
                "1 differences, 2 trouble.")
 
 
-def add_arguments(parser) -> None:
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("files", nargs="+", metavar="FILE", help="OLD NEW, or with --rev just the file")
     parser.add_argument("--rev", metavar="REV", help="read OLD from git at this revision (e.g. HEAD~3)")
     parser.add_argument("--format", choices=("text", "json", "yaml"), default="text",
@@ -37,7 +38,7 @@ def _from_git(rev: str, path: Path):
     return git_text(rev, path)
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
 
     if args.rev:
         if len(args.files) != 1:

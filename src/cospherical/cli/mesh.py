@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 import time
@@ -40,7 +41,7 @@ DESCRIPTION = ("Mesh a 1-irregular octree: each leaf's true configuration, its e
                "coefficients).")
 
 
-def add_arguments(parser) -> None:
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     domain = parser.add_mutually_exclusive_group(required=True)
     domain.add_argument("--domain", nargs=3, metavar=("A", "B", "C"),
                         help="the root cell's lengths, exact: 1, 1.4142, 3/2, sqrt(2)")
@@ -177,7 +178,7 @@ def _text(value) -> str:
     return f"{value:,}" if isinstance(value, int) else str(value)
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     pieces = _pieces(args)
     if args.device is not None:
         from ..formats.device_file import read_device

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import functools
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from ..errors import one_line
@@ -25,7 +26,7 @@ def path_argument(text: str) -> Path:
     return Path(text)
 
 
-def emit(data, fmt: str) -> None:
+def emit(data: object, fmt: str) -> None:
     sys.stdout.write(dump(data, fmt))
 
 
@@ -40,12 +41,12 @@ def say(line: str) -> None:
     sys.stdout.write(one_line(line) + "\n")
 
 
-def holding_out(run):
+def holding_out(run: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
     """``run(args)`` with ``args.out``, when given, held by a :class:`FolderLock` for the whole run: one
     run at a time fills a folder (a study's checkpoints, a sweep's figures)."""
 
     @functools.wraps(run)
-    def held(args) -> int:
+    def held(args: argparse.Namespace) -> int:
         if args.out is None:
             return run(args)
         with FolderLock(args.out):

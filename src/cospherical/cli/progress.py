@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import cast
 
 __all__ = ["progress_bar", "stage_bars"]
 
@@ -13,7 +15,7 @@ def _quiet(*args) -> None:
 
 
 @contextmanager
-def progress_bar(total: int, label: str):
+def progress_bar(total: int, label: str) -> Iterator[Callable[[int], None]]:
     """Yield ``advance(n)``; the bar shows configurations done out of ``total``."""
     if not sys.stderr.isatty():  # tqdm would draw nothing; not importing it saves start-up time
         yield _quiet
@@ -21,11 +23,12 @@ def progress_bar(total: int, label: str):
     from tqdm import tqdm
 
     with tqdm(total=total, desc=label, unit="cfg", disable=None, leave=False) as bar:
-        yield bar.update
+        # update's result (whether it redrew) is no caller's business: handed on as a callback that returns nothing
+        yield cast(Callable[[int], None], bar.update)
 
 
 @contextmanager
-def stage_bars(stages: dict[str, tuple[int | None, str, str]]):
+def stage_bars(stages: dict[str, tuple[int | None, str, str]]) -> Iterator[Callable[[str, int], None]]:
     """Yield ``advance(stage, n)``; one bar per stage (total or None, label, unit), opened when it starts."""
     if not sys.stderr.isatty():  # as progress_bar: nothing drawn, tqdm (and the multiprocessing it imports) not imported
         yield _quiet

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 from pathlib import Path
@@ -28,7 +29,7 @@ DESCRIPTION = ("Render the element, frequency, FVM and paper-comparison tables o
                "(jinja2 templates), with a standalone document.tex that includes them all.")
 
 
-def add_arguments(parser) -> None:
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--study", choices=["bisection"], help="run this study first")
     source.add_argument("--summary", nargs="+", type=path_argument, metavar="FILE",
@@ -77,7 +78,7 @@ def _refuse_non_finite(data, path: Path) -> None:
             stack.extend(((*where, str(i)), v) for i, v in enumerate(item))
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
 
     if args.study:
         if not args.box:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 from ..outputs.reproduce import reproduce
@@ -19,12 +20,12 @@ DESCRIPTION = ("Run the bisection studies of the paper's boxes A (1,1,1), B (1,2
                "the paper side by side.")
 
 
-def add_arguments(parser) -> None:
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--root", type=path_argument, default=Path("."), metavar="DIR",
                         help="where catalogue/, patterns/ and results/ go (default: the current folder)")
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     with progress_bar(paper_studies_total(), "reproduce") as advance:
         message = reproduce(args.root, progress=advance)
     say(message)

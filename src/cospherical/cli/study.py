@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from typing import Any
 
 from ..catalogue import shipped_catalogue
 from ..choices import INSERTION_ORDERS, POINT_POLICIES
@@ -46,7 +47,7 @@ DESCRIPTION = ("Tessellate every configuration of a family (one per symmetry orb
                "cospherical study FAMILY --help.")
 
 
-def add_arguments(parser) -> None:
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     families = parser.add_subparsers(dest="family", required=True, metavar="{bisection,leaves,intersection}",
                                      help="the family of configurations to study",
                                      parser_class=type(parser))
@@ -54,10 +55,10 @@ def add_arguments(parser) -> None:
         _add_family(families.add_parser(family, help=summary, description=description), family)
 
 
-def _add_family(parser, family: str) -> None:
+def _add_family(parser: argparse.ArgumentParser, family: str) -> None:
     """The options of one family; the others' are accepted but hidden, so that ``run`` refuses them by name."""
 
-    def option(*flags, only=None, **kwargs):
+    def option(*flags: str, only: tuple[str, ...] | None = None, **kwargs: Any) -> None:
         if only is not None and family not in only:
             kwargs["help"] = argparse.SUPPRESS
         parser.add_argument(*flags, **kwargs)
@@ -113,7 +114,7 @@ _INTERSECTION_DEFAULTS = {"resolution": 16, "order": "edge", "jobs": os.cpu_coun
 
 
 @holding_out
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     if args.element != "cuboid" and args.family != "bisection":
         raise UsageError(f"cospherical study: error: --element {args.element}: the {args.family} study is of cuboids; "
                          "other base elements have the bisection study")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 
 from ..core.exact import parse_rational
@@ -22,7 +23,7 @@ DESCRIPTION = ("Run the bisection study for every box (1, b, c) of a grid (b <= 
                "along a ray of boxes such as (1, r, r), every r where the FVM-adequate count or the element set changes.")
 
 
-def add_arguments(parser) -> None:
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     mode = parser.add_mutually_exclusive_group(required=True)
     mode.add_argument("--ratios", nargs=2, metavar=("B_MIN:B_MAX:STEPS", "C_MIN:C_MAX:STEPS"),
                       help="grid of b and c values, each MIN:MAX:STEPS (exact numbers)")
@@ -35,7 +36,7 @@ def add_arguments(parser) -> None:
 
 
 @holding_out
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     if args.ray:
         return _ray(args)
     b_values = grid_values(args.ratios[0], "b range")

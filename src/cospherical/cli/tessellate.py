@@ -42,7 +42,7 @@ HELP = "tessellate one 1-irregular cuboid, prism, pyramid or tetrahedron"
 DESCRIPTION = "Tessellate one 1-irregular element: Delaunay cells = largest co-spherical elements."
 
 
-def add_arguments(parser) -> None:
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.epilog = _NUMBERING  # laid out by hand: printed as written
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     element = parser.add_mutually_exclusive_group()
@@ -93,7 +93,7 @@ def _configuration(args):
     return Configuration.from_steiner(None, args.steiner, policy, args.faces, args.body, shape=shape)
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     tess = tessellate(_configuration(args))
     if args.criterion != "optimal":
         tess = apply_catalogue_criterion(tess, args.criterion)

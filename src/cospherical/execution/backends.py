@@ -3,13 +3,21 @@
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import Any, Callable, Hashable, Iterator, Mapping, TypeVar
+from typing import Any, Callable, Hashable, Iterator, Mapping, TypedDict, TypeVar
 
 from ..errors import InputError, UsageError
 
-__all__ = ["check_backend", "completed"]
+__all__ = ["Backend", "check_backend", "completed"]
 
 _Key = TypeVar("_Key", bound=Hashable)  # a task's key: what its result comes back with
+
+
+class Backend(TypedDict):
+    """Where work runs: :func:`completed`'s keywords, kept together by a caller that runs several stages."""
+
+    jobs: int
+    scheduler: str | None
+    dask_workers: int | None
 
 
 # Local worker processes (--jobs, --dask-workers) at most: each one starts a Python with numpy

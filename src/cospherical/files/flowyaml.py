@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Iterator
+from typing import Any
 
 from ..errors import FormatError
 from .yamlio import yaml_float
@@ -43,7 +45,7 @@ _SEQUENCE_LINES = re.compile(r"^- (\{[^\n]*\})$", re.M)
 _TOP_LEVEL_LINE = re.compile(r"\n[^ \-\n#]")
 
 
-def flow(value) -> str:
+def flow(value: object) -> str:
     """A value as one line of JSON that YAML 1.1 reads back as the same value.
 
     JSON is YAML flow style, except that YAML 1.1 (PyYAML) reads ``1e-05`` as a
@@ -87,7 +89,7 @@ def sequence_line(entry: dict) -> str:
     return f"- {flow(entry)}\n"
 
 
-def mapping_entries(text: str):
+def mapping_entries(text: str) -> Iterator[tuple[str, str]]:
     """The (key, JSON text) pairs of consecutive :func:`mapping_line` lines; another line raises FormatError."""
     for line in text.splitlines():
         found = _MAPPING_LINE.fullmatch(line)
@@ -178,7 +180,7 @@ _STRICT = json.JSONDecoder(object_pairs_hook=_refuse_repeats, parse_constant=_re
                            parse_float=_yaml_float)
 
 
-def decode_entry(text: str, where: str):
+def decode_entry(text: str, where: str) -> Any:
     """One entry's JSON text as data; a malformed entry raises :class:`FormatError` naming ``where``.
 
     Refused like the YAML reader refuses them: a repeated key, and numbers that

@@ -11,7 +11,7 @@ import json
 __all__ = ["dump", "to_json"]
 
 
-def to_json(data, indent: int = 0) -> str:
+def to_json(data: object, indent: int = 0) -> str:
     """Indented JSON with lists of numbers and strings kept on one line, for people reading it."""
     pad, inner = " " * indent, " " * (indent + 2)
     if isinstance(data, dict) and data:
@@ -23,7 +23,7 @@ def to_json(data, indent: int = 0) -> str:
     return json.dumps(data)
 
 
-def dump(data, fmt: str) -> str:
+def dump(data: object, fmt: str) -> str:
     if fmt == "yaml":
         import yaml  # here: most commands write JSON, and start faster without it
 

@@ -37,9 +37,10 @@ import re
 import shutil
 import stat
 import tempfile
-from collections.abc import Callable, Iterable
-from contextlib import contextmanager
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
+from typing import IO, Any, BinaryIO, Literal, TextIO, overload
 
 from ..errors import InputError
 
@@ -154,7 +155,7 @@ def _umask() -> int:
 
 
 @contextmanager
-def atomic_path(path: str | Path):
+def atomic_path(path: str | Path) -> Iterator[Path]:
     """A temporary path to write, renamed to ``path`` only when the block ends without an error.
 
     The temporary file is in the same folder, so the rename is atomic: never a
@@ -185,9 +186,19 @@ def atomic_path(path: str | Path):
         raise
 
 
-@contextmanager
-def atomic_open(path: str | Path, binary: bool = False):
+@overload
+def atomic_open(path: str | Path, binary: Literal[False] = False) -> AbstractContextManager[TextIO]: ...
+@overload
+def atomic_open(path: str | Path, binary: Literal[True]) -> AbstractContextManager[BinaryIO]: ...
+@overload
+def atomic_open(path: str | Path, binary: bool) -> AbstractContextManager[IO[Any]]: ...
+def atomic_open(path: str | Path, binary: bool = False) -> AbstractContextManager[IO[Any]]:
     """A file to write, in place at ``path`` only when the block ends without an error (see :func:`atomic_path`)."""
+    return _atomic_open(path, binary)
+
+
+@contextmanager
+def _atomic_open(path: str | Path, binary: bool) -> Iterator[IO[Any]]:
     with atomic_path(path) as tmp:
         try:
             handle = open(tmp, "wb") if binary else open(tmp, "w", encoding="utf-8", newline="\n")

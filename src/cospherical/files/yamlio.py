@@ -8,6 +8,7 @@ import os
 import re
 import stat
 import sys
+from collections.abc import Hashable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -42,7 +43,7 @@ class _Loader(_SafeLoader):
         for first, resolvers in getattr(yaml, "CSafeLoader", yaml.SafeLoader).yaml_implicit_resolvers.items()
     }
 
-    def construct_mapping(self, node, deep=False):
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Hashable, Any]:
         seen = set()
         for key_node, _ in node.value:
             key = self.construct_object(key_node, deep=deep)
@@ -80,11 +81,11 @@ def machine_memory() -> int:
         return 8 * 1024**3
 
 
-def yaml_text(data) -> str:
+def yaml_text(data: object) -> str:
     return yaml.dump(data, Dumper=_Dumper, sort_keys=False, default_flow_style=None, width=100, allow_unicode=True)
 
 
-def dump_yaml(data, path: str | Path) -> None:
+def dump_yaml(data: object, path: str | Path) -> None:
     atomic_write(path, yaml_text(data))
 
 
@@ -97,7 +98,7 @@ def yaml_float(x: float) -> str:
     return text
 
 
-def load_yaml(path: str | Path):
+def load_yaml(path: str | Path) -> Any:
     """Read a YAML file with safe loading; a missing, unreadable or malformed file raises FormatError."""
     return parse_yaml(read_text(path), str(path))
 
@@ -177,7 +178,7 @@ MAX_INTEGER_DIGITS = 40
 _LONG_NUMBER = re.compile(rf"[0-9]{{{MAX_INTEGER_DIGITS + 1},}}")
 
 
-def parse_json(text: str, name: str, max_digits: int = MAX_INTEGER_DIGITS):
+def parse_json(text: str, name: str, max_digits: int = MAX_INTEGER_DIGITS) -> Any:
     """Parse JSON text as every reader of ours does: no repeated key, no nesting deeper than
     we write, no run of more than ``max_digits`` digits (:data:`MAX_INTEGER_DIGITS`, unless
     the format writes longer exact numbers, as text); errors as one-line :class:`FormatError`.
@@ -225,7 +226,7 @@ def load_document(text: str, name: str, loader: type) -> Any:
         raise FormatError(f"{name}: a value cannot be read: {str(error).splitlines()[0][:120]}") from None
 
 
-def parse_yaml(text: str, name: str):
+def parse_yaml(text: str, name: str) -> Any:
     """Parse YAML text safely: no aliases, no deep nesting, no Python tags; errors as one-line FormatError."""
     json_like = text.lstrip().startswith("{")
     if len(text) > MAX_YAML_PARSE and not json_like:  # before the nesting scan, which takes seconds on it
@@ -302,7 +303,7 @@ def _keep(folder: Path, path: Path, data: bytes) -> None:
         pass  # a read-only install: compiled again next time
 
 
-def validate(data, schema: str, path: str | Path) -> None:
+def validate(data: object, schema: str, path: str | Path) -> None:
     """Check data against one of the package's JSON Schemas; the error names the place."""
     import fastjsonschema
 

@@ -32,7 +32,7 @@ from ..errors import FormatError, InputError
 from ..files.flowyaml import split_section
 from ..files.yamlio import parse_yaml, read_text, validate
 from .diff import document_kind
-from .patterns import Entries, entry_elements, load, table_from_data, table_from_text
+from .patterns import Entries, PatternTable, entry_elements, load, table_from_data, table_from_text
 from .sqlite_store import is_store
 
 __all__ = ["EntryCheck", "SharedChecks", "check_catalogue", "check_patterns", "document_data", "read_document", "read_document_file",
@@ -92,7 +92,7 @@ class SharedChecks:
         self.passed: set[tuple[Any, ...]] = set()  # (context, point-set code, digest of the entry's text)
 
 
-def check_patterns(table, catalogue: Catalogue | None, name: str, tiling: bool = True,
+def check_patterns(table: PatternTable, catalogue: Catalogue | None, name: str, tiling: bool = True,
                    shared: SharedChecks | None = None) -> None:
     """Check a loaded :class:`~cospherical.formats.patterns.PatternTable` against the catalogue and geometry.
 
@@ -422,7 +422,7 @@ def _shape_name(shape: Shape) -> str:
     return "box" if shape.name == "cuboid" else shape.name
 
 
-def read_document(text: str, name: str):
+def read_document(text: str, name: str) -> tuple[str, Catalogue | PatternTable]:
     """A catalogue's or pattern table's text: ``("catalogue", Catalogue)`` or ``("patterns", PatternTable)``, validated.
 
     Files as this package writes them take the fast path of each reader (one
@@ -450,17 +450,18 @@ def read_document_file(path: str | Path) -> tuple[str, Any]:
     return read_document(read_text(path), str(path))
 
 
-def document_data(document) -> dict:
+def document_data(document: Catalogue | PatternTable) -> dict[str, Any]:
     """A read document as one mapping (a pattern table's header with its configurations), as diff compares them."""
     if isinstance(document, Catalogue):
         return document.to_dict()
     return {**document.header, "configurations": document.configurations}
 
 
-def validated(data, name: str) -> tuple[str, dict]:
+def validated(data: object, name: str) -> tuple[str, dict[str, Any]]:
     """The document's kind (``catalogue`` or ``patterns``), after schema validation (and, for a
     catalogue, every type once)."""
     kind = document_kind(data, name)
+    assert isinstance(data, dict)  # document_kind refuses anything else
     validate(data, kind, name)
     if kind == "catalogue":
         _check_unique(Catalogue.from_dict(data), name)

@@ -7,6 +7,7 @@ is reported as renamed, not as one removed and one added.
 from __future__ import annotations
 
 from collections import Counter
+from typing import Any
 
 from ..errors import FormatError, one_line
 from .patterns import Entries, entry_elements
@@ -14,7 +15,7 @@ from .patterns import Entries, entry_elements
 __all__ = ["diff_catalogues", "diff_documents", "diff_patterns", "document_kind", "text_report"]
 
 
-def document_kind(data, name: str) -> str:
+def document_kind(data: object, name: str) -> str:
     """``catalogue`` or ``patterns``, from the document's own keys."""
     if isinstance(data, dict) and "types" in data and "configurations" not in data:
         return "catalogue"
@@ -119,7 +120,7 @@ def diff_patterns(old: dict, new: dict) -> dict:
     return {k: v for k, v in result.items() if v or k == "kind"}
 
 
-def diff_documents(old, new, old_name: str, new_name: str) -> dict:
+def diff_documents(old: dict[str, Any], new: dict[str, Any], old_name: str, new_name: str) -> dict[str, Any]:
     kinds = document_kind(old, old_name), document_kind(new, new_name)
     if kinds[0] != kinds[1]:
         label = {"catalogue": "a catalogue", "patterns": "a pattern table"}

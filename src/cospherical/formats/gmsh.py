@@ -140,7 +140,7 @@ def _write_41(out, points, groups, binary: bool) -> None:
     volumes = [g for g in groups if g[0] == 3]
     low, high = (points.min(axis=0), points.max(axis=0)) if n else (np.zeros(3), np.zeros(3))
 
-    def box_of(rows):
+    def box_of(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         if not len(rows):
             return low, high
         used = points[rows.reshape(-1) - 1]

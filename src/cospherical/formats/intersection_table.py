@@ -10,12 +10,29 @@ writes the indexed store alone unless asked for both.
 from __future__ import annotations
 
 from contextlib import nullcontext
+from pathlib import Path
+from typing import IO, Any, Callable, Iterator, Protocol, TypeVar
 
 from ..files.flowyaml import mapping_text
 from ..files.yamlio import atomic_open, yaml_text
 from ..version import __version__
 from .patterns import SCHEMA_VERSION
 from .sqlite_store import dictionary_of, pack, write_store
+
+_T = TypeVar("_T")
+
+
+class TableRun(Protocol):
+    """What the writer reads of the study's run (:class:`cospherical.studies.intersection.table.TableRun`,
+    which the formats do not import: they read and write, the studies compute)."""
+
+    resolution: int
+    order: str
+    criteria: list[str]
+
+    def cells(self) -> None: ...
+    def sample_entries(self, samples: int) -> list[str]: ...
+    def chunks(self, finish: Callable[..., _T], *args: object) -> Iterator[_T]: ...
 
 __all__ = ["SYMMETRY_CONVENTION", "YAML_UP_TO", "entry_chunk", "write_pattern_table"]
 
@@ -41,7 +58,8 @@ def entry_chunk(entries: list[tuple[str, str]], yaml: bool, dictionary: bytes | 
     return text, [] if dictionary is None else [(code, pack(entry, dictionary)) for code, entry in entries]
 
 
-def write_pattern_table(run, catalogue_version: str, yaml_path=None, store=None) -> None:
+def write_pattern_table(run: TableRun, catalogue_version: str, yaml_path: str | Path | None = None,
+                        store: str | Path | None = None) -> None:
     """Write the pattern table that ``run`` computes (a
     :class:`~cospherical.studies.intersection.table.TableRun`: the study's orbit representatives
     and kept sets) as YAML at ``yaml_path`` and/or as an indexed store
@@ -58,7 +76,7 @@ def write_pattern_table(run, catalogue_version: str, yaml_path=None, store=None)
     # the store's compression dictionary: entries spread over the whole table
     dictionary = dictionary_of(run.sample_entries(_SAMPLES)) if store else None
 
-    def rows_in_order(handle):
+    def rows_in_order(handle: IO[Any] | None) -> Iterator[tuple[str, bytes]]:
         for text, packed in run.chunks(entry_chunk, bool(yaml_path), dictionary):
             if handle:
                 handle.write(text)

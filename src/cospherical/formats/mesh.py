@@ -24,7 +24,7 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
@@ -36,6 +36,7 @@ from ..files.yamlio import atomic_write, parse_json, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
 from .check import EntryCheck
+from .patterns import PatternTable
 from .vtu import quoteattr
 
 if TYPE_CHECKING:  # the device's modules are imported where a device is meshed
@@ -121,7 +122,7 @@ def read_leaves(path: str | Path, max_leaves: int | None = None) -> tuple[np.nda
     return array[:, 0], array[:, 1:]
 
 
-def table_lookup(table, criterion: str, box: Box, name: str = "pattern table",
+def table_lookup(table: PatternTable, criterion: str, box: Box, name: str = "pattern table",
                  catalogue: Catalogue | None = None, every_criterion: bool = False) -> Lookup:
     """A lookup for :func:`cospherical.mesh.assembly.assemble` reading a pattern table.
 
@@ -161,7 +162,7 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table",
     check = EntryCheck(header, catalogue, name, only=None if every_criterion else criterion)
     checked: set[str] = set()
 
-    def elements(code: str):
+    def elements(code: str) -> list[dict[str, Any]] | None:
         """The table's elements of ``code``, its entry checked as ``check`` does the first time (KeyError: none)."""
         found = table.elements(code, criterion)
         if code not in checked:
@@ -169,7 +170,7 @@ def table_lookup(table, criterion: str, box: Box, name: str = "pattern table",
             checked.add(code)
         return found
 
-    def lookup(configuration: Configuration):
+    def lookup(configuration: Configuration) -> list[dict[str, Any]] | None:
         code = configuration.point_set_code
         if code is None:  # a table holds configurations by their point-set codes
             return None
@@ -213,7 +214,7 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
     symmetries = box_symmetries(box)
     vtk = {entry.id: entry.vtk for entry in catalogue}
 
-    def mapped(configuration: Configuration):
+    def mapped(configuration: Configuration) -> list[dict[str, Any]] | None:
         found = lookup(configuration)
         if found is not None:
             return found

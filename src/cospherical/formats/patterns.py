@@ -20,7 +20,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterable, Protocol
+from typing import Any, Callable, Iterable, Iterator, Protocol, Sequence
 
 from ..caches import cached
 from ..choices import FacePointSource, POINT_POLICIES
@@ -46,7 +46,7 @@ _SCHEMES = {
 }
 
 
-def pattern_name(study: str, box_texts, face_points: str = "octree", element: str = "cuboid") -> str:
+def pattern_name(study: str, box_texts: Sequence[str], face_points: str = "octree", element: str = "cuboid") -> str:
     """File stem for a study's outputs, e.g. ``bisection-1x1.4142x1.4142``: a lossless name of the box.
 
     Another base element than the cuboid is named after the study:
@@ -130,7 +130,7 @@ def configuration_line(code: str, fvm_adequate: bool, tessellations: Mapping[str
     return mapping_line(code, entry)
 
 
-def element_entries(tess) -> list[dict]:
+def element_entries(tess: Tessellation) -> list[dict]:
     """A tessellation's elements as pattern-table data (see :func:`element_entry`)."""
     scale = tess.configuration.box.to_float()
     return [element_entry(element, scale) for element in tess.elements]
@@ -162,7 +162,7 @@ class Entries(Mapping):
             self._decoded[code] = entry
         return entry
 
-    def items(self, chunk: int = 4096):
+    def items(self, chunk: int = 4096) -> Iterator[tuple[str, dict]]:  # type: ignore[override]  # streamed, not a view
         """Every (code, entry) in file order, decoded and validated a chunk at a time.
 
         One schema validation per chunk costs a quarter of one per entry; entries
@@ -171,7 +171,8 @@ class Entries(Mapping):
         """
         return ((code, entry) for code, entry, _ in self.items_with_texts(chunk))
 
-    def items_with_texts(self, chunk: int = 4096, skip: Callable[[str, str], bool] | None = None):
+    def items_with_texts(self, chunk: int = 4096,
+                         skip: Callable[[str, str], bool] | None = None) -> Iterator[tuple[str, dict, str]]:
         """Every (code, entry, entry's text as written), as :meth:`items`; ``skip(code, text)``: true
         for an entry to pass over, neither decoded nor validated (one checked before)."""
         # An indexed store streams its rows; a dict of lines is read in place.
@@ -192,7 +193,7 @@ class Entries(Mapping):
         _check_entries({**self._header, "configurations": batch}, self._name, header_checked=True)
         yield from ((code, entry, texts[code]) for code, entry in batch.items())
 
-    def values(self):
+    def values(self) -> Iterator[dict]:  # type: ignore[override]  # streamed, not a view
         return (entry for _, entry in self.items())
 
     def text(self, code: str) -> str:
@@ -317,7 +318,7 @@ def table_from_text(text: str, name: str) -> PatternTable:
     return PatternTable(header, Entries(texts, header, name))
 
 
-def table_from_data(data, name: str) -> PatternTable:
+def table_from_data(data: dict[str, Any], name: str) -> PatternTable:
     """A :class:`PatternTable` from parsed YAML, validated (schema, criteria references)."""
     _check_entries(data, name)
     header = {k: v for k, v in data.items() if k != "configurations"}

@@ -25,7 +25,8 @@ import os
 import sqlite3
 import stat
 import zlib
-from collections.abc import Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from typing import Any
 from pathlib import Path
 
 from ..errors import FormatError
@@ -92,7 +93,7 @@ def pack(text: str, dictionary: bytes) -> bytes:
     return packer.compress(text.encode("utf-8")) + packer.flush()
 
 
-def write_store(path: str | Path, header: dict, dictionary: bytes, rows) -> None:
+def write_store(path: str | Path, header: dict[str, Any], dictionary: bytes, rows: Iterable[tuple[str, bytes]]) -> None:
     """Write a store of ``header`` and ``rows`` ((code, entry packed with ``dictionary``) pairs, in
     code order, which makes the file the same bytes for the same table), atomically."""
     with atomic_path(path) as tmp:  # an empty file: SQLite makes it a new database
@@ -229,7 +230,7 @@ class StoreEntries(Mapping):
     def __len__(self) -> int:
         return self._count
 
-    def texts(self):
+    def texts(self) -> Iterator[tuple[str, str]]:
         """Every (code, entry text), in code order, streamed (:func:`open_store` counted them)."""
         for code, blob in self._rows(f"SELECT code, {_BOUNDED_ENTRY} FROM entries ORDER BY code"):
             yield code, self._text(blob)

@@ -35,7 +35,7 @@ def heatmap_png(boxes: list[dict], path: Path) -> None:
     for x in boxes:
         grid[cs.index(_value(x["box"][2])), bs.index(_value(x["box"][1]))] = x["fvm_adequate"]
     fig, ax = plt.subplots(figsize=(5.5, 4.5))
-    def edges(values):
+    def edges(values: list[float]) -> list[float]:
         if len(values) == 1:
             return [values[0] - 0.5, values[0] + 0.5]
         mids = [(a + b) / 2 for a, b in zip(values, values[1:])]

@@ -14,6 +14,7 @@ import re
 import shutil
 import subprocess
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import jinja2
 
@@ -28,6 +29,9 @@ from ..formats.patterns import pattern_name
 from ..paper import comparison_notes, paper_comparison, paper_notes, paper_studies, paper_study_key
 from ..version import __version__
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 __all__ = ["element_png", "render_tables", "tex", "tikz_picture"]
 
 _TEX = {
@@ -36,7 +40,7 @@ _TEX = {
 }
 
 
-def tex(value) -> str:
+def tex(value: object) -> str:
     """Escape text for LaTeX.
 
     >>> tex("Generic #5 (50% of a_b & c)")
@@ -141,7 +145,7 @@ def element_png(entry: CatalogueType, path: Path, size_px: int = 160) -> None:
     save_png(fig, path)
 
 
-def save_png(fig, path: Path, dpi: int = 100) -> None:
+def save_png(fig: Figure, path: Path, dpi: int = 100) -> None:
     """Save a matplotlib figure atomically (temporary file, then rename), without a version stamp."""
     import matplotlib.pyplot as plt
 
@@ -205,7 +209,7 @@ def _write_tables(summaries: list[dict], catalogue: Catalogue, folder: OutputFol
     env = environment()
     written: list[str] = []
 
-    def write(name: str, template: str, **context) -> str:
+    def write(name: str, template: str, **context: object) -> str:
         if not _OUR_NAME.fullmatch(name):  # names come from validated summaries; never a path
             raise InputError(f"{name!r}: not a file name of a rendered table")
         folder.path(name).write_text(env.get_template(template).render(**context), encoding="utf-8", newline="\n")

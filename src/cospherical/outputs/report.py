@@ -91,7 +91,7 @@ def study_comparison_lines(summary: dict) -> list[str]:
     lines = [f"Beside the {other['study']} study with the {other['face_points']} point policy, same box:",
              f"  {'':<56} {ours:>{width}} {theirs:>{width}}"]
 
-    def row(label, mine, them):
+    def row(label: str, mine: object, them: object) -> None:
         lines.append(f"  {label[:56]:<56} {mine:>{width}} {them:>{width}}")
 
     for key, label in (("configurations", "configurations"), ("orbits", "symmetry orbits"),

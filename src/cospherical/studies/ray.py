@@ -15,6 +15,7 @@ FVM count or the set of element types really changes, as r = sqrt(u).
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -178,7 +179,8 @@ class Step:
         return f"{'[' if self.lo_closed else '('}{lo}, {hi}{']' if self.hi_closed else ')'}"
 
 
-def ray_profile(ray: Ray, r_lo: Fraction, r_hi: Fraction, progress=None) -> list[Step]:
+def ray_profile(ray: Ray, r_lo: Fraction, r_hi: Fraction,
+                progress: Callable[[int], None] | None = None) -> list[Step]:
     """The bisection study along the ray for r in [r_lo, r_hi], exactly, as steps in u = r^2."""
     u_lo, u_hi = r_lo * r_lo, r_hi * r_hi
     codes = bisection_codes()

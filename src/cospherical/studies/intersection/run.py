@@ -32,10 +32,11 @@ from ...core.configuration import Configuration
 from ...core.delaunay import delaunay_cells
 from ...core.element_types import classify
 from ...core.geometry import Frame
-from ...core.polyhedron import polyhedron
+from ...core.polyhedron import Polyhedron, polyhedron
+from ...core.shapes import Point
 from ...choices import SPLIT_CRITERIA
 from ...core.symmetry import key_code
-from ...execution.backends import completed
+from ...execution.backends import Backend, completed
 from ...files.yamlio import atomic_write, parse_json
 from ..summary import TypeInfo
 from .family import all_configurations, orbits
@@ -94,7 +95,8 @@ class NotACell(ValueError):
         return f"node mask {self.node_mask:#x} of configuration {key_code(self.code)} is not one cell"
 
 
-def cell_polyhedron(node_mask: int, code: int, of_configuration: bool = True):
+def cell_polyhedron(node_mask: int, code: int,
+                    of_configuration: bool = True) -> tuple[tuple[tuple[int, Point], ...], Polyhedron]:
     """A cell named as stage 1 names it, (node mask, a configuration code holding it), as
     ``(points, polyhedron)``: its (node, unit coordinates) pairs and its exact polyhedron.
 
@@ -266,8 +268,8 @@ def _tetrahedron():
     return element_entries([(sum(1 << n for n in corners), 0)], of_configuration=False)
 
 
-def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, checkpoints=None,
-                     progress=None, chunk: int = CHUNK, scheduler: str | None = None,
+def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, checkpoints: str | Path | None = None,
+                     progress: Callable[[str, int], None] | None = None, chunk: int = CHUNK, scheduler: str | None = None,
                      dask_workers: int | None = None, brute_force: bool = False,
                      examples: dict | None = None, notice: Callable[[str], None] | None = None) -> dict:
     """The intersection study's summary, all criteria, in the shape of the bisection study's.
@@ -316,7 +318,7 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     tag = f"v{_CHECKPOINT_FORMAT}-r{resolution}-{order}-c{chunk}{'-brute' if brute_force else ''}"
     if folder:
         folder.mkdir(parents=True, exist_ok=True)
-    backend = dict(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
+    backend = Backend(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
     report = progress or (lambda stage, n: None)
 
     # Stage 1: cells.
@@ -333,7 +335,7 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
             report("cells", int(sizes[start:start + chunk].sum()))
     _notice(notice, damaged)
 
-    def tessellate_missing():
+    def tessellate_missing() -> None:
         todo = {i: (reps[start:start + chunk],) for i, start in enumerate(starts) if i not in stage1}
         for i, part in completed(tessellate_chunk, todo, **backend):
             stage1[i] = part
@@ -379,7 +381,7 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     }
 
 
-def _element_stage(work: list[tuple[int, int]], folder: Path | None, tag: str, backend: dict, report,
+def _element_stage(work: list[tuple[int, int]], folder: Path | None, tag: str, backend: Backend, report,
                    notice) -> tuple[list, dict]:
     """Stage 2 of :func:`run_intersection`: the entries of ``work`` (after the tetrahedron's) and the types.
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Callable, Iterator, TypedDict
+from typing import Callable, Iterator, TypeVar
 
 import numpy as np
 
@@ -34,7 +34,7 @@ from ...catalogue import kept_split, split_options
 from ...core.symmetry import key_code
 from ...core.tessellation import Element, element_entry
 from ...errors import InputError
-from ...execution.backends import completed
+from ...execution.backends import Backend, completed
 from ...files.flowyaml import flow
 from .family import orbits
 from .run import cell_polyhedron, tessellate_chunk
@@ -42,17 +42,18 @@ from .run import cell_polyhedron, tessellate_chunk
 __all__ = ["CHUNK", "CellText", "TableRun", "cell_texts", "distinct_cells", "representative_cells", "table_entries"]
 
 CHUNK = 20_000
+_T = TypeVar("_T")
 _CELL_CHUNK = 2_000
 
 
-def representative_cells(codes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def representative_cells(codes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per configuration (base-16 codes) its cell count, and per cell, in the walk's order, its
     node mask and masked code (see :func:`cospherical.core.compiled.cube_batch`)."""
     cells = tessellate_chunk(codes, every_cell=True)
     return cells["polys"], cells["poly_mask"], cells["poly_code"]
 
 
-def distinct_cells(codes) -> np.ndarray:
+def distinct_cells(codes: np.ndarray) -> np.ndarray:
     """Pass 1 on a chunk: its distinct cells as rows (node mask, masked code, a configuration holding it)."""
     counts, masks, masked = representative_cells(codes)
     owners = np.repeat(np.asarray(codes, dtype=np.int64), counts)
@@ -98,7 +99,7 @@ def cell_texts(cells: list[tuple[int, int, int]], kept: dict[str, list[str]]) ->
     return found
 
 
-def table_entries(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str]) -> list[tuple[str, str]]:
+def table_entries(codes: np.ndarray, cells: Mapping[tuple[int, int], CellText], criteria: list[str]) -> list[tuple[str, str]]:
     """The pattern-table entries of some representatives as (code, entry JSON), joined from their
     cells' texts (``cells``: (node mask, masked code) -> :class:`CellText`, every cell they hold)."""
     counts, masks, masked = representative_cells(codes)
@@ -124,17 +125,10 @@ def table_entries(codes, cells: Mapping[tuple[int, int], CellText], criteria: li
     return entries
 
 
-def _finished_chunk(codes, cells: Mapping[tuple[int, int], CellText], criteria: list[str], finish: Callable, *args):
+def _finished_chunk(codes: np.ndarray, cells: Mapping[tuple[int, int], CellText], criteria: list[str],
+                    finish: Callable[..., _T], *args: object) -> _T:
     """Pass 3 on a chunk (in a worker): its entries as (code, entry JSON), handed to ``finish(entries, *args)``."""
     return finish(table_entries(codes, cells, criteria), *args)
-
-
-class _Backend(TypedDict):
-    """Where the table's work runs (:func:`~cospherical.execution.backends.completed`'s keywords)."""
-
-    jobs: int
-    scheduler: str | None
-    dask_workers: int | None
 
 
 class TableRun:
@@ -154,7 +148,7 @@ class TableRun:
         self.criteria = ["optimal", *self.kept]
         self.chunk = chunk
         self._report = progress or (lambda stage, n: None)
-        self._backend = _Backend(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
+        self._backend = Backend(jobs=jobs, scheduler=scheduler, dask_workers=dask_workers)
         self._held: dict[int, list[tuple[int, int]]] | None = None
         self._texts: dict[tuple[int, int], CellText] = {}
 
@@ -183,7 +177,7 @@ class TableRun:
         codes = self.reps[::max(1, len(self.reps) // samples)]
         return [entry for _, entry in table_entries(codes, self._texts, self.criteria)]
 
-    def chunks(self, finish: Callable, *args) -> Iterator:
+    def chunks(self, finish: Callable[..., _T], *args: object) -> Iterator[_T]:
         """Pass 3 (after :meth:`cells`): ``finish(entries, *args)`` of every chunk, in code order, whatever
         order the workers finish in.  ``finish`` is a module-level function: workers import it by name."""
         reps, chunk, held = self.reps, self.chunk, self._held
