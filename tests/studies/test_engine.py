@@ -35,6 +35,7 @@ def test_study_counts_equal_direct_counts(shape_studies, name):
     every configuration, and every member's mapped tessellation is its direct one."""
     study = shape_studies[name]
     shape = standard_shape(name)
+    rows = {code: (adequate, tessellations, image) for code, adequate, tessellations, image in study.rows()}
     counts, fvm, fvm_open = Counter(), 0, 0
     for code in study.codes:
         cfg = Configuration.from_code(code, shape=shape)
@@ -48,6 +49,11 @@ def test_study_counts_equal_direct_counts(shape_studies, name):
         mapped = study.tessellation(code)
         assert [(e.type.id, e.nodes, e.mirrored) for e in mapped.elements] == \
             [(e.type.id, e.nodes, e.mirrored) for e in tess.elements], code
+        # what a pattern table writes: the rows' images (equal elements mapped once, shared) are the same
+        adequate, tessellations, image = rows[code]
+        assert adequate == tess.fvm_adequate
+        assert [(e.type.id, e.nodes, e.mirrored, e.polyhedron) for e in image(tessellations["optimal"]).elements] == \
+            [(e.type.id, e.nodes, e.mirrored, e.polyhedron) for e in mapped.elements], code
     assert {t.type.id: t.count for t in study.type_counts()} == dict(counts)
     assert (study.fvm_adequate, study.fvm_adequate_open) == (fvm, fvm_open)
     assert study.configurations == 1 << len(shape.edges)

@@ -119,8 +119,9 @@ def build_catalogue(studies: Sequence[StudyResult], extra: Sequence[dict[str, An
                 for element in reps[rep].elements:
                     t = element.type
                     types[t.id] = t
-                    examples.setdefault(t.id, (study.box.texts, study.face_points, reps[rep].configuration, element,
-                                              study.element))
+                    if t.id not in examples:  # (the box's texts cost more than the rest of this loop)
+                        examples[t.id] = (study.box.texts, study.face_points, reps[rep].configuration, element,
+                                          study.element)
                     if label not in appears.setdefault(t.id, []):
                         appears[t.id].append(label)
     for example in extra:

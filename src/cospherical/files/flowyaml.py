@@ -45,6 +45,10 @@ _SEQUENCE_LINES = re.compile(r"^- (\{[^\n]*\})$", re.M)
 _TOP_LEVEL_LINE = re.compile(r"\n[^ \-\n#]")
 
 
+# what json.dumps(text, ensure_ascii=False) writes, without a new encoder per call
+_string = json.encoder.encode_basestring
+
+
 def flow(value: object) -> str:
     """A value as one line of JSON that YAML 1.1 reads back as the same value.
 
@@ -55,6 +59,15 @@ def flow(value: object) -> str:
     >>> flow({"type": "v4f4-8f0284", "nodes": [0, 1], "circumcenter": [1e-05, 0.5], "mirror": True})
     '{"type": "v4f4-8f0284", "nodes": [0, 1], "circumcenter": [1.0e-05, 0.5], "mirror": true}'
     """
+    # the exact types first: a pattern table writes millions of values
+    if type(value) is str:
+        return _string(value)
+    if type(value) is float:
+        return yaml_float(value)
+    if type(value) is list or type(value) is tuple:
+        if all(type(v) is int for v in value):  # node ids
+            return "[" + ", ".join(map(str, value)) + "]"
+        return "[" + ", ".join(map(flow, value)) + "]"
     if value is True:
         return "true"
     if value is False:
@@ -66,9 +79,9 @@ def flow(value: object) -> str:
     if isinstance(value, float):
         return yaml_float(value)
     if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
+        return _string(value)
     if isinstance(value, dict):
-        return "{" + ", ".join(f"{json.dumps(str(k), ensure_ascii=False)}: {flow(v)}" for k, v in value.items()) + "}"
+        return "{" + ", ".join(f"{_string(str(k))}: {flow(v)}" for k, v in value.items()) + "}"
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(flow(v) for v in value) + "]"
     raise TypeError(f"cannot write {type(value).__name__} as a flow value")

@@ -29,12 +29,12 @@ from ..core.shapes import ELEMENTS
 from ..core.tessellation import Tessellation, element_entry
 from ..errors import FormatError, InputError, shown
 from ..files.data import data_path
-from ..files.flowyaml import decode_entry, mapping_line, split_section
+from ..files.flowyaml import decode_entry, flow, mapping_text, split_section
 from ..files.yamlio import atomic_write, parse_yaml, read_text, validate, yaml_text
 from ..version import __version__
 from .sqlite_store import is_store, open_store
 
-__all__ = ["Entries", "PatternTable", "SCHEMA_VERSION", "configuration_line", "element_entries", "element_entry",
+__all__ = ["Entries", "PatternTable", "SCHEMA_VERSION", "configuration_line", "element_entry",
            "entry_elements", "load", "pattern_name", "patterns_text", "table_from_data", "table_from_text",
            "write_patterns"]
 
@@ -103,12 +103,14 @@ def patterns_text(study: _StudyTable, catalogue_version: str) -> str:
         "criteria": list(study.criteria),
     }
     lines = [yaml_text(header), "configurations:\n"]
-    lines.extend(configuration_line(*row) for row in study.rows())
+    texts: dict = {}  # one table's element texts: an element repeats in thousands of configurations
+    lines.extend(configuration_line(*row, texts=texts) for row in study.rows())
     return "".join(lines)
 
 
 def configuration_line(code: str, fvm_adequate: bool, tessellations: Mapping[str, Tessellation],
-                       image: Callable[[Tessellation], Tessellation] = lambda tess: tess) -> str:
+                       image: Callable[[Tessellation], Tessellation] = lambda tess: tess,
+                       texts: dict | None = None) -> str:
     """One configuration's entry in a pattern table, every table's: one line of YAML (a JSON flow mapping).
 
     ``tessellations``: per criterion, in the table's order.  Where a criterion
@@ -116,24 +118,33 @@ def configuration_line(code: str, fvm_adequate: bool, tessellations: Mapping[str
     split), the entry names that criterion instead of a copy.  ``image`` maps a
     tessellation to the configuration ``code`` (a study keeps one per orbit).
     One line per entry is what lets :func:`load` hand each to a JSON parser
-    (:mod:`cospherical.files.flowyaml`).
+    (:mod:`cospherical.files.flowyaml`).  ``texts``: a dict the lines of one table
+    share, where each element object's text is kept once written (with the object,
+    so that its id stays its own); an image that returns the same object for an
+    equal element (a study's rows do) is written once per table.
+    The line is :func:`~cospherical.files.flowyaml.mapping_line` of the entry
+    ``{"fvm_adequate": ..., criterion: elements or the earlier criterion's name}``.
     """
-    entry: dict = {"fvm_adequate": fvm_adequate}
+    if texts is None:
+        texts = {}
+    parts = [f'"fvm_adequate": {flow(fvm_adequate)}']
     written: dict[tuple, str] = {}
     for criterion, tess in tessellations.items():
         key = tuple(e.polyhedron.nodes for e in tess.elements)
         if key in written:
-            entry[criterion] = written[key]
+            parts.append(f"{flow(criterion)}: {flow(written[key])}")
             continue
         written[key] = criterion
-        entry[criterion] = element_entries(image(tess))
-    return mapping_line(code, entry)
-
-
-def element_entries(tess: Tessellation) -> list[dict]:
-    """A tessellation's elements as pattern-table data (see :func:`element_entry`)."""
-    scale = tess.configuration.box.to_float()
-    return [element_entry(element, scale) for element in tess.elements]
+        mapped = image(tess)
+        scale = mapped.configuration.box.to_float()
+        elements = []
+        for element in mapped.elements:
+            known = texts.get((id(element), scale))
+            if known is None:
+                known = texts[id(element), scale] = (element, flow(element_entry(element, scale)))
+            elements.append(known[1])
+        parts.append(f"{flow(criterion)}: [{', '.join(elements)}]")
+    return mapping_text(code, "{" + ", ".join(parts) + "}")
 
 
 def write_patterns(study: _StudyTable, path: str | Path, catalogue_version: str) -> None:
@@ -242,6 +253,7 @@ class PatternTable:
 
         Examples
         --------
+        >>> from cospherical.files.flowyaml import mapping_line
         >>> text = ("schema_version: 1\\ngenerator: g\\ncatalogue_version: c\\nstudy: s\\nbox: ['1', '1', '1']\\n"
         ...         "face_points: octree\\nscheme: s\\ncriteria: [optimal]\\nconfigurations:\\n"
         ...         + mapping_line("000000000000", {"fvm_adequate": True, "optimal": [
