@@ -237,7 +237,7 @@ class Configuration:
             return self.point_set_code
         return parameter_digits(self.steiner)
 
-    @property
+    @cached_property  # asked for by the table look-up, the assembly and the statistics: its digits are Fractions'
     def point_set_code(self) -> str | None:
         """The code of the whole point set, the same under every policy (always suffixed;
         ``None`` as :attr:`code`, or where a face number has more than one digit)."""
