@@ -56,9 +56,13 @@ def test_wrong_imports_break_the_contracts(tmp_path):
     # One check reaching into another: the mesh's checks stand side by side.
     volume = tmp_path / "cospherical" / "mesh" / "checks" / "volume.py"
     volume.write_text(volume.read_text() + "\nfrom .conformity import pair_faces  # wrong on purpose\n")
+    # dual.npz's member table knows nothing of the writer that writes it.
+    members = tmp_path / "cospherical" / "formats" / "dual" / "members.py"
+    members.write_text(members.read_text() + "\nfrom .writer import write_dual  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
-    assert "Contracts: 0 kept, 10 broken." in result.stdout
+    assert "Contracts: 0 kept, 11 broken." in result.stdout
+    assert "cospherical.formats.dual.members -> cospherical.formats.dual.writer" in result.stdout
     assert "cospherical.mesh.checks.volume -> cospherical.mesh.checks.conformity" in result.stdout
     assert "cospherical.formats.deflated -> cospherical.formats.dual" in result.stdout
     assert "cospherical.mesh.merged_cells -> cospherical.mesh.delaunay" in result.stdout

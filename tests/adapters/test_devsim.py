@@ -204,7 +204,7 @@ def test_a_forged_mesh_folder_never_reaches_devsim(devsim, graded, tmp_path):
     # a dual.npz whose node volumes were changed and re-signed: read_dual alone took it (NaN node volumes
     # in DEVSIM); the folder is checked as `cospherical check` checks it
     sys.path.insert(0, str(ROOT / "tests" / "formats"))
-    from test_dual import _resigned
+    from dual.forged import _resigned
 
     from cospherical.errors import FormatError
 

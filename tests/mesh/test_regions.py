@@ -365,7 +365,7 @@ def test_the_dual_splits_exactly_per_region(mos_dual):
 def test_check_proves_the_region_parts_and_refuses_altered_ones(mos_dual, tmp_path, capsys):
     import sys
     sys.path.insert(0, str(Path(__file__).parents[1] / "formats"))
-    from test_dual import _resigned
+    from dual.forged import _resigned
 
     from cospherical.cli import main
 
