@@ -1,8 +1,8 @@
-"""The type checker passes: mypy, configured in pyproject.toml ([tool.mypy]), strict on the core.
+"""The type checker passes: mypy, configured in pyproject.toml ([tool.mypy]), strict where it says.
 
 mypy reads the annotations the way a user's checker does (the package ships ``py.typed``): the
-core's every function annotated and checked with the flags of ``--strict``, the rest of the
-package with mypy's default checks.  Each run starts from an empty cache, as in a fresh CI
+strict modules (CONTRIBUTING.md lists them) checked with the flags of ``--strict``, the rest of the
+package with mypy's default checks, every public function annotated everywhere.  Each run starts from an empty cache, as in a fresh CI
 clone (about 11 CPU-s for the whole package: pyproject.toml says which libraries mypy does not
 follow, and why).
 """
@@ -102,3 +102,11 @@ def test_every_public_function_is_annotated():
     missing = {str(path.relative_to(package)): found for path in sorted(package.rglob("*.py"))
                if (found := _unannotated(path.read_text()))}
     assert missing == {}
+
+
+def test_contributing_lists_the_strict_modules_of_the_configuration():
+    # CONTRIBUTING.md tells a contributor where mypy is strict: the same list as pyproject.toml, in its order
+    text = (ROOT / "CONTRIBUTING.md").read_text()
+    listed = re.search(r"<!-- strict modules -->(.*?)<!-- /strict modules -->", text, re.S)
+    assert listed is not None, "CONTRIBUTING.md's list of strict modules, between its markers"
+    assert re.findall(r"`([^`]+)`", listed[1]) == _strict_modules()

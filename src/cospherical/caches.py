@@ -16,14 +16,14 @@ True
 
 from __future__ import annotations
 
-from functools import lru_cache
-from typing import Callable, TypeVar, cast
+from functools import _lru_cache_wrapper, lru_cache
+from typing import Any, Callable, TypeVar, cast
 
 __all__ = ["cached", "caches", "clear_caches"]
 
-F = TypeVar("F", bound=Callable)
+F = TypeVar("F", bound=Callable[..., Any])
 
-_CACHES: list = []  # every function declared with cached(), in import order
+_CACHES: list[_lru_cache_wrapper[Any]] = []  # every function declared with cached(), in import order
 
 
 def cached(maxsize: int) -> Callable[[F], F]:
@@ -39,7 +39,7 @@ def cached(maxsize: int) -> Callable[[F], F]:
     return decorate
 
 
-def caches() -> list[tuple[str, int, int]]:
+def caches() -> list[tuple[str, int | None, int]]:
     """(module.function, most results kept, results kept now) of every cache declared so far."""
     return [(f"{c.__module__}.{c.__qualname__}", c.cache_info().maxsize, c.cache_info().currsize) for c in _CACHES]
 

@@ -46,17 +46,18 @@ Examples
 from __future__ import annotations
 
 import contextlib
+import importlib
 import io
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
-from typing import Protocol, Sequence, Union
+from typing import Iterable, Protocol, Sequence, Union
 
 import numpy as np
 
 from ..errors import InputError, shown
 from ..mesh.assembly import Mesh
-from ..mesh.dual import Dual
+from ..mesh.dual import Dual, RegionParts
 from ..mesh.tetrahedra import SimplexMesh
 
 __all__ = ["EXACT_EDGE_COUPLE", "EXACT_NODE_VOLUME", "EXACT_SURFACE_AREA", "MeshInput", "DevsimDevice", "MeshWithDual", "create_device",
@@ -98,7 +99,7 @@ def import_devsim() -> ModuleType:
         import devsim_openblas
 
         devsim_openblas.configure()
-        import devsim
+        devsim = importlib.import_module("devsim")  # a module to the checker (devsim has no type information)
     except ImportError as error:
         raise InputError(f"DEVSIM is not installed ({error.name or error}): pip install 'cospherical[devsim]'") from None
     return devsim
@@ -118,10 +119,15 @@ class DevsimDevice:
     contacts: tuple[str, ...]
     simplices: SimplexMesh
     dual: Dual
-    node_ids: dict
-    edge_ids: dict
+    node_ids: dict[str, np.ndarray]
+    edge_ids: dict[str, np.ndarray]
     interfaces: tuple[str, ...] = ()
     log: str = ""
+
+
+# A region's exact geometry for DEVSIM: node volume per vertex, dual-face area per edge, surface area per vertex
+# (None: a dual without interfaces).
+RegionGeometry = tuple[np.ndarray, np.ndarray, "np.ndarray | None"]
 
 
 @dataclass(frozen=True)
@@ -131,9 +137,9 @@ class _Source:
 
     simplices: SimplexMesh
     dual: Dual
-    geometry: dict
-    contact_region: dict
-    materials: tuple = ()
+    geometry: dict[str, RegionGeometry]
+    contact_region: dict[str, str]
+    materials: tuple[str, ...] = ()
 
 
 def _source(mesh: MeshInput) -> _Source:
@@ -180,16 +186,17 @@ def _source(mesh: MeshInput) -> _Source:
     faces = region_faces(assembled)
     simplices = simplex_mesh(assembled, faces=faces)
     dual = full_dual(assembled, faces, dual)  # with its parts per region
+    assert dual.regions is not None
     geometry = _region_geometry(dual, dual.regions)
     device = regions.layout.device
     return _Source(simplices, dual, geometry, {c.name: c.region for c in device.contacts}, tuple(regions.materials))
 
 
-def _region_geometry(dual: Dual, parts) -> dict:
+def _region_geometry(dual: Dual, parts: RegionParts) -> dict[str, RegionGeometry]:
     """Per region name: its node volume per vertex, its dual-face area per edge (0 where it has none) and its
     surface area per vertex: its part of the interfaces the region is on, what DEVSIM's ``SurfaceArea`` holds
     (``None`` for a dual without interfaces: a version 4 file)."""
-    geometry = {}
+    geometry: dict[str, RegionGeometry] = {}
     interfaces = parts.interfaces
     for r, name in enumerate(parts.names):
         volume = np.zeros(len(dual.vertices))
@@ -296,7 +303,7 @@ def create_device(mesh: MeshInput, device: str = "device", contacts: Sequence[st
                         tuple(interfaces), log.getvalue())
 
 
-def _pair(interface: str, regions) -> tuple[str, str]:
+def _pair(interface: str, regions: Iterable[str]) -> tuple[str, str]:
     """The two regions of an interface named ``"a|b"`` (region names may hold ``|`` themselves)."""
     for first in regions:
         for second in regions:
@@ -305,7 +312,8 @@ def _pair(interface: str, regions) -> tuple[str, str]:
     raise InputError(f"interface {shown(interface)}: names no two regions")
 
 
-def _install_dual(devsim, device: str, region: str, points: np.ndarray, dual, geometry, scale: float
+def _install_dual(devsim: ModuleType, device: str, region: str, points: np.ndarray, dual: Dual, geometry: RegionGeometry,
+                  scale: float
                   ) -> tuple[np.ndarray, np.ndarray]:
     """Set the region's exact node volumes, edge couplings and (a device's) surface areas and select them;
     DEVSIM's node and edge maps."""

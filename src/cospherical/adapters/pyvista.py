@@ -10,6 +10,7 @@ cells sorted by VTK cell type, cell data ``element`` (the element each cell is),
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Sequence
 from types import ModuleType
 from typing import TYPE_CHECKING
@@ -31,7 +32,7 @@ __all__ = ["import_pyvista", "legacy_cells", "to_pyvista"]
 def import_pyvista() -> ModuleType:
     """The pyvista module, or one clear error when it is missing."""
     try:
-        import pyvista
+        pyvista = importlib.import_module("pyvista")  # a module to the checker, which does not follow pyvista
     except ImportError as error:
         raise InputError(f"pyvista is not installed ({error.name or error}): pip install 'cospherical[pyvista]'") \
             from None

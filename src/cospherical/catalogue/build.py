@@ -27,13 +27,13 @@ from ..files.flowyaml import decode_entry, split_section
 from ..files.yamlio import read_text
 from ..version import __version__
 from .model import Catalogue
-from .criteria import Choice, option_types, split_options, split_positions
+from .criteria import Choice, SplitPositions, option_types, split_options, split_positions
 from .names import SCHEMA_VERSION, type_names
 
 __all__ = ["StudyResult", "build_catalogue", "intersection_examples"]
 
 
-def _chiral(element) -> bool:
+def _chiral(element: Element) -> bool:
     """Whether the type differs from its mirror image (its canonical walks need one handedness)."""
     mirror = [tuple(reversed(face)) for face in element.polyhedron.faces]
     return canonical_form(mirror, element.polyhedron.face_kinds).mirrored != element.mirrored
@@ -59,7 +59,7 @@ def _study_label(study: StudyResult) -> str:
     return f"{study.name}{element} {'x'.join(study.box.texts)} {study.face_points}"
 
 
-def intersection_examples(path: str | Path | None = None) -> list[dict]:
+def intersection_examples(path: str | Path | None = None) -> list[dict[str, Any]]:
     """The examples of the intersection studies' types (``scripts/intersection_examples.py`` writes them),
     each rebuilt as an element: dicts with ``configuration``, ``element``, ``studies`` and ``splits``
     (per criterion, the splits the studies used, as (piece type, positions in the element's
@@ -104,7 +104,7 @@ def build_catalogue(studies: Sequence[StudyResult], extra: Sequence[dict[str, An
 
     ``extra``: examples of further types (:func:`intersection_examples`), after the studies'.
     """
-    examples: dict[str, tuple] = {}
+    examples: dict[str, tuple[Sequence[str], str, Configuration, Element, str]] = {}
     appears: dict[str, list[str]] = {}
     types: dict[str, ElementType] = {}
     # Optimal elements first, so that a type's example is an unsplit element where
@@ -130,7 +130,7 @@ def build_catalogue(studies: Sequence[StudyResult], extra: Sequence[dict[str, An
         examples.setdefault(element.type.id, (("1", "1", "1"), "octree", example["configuration"], element, "cuboid"))
         appears.setdefault(element.type.id, []).extend(example["studies"])
     names = type_names(types.values())
-    splits: dict[str, dict[str, set]] = {}
+    splits: dict[str, dict[str, set[SplitPositions]]] = {}
     kept: dict[str, set[str]] = {}
     for study in studies:
         for criterion, choice in study.choices.items():

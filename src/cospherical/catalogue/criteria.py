@@ -24,7 +24,11 @@ from .model import Catalogue
 from .names import shipped_catalogue
 
 __all__ = ["Choice", "apply_catalogue_criterion", "choose", "choose_kept",
-           "element_options", "kept_split", "minimal_kept_sets", "option_types", "split_options", "split_positions", "split_tessellation"]
+           "element_options", "kept_split", "minimal_kept_sets", "option_types", "split_options", "split_positions", "split_tessellation",
+           "SplitPositions"]
+
+# A split as the catalogue records it: per piece its type id and its nodes as positions in the parent's reference order.
+SplitPositions = tuple[tuple[str, tuple[int, ...]], ...]
 
 
 def element_options(tess: Tessellation, element: Element, criterion: str) -> tuple[tuple[Element, ...], ...]:
@@ -110,7 +114,7 @@ class Choice:
     criterion: str
     kept: frozenset[str]
     tessellations: dict[str, Tessellation]  # orbit representative -> tessellation after splitting
-    splits: dict[str, Counter]
+    splits: dict[str, Counter[SplitPositions]]
 
 
 @overload
@@ -205,7 +209,7 @@ def choose(tessellations: dict[str, Tessellation], sizes: dict[str, int], criter
     kept, _ = choose_kept([[option_types(o) for o in options] for _, options in elements],
                           [sizes[rep] for rep, _ in elements])
     split: dict[str, Tessellation] = {}
-    splits: dict[str, Counter] = {}
+    splits: dict[str, Counter[SplitPositions]] = {}
     for rep, tess in tessellations.items():
         done = split_tessellation(tess, kept, criterion)
         assert done is not None, "choose_kept's set splits every element into kept types"
@@ -215,7 +219,7 @@ def choose(tessellations: dict[str, Tessellation], sizes: dict[str, int], criter
     return Choice(criterion, kept, split, splits)
 
 
-def split_positions(element: Element, pieces: Sequence[Element]) -> tuple[tuple[str, tuple[int, ...]], ...]:
+def split_positions(element: Element, pieces: Sequence[Element]) -> SplitPositions:
     """A split as the catalogue records it: (piece type, piece nodes as positions in the element's
     reference order), sorted."""
     position = {node: i for i, node in enumerate(element.nodes)}

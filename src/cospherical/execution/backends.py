@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from contextlib import contextmanager
+from types import FrameType
 from typing import Any, Callable, Hashable, Iterator, Mapping, TypedDict, TypeVar
 
 from ..errors import InputError, UsageError
@@ -60,8 +61,8 @@ def check_backend(prog: str, scheduler: str | None, dask_workers: int | None, ti
         dask.config.set({"distributed.comm.timeouts.connect": f"{timeout}s"})
 
 
-def completed(function: Callable, tasks: Mapping[_Key, tuple], jobs: int = 1, scheduler: str | None = None,
-              dask_workers: int | None = None, common: tuple = ()) -> Iterator[tuple[_Key, Any]]:
+def completed(function: Callable[..., Any], tasks: Mapping[_Key, tuple[Any, ...]], jobs: int = 1, scheduler: str | None = None,
+              dask_workers: int | None = None, common: tuple[Any, ...] = ()) -> Iterator[tuple[_Key, Any]]:
     """Yield ``(key, function(*args))`` for every task, in the order they finish, on the chosen backend.
 
     Parameters
@@ -104,8 +105,8 @@ def completed(function: Callable, tasks: Mapping[_Key, tuple], jobs: int = 1, sc
                     yield pending.pop(future), future.result()
 
 
-def _dask_completed(function: Callable, tasks: Mapping[_Key, tuple], scheduler: str | None,
-                    dask_workers: int | None, common: tuple = ()) -> Iterator[tuple[_Key, Any]]:
+def _dask_completed(function: Callable[..., Any], tasks: Mapping[_Key, tuple[Any, ...]], scheduler: str | None,
+                    dask_workers: int | None, common: tuple[Any, ...] = ()) -> Iterator[tuple[_Key, Any]]:
     """:func:`completed` on Dask: a running scheduler, or a local cluster whose scratch space
     (its lock files included) is a private temporary folder, removed at the end however the run ends."""
     import logging
@@ -248,7 +249,7 @@ def _listening(scheduler: str, timeout: float) -> None:
 
 
 @contextmanager
-def _interrupt_deferred():
+def _interrupt_deferred() -> Iterator[None]:
     """Hold a Ctrl-C or SIGTERM back until the block has ended, then act on it as the command would have.
 
     A cluster half made when the signal arrived could not be closed: its workers went on
@@ -257,8 +258,8 @@ def _interrupt_deferred():
     """
     import signal
 
-    held = []
-    previous = {}
+    held: list[int] = []
+    previous: dict[int, Callable[[int, FrameType | None], Any] | int | None] = {}
     try:
         for signum in (signal.SIGINT, signal.SIGTERM):
             previous[signum] = signal.signal(signum, lambda signum, frame: held.append(signum))
@@ -268,8 +269,8 @@ def _interrupt_deferred():
     try:
         yield
     finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
     if held:
         handler = previous[held[0]]
         if held[0] == signal.SIGINT and not callable(handler):

@@ -6,6 +6,8 @@ import os
 import signal
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
+from types import TracebackType
+from typing import Any, Literal
 
 __all__ = ["die_with_parent", "process_pool", "register_stop", "stop_all", "unregister_stop"]
 
@@ -42,7 +44,7 @@ def stop_all() -> None:
 class _Pool(ProcessPoolExecutor):
     """A process pool that, left by an error, Ctrl-C or SIGTERM, stops at once instead of waiting."""
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         register_stop(id(self), self.stop)
 
@@ -50,7 +52,8 @@ class _Pool(ProcessPoolExecutor):
         unregister_stop(id(self))
         super().shutdown(wait=wait, cancel_futures=cancel_futures)
 
-    def __exit__(self, kind, value, traceback):
+    def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
+                 traceback: TracebackType | None) -> Literal[False]:
         if kind is None:
             self.shutdown(wait=True)
         else:

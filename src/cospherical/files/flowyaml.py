@@ -29,7 +29,7 @@ from __future__ import annotations
 import json
 import re
 from collections.abc import Iterator
-from typing import Any
+from typing import Any, NoReturn
 
 from ..errors import FormatError
 from .yamlio import yaml_float
@@ -87,7 +87,7 @@ def flow(value: object) -> str:
     raise TypeError(f"cannot write {type(value).__name__} as a flow value")
 
 
-def mapping_line(key: str, entry: dict) -> str:
+def mapping_line(key: str, entry: dict[str, Any]) -> str:
     """One entry of a block mapping at indent 2, its value as a JSON flow mapping (with a newline)."""
     return mapping_text(key, flow(entry))
 
@@ -97,7 +97,7 @@ def mapping_text(key: str, text: str) -> str:
     return f"  '{key}': {text}\n"
 
 
-def sequence_line(entry: dict) -> str:
+def sequence_line(entry: dict[str, Any]) -> str:
     """One item of a block sequence at indent 0, as a JSON flow mapping (with a newline)."""
     return f"- {flow(entry)}\n"
 
@@ -149,7 +149,7 @@ def split_section(text: str, key: str) -> tuple[str, dict[str, str] | list[str]]
     return text[: start + 1] + text[end:], found
 
 
-def _refuse_repeats(pairs):
+def _refuse_repeats(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     entry = dict(pairs)
     if len(entry) != len(pairs):
         repeated = next(k for k in entry if sum(1 for p, _ in pairs if p == k) > 1)
@@ -157,7 +157,7 @@ def _refuse_repeats(pairs):
     return entry
 
 
-def _refuse_constant(text: str):
+def _refuse_constant(text: str) -> NoReturn:
     raise ValueError(f"{text} is not a YAML value")
 
 
@@ -176,7 +176,7 @@ def _decode_counting(text: str) -> tuple[object, int]:
     a decoder per call keeps the count to the call (threads may decode at once)."""
     kept = 0
 
-    def count(value: dict) -> dict:
+    def count(value: dict[str, Any]) -> dict[str, Any]:
         nonlocal kept
         kept += len(value)
         return value

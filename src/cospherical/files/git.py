@@ -11,7 +11,7 @@ from . import yamlio
 __all__ = ["git_text"]
 
 
-def _git(args: list[str], cwd: Path, what: str) -> subprocess.CompletedProcess:
+def _git(args: list[str], cwd: Path, what: str) -> subprocess.CompletedProcess[bytes]:
     try:
         result = subprocess.run(["git", *args], cwd=cwd, capture_output=True, stdin=subprocess.DEVNULL)
     except OSError as error:

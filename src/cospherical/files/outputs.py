@@ -40,6 +40,7 @@ import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
+from types import TracebackType
 from typing import IO, Any, BinaryIO, Literal, TextIO, overload
 
 from ..errors import InputError
@@ -298,7 +299,8 @@ class OutputFolder:
             raise RuntimeError(f"{self.folder}: the output folder is not open (write inside its with block)")
         return self.staging
 
-    def __exit__(self, kind, value, traceback) -> None:
+    def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
+                 traceback: TracebackType | None) -> None:
         if kind is not None:
             staging = self.staging
             self._release(failed=True)
@@ -329,7 +331,7 @@ class OutputFolder:
             if path.name.startswith(_STAGING_PREFIX) and _is_marked_staging(path):
                 shutil.rmtree(path, ignore_errors=True)
 
-    def _read_manifest(self) -> dict:
+    def _read_manifest(self) -> dict[str, Any]:
         """The manifest, or an empty one if it is missing or damaged: then nothing is removed."""
         path = self.folder / MANIFEST
         try:
@@ -469,5 +471,6 @@ class FolderLock:
         self.acquire()
         return self
 
-    def __exit__(self, kind, value, traceback) -> None:
+    def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
+                 traceback: TracebackType | None) -> None:
         self.release(failed=kind is not None)

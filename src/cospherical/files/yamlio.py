@@ -8,9 +8,9 @@ import os
 import re
 import stat
 import sys
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import yaml
 
@@ -146,7 +146,7 @@ def check_nesting(text: str, name: str) -> None:
         raise FormatError(f"{name}: nested too deeply (more than {_MAX_DEPTH} levels)")
 
 
-def _refuse_aliases(data, name: str) -> None:
+def _refuse_aliases(data: object, name: str) -> None:
     """Refuse YAML aliases: the tool never writes them, and they make small files expand without bound.
 
     An alias makes two places hold the same list or mapping object; a walk that
@@ -163,12 +163,14 @@ def _refuse_aliases(data, name: str) -> None:
             stack.extend(item.values() if isinstance(item, dict) else item)
 
 
-def _unique_pairs(pairs):
+def _unique_pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     mapping = dict(pairs)
     if len(mapping) != len(pairs):
-        seen: set = set()
-        repeated = next(key for key, _ in pairs if key in seen or seen.add(key))
-        raise ValueError(f"repeated key {repeated!r}")
+        seen: set[str] = set()
+        for key, _ in pairs:
+            if key in seen:
+                raise ValueError(f"repeated key {key!r}")
+            seen.add(key)
     return mapping
 
 
@@ -202,7 +204,7 @@ def parse_json(text: str, name: str, max_digits: int = MAX_INTEGER_DIGITS) -> An
         raise FormatError(f"{name}: not valid JSON: {str(error).splitlines()[0][:120]}") from None
 
 
-def _refuse_size(text: str, name: str):
+def _refuse_size(text: str, name: str) -> NoReturn:
     raise FormatError(f"{name}: {len(text):,} characters of YAML not in the form cospherical writes (one line "
                       f"per entry); the full YAML parser takes at most {MAX_YAML_PARSE:,}")
 
@@ -245,14 +247,14 @@ def parse_yaml(text: str, name: str) -> Any:
 
 
 @cached(maxsize=16)
-def _validator(name: str):
+def _validator(name: str) -> Callable[[object], object]:
     # fastjsonschema compiles the schema to Python: a 4096-configuration pattern
     # table validates in a fraction of a second instead of seconds.
     text = data_path(f"schemas/{name}.schema.json").read_text(encoding="utf-8")
     return _compiled_validator(name, text, data_path("schemas") / "__pycache__")
 
 
-def _compiled_validator(name: str, text: str, folder: Path):
+def _compiled_validator(name: str, text: str, folder: Path) -> Callable[[object], object]:
     """fastjsonschema's validator of the schema ``text``, its bytecode kept as Python keeps a module's.
 
     Generating and compiling a validator costs 15-40 ms a schema (the mesh report's is
@@ -286,7 +288,8 @@ def _compiled_validator(name: str, text: str, folder: Path):
             _keep(folder, path, marshal.dumps((function, code)))
     namespace: dict[str, Any] = {}
     exec(code, namespace)
-    return namespace[function]
+    validator: Callable[[object], object] = namespace[function]
+    return validator
 
 
 def _keep(folder: Path, path: Path, data: bytes) -> None:

@@ -7,7 +7,7 @@ study``), so the text report and the LaTeX tables compare in one way.
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Iterable
+from typing import Any, Iterable
 
 from ..core.configuration import Box
 from .published import paper_classes, paper_studies
@@ -20,7 +20,7 @@ def _normalised(box: Box) -> tuple[Fraction, ...]:
     return tuple(s / squared[0] for s in squared)
 
 
-def paper_study_key(summary: dict) -> tuple[str | None, list[str]]:
+def paper_study_key(summary: dict[str, Any]) -> tuple[str | None, list[str]]:
     """The paper's study to compare a study summary with, and the notes on why figures may differ.
 
     The paper computed its sqrt 2 case at 1.4142; a box at exactly sqrt 2 is
@@ -51,7 +51,7 @@ def paper_study_key(summary: dict) -> tuple[str | None, list[str]]:
     return None, notes
 
 
-def paper_comparison(summary: dict, key: str, criterion: str = "optimal") -> dict:
+def paper_comparison(summary: dict[str, Any], key: str, criterion: str = "optimal") -> dict[str, Any]:
     """Rows (paper class or type name, paper count, our count) for one criterion."""
     paper = paper_studies()[key]
     published = paper.get(criterion, {})
@@ -80,7 +80,7 @@ def paper_comparison(summary: dict, key: str, criterion: str = "optimal") -> dic
     }
 
 
-def comparison_notes(summary: dict, key: str, criteria: Iterable[str]) -> list[str]:
+def comparison_notes(summary: dict[str, Any], key: str, criteria: Iterable[str]) -> list[str]:
     """The keys of :func:`~cospherical.paper.paper_notes` that explain a comparison of these criteria.
 
     The study's own notes (:func:`paper_study_key`), ``splits`` when a split

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from typing import Any
 
 from ..caches import cached
 from ..core.element_types import ElementType
@@ -12,26 +13,31 @@ __all__ = ["paper_class", "paper_classes", "paper_notes", "paper_studies"]
 
 
 @cached(maxsize=1)
-def _data() -> dict:
-    return load_yaml(data_path("paper.yaml"))  # the package's reader: the C parser, 5x faster than yaml.safe_load
+def _data() -> dict[str, Any]:
+    # the package's reader: the C parser, 5x faster than yaml.safe_load
+    data: dict[str, Any] = load_yaml(data_path("paper.yaml"))
+    return data
 
 
-def paper_classes() -> list[dict]:
+def paper_classes() -> list[dict[str, Any]]:
     """The paper's element classes: name, short name, V/E/F counts, the face kinds they admit."""
-    return _data()["classes"]
+    classes: list[dict[str, Any]] = _data()["classes"]
+    return classes
 
 
-def paper_studies() -> dict:
+def paper_studies() -> dict[str, Any]:
     """The paper's studies by key (``bisection_A``, ...): box, configurations, published counts."""
-    return _data()["studies"]
+    studies: dict[str, Any] = _data()["studies"]
+    return studies
 
 
 def paper_notes() -> dict[str, str]:
     """Why a published figure and ours differ, by key; each comparison cites the ones that apply."""
-    return _data()["notes"]
+    notes: dict[str, str] = _data()["notes"]
+    return notes
 
 
-def paper_class(etype: ElementType) -> dict | None:
+def paper_class(etype: ElementType) -> dict[str, Any] | None:
     """The paper's class of an element type: same V/E/F and face kinds, or ``None``.
 
     Examples
