@@ -16,10 +16,14 @@ import signal
 import sys
 import threading
 import warnings
-from typing import NoReturn, TextIO
+from types import FrameType
+from typing import TYPE_CHECKING, NoReturn, TextIO
 
 from ..errors import CosphericalError, CosphericalWarning, UsageError, one_line
 from ..version import __version__
+
+if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
 
 __all__ = ["build_parser", "main"]
 
@@ -35,11 +39,13 @@ class _Parser(argparse.ArgumentParser):
 
     # argparse drops a failed write of --help or --version (a closed stdout, /dev/full) and exits 0;
     # written and flushed here, the failure reaches main's one line and exit 2 like any other output's.
-    def _print_message(self, message: str, file=None) -> None:
+    def _print_message(self, message: str, file: SupportsWrite[str] | None = None) -> None:
         if message:
             stream = file or sys.stderr
             stream.write(message)
-            stream.flush()
+            flush = getattr(stream, "flush", None)  # argparse hands sys.stdout or sys.stderr
+            if flush is not None:
+                flush()
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
@@ -68,7 +74,7 @@ _terminated = threading.Event()
 _redelivery: list[threading.Timer] = []  # signals held back while numba's compiler or a fork hook ran
 
 
-def _on_signal(signum, frame):
+def _on_signal(signum: int, frame: FrameType | None) -> None:
     # SIGINT unwinds as KeyboardInterrupt, SIGTERM as SystemExit(143), so that temporary
     # files are removed and every output stays either the old complete file or the new
     # complete file. Each is remembered as well as raised: raised inside a call into
@@ -91,7 +97,7 @@ def _on_signal(signum, frame):
     raise KeyboardInterrupt
 
 
-def _cannot_unwind(frame) -> bool:
+def _cannot_unwind(frame: FrameType | None) -> bool:
     while frame is not None:
         name = frame.f_globals.get("__name__", "")
         if name.startswith(("numba.", "llvmlite.")) or name == "logging":
@@ -165,7 +171,7 @@ def _main(argv: list[str] | None) -> int:
         words = sys.argv[1:] if argv is None else argv
         command = next((word for word in words if not word.startswith("-")), None)
         args = build_parser(command if command in _SUBCOMMANDS else None).parse_args(argv)
-        status = args.run(args)
+        status: int = args.run(args)
         sys.stdout.flush()  # a full disk or /dev/full shows here, as one line, not at exit
         if _terminated.is_set():
             raise SystemExit(128 + signal.SIGTERM)

@@ -80,7 +80,7 @@ def _check_dual(path: Path) -> None:
           f"{negative.interior} interior and {negative.boundary} boundary negative coefficients")
 
 
-def _cut(value, most: int = 40) -> str:
+def _cut(value: object, most: int = 40) -> str:
     """An exact sum as an error line names it: its text, cut after ``most`` characters (a forged
     denominator of a thousand digits is named, not echoed)."""
     text = str(value)

@@ -31,7 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="text (default): a readable report; json or yaml: the same report as data")
 
 
-def _from_git(rev: str, path: Path):
+def _from_git(rev: str, path: Path) -> str:
     # A revision is data, never an option: refuse a leading '-' and end git's options before it.
     if not rev or rev.startswith("-") or any(ch.isspace() or ch == ":" or not ch.isprintable() for ch in rev):
         raise UsageError(f"cospherical diff: error: --rev {rev!r}: not a git revision")

@@ -6,6 +6,7 @@ import argparse
 import os
 import sys
 import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
@@ -27,6 +28,7 @@ from .progress import stage_bars
 from .output import path_argument
 
 if TYPE_CHECKING:  # the report's types, for annotations only (the report module loads with the mesher)
+    from ..mesh.assembly import Mesh
     from ..mesh.report import ChecksSummary, DeviceSummary, MeshReport
 
 
@@ -157,7 +159,7 @@ _SUMMARY_KEYS = ("delaunay_mode", "leaves", "vertices", "elements", "types", "vo
                 "paper_final_share")
 
 
-def _cut(args) -> float | None:
+def _cut(args: argparse.Namespace) -> float | None:
     """``--cut``, checked before the work; ``None``: the picture's own default (through the first shape)."""
     if args.cut is None:
         return None
@@ -170,7 +172,7 @@ def _cut(args) -> float | None:
     return float(value)
 
 
-def _text(value) -> str:
+def _text(value: object) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if value is None:
@@ -212,7 +214,7 @@ def run(args: argparse.Namespace) -> int:
         return _run(args, out)
 
 
-def _pieces(args) -> int | None:
+def _pieces(args: argparse.Namespace) -> int | None:
     """``--partitions`` and its backend, checked before any work; ``None`` without it."""
     backend = [option for option, value in (("--jobs", args.jobs), ("--scheduler", args.scheduler),
                                             ("--dask-workers", args.dask_workers)) if value is not None]
@@ -233,7 +235,7 @@ def _pieces(args) -> int | None:
     return pieces
 
 
-def _run(args, out: OutputFolder | None) -> int:
+def _run(args: argparse.Namespace, out: OutputFolder | None) -> int:
     delaunay_mode(args.criterion, args.delaunay)  # a contradiction refused before the work
     at = _cut(args)
     max_leaves = _max_leaves(args.max_leaves)
@@ -286,7 +288,7 @@ _PIECE_BARS = {"pieces": ("meshing pieces", "piece"), "again": ("pieces re-tesse
 
 
 @contextmanager
-def _bars():
+def _bars() -> Iterator[Callable[[str, int | None, int], None]]:
     """Yield the pipeline's ``progress(stage, total, advance)``: a bar per stage once the tree proves large."""
     stages: dict[str, tuple[int | None, str, str]] = {}
     large = False
@@ -303,7 +305,7 @@ def _bars():
         yield progress
 
 
-def _print(args, report: MeshReport) -> None:
+def _print(args: argparse.Namespace, report: MeshReport) -> None:
     data = report.to_dict()
     if args.format == "json":
         sys.stdout.write(report_json(data))
@@ -340,14 +342,14 @@ def _print_device(device: DeviceSummary) -> None:
     sys.stdout.write("".join(lines))
 
 
-def _write_listed_piece(listed: np.ndarray, mesh, path, leaves: np.ndarray) -> None:
+def _write_listed_piece(listed: np.ndarray, mesh: Mesh, path: str | Path, leaves: np.ndarray) -> None:
     """A piece whose cell data ``leaf`` numbers the leaves as the ``--leaves`` file lists them (tasks pickle it)."""
     from ..formats.mesh import write_piece
 
     write_piece(mesh, path, listed[leaves])
 
 
-def _in_pieces(args, source: TreeSource, out: OutputFolder | None) -> int:
+def _in_pieces(args: argparse.Namespace, source: TreeSource, out: OutputFolder | None) -> int:
     """``--partitions N``: the pieces meshed, checked and written by tasks, mesh.pvtu and the report here."""
     from functools import partial
 

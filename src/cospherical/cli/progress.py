@@ -5,12 +5,15 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import cast
+from typing import TYPE_CHECKING, NoReturn, cast
+
+if TYPE_CHECKING:
+    from tqdm import tqdm
 
 __all__ = ["progress_bar", "stage_bars"]
 
 
-def _quiet(*args) -> None:
+def _quiet(*args: object) -> None:
     pass
 
 
@@ -33,7 +36,7 @@ def stage_bars(stages: dict[str, tuple[int | None, str, str]]) -> Iterator[Calla
     if not sys.stderr.isatty():  # as progress_bar: nothing drawn, tqdm (and the multiprocessing it imports) not imported
         yield _quiet
         return
-    bars: dict = {}
+    bars: dict[str, tqdm[NoReturn]] = {}
 
     def advance(stage: str, n: int) -> None:
         if stage not in bars:

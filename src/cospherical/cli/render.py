@@ -6,6 +6,7 @@ import argparse
 import math
 import sys
 from pathlib import Path
+from typing import Any
 
 from ..catalogue import build_catalogue, shipped_catalogue
 from ..choices import POINT_POLICIES
@@ -47,9 +48,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="compile document.tex with pdflatex (in a private folder) into DIR/document.pdf")
 
 
-def _load_summary(path: Path) -> dict:
+def _load_summary(path: Path) -> dict[str, Any]:
     """A summary file, validated: every name in it is one of the known ones, every count a number."""
-    data = load_yaml(path)  # JSON is YAML
+    data: dict[str, Any] = load_yaml(path)  # JSON is YAML; checked below to be a summary
     if isinstance(data, dict) and any(key not in data for key in _SUMMARY_KEYS):
         missing = [k for k in _SUMMARY_KEYS if k not in data]
         raise FormatError(f"{path}: not a study summary (missing {', '.join(missing)})")
@@ -64,7 +65,7 @@ def _load_summary(path: Path) -> dict:
     return data
 
 
-def _refuse_non_finite(data, path: Path) -> None:
+def _refuse_non_finite(data: object, path: Path) -> None:
     """JSON Schema's numbers admit NaN and infinities (``"share": NaN`` parses); no summary holds one,
     and a table would print ``nan \\%``."""
     stack: list[tuple[tuple[str, ...], object]] = [((), data)]

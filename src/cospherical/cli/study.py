@@ -15,7 +15,7 @@ from ..errors import UsageError, one_line
 from ..files.yamlio import atomic_write
 from ..outputs.report import text_report
 from ..paper import paper_comparison, paper_study_key
-from ..studies.engine import bisection_codes, run_study
+from ..studies.engine import Study, bisection_codes, run_study
 from ..studies.leaves import leaf_codes, run_leaves
 from ..studies.summary import compared_with, study_summary
 from .output import FACE_POINTS_HELP, dump, emit, holding_out, path_argument
@@ -150,7 +150,7 @@ def run(args: argparse.Namespace) -> int:
     return _report(summary, args, study)
 
 
-def _report(summary: dict, args, study=None) -> int:
+def _report(summary: dict[str, Any], args: argparse.Namespace, study: Study | None = None) -> int:
     """The summary on stdout, as JSON or text, with the paper beside it if asked."""
     if args.format == "json":
         if args.compare_paper:
@@ -162,11 +162,11 @@ def _report(summary: dict, args, study=None) -> int:
     return 0
 
 
-def _intersection(args) -> int:
+def _intersection(args: argparse.Namespace) -> int:
     from ..studies.intersection import run_intersection, set_patterns  # numpy: not for the other studies
     from ..execution.backends import check_backend
 
-    if Box.parse(args.box).squared != (1, 1, 1) or args.face_points != "octree":
+    if any(side != 1 for side in Box.parse(args.box).squared) or args.face_points != "octree":
         raise UsageError("cospherical study: error: the intersection study is the paper's: the cube, octree points")
     if args.resolution not in (2, 4, 8, 16):
         raise UsageError(f"cospherical study: error: --resolution {args.resolution}: choose 2, 4, 8 or 16")

@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _ray(args) -> int:
+def _ray(args: argparse.Namespace) -> int:
     ray = Ray.parse(args.ray)
     parts = args.range.split(":")
     if len(parts) != 2:

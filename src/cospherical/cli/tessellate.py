@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterable
 from pathlib import Path
 
-from ..choices import CRITERIA, POINT_POLICIES
+from ..choices import CRITERIA, POINT_POLICIES, FacePointSource
 from ..catalogue import apply_catalogue_criterion
 from ..core.configuration import Configuration
 from ..core.shapes import ELEMENTS, Shape, standard_shape
@@ -74,7 +75,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--vtu", type=path_argument, metavar="FILE", help="also write the tessellation as a VTU mesh (ParaView)")
 
 
-def _shape_file(path: Path, box) -> Shape:
+def _shape_file(path: Path, box: Iterable[str]) -> Shape:
     data = load_yaml(path)
     if not isinstance(data, dict) or any(not isinstance(data.get(key), list) for key in ("corners", "edges", "faces")):
         raise FormatError(f"{path}: needs the lists corners, edges and faces")
@@ -84,9 +85,9 @@ def _shape_file(path: Path, box) -> Shape:
         raise FormatError(f"{path}: {error}") from None
 
 
-def _configuration(args):
+def _configuration(args: argparse.Namespace) -> Configuration:
     """The configuration the arguments name: a cuboid's or another shape's."""
-    policy = args.face_points or "octree"  # no default in the parser: --faces excludes it
+    policy: FacePointSource = args.face_points or "octree"  # no default in the parser: --faces excludes it
     shape = _shape_file(args.shape, args.box) if args.shape else standard_shape(args.element, args.box)
     if args.code is not None:
         return Configuration.from_code(args.code, None, policy, args.faces, args.body, shape=shape)

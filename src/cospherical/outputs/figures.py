@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 from pathlib import Path
+from types import ModuleType
+from typing import Any
 
 from ..core.exact import Length
 from ..files.yamlio import atomic_write
@@ -15,7 +17,7 @@ def _value(text: str) -> float:
     return float(Length.parse(text))
 
 
-def _pyplot():
+def _pyplot() -> ModuleType:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -24,7 +26,7 @@ def _pyplot():
     return plt
 
 
-def heatmap_png(boxes: list[dict], path: Path) -> None:
+def heatmap_png(boxes: list[dict[str, Any]], path: Path) -> None:
     """FVM-adequate configurations of every box (1, b, c) of a sweep, b <= c."""
     plt = _pyplot()
     bs = sorted({_value(x["box"][1]) for x in boxes})
@@ -50,7 +52,7 @@ def heatmap_png(boxes: list[dict], path: Path) -> None:
     save_png(fig, path)
 
 
-def heatmap_tex(boxes: list[dict], path: Path) -> None:
+def heatmap_tex(boxes: list[dict[str, Any]], path: Path) -> None:
     rows = [{"b": f"{_value(x['box'][1]):.6g}", "c": f"{_value(x['box'][2]):.6g}", "fvm": x["fvm_adequate"]}
             for x in boxes]
     count = max(1, len({r["b"] for r in rows}))
@@ -59,7 +61,7 @@ def heatmap_tex(boxes: list[dict], path: Path) -> None:
     atomic_write(path, text)
 
 
-def _step_points(profile: dict) -> tuple[list[dict], list[dict]]:
+def _step_points(profile: dict[str, Any]) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     line, marks = [], []
     for step in profile["steps"]:
         lo, hi = _value(step["r_from"]), _value(step["r_to"])
@@ -71,7 +73,7 @@ def _step_points(profile: dict) -> tuple[list[dict], list[dict]]:
     return line, marks
 
 
-def steps_png(profile: dict, path: Path) -> None:
+def steps_png(profile: dict[str, Any], path: Path) -> None:
     """FVM-adequate configurations along the ray: a line on each interval, a dot at each threshold."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 3.6))
@@ -90,7 +92,7 @@ def steps_png(profile: dict, path: Path) -> None:
     save_png(fig, path)
 
 
-def steps_tex(profile: dict, path: Path) -> None:
+def steps_tex(profile: dict[str, Any], path: Path) -> None:
     line, marks = _step_points(profile)
     text = environment().get_template("steps.tex.j2").render(
         points=line, marks=marks, title=f"FVM-adequate configurations, boxes ({profile['ray']})")

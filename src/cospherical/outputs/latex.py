@@ -14,13 +14,13 @@ import re
 import shutil
 import subprocess
 from pathlib import Path
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import jinja2
 
 from ..catalogue import Catalogue, CatalogueType
 from ..core.element_types import face_summary
-from ..core.geometry import cross
 from ..choices import CRITERIA
 from ..errors import InputError
 from ..files.data import data_path
@@ -66,7 +66,7 @@ def environment() -> jinja2.Environment:
 _TOWARD_VIEWER = (0.35, -1.0, 0.55)
 
 
-def _normalise(v):
+def _normalise(v: Sequence[float]) -> tuple[float, ...]:
     n = math.sqrt(sum(x * x for x in v))
     return tuple(x / n for x in v)
 
@@ -79,18 +79,21 @@ def _drawn_normal(p: tuple[float, ...], q: tuple[float, ...], r: tuple[float, ..
     return (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
 
 
-def _projection(entry: CatalogueType, size: float):
+def _projection(entry: CatalogueType,
+                size: float) -> tuple[list[tuple[float, float]], list[tuple[int, ...]], set[tuple[int, ...]]]:
     """Screen coordinates of the example's vertices and each edge's visibility."""
     d = _normalise(_TOWARD_VIEWER)
-    right = _normalise(cross((0, 0, 1), d))
-    up = cross(d, right)
+    origin = (0.0, 0.0, 0.0)  # a cross product a x b is the drawn normal of (0, a, b); floats, as the picture is
+    right = _normalise(_drawn_normal(origin, (0.0, 0.0, 1.0), d))
+    up = _drawn_normal(origin, d, right)
     points = entry.example.coordinates
     screen = [(sum(a * b for a, b in zip(p, right)), sum(a * b for a, b in zip(p, up))) for p in points]
     xs, ys = [s[0] for s in screen], [s[1] for s in screen]
     scale = size / max(max(xs) - min(xs), max(ys) - min(ys))
     cx, cy = (max(xs) + min(xs)) / 2, (max(ys) + min(ys)) / 2
     screen = [((x - cx) * scale, (y - cy) * scale) for x, y in screen]
-    visible_edges, edges = set(), set()
+    visible_edges: set[tuple[int, ...]] = set()
+    edges: set[tuple[int, ...]] = set()
     for face in entry.reference_faces:
         nodes = face.nodes
         p0, p1, p2 = (points[i] for i in nodes[:3])
@@ -156,8 +159,8 @@ def save_png(fig: Figure, path: Path, dpi: int = 100) -> None:
         plt.close(fig)
 
 
-def _type_rows(summaries: list[dict], catalogue: Catalogue) -> list[dict]:
-    seen: dict[str, dict] = {}
+def _type_rows(summaries: list[dict[str, Any]], catalogue: Catalogue) -> list[dict[str, Any]]:
+    seen: dict[str, dict[str, Any]] = {}
     for summary in summaries:
         for data in summary["criteria"].values():
             for type_id, t in data["types"].items():
@@ -171,7 +174,7 @@ def _type_rows(summaries: list[dict], catalogue: Catalogue) -> list[dict]:
     return rows
 
 
-def _stem(summary: dict) -> str:
+def _stem(summary: dict[str, Any]) -> str:
     if summary["study"] == "intersection":
         return f"intersection-r{summary['resolution']}-{summary['insertion_order']}"
     return pattern_name(summary["study"], summary["box"], summary["face_points"], summary.get("element", "cuboid"))
@@ -187,7 +190,7 @@ def _readable(name: str) -> str:
     return name.replace("_", " ")
 
 
-def render_tables(summaries: list[dict], catalogue: Catalogue, out: Path, title: str, pdf: bool = False) -> list[Path]:
+def render_tables(summaries: list[dict[str, Any]], catalogue: Catalogue, out: Path, title: str, pdf: bool = False) -> list[Path]:
     """Write every table of the studies' summaries, and ``document.tex`` including them all
     (and, with ``pdf``, ``document.pdf`` compiled from it, with its log).
 
@@ -205,7 +208,7 @@ def render_tables(summaries: list[dict], catalogue: Catalogue, out: Path, title:
     return [out / name for name in names]
 
 
-def _write_tables(summaries: list[dict], catalogue: Catalogue, folder: OutputFolder, title: str) -> list[str]:
+def _write_tables(summaries: list[dict[str, Any]], catalogue: Catalogue, folder: OutputFolder, title: str) -> list[str]:
     env = environment()
     written: list[str] = []
 

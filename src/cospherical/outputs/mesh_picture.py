@@ -4,12 +4,15 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..files.yamlio import atomic_open
 from ..mesh.assembly import Mesh
+
+if TYPE_CHECKING:
+    from PIL import ImageFont
 
 __all__ = ["TAB20", "cut_png", "cut_polygons", "frame"]
 
@@ -179,7 +182,7 @@ def _ticks(length: float) -> list[tuple[float, str]]:
     return [(i * step, f"{i * step:.{decimals}f}") for i in range(int(length / step + 1e-9) + 1)]
 
 
-def _wrap(text: str, font, width: float) -> list[str]:
+def _wrap(text: str, font: ImageFont.FreeTypeFont | ImageFont.ImageFont, width: float) -> list[str]:
     """``text`` broken at spaces into lines no wider than ``width`` pixels (a longer word stays whole)."""
     lines: list[str] = []
     for word in text.split(" "):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from ..catalogue import Catalogue, element_options, type_name
 from ..paper import comparison_notes, paper_class, paper_comparison, paper_notes, paper_studies, paper_study_key
 from ..studies.engine import Study
@@ -9,7 +11,7 @@ from ..studies.engine import Study
 __all__ = ["comparison_lines", "paper_set_gaps", "study_comparison_lines", "text_report"]
 
 
-def paper_set_gaps(study: Study, key: str, criterion: str, catalogue: Catalogue | None = None) -> list[dict]:
+def paper_set_gaps(study: Study, key: str, criterion: str, catalogue: Catalogue | None = None) -> list[dict[str, Any]]:
     """Element types of the study that cannot be split into the paper's kept classes.
 
     The paper's table for a criterion names the classes it keeps; an element whose
@@ -18,7 +20,7 @@ def paper_set_gaps(study: Study, key: str, criterion: str, catalogue: Catalogue 
     """
     kept_classes = set(paper_studies()[key][criterion]["counts"])
     sizes = study.orbit_sizes()
-    gaps: dict[str, dict] = {}
+    gaps: dict[str, dict[str, Any]] = {}
     for rep, tess in study.tessellations.items():
         for element in tess.elements:
             options = element_options(tess, element, criterion)
@@ -32,16 +34,17 @@ def paper_set_gaps(study: Study, key: str, criterion: str, catalogue: Catalogue 
     return sorted(gaps.values(), key=lambda g: g["type"])
 
 
-def _mark(paper, ours) -> str:
+def _mark(paper: object, ours: object) -> str:
     return "" if paper == ours else "  <- differs"
 
 
-def _region(summary: dict) -> str:
+def _region(summary: dict[str, Any]) -> str:
     """Where the FVM test wants the circumcenters: the box, or another base element itself."""
-    return summary.get("element", "box")
+    region: str = summary.get("element", "box")
+    return region
 
 
-def text_report(summary: dict, compare_paper: bool = False, study: Study | None = None) -> str:
+def text_report(summary: dict[str, Any], compare_paper: bool = False, study: Study | None = None) -> str:
     """A plain-text report: the frequency table and, if asked, the paper beside it."""
     lines = [
         f"{summary['study']} study{' of the ' + summary['element'] if 'element' in summary else ''}, "
@@ -81,7 +84,7 @@ def text_report(summary: dict, compare_paper: bool = False, study: Study | None 
     return "\n".join(lines) + "\n"
 
 
-def study_comparison_lines(summary: dict) -> list[str]:
+def study_comparison_lines(summary: dict[str, Any]) -> list[str]:
     """The summary's ``compared_with`` study beside it: the figures, then every type's count."""
     other = summary["compared_with"]
     ours, theirs = summary["study"], f"{other['study']} ({other['face_points']})"
@@ -107,7 +110,7 @@ def study_comparison_lines(summary: dict) -> list[str]:
     return lines
 
 
-def comparison_lines(summary: dict, study: Study | None = None, catalogue: Catalogue | None = None) -> list[str]:
+def comparison_lines(summary: dict[str, Any], study: Study | None = None, catalogue: Catalogue | None = None) -> list[str]:
     """The paper's figures beside ours; with the ``study``, also the elements the paper's kept
     classes cannot tessellate, named by ``catalogue`` (default: the shipped one)."""
     key, _ = paper_study_key(summary)

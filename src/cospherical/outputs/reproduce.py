@@ -16,6 +16,7 @@ from ..files.yamlio import atomic_write
 from ..formats.catalogue_file import write_catalogue
 from ..formats.patterns import pattern_name, write_patterns
 from ..studies.reproduce import run_paper_studies
+from ..studies.engine import Study
 from ..studies.summary import compared_with, study_summary
 from .latex import element_png, render_tables
 from .report import comparison_lines, text_report
@@ -38,7 +39,7 @@ def reproduce(root: str | Path = ".", progress: Callable[[int], None] | None = N
         return _write(root, run.bisection, run.leaves, run.shapes)
 
 
-def _write(root: Path, studies, leaves, shapes) -> str:
+def _write(root: Path, studies: list[Study], leaves: list[Study], shapes: list[Study]) -> str:
     catalogue = build_catalogue(studies + leaves + shapes, intersection_examples())
     names = catalogue.names()
     write_catalogue(catalogue, root / "catalogue" / "catalogue.yaml")
