@@ -38,7 +38,7 @@ def test_a_pattern_table_at_resolution_4_passes_check(r4_table, r4_run):
     # Every type of the intersection studies is in the shipped catalogue, so `check`
     # (known types, node counts, exact tiling, recomputed types and circumcenters) passes their
     # tables. All 32,077 entries take 30 CPU-s (--full); by default the table of a sample of them
-    # (conftest.py) with every type of the whole table and a seeded 1 in 8 of the other entries. The
+    # (conftest.py) with every type of the whole table and a seeded 1 in 16 of the other entries. The
     # R = 2 table is checked whole, as YAML and as a store, in test_pattern_table_of_the_representatives.
     from cospherical.cli import main
 
