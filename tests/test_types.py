@@ -60,14 +60,14 @@ def test_the_strict_sections_turn_on_every_flag_of_strict():
 
 def test_strict_modules_refuse_an_unannotated_function(tmp_path):
     # The checker really is strict where the configuration says so, and only there: the same
-    # unannotated function is an error in a core module and accepted in a study module.
-    for package in ("cospherical", "cospherical/core", "cospherical/studies"):
+    # unannotated function is an error in a core module and accepted in a module of the formats.
+    for package in ("cospherical", "cospherical/core", "cospherical/formats"):
         (tmp_path / package).mkdir()
         (tmp_path / package / "__init__.py").write_text("")
     probe = "def half(x):\n    return x / 2\n"
     (tmp_path / "cospherical" / "core" / "probe.py").write_text(probe)
-    (tmp_path / "cospherical" / "studies" / "probe.py").write_text(probe)
-    result = mypy("cospherical/core/probe.py", "cospherical/studies/probe.py", cwd=tmp_path, cache=tmp_path / "cache")
+    (tmp_path / "cospherical" / "formats" / "probe.py").write_text(probe)
+    result = mypy("cospherical/core/probe.py", "cospherical/formats/probe.py", cwd=tmp_path, cache=tmp_path / "cache")
     assert result.returncode == 1
     errors = [line for line in result.stdout.splitlines() if ": error:" in line]
     assert len(errors) == 1 and errors[0].startswith("cospherical/core/probe.py:1:"), result.stdout

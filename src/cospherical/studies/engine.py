@@ -122,7 +122,7 @@ class Study:
     def orbits(self) -> int:
         return len(self.tessellations)
 
-    def orbit_sizes(self) -> Counter:
+    def orbit_sizes(self) -> Counter[str]:
         return Counter(rep for rep, _ in self.representative.values())
 
     def tessellation(self, code: str, criterion: str = "optimal") -> Tessellation:
@@ -171,8 +171,8 @@ class Study:
 
     def type_counts(self, criterion: str = "optimal") -> list[TypeCount]:
         """Element types by decreasing count, then id."""
-        counts: Counter = Counter()
-        configurations: Counter = Counter()
+        counts: Counter[str] = Counter()
+        configurations: Counter[str] = Counter()
         types: dict[str, ElementType] = {}
         reps = self.choices[criterion].tessellations
         for rep, size in self.orbit_sizes().items():

@@ -15,8 +15,9 @@ FVM count or the set of element types really changes, as r = sqrt(u).
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import Any
 from fractions import Fraction
 
 from ..caches import cached
@@ -29,6 +30,9 @@ from ..errors import InputError
 from .engine import bisection_codes
 
 __all__ = ["Ray", "Step", "code_pieces", "profile_summary", "ray_profile"]
+
+# A configuration's state at a box of the ray: FVM-adequate or not, and its element types.
+State = tuple[bool, frozenset[str]]
 
 
 @dataclass(frozen=True)
@@ -67,7 +71,7 @@ class _Critical(Exception):
     """The probed value of u is itself a root: probe elsewhere."""
 
 
-def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int]], tuple]:
+def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int]], State]:
     """The linear forms a + b*u whose signs hold the tessellation at u, and its state there.
 
     Raises :class:`_Critical` when u is a root of one of them (a degenerate value).
@@ -111,7 +115,7 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
     return forms, state
 
 
-def _interval(forms, u: Fraction) -> tuple[Fraction | None, Fraction | None]:
+def _interval(forms: Iterable[tuple[int, int]], u: Fraction) -> tuple[Fraction | None, Fraction | None]:
     lo = hi = None
     for a, b in forms:
         if b:
@@ -123,13 +127,13 @@ def _interval(forms, u: Fraction) -> tuple[Fraction | None, Fraction | None]:
     return lo, hi
 
 
-def _state_at(code: str, ray: Ray, u: Fraction) -> tuple:
+def _state_at(code: str, ray: Ray, u: Fraction) -> State:
     tess = tessellate(Configuration.from_code(code, ray.box(u)))
     return tess.fvm_adequate, frozenset(e.type.id for e in tess.elements)
 
 
 @cached(maxsize=1 << 14)
-def code_pieces(code: str, ray: Ray, u_lo: Fraction, u_hi: Fraction) -> tuple:
+def code_pieces(code: str, ray: Ray, u_lo: Fraction, u_hi: Fraction) -> tuple[tuple[Fraction, Fraction, State], ...]:
     """The configuration's state on [u_lo, u_hi] as pieces ``(u_from, u_to, state)``.
 
     Open intervals alternate with single points (``u_from == u_to``), starting
@@ -201,7 +205,8 @@ def ray_profile(ray: Ray, r_lo: Fraction, r_hi: Fraction,
             spans.append((cut, cuts[i + 1], (cut + cuts[i + 1]) / 2))
     steps = []
     for u_from, u_to, probe in spans:
-        fvm, types = 0, set()
+        fvm = 0
+        types: set[str] = set()
         for rep, pieces in per_code.items():
             state = _state_in(pieces, probe)
             fvm += sizes[rep] * state[0]
@@ -218,7 +223,7 @@ def ray_profile(ray: Ray, r_lo: Fraction, r_hi: Fraction,
     return merged
 
 
-def _state_in(pieces, u: Fraction):
+def _state_in(pieces: Iterable[tuple[Fraction, Fraction, State]], u: Fraction) -> State:
     """The state at u: of the point piece at u, else of the open interval around u."""
     for start, end, state in pieces:
         if start == end == u or start < u < end:
@@ -226,7 +231,7 @@ def _state_in(pieces, u: Fraction):
     raise ValueError(f"u = {u} is outside the pieces")
 
 
-def profile_summary(ray: Ray, r_lo: Fraction, r_hi: Fraction, steps: list[Step]) -> dict:
+def profile_summary(ray: Ray, r_lo: Fraction, r_hi: Fraction, steps: list[Step]) -> dict[str, Any]:
     """The JSON shape of ``cospherical sweep --ray``: steps in r, thresholds, largest fully adequate r."""
     def text(u: Fraction) -> str:
         return Length(u).text

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Any, Mapping
 
 from ..catalogue import type_name
 from ..core.element_types import ElementType
@@ -40,7 +40,7 @@ class TypeInfo:
 
 
 def frequency_table(counts: Mapping[str, int], configurations: Mapping[str, int], types: Mapping[str, TypeInfo],
-                    splits: Mapping[str, Mapping[tuple[str, ...], int]]) -> dict:
+                    splits: Mapping[str, Mapping[tuple[str, ...], int]]) -> dict[str, Any]:
     """One criterion's part of a summary.
 
     Parameters
@@ -74,7 +74,7 @@ def frequency_table(counts: Mapping[str, int], configurations: Mapping[str, int]
     return data
 
 
-def study_summary(study: Study, names: Mapping[str, tuple[str, list[str]]] | None = None) -> dict:
+def study_summary(study: Study, names: Mapping[str, tuple[str, list[str]]] | None = None) -> dict[str, Any]:
     """The study's statistics in the JSON shape of ``cospherical study --format json``.
 
     ``names``: type id -> (name, aliases), as :func:`cospherical.catalogue.type_names`
@@ -88,7 +88,7 @@ def study_summary(study: Study, names: Mapping[str, tuple[str, list[str]]] | Non
             t = entry.type
             counts[t.id], configurations[t.id] = entry.count, entry.configurations
             types[t.id] = TypeInfo.of(t, names[t.id][0] if names and t.id in names else None)
-        splits: dict[str, Counter] = {}
+        splits: dict[str, Counter[tuple[str, ...]]] = {}
         for type_id, used in study.choices[criterion].splits.items():
             for split, n in used.items():
                 splits.setdefault(type_id, Counter())[tuple(sorted(piece_type for piece_type, _ in split))] += n
@@ -106,7 +106,7 @@ def study_summary(study: Study, names: Mapping[str, tuple[str, list[str]]] | Non
     }
 
 
-def compared_with(summary: dict, other: dict) -> dict:
+def compared_with(summary: dict[str, Any], other: dict[str, Any]) -> dict[str, Any]:
     """``summary`` with an entry ``compared_with``: another study's figures, to set beside ours.
 
     The other study's configurations, orbits, FVM counts and, per criterion, its

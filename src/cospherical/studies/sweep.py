@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Callable, Iterable
+from typing import Any, Callable, Iterable
 
 from ..core.configuration import Box
 from ..core.exact import parse_rational, rational_text
@@ -35,7 +35,7 @@ def grid_values(spec: str, what: str = "ratio range") -> list[Fraction]:
     return [low + (high - low) * i / (steps - 1) for i in range(steps)]
 
 
-def box_statistics(lengths: tuple[str, str, str]) -> dict:
+def box_statistics(lengths: tuple[str, str, str]) -> dict[str, Any]:
     """FVM-adequate configurations, element types and elements of one box's bisection study."""
     box = Box.parse(lengths)
     study = run_study("bisection", box, bisection_codes(), criteria=("optimal",))
@@ -49,7 +49,7 @@ def box_statistics(lengths: tuple[str, str, str]) -> dict:
 
 
 def sweep(b_values: Iterable[Fraction], c_values: Iterable[Fraction], jobs: int = 1,
-          progress: Callable[[int], None] | None = None) -> list[dict]:
+          progress: Callable[[int], None] | None = None) -> list[dict[str, Any]]:
     """Statistics of every box (1, b, c) of the grid with b <= c, in grid order."""
     boxes = [("1", rational_text(b), rational_text(c)) for b in b_values for c in c_values if b <= c]
     if jobs <= 1:

@@ -20,6 +20,7 @@ with at most d levels exist; at R = 16 every pattern (150 per set) does.
 from __future__ import annotations
 
 from fractions import Fraction
+from collections.abc import Iterator
 from itertools import combinations, product
 
 import numpy as np
@@ -35,7 +36,7 @@ __all__ = ["PARALLEL_EDGES", "all_configurations", "intersection_codes", "orbits
 PARALLEL_EDGES = tuple(tuple(k for k in range(12) if edge_axis(k) == axis) for axis in range(3))
 
 
-def _ordered_partitions(k: int):
+def _ordered_partitions(k: int) -> Iterator[tuple[int, ...]]:
     """Every surjection of k points onto levels 0..m-1 (weak orders of k items)."""
     for m in range(1, k + 1):
         for levels in product(range(m), repeat=k):

@@ -22,7 +22,7 @@ import re
 import stat
 from dataclasses import asdict
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable, TypeVar
 
 import numpy as np
 
@@ -44,6 +44,13 @@ from .statistics import ElementEntry, statistics
 
 __all__ = ["CHUNK", "ELEMENT_CHUNK", "cell_polyhedron", "element_entries", "example_elements", "run_intersection",
            "tessellate_chunk"]
+
+_T = TypeVar("_T")
+# Stage 2 on some elements: their entries, and every type met (pieces included), described.
+ElementStage = tuple[list[ElementEntry], dict[str, TypeInfo]]
+# What run_intersection collects per type: (node mask, code) of an element of that type, or
+# (node mask, code, criterion) of one whose split under that criterion has a piece of that type.
+Example = tuple[int, int] | tuple[int, int, str]
 
 CHUNK = 5000
 ELEMENT_CHUNK = 500
@@ -145,7 +152,7 @@ def element_entries(elements: list[tuple[int, int]],
     return entries, types
 
 
-def _element_chunk_json(part) -> str:
+def _element_chunk_json(part: ElementStage) -> str:
     entries, types = part
     return json.dumps([[asdict(e) for e in entries], {k: asdict(t) for k, t in types.items()}], sort_keys=True)
 
@@ -226,7 +233,7 @@ def _read_cells(path: Path, count: int) -> dict[str, np.ndarray]:
     return part
 
 
-def _read_elements(path: Path, count: int):
+def _read_elements(path: Path, count: int) -> ElementStage:
     """A stage-2 checkpoint of ``count`` elements, checked: ``(entries, types)``; ValueError says why not."""
     text = _checked_payload(path, 4096 + _ELEMENT_BYTES * count).decode("utf-8")
     data = parse_json(text, path.name)
@@ -245,7 +252,7 @@ def _read_elements(path: Path, count: int):
     return entries, types
 
 
-def _resumed(read, path: Path, count: int, damaged: list):
+def _resumed(read: Callable[[Path, int], _T], path: Path, count: int, damaged: list[str]) -> _T | None:
     """A checkpoint's content, or ``None`` when it is missing or damaged (noted in ``damaged``)."""
     if not path.exists():
         return None
@@ -256,13 +263,13 @@ def _resumed(read, path: Path, count: int, damaged: list):
         return None
 
 
-def _npz_bytes(arrays: dict) -> bytes:
+def _npz_bytes(arrays: dict[str, np.ndarray]) -> bytes:
     buffer = io.BytesIO()
-    np.savez(buffer, **arrays)
+    np.savez(buffer, **arrays)  # type: ignore[arg-type]  # numpy's stub takes a name for allow_pickle's
     return buffer.getvalue()
 
 
-def _tetrahedron():
+def _tetrahedron() -> ElementStage:
     """The entry of the tetrahedron (every 4-point cell has this one type; no split)."""
     corners = (0, 1, 3, 4)  # of the cube with no Steiner point (code 0)
     return element_entries([(sum(1 << n for n in corners), 0)], of_configuration=False)
@@ -271,7 +278,8 @@ def _tetrahedron():
 def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, checkpoints: str | Path | None = None,
                      progress: Callable[[str, int], None] | None = None, chunk: int = CHUNK, scheduler: str | None = None,
                      dask_workers: int | None = None, brute_force: bool = False,
-                     examples: dict | None = None, notice: Callable[[str], None] | None = None) -> dict:
+                     examples: dict[str, Example] | None = None,
+                     notice: Callable[[str], None] | None = None) -> dict[str, Any]:
     """The intersection study's summary, all criteria, in the shape of the bisection study's.
 
     Parameters
@@ -323,7 +331,7 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
 
     # Stage 1: cells.
     starts = range(0, len(reps), chunk)
-    stage1: dict[int, dict] = {}
+    stage1: dict[int, dict[str, np.ndarray]] = {}
     resumed: set[int] = set()  # the stage-1 chunks read from checkpoints: what stage 2 may find not cells
     damaged: list[str] = []
     for i, start in enumerate(starts):
@@ -381,8 +389,8 @@ def run_intersection(resolution: int = 16, order: str = "edge", jobs: int = 1, c
     }
 
 
-def _element_stage(work: list[tuple[int, int]], folder: Path | None, tag: str, backend: Backend, report,
-                   notice) -> tuple[list, dict]:
+def _element_stage(work: list[tuple[int, int]], folder: Path | None, tag: str, backend: Backend,
+                   report: Callable[[str, int], None], notice: Callable[[str], None] | None) -> ElementStage:
     """Stage 2 of :func:`run_intersection`: the entries of ``work`` (after the tetrahedron's) and the types.
 
     Its checkpoints are named by a digest of ``work``: they are the entries of these elements
@@ -390,7 +398,7 @@ def _element_stage(work: list[tuple[int, int]], folder: Path | None, tag: str, b
     """
     digest = hashlib.sha256(json.dumps(work).encode()).hexdigest()[:16]
     element_starts = range(0, len(work), ELEMENT_CHUNK)
-    stage2: dict[int, tuple] = {}
+    stage2: dict[int, ElementStage] = {}
     damaged: list[str] = []
     for i, start in enumerate(element_starts):
         part = _resumed(_read_elements, folder / f"{tag}-w{digest}-elements-{i:05d}.json",
@@ -419,13 +427,13 @@ def _element_stage(work: list[tuple[int, int]], folder: Path | None, tag: str, b
     return entries, types
 
 
-def _notice(notice, damaged: list[str]) -> None:
+def _notice(notice: Callable[[str], None] | None, damaged: list[str]) -> None:
     if damaged and notice is not None:
         more = f" and {len(damaged) - 1} more" if len(damaged) > 1 else ""
         notice(f"damaged checkpoint {damaged[0]}{more}: computed again")
 
 
-def example_elements(examples: dict) -> dict[str, tuple[str, tuple[int, ...]]]:
+def example_elements(examples: dict[str, Example]) -> dict[str, tuple[str, tuple[int, ...]]]:
     """The examples :func:`run_intersection` collects as type id -> (configuration code, node ids).
 
     A piece type's example is a piece of its parent element's splits with that type.

@@ -9,6 +9,7 @@ frequency tables come from the same functions as the bisection study's
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -28,12 +29,12 @@ class ElementEntry:
     options: dict[str, tuple[tuple[str, ...], ...]]
 
     @classmethod
-    def from_json(cls, data: dict) -> ElementEntry:
+    def from_json(cls, data: dict[str, Any]) -> ElementEntry:
         return cls(data["type"], {c: tuple(map(tuple, o)) for c, o in data["options"].items()})
 
 
-def statistics(sizes: np.ndarray, cells: dict, element_of: np.ndarray, entries: list[ElementEntry],
-               types: dict[str, TypeInfo]) -> dict:
+def statistics(sizes: np.ndarray, cells: dict[str, np.ndarray], element_of: np.ndarray, entries: list[ElementEntry],
+               types: dict[str, TypeInfo]) -> dict[str, Any]:
     """FVM counts and, per criterion, the kept types, totals, frequencies and splits.
 
     ``entries[e]`` describes element e (entry 0 the tetrahedron); ``element_of``
@@ -72,7 +73,8 @@ def statistics(sizes: np.ndarray, cells: dict, element_of: np.ndarray, entries: 
     }
 
 
-def _counts(pieces, weight, sizes, config, element) -> tuple[dict[str, int], dict[str, int]]:
+def _counts(pieces: list[tuple[str, ...]], weight: np.ndarray, sizes: np.ndarray, config: np.ndarray,
+            element: np.ndarray) -> tuple[dict[str, int], dict[str, int]]:
     """Per type: its elements, and the configurations holding at least one (weighted by orbit size)."""
     type_ids = sorted({t for e in range(len(pieces)) if weight[e] > 0 for t in pieces[e]})
     index = {t: i for i, t in enumerate(type_ids)}

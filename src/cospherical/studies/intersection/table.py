@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Callable, Iterator, TypeVar
+from typing import Any, Callable, Iterator, TypeVar
 
 import numpy as np
 
@@ -110,7 +110,7 @@ def table_entries(codes: np.ndarray, cells: Mapping[tuple[int, int], CellText], 
         mine = held[start:start + count]
         start += count
         parts = [f'"fvm_adequate": {"true" if all(cell.closed for cell in mine) else "false"}']
-        written: dict[tuple, str] = {}
+        written: dict[tuple[tuple[int, ...], ...], str] = {}
         for k, criterion in enumerate(criteria):
             # in node-id order, as a tessellation sorts its elements; the same
             # elements as an earlier criterion are that criterion's name
@@ -140,7 +140,8 @@ class TableRun:
     ``scheduler``, ``dask_workers``).
     """
 
-    def __init__(self, summary: dict, jobs: int = 1, progress=None, scheduler: str | None = None,
+    def __init__(self, summary: dict[str, Any], jobs: int = 1, progress: Callable[[str, int], None] | None = None,
+                 scheduler: str | None = None,
                  dask_workers: int | None = None, chunk: int = CHUNK) -> None:
         self.resolution, self.order = summary["resolution"], summary["insertion_order"]
         self.reps, _, _ = orbits(self.resolution, self.order)
