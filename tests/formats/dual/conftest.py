@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import pytest
 
 
@@ -16,6 +15,7 @@ def dual_run(tmp_path_factory):
     assert main([*argv, "--out", str(out / "a")]) == 0
     assert main([*argv, "--out", str(out / "b")]) == 0
     return out
+
 
 @pytest.fixture(scope="package")
 def device_dual(tmp_path_factory):

@@ -33,6 +33,7 @@ def _resigned(good: Path, target: Path, manifest_edit=None, members: dict | None
         for name, blob in blobs.items():
             archive.writestr(f"{name}.npy", blob)
 
+
 def _edited(good: Path, target: Path, edit) -> None:
     """A re-signed copy of ``good`` whose members ``edit(arrays)`` changed in place (numpy arrays by name)."""
     import io
@@ -78,6 +79,7 @@ def _forged_dual(path: Path, replaced: dict[int, list[list[int]]], tetrahedra: b
     nodes = np.array(rows, dtype=np.int32)
     write_dual(mesh_dual(mesh, (nodes, (nodes >= 0).sum(axis=1).astype(np.int8))), path)
     return path
+
 
 def _with_contact_faces(good: Path, target: Path, faces: np.ndarray, which: np.ndarray, regions=None,
                         element_region=None) -> None:

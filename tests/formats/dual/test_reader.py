@@ -52,6 +52,7 @@ def test_a_truncated_or_tampered_dual_npz_is_refused_with_one_line(dual_run, tmp
         assert err.count("\n") == 1 and f"{name}.npz" in err and "Traceback" not in err
     assert "member 'edges.npy' appears twice" in err
 
+
 @pytest.mark.parametrize("case", ["factor 1e999999999", "factor 1e400", "grid 10**400", "integers --5",
                                   "integers of 5000 digits", "boundary factors not the domain's",
                                   "manifest nested 100,000 deep", "manifest with a repeated key",
@@ -99,6 +100,7 @@ def test_a_resigned_dual_npz_with_hostile_numbers_is_one_line_at_once(dual_run, 
     assert not case.startswith("version 2") or "dual format version 2; this reads 3, 4 and 5 (write it again with " \
         "cospherical mesh --dual)" in err, err
     assert not case.startswith("version 3") or "dual format version 3.0; this reads" in err, err
+
 
 def test_a_dual_npz_that_inflates_is_refused_from_its_headers(dual_run, tmp_path, capsys, monkeypatch):
     """A member whose header claims 100 MB of zeros (deflated to 100 KB, re-signed) is refused
@@ -152,6 +154,7 @@ def test_a_dual_npz_that_inflates_is_refused_from_its_headers(dual_run, tmp_path
     monkeypatch.setattr(dual_format, "machine_memory", lambda: 2 * good.stat().st_size)
     assert main(["check", str(good)]) == 2
     assert "more than half this machine's memory" in capsys.readouterr().err
+
 
 def test_distinct_elements_are_proved_distinct_even_when_every_hash_collides(dual_run, monkeypatch):
     """Elements are proved pairwise different by one hash per element; equal hashes (here: all of them) send

@@ -71,6 +71,7 @@ def test_a_resigned_edit_that_keeps_every_sum_is_refused_naming_the_edge(dual_ru
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and needle in err and "Traceback" not in err, (needle, err)
 
+
 def test_elements_whose_exact_hulls_are_too_much_work_are_refused_before_any_geometry(dual_run, tmp_path, capsys,
                                                                                          monkeypatch):
     """Re-signed elements of 64 co-spherical vertices, each a different shape: every distinct shape costs
@@ -126,6 +127,7 @@ def test_a_resigned_dual_whose_elements_overlap_and_leave_a_hole_is_refused(tmp_
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "forged.npz: member element_nodes: the elements are not a mesh" in err, err
     assert main(["check", str(_forged_dual(tmp_path / "good.npz", {}, tetrahedra))]) == 0  # unforged, it passes
+
 
 @pytest.mark.parametrize("case", ["names with a newline and ESC", "names as paths", "two regions of one name",
                                   "two contacts of one name", "a region index true", "a part denominator of "
@@ -198,6 +200,7 @@ def test_a_forged_device_dual_is_refused_with_one_line(device_dual, tmp_path, ca
     assert case != "an element given the other region" or "member element_region" in err, err
     assert case != "a contact on a region it does not touch" or "is no face of an element of its region" in err \
         or "not on the boundary of region 'ox'" in err, err
+
 
 def test_a_version_4_device_dual_is_still_read_and_checked(tmp_path, capsys):
     """Version 4 (before interfaces) counted a device's boundary in its bounding box's sides only: such a file

@@ -38,6 +38,7 @@ def test_mesh_dual_writes_a_deterministic_dual_npz_and_vtu_data(dual_run):
     assert (ok == 0).sum() == report["delaunay_violations"] > 0
     assert np.concatenate(vtu.cell_data["circumcenter"]).shape == (report["elements"], 3)
 
+
 def test_each_member_is_what_numpy_save_writes():
     """The writer makes each .npy itself (its header, then the array's own bytes): its bytes are numpy.save's, for
     every kind of member (ints, floats, bools, bytes, decimal text, empty, a non-contiguous view)."""
@@ -52,6 +53,7 @@ def test_each_member_is_what_numpy_save_writes():
         np.save(saved, array, allow_pickle=False)
         header, data = _npy(array)
         assert header + bytes(data) == saved.getvalue()
+
 
 def test_exact_values_wider_than_the_text_column_are_written_whole(tmp_path, capsys):
     """Lengths of 37-digit fractions make coefficients of about 220 digits: they were cut to 200 characters
