@@ -7,6 +7,7 @@ is reported as renamed, not as one removed and one added.
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Iterable
 from typing import Any
 
 from ..errors import FormatError, one_line
@@ -24,11 +25,11 @@ def document_kind(data: object, name: str) -> str:
     raise FormatError(f"{name}: neither a catalogue (no 'types') nor a pattern table (no 'configurations')")
 
 
-def _changed(old: dict, new: dict, keys) -> dict:
+def _changed(old: dict[str, Any], new: dict[str, Any], keys: Iterable[str]) -> dict[str, Any]:
     return {k: {"old": old.get(k), "new": new.get(k)} for k in keys if old.get(k) != new.get(k)}
 
 
-def diff_catalogues(old: dict, new: dict) -> dict:
+def diff_catalogues(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
     header = _changed(old, new, ("schema_version", "version"))
     old_types = {t["code"]: t for t in old["types"]}
     new_types = {t["code"]: t for t in new["types"]}
@@ -66,21 +67,22 @@ def diff_catalogues(old: dict, new: dict) -> dict:
 _REPORTED_APART = {"code", "name", "aliases", "splits"}
 
 
-def _brief(entry: dict) -> dict:
+def _brief(entry: dict[str, Any]) -> dict[str, Any]:
     return {"id": entry["id"], "name": entry["name"], "vef": [entry["vertices"], entry["edges"], entry["faces"]]}
 
 
-def _split_text(split) -> str:
+def _split_text(split: Iterable[dict[str, Any]]) -> str:
     return " + ".join(f"{piece['type']}{piece['nodes']}" for piece in split)
 
 
-def _types(elements) -> list[str]:
+def _types(elements: Iterable[dict[str, Any]] | None) -> list[str]:
     counts = Counter(e["type"] for e in elements or [])
     return [f"{n} x {t}" if n > 1 else t for t, n in sorted(counts.items())]
 
 
-def _what_changed(before, after) -> str:
-    """``types``, ``nodes`` (same types) or ``circumcenters`` (same types and nodes)."""
+def _what_changed(before: list[dict[str, Any]] | None, after: list[dict[str, Any]] | None) -> str:
+    """``types``, ``nodes`` (same types) or ``circumcenters`` (same types and nodes); no elements as none."""
+    before, after = before or [], after or []
     if Counter(e["type"] for e in before) != Counter(e["type"] for e in after):
         return "types"
     if [(e["type"], e["nodes"]) for e in before] != [(e["type"], e["nodes"]) for e in after]:
@@ -88,13 +90,13 @@ def _what_changed(before, after) -> str:
     return "circumcenters"
 
 
-def diff_patterns(old: dict, new: dict) -> dict:
+def diff_patterns(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
     header = _changed(old, new, [k for k in {**old, **new} if k != "configurations"])  # every header field
     old_conf, new_conf = old["configurations"], new["configurations"]
     added = sorted(set(new_conf) - set(old_conf))
     removed = sorted(set(old_conf) - set(new_conf))
     criteria = [c for c in new.get("criteria", []) if c in old.get("criteria", [])]
-    changed: dict[str, list] = {}
+    changed: dict[str, list[Any]] = {}
     fvm = []
     # Entries written alike are alike: tables of a million entries that mostly agree
     # (the YAML and the store of one table) are compared without decoding those.
@@ -128,11 +130,11 @@ def diff_documents(old: dict[str, Any], new: dict[str, Any], old_name: str, new_
     return diff_catalogues(old, new) if kinds[0] == "catalogue" else diff_patterns(old, new)
 
 
-def has_changes(report: dict) -> bool:
+def has_changes(report: dict[str, Any]) -> bool:
     return any(k != "kind" for k in report)
 
 
-def text_report(report: dict, old_name: str, new_name: str) -> str:
+def text_report(report: dict[str, Any], old_name: str, new_name: str) -> str:
     """Human-readable diff; empty when nothing changed.  Each line as a terminal shows it as written
     (:func:`~cospherical.errors.one_line`): the file names and the names from the files are data, and a
     newline or an ESC sequence in one must neither forge a line nor drive the terminal."""

@@ -63,7 +63,11 @@ def _check_name(name: str) -> str:
     return name
 
 
-def _groups(simplices: SimplexMesh) -> list[tuple[int, int, str, np.ndarray, int]]:
+# A physical group: its dimension, tag, name, element rows (1-based node ids) and Gmsh element type.
+_Group = tuple[int, int, str, np.ndarray, int]
+
+
+def _groups(simplices: SimplexMesh) -> list[_Group]:
     """(dimension, tag, name, elements (rows of 1-based node tags), element type) per physical group."""
     groups = []
     volumes, surfaces = list(simplices.volumes), list(simplices.surfaces)
@@ -107,7 +111,7 @@ def msh_bytes(simplices: SimplexMesh, version: str = "4.1", binary: bool = False
     return out.getvalue()
 
 
-def _write_22(out, points, groups, binary: bool) -> None:
+def _write_22(out: io.BytesIO, points: np.ndarray, groups: list[_Group], binary: bool) -> None:
     n = len(points)
     out.write(f"$Nodes\n{n}\n".encode())
     if binary:
@@ -134,7 +138,7 @@ def _write_22(out, points, groups, binary: bool) -> None:
     out.write(b"\n$EndElements\n" if binary else b"$EndElements\n")
 
 
-def _write_41(out, points, groups, binary: bool) -> None:
+def _write_41(out: io.BytesIO, points: np.ndarray, groups: list[_Group], binary: bool) -> None:
     n = len(points)
     surfaces = [g for g in groups if g[0] == 2]
     volumes = [g for g in groups if g[0] == 3]

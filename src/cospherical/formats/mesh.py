@@ -24,7 +24,7 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence, TypedDict
 
 import numpy as np
 
@@ -242,7 +242,21 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
     return mapped
 
 
-def vtu_arrays(mesh: Mesh) -> dict:
+class VtuArrays(TypedDict):
+    """What :func:`vtu_arrays` gives: the type ids, the cells' order and VTK types, connectivity and offsets, the
+    polyhedra's face streams (``None`` without polyhedra), each element's type index."""
+
+    ids: list[str]
+    order: np.ndarray
+    types: np.ndarray
+    connectivity: np.ndarray
+    offsets: np.ndarray
+    faces: np.ndarray | None
+    faceoffsets: np.ndarray | None
+    element_type: np.ndarray
+
+
+def vtu_arrays(mesh: Mesh) -> VtuArrays:
     """The mesh as the arrays of a VTU grid (see :func:`write_vtu`), built per block of alike elements, never per element.
 
     Cells are sorted by VTK cell type (stable: in element order within a type), so a
@@ -295,8 +309,8 @@ def vtu_arrays(mesh: Mesh) -> dict:
             "faces": faces, "faceoffsets": faceoffsets, "element_type": element_type}
 
 
-def write_vtu(mesh: Mesh, path: str | Path, point_data: dict | None = None, cell_data: dict | None = None,
-              leaves: np.ndarray | None = None, field_data: dict | None = None, origin: Sequence[Fraction] | None = None) -> None:
+def write_vtu(mesh: Mesh, path: str | Path, point_data: dict[str, np.ndarray] | None = None, cell_data: dict[str, np.ndarray] | None = None,
+              leaves: np.ndarray | None = None, field_data: dict[str, np.ndarray] | None = None, origin: Sequence[Fraction] | None = None) -> None:
     """Write the mesh as one compressed binary VTU grid, atomically (a complete new file or the old one).
 
     Standard VTK cells (tetra, pyramid, wedge, hexahedron, nodes in VTK order) for
@@ -321,13 +335,13 @@ class VtuGrid:
     offsets: np.ndarray
     faces: np.ndarray | None
     faceoffsets: np.ndarray | None
-    point_data: dict
-    cell_data: dict
-    field_data: dict
+    point_data: dict[str, np.ndarray]
+    cell_data: dict[str, np.ndarray]
+    field_data: dict[str, np.ndarray]
 
 
-def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None = None,
-             leaves: np.ndarray | None = None, field_data: dict | None = None, origin: Sequence[Fraction] | None = None) -> VtuGrid:
+def vtu_grid(mesh: Mesh, point_data: dict[str, np.ndarray] | None = None, cell_data: dict[str, np.ndarray] | None = None,
+             leaves: np.ndarray | None = None, field_data: dict[str, np.ndarray] | None = None, origin: Sequence[Fraction] | None = None) -> VtuGrid:
     """The grid :func:`write_vtu` writes (and the pyvista adapter builds in memory), cells sorted by VTK cell type.
 
     Point data: ``grid_coordinates`` (the exact integer grid point of each vertex),
@@ -384,13 +398,13 @@ def vtu_grid(mesh: Mesh, point_data: dict | None = None, cell_data: dict | None 
                    arrays["faceoffsets"], points, cells, fields)
 
 
-def report_json(report: dict) -> str:
+def report_json(report: dict[str, Any]) -> str:
     """The report as JSON text (deterministic), validated against its schema."""
     validate(report, "mesh-report", "mesh report")
     return json.dumps(report, indent=1) + "\n"
 
 
-def write_report(report: dict, path: str | Path) -> None:
+def write_report(report: dict[str, Any], path: str | Path) -> None:
     atomic_write(path, report_json(report))
 
 

@@ -137,7 +137,7 @@ def _complete(path: Path) -> bool:
     return pages > 0 and os.path.getsize(path) >= page_size * pages
 
 
-def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
+def open_store(path: str | Path) -> tuple[dict[str, Any], "StoreEntries"]:
     """The header and the entries of a store; a bad or truncated store raises :class:`FormatError`."""
     path = Path(path)
     if not _complete(path):
@@ -156,13 +156,13 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
             raise ValueError(f"no header and count of at most {_MAX_HEADER} bytes")
         header = parse_json(meta["header"], f"{path}: header")
         count = int(meta["count"])
-        rows = connection.execute("SELECT data FROM dictionary WHERE length(data) <= ? LIMIT 2",
+        dictionaries = connection.execute("SELECT data FROM dictionary WHERE length(data) <= ? LIMIT 2",
                                   (_DICTIONARY_SIZE,)).fetchall()
-        if not isinstance(header, dict) or not 0 <= count <= 16 ** 12 or len(rows) != 1 \
-                or not isinstance(rows[0][0], bytes):
+        if not isinstance(header, dict) or not 0 <= count <= 16 ** 12 or len(dictionaries) != 1 \
+                or not isinstance(dictionaries[0][0], bytes):
             raise ValueError(f"its header is not a mapping, its count is not that of a table, or it has not one "
                              f"dictionary of at most {_DICTIONARY_SIZE} bytes")
-        (dictionary,) = rows[0]
+        (dictionary,) = dictionaries[0]
         try:
             oversized = connection.execute(_OVERSIZED_RECORD).fetchone() is not None
         except sqlite3.OperationalError:  # an SQLite built without dbstat: the scan below reads a long code whole
@@ -180,7 +180,7 @@ def open_store(path: str | Path) -> tuple[dict, "StoreEntries"]:
     return header, StoreEntries(connection, count, dictionary, str(path))
 
 
-class StoreEntries(Mapping):
+class StoreEntries(Mapping[str, str]):
     """A store's configurations as code -> raw entry text (JSON), read one at a time by the index."""
 
     def __init__(self, connection: sqlite3.Connection, count: int, dictionary: bytes, name: str):
@@ -189,7 +189,7 @@ class StoreEntries(Mapping):
         self._dictionary = dictionary
         self._name = name
 
-    def _rows(self, sql: str, arguments=()):
+    def _rows(self, sql: str, arguments: tuple[object, ...] = ()) -> Iterator[tuple[Any, ...]]:
         # SQLite reads pages as rows are stepped through: a damaged page shows while
         # iterating, not only when the query starts
         try:
@@ -197,10 +197,10 @@ class StoreEntries(Mapping):
         except sqlite3.Error as error:
             raise FormatError(f"{self._name}: store damaged: {str(error).splitlines()[0][:120]}") from None
 
-    def _one(self, sql: str, arguments=()):
+    def _one(self, sql: str, arguments: tuple[object, ...] = ()) -> tuple[Any, ...] | None:
         return next(self._rows(sql, arguments), None)
 
-    def _text(self, blob) -> str:
+    def _text(self, blob: bytes | None) -> str:
         if blob is None:  # the query's bound on the stored size: the blob was never read
             raise FormatError(f"{self._name}: store damaged: an entry is stored in over {MAX_ENTRY} bytes")
         try:
@@ -221,10 +221,10 @@ class StoreEntries(Mapping):
             raise KeyError(code)
         return self._text(row[0])
 
-    def __contains__(self, code) -> bool:
+    def __contains__(self, code: object) -> bool:
         return isinstance(code, str) and self._one("SELECT 1 FROM entries WHERE code = ?", (code,)) is not None
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[str]:
         return (code for (code,) in self._rows("SELECT code FROM entries ORDER BY code"))
 
     def __len__(self) -> int:

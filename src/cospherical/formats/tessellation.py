@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from ..catalogue import type_name
 from ..core.tessellation import Tessellation
 
 __all__ = ["tessellation_data"]
 
 
-def tessellation_data(tess: Tessellation) -> dict:
+def tessellation_data(tess: Tessellation) -> dict[str, Any]:
     """The JSON/YAML shape of ``cospherical tessellate``: nodes in box coordinates, elements with
     the catalogue's names, circumcenters in box coordinates, and the FVM tests.
 

@@ -90,8 +90,8 @@ def text_array(text: str) -> np.ndarray:
 
 def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, connectivity: np.ndarray,
                offsets: np.ndarray, faces: np.ndarray | None = None, faceoffsets: np.ndarray | None = None,
-               point_data: dict | None = None, cell_data: dict | None = None,
-               field_data: dict | None = None) -> None:
+               point_data: dict[str, np.ndarray] | None = None, cell_data: dict[str, np.ndarray] | None = None,
+               field_data: dict[str, np.ndarray] | None = None) -> None:
     """Write one unstructured grid as a compressed binary VTU, atomically.
 
     ``connectivity`` lists every cell's points one after the other, ``offsets`` is
