@@ -57,8 +57,13 @@ class ShapePieces:
         nodes = sorted(volumes)
         self.volume_nodes: NDArray[np.int64] = np.array(nodes, dtype=np.int64)
         self.volume_q: list[Fraction] = [volumes[n] for n in nodes]
+        entries = [((axis, planes[axis, node], node), q) for (axis, node), q in boundary.items()]
+        # sorted by (axis, plane, node), the planes compared as integers over their common denominator (the same
+        # order as the fractions', at a fraction of the cost)
+        common = math.lcm(1, *(value.denominator for (_, value, _), _ in entries))
         self.boundary: list[tuple[tuple[int, Fraction, int], Fraction]] = sorted(
-            ((axis, planes[axis, node], node), q) for (axis, node), q in boundary.items())
+            entries, key=lambda entry: (entry[0][0], entry[0][1].numerator * (common // entry[0][1].denominator),
+                                        entry[0][2]))
 
 
 Key = TypeVar("Key", bound=Hashable)
@@ -199,17 +204,19 @@ def _signed_permutations() -> NDArray[np.int64]:
 _SIGNED_PERMUTATIONS = _signed_permutations()
 
 
-_ISOMETRIES: dict[tuple[bool, bool, bool], NDArray[np.int64]] = {}
+_ISOMETRIES: dict[tuple[bool, bool, bool], tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]] = {}
 
 
-def _isometries(squared: Squared) -> NDArray[np.int64]:
-    """The box's symmetries (of the 48): the reflections, and the permutations of axes of equal length."""
+def _isometries(squared: Squared) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """The box's symmetries (of the 48): the reflections, and the permutations of axes of equal length; as
+    matrices, and as each one's axis taken per coordinate with its sign."""
     equal = (squared[0] == squared[1], squared[1] == squared[2], squared[0] == squared[2])
     found = _ISOMETRIES.get(equal)
     if found is None:
         keep = [all(squared[i] == squared[int(np.flatnonzero(m[i])[0])] for i in range(3))
                 for m in _SIGNED_PERMUTATIONS]
-        found = _ISOMETRIES[equal] = _SIGNED_PERMUTATIONS[np.array(keep)]
+        matrices = _SIGNED_PERMUTATIONS[np.array(keep)]
+        found = _ISOMETRIES[equal] = (matrices, np.abs(matrices).argmax(axis=2), matrices.sum(axis=2))
     return found
 
 
@@ -223,26 +230,25 @@ def _shape_class(points: tuple[tuple[int, int, int], ...], scale: int, faces: tu
     point in the orders returned, with the same faces and centre, so that their pieces are the same up to
     that map (exact, as rationals: lengths, areas and volumes are kept, and so the signs).
     """
-    isometries = _isometries(squared)
+    matrices, axes, signs = _isometries(squared)
     coordinates = np.array(points, dtype=np.int64)
-    images = np.einsum("gij,kj->gki", isometries, coordinates)
-    low = images.min(axis=1)
-    images -= low[:, None, :]
+    images = coordinates[:, axes] * signs  # points x symmetries x 3
+    low = images.min(axis=0)
+    images -= low
     base = int(coordinates.max()) + 1  # every image's coordinates are below it (its extents, permuted)
-    codes = (images[..., 0] * base + images[..., 1]) * base + images[..., 2]
-    orders = np.argsort(codes, axis=1)
-    ordered = np.take_along_axis(codes, orders, axis=1)
-    g = int(np.lexsort(ordered.T[::-1])[0])
-    order = tuple(orders[g].tolist())
+    codes = images @ np.array([base * base, base, 1], dtype=np.int64)  # points x symmetries
+    ordered = np.sort(codes, axis=0).T.tolist()
+    g = min(range(len(ordered)), key=ordered.__getitem__)
+    order = tuple(np.argsort(codes[:, g]).tolist())
     position = {n: i for i, n in enumerate(order)}
     common = math.lcm(*(d for _, d in center))
     # the centre n / (d * scale) as integers over common * scale, moved like the points (Python integers: on a
     # tiny or huge domain they pass int64)
     offset = [n * (common // d) for n, d in center]
     moved = tuple(sum(int(m) * x for m, x in zip(row, offset)) - common * int(corner)
-                  for row, corner in zip(isometries[g].tolist(), low[g].tolist()))
+                  for row, corner in zip(matrices[g].tolist(), low[g].tolist()))
     shape_faces = tuple(sorted(tuple(sorted(position[n] for n in face)) for face in faces))
-    key = (scale, base, tuple(ordered[g].tolist()), common, moved, shape_faces, squared)
+    key = (scale, base, tuple(ordered[g]), common, moved, shape_faces, squared)
     return key, order
 
 
