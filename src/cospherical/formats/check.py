@@ -19,13 +19,13 @@ from dataclasses import dataclass
 from fractions import Fraction
 from math import lcm
 from pathlib import Path
-from typing import Any, cast
+from typing import Any, Sequence, cast
 
 from ..catalogue import Catalogue, CatalogueType, catalogue_from_text
 from ..core.base_element import base_element
 from ..core.configuration import Box
 from ..core.element_types import classify_faces
-from ..core.geometry import Frame
+from ..core.geometry import Frame, Rational
 from ..core.polyhedron import face_kind, measure
 from ..core.shapes import Shape
 from ..errors import FormatError, InputError
@@ -136,7 +136,7 @@ class EntryCheck:
     describes); ``None``: every criterion, as ``check`` does.
     """
 
-    def __init__(self, header: dict, catalogue: Catalogue | None, name: str, geometry: bool = True,
+    def __init__(self, header: dict[str, Any], catalogue: Catalogue | None, name: str, geometry: bool = True,
                  shared: SharedChecks | None = None, only: str | None = None):
         self._types = catalogue if catalogue is not None and len(catalogue) else None
         self._known = frozenset(t.id for t in self._types) if self._types is not None else None
@@ -163,7 +163,7 @@ class EntryCheck:
         # what an entry's verdict depends on besides its text and its points
         self._context = (self._squared, shape, self._scale, tuple(self._criteria), self._geometry,
                          catalogue.version if catalogue is not None else None, only)
-        self._placed: dict[tuple, _Placed | str] = {}
+        self._placed: dict[tuple[str, bool, tuple[int, ...], tuple[int, ...]], _Placed | str] = {}
         unit = shape.unit_volume
         self._unit_volume = (unit.numerator, unit.denominator)
 
@@ -205,7 +205,7 @@ class EntryCheck:
                                  if normal[0] * point[0] + normal[1] * point[1] + normal[2] * point[2] == offset))
         return [masks[p] for p in points]
 
-    def __call__(self, code: str, entry: dict, text: str | None = None) -> None:
+    def __call__(self, code: str, entry: dict[str, Any], text: str | None = None) -> None:
         """Check ``entry``, the entry of ``code``; ``text``: the entry as written (remembered once it passes)."""
         where = f"{self._name}: configurations/{code}"
         try:
@@ -213,7 +213,7 @@ class EntryCheck:
         except InputError as error:
             raise FormatError(f"{where}: {error}") from None
         shape = self._family.shape
-        checked: list = []
+        checked: list[list[dict[str, Any]]] = []
         inside = True
         for c, criterion in enumerate(self._criteria):
             if self._only is not None and criterion != self._only:
@@ -233,13 +233,13 @@ class EntryCheck:
         if text is not None:
             self._shared.passed.add((self._context, point_set, _digest(text)))
 
-    def _elements(self, elements: list, positions: dict[int, int], shape: Shape, where: str) -> bool:
+    def _elements(self, elements: list[dict[str, Any]], positions: dict[int, int], shape: Shape, where: str) -> bool:
         """Check one criterion's elements (see the class); returns whether every circumcenter is inside."""
         placed_all: list[_Placed] = []
         unit_num, unit_den = self._unit_volume
         total, denominator = 0, 1  # the volume so far: total / denominator
-        seen: set = set()  # (oriented face, on the boundary) of the elements so far
-        needed: set = set()  # the faces inside the base element seen from their other side
+        seen: set[_Face] = set()  # (oriented face, on the boundary) of the elements so far
+        needed: set[_Face] = set()  # the faces inside the base element seen from their other side
         clash = False  # a face met twice from the same side: found again, with its message, below
         inside = True
         where_is = positions.get
@@ -285,15 +285,15 @@ class EntryCheck:
             raise FormatError(f"{where}: the elements do not fill the {_shape_name(shape)} "
                               f"(volume {Fraction(total, denominator)} of {shape.unit_volume})")
         if clash or not needed <= seen:
-            faces: Counter = Counter()  # (oriented face, on the boundary) -> the elements that have it
-            across: dict = {}  # a face inside the base element -> the same face seen from its other side
+            faces: Counter[_Face] = Counter()  # (oriented face, on the boundary) -> the elements that have it
+            across: dict[_Face, _Face] = {}  # a face inside the base element -> the same face seen from its other side
             for found in placed_all:
                 faces.update(found.faces)
                 across.update(found.across)
             _check_faces(faces, across, where)
         return inside
 
-    def _place(self, element: dict, nodes: tuple, points: tuple[int, ...], shape: Shape) -> _Placed | str:
+    def _place(self, element: dict[str, Any], nodes: tuple[int, ...], points: tuple[int, ...], shape: Shape) -> _Placed | str:
         """The element measured (once per type, mirror flag and points) and its faces in node ids
         (once per node list at those points: the same nodes recur across a table's configurations)."""
         mirror = bool(element.get("mirror"))
@@ -338,6 +338,11 @@ class _Measured:
     real_center: list[float]
 
 
+# A face of an element as placed: its cycle of node ids (started at the smallest), and whether it lies on the
+# base element's boundary.
+_Face = tuple[tuple[int, ...], bool]
+
+
 @dataclass(frozen=True)
 class _Placed:
     """A measured element at its nodes: what an entry's check sums and counts, made once."""
@@ -345,13 +350,13 @@ class _Placed:
     volume_pair: tuple[int, int]  # its unit volume, numerator and denominator
     real_center: list[float]
     inside: bool  # its exact circumcenter in the closed base element (the FVM test)
-    faces: tuple[tuple[tuple[int, ...], bool], ...]  # (oriented face in node ids, on the boundary)
-    across: dict  # each face inside the base element -> the same face from its other side
-    face_keys: frozenset  # the faces, as a set
-    opposites: frozenset  # the faces the neighbours across its inner faces must have
+    faces: tuple[_Face, ...]  # (oriented face in node ids, on the boundary)
+    across: dict[_Face, _Face]  # each face inside the base element -> the same face from its other side
+    face_keys: frozenset[_Face]  # the faces, as a set
+    opposites: frozenset[_Face]  # the faces the neighbours across its inner faces must have
 
     @classmethod
-    def of(cls, found: _Measured, nodes: tuple, shape: Shape) -> _Placed:
+    def of(cls, found: _Measured, nodes: tuple[int, ...], shape: Shape) -> _Placed:
         faces = tuple((_turned(tuple(nodes[p] for p in cycle)), on_boundary)
                       for cycle, on_boundary in zip(found.faces, found.on_boundary))
         across = {face: (_turned(face[0][::-1]), False) for face in faces if not face[1]}
@@ -359,8 +364,8 @@ class _Placed:
                    shape.contains(found.center), faces, across, frozenset(faces), frozenset(across.values()))
 
 
-def _measure_element(type_id: str, mirror: bool, points: tuple, plane_masks: list[int], squared,
-                     catalogued: CatalogueType, scale,
+def _measure_element(type_id: str, mirror: bool, points: tuple[tuple[Fraction, Fraction, Fraction], ...],
+                     plane_masks: list[int], squared: Sequence[Rational], catalogued: CatalogueType, scale: Sequence[float],
                      hull: tuple[tuple[tuple[int, ...], ...], Fraction] | None = None) -> _Measured | str:
     """An element of type ``type_id`` (``catalogued``, its catalogue entry) listed by ``points``
     (unit coordinates; ``plane_masks``: per point, the face planes of the base element that hold it)
@@ -387,13 +392,13 @@ def _measure_element(type_id: str, mirror: bool, points: tuple, plane_masks: lis
                      [float(x) * s for x, s in zip(element.center, scale)])
 
 
-def _turned(cycle) -> tuple[int, ...]:
+def _turned(cycle: Sequence[int]) -> tuple[int, ...]:
     """A face cycle started at its smallest node, in its own direction: equal for the same oriented face."""
     start = cycle.index(min(cycle))
     return tuple(cycle[start:]) + tuple(cycle[:start])
 
 
-def _check_faces(faces: Counter, across: dict, where: str) -> None:
+def _check_faces(faces: Counter[_Face], across: dict[_Face, _Face], where: str) -> None:
     """Elements that meet face to face: every face met once from each side, or once on the base
     element's boundary (``faces``: (oriented face, on the boundary) -> how many elements have it;
     ``across``: a face inside the base element -> the same face seen from its other side)."""
@@ -406,7 +411,7 @@ def _check_faces(faces: Counter, across: dict, where: str) -> None:
                               "meet face to face")
 
 
-def _on_boundary(cycles, plane_masks: list[int]) -> tuple[bool, ...]:
+def _on_boundary(cycles: Sequence[Sequence[int]], plane_masks: list[int]) -> tuple[bool, ...]:
     """Per face cycle (positions in the node list): whether it lies in a face plane of the base element,
     i.e. one plane holds all its points (``plane_masks``: per point, the planes that hold it)."""
     found = []

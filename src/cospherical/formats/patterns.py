@@ -26,7 +26,7 @@ from ..caches import cached
 from ..choices import FacePointSource, POINT_POLICIES
 from ..core.configuration import Box
 from ..core.shapes import ELEMENTS
-from ..core.tessellation import Tessellation, element_entry
+from ..core.tessellation import Element, Tessellation, element_entry
 from ..errors import FormatError, InputError, shown
 from ..files.data import data_path
 from ..files.flowyaml import decode_entry, flow, mapping_text, split_section
@@ -103,14 +103,19 @@ def patterns_text(study: _StudyTable, catalogue_version: str) -> str:
         "criteria": list(study.criteria),
     }
     lines = [yaml_text(header), "configurations:\n"]
-    texts: dict = {}  # one table's element texts: an element repeats in thousands of configurations
+    texts: ElementTexts = {}  # one table's element texts: an element repeats in thousands of configurations
     lines.extend(configuration_line(*row, texts=texts) for row in study.rows())
     return "".join(lines)
 
 
+# The element texts one table's lines share: (the element object's id, the box's scale) -> (the element, its
+# text), the element kept so that its id stays its own.
+ElementTexts = dict[tuple[int, tuple[float, float, float]], tuple[Element, str]]
+
+
 def configuration_line(code: str, fvm_adequate: bool, tessellations: Mapping[str, Tessellation],
                        image: Callable[[Tessellation], Tessellation] = lambda tess: tess,
-                       texts: dict | None = None) -> str:
+                       texts: ElementTexts | None = None) -> str:
     """One configuration's entry in a pattern table, every table's: one line of YAML (a JSON flow mapping).
 
     ``tessellations``: per criterion, in the table's order.  Where a criterion
@@ -128,7 +133,7 @@ def configuration_line(code: str, fvm_adequate: bool, tessellations: Mapping[str
     if texts is None:
         texts = {}
     parts = [f'"fvm_adequate": {flow(fvm_adequate)}']
-    written: dict[tuple, str] = {}
+    written: dict[tuple[tuple[int, ...], ...], str] = {}
     for criterion, tess in tessellations.items():
         key = tuple(e.polyhedron.nodes for e in tess.elements)
         if key in written:
@@ -151,7 +156,7 @@ def write_patterns(study: _StudyTable, path: str | Path, catalogue_version: str)
     atomic_write(path, patterns_text(study, catalogue_version))
 
 
-class Entries(Mapping):
+class Entries(Mapping[str, dict[str, Any]]):
     """A table's configurations, code -> entry, each decoded and validated when first asked for.
 
     A mesher looks up a few configurations of a table of thousands (millions at
@@ -159,13 +164,13 @@ class Entries(Mapping):
     visits every entry, so ``check`` still validates the whole table.
     """
 
-    def __init__(self, texts: Mapping[str, str], header: dict, name: str):
+    def __init__(self, texts: Mapping[str, str], header: dict[str, Any], name: str) -> None:
         self._texts = texts
         self._header = header
         self._name = name
-        self._decoded: dict[str, dict] = {}
+        self._decoded: dict[str, dict[str, Any]] = {}
 
-    def __getitem__(self, code: str) -> dict:
+    def __getitem__(self, code: str) -> dict[str, Any]:
         entry = self._decoded.get(code)
         if entry is None:
             entry = decode_entry(self._texts[code], f"{self._name}: configurations/{code}")
@@ -173,7 +178,7 @@ class Entries(Mapping):
             self._decoded[code] = entry
         return entry
 
-    def items(self, chunk: int = 4096) -> Iterator[tuple[str, dict]]:  # type: ignore[override]  # streamed, not a view
+    def items(self, chunk: int = 4096) -> Iterator[tuple[str, dict[str, Any]]]:  # type: ignore[override]  # streamed, not a view
         """Every (code, entry) in file order, decoded and validated a chunk at a time.
 
         One schema validation per chunk costs a quarter of one per entry; entries
@@ -183,12 +188,12 @@ class Entries(Mapping):
         return ((code, entry) for code, entry, _ in self.items_with_texts(chunk))
 
     def items_with_texts(self, chunk: int = 4096,
-                         skip: Callable[[str, str], bool] | None = None) -> Iterator[tuple[str, dict, str]]:
+                         skip: Callable[[str, str], bool] | None = None) -> Iterator[tuple[str, dict[str, Any], str]]:
         """Every (code, entry, entry's text as written), as :meth:`items`; ``skip(code, text)``: true
         for an entry to pass over, neither decoded nor validated (one checked before)."""
         # An indexed store streams its rows; a dict of lines is read in place.
         pairs = self._texts.texts() if hasattr(self._texts, "texts") else self._texts.items()
-        batch: dict = {}
+        batch: dict[str, dict[str, Any]] = {}
         texts: dict[str, str] = {}
         for code, text in pairs:
             self._check_code(code)
@@ -204,22 +209,22 @@ class Entries(Mapping):
         _check_entries({**self._header, "configurations": batch}, self._name, header_checked=True)
         yield from ((code, entry, texts[code]) for code, entry in batch.items())
 
-    def values(self) -> Iterator[dict]:  # type: ignore[override]  # streamed, not a view
+    def values(self) -> Iterator[dict[str, Any]]:  # type: ignore[override]  # streamed, not a view
         return (entry for _, entry in self.items())
 
     def text(self, code: str) -> str:
         """An entry as written (its JSON text): equal texts are equal entries, which ``diff`` skips."""
         return self._texts[code]
 
-    def __contains__(self, code) -> bool:
+    def __contains__(self, code: object) -> bool:
         return code in self._texts
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[str]:
         for code in self._texts:
             self._check_code(code)
             yield code
 
-    def _check_code(self, code) -> None:
+    def _check_code(self, code: object) -> None:
         # Codes are names read from the file, reported by check and diff: each must have
         # the schema's syntax, matched whole (a store's keys are any text, newlines too,
         # and the schema's "$" lets a trailing newline through).
@@ -231,7 +236,7 @@ class Entries(Mapping):
 
 
 @cached(maxsize=1)
-def _code_syntax() -> re.Pattern:
+def _code_syntax() -> re.Pattern[str]:
     """The schema's pattern of configuration codes (its one home), to match whole."""
     schema = json.loads(data_path("schemas/patterns.schema.json").read_text(encoding="utf-8"))
     pattern = schema["properties"]["configurations"]["propertyNames"]["pattern"]
@@ -242,10 +247,10 @@ def _code_syntax() -> re.Pattern:
 class PatternTable:
     """A loaded pattern table: its header and its configurations, validated against the JSON Schema."""
 
-    header: dict
-    configurations: Mapping[str, dict]
+    header: dict[str, Any]
+    configurations: Mapping[str, dict[str, Any]]
 
-    def elements(self, code: str, criterion: str = "optimal") -> list[dict] | None:
+    def elements(self, code: str, criterion: str = "optimal") -> list[dict[str, Any]] | None:
         """The elements of one configuration: dicts with ``type``, ``nodes``, ``circumcenter``.
 
         A code the table does not hold, or that is not a string, raises :class:`KeyError`
@@ -269,7 +274,7 @@ class PatternTable:
         return entry_elements(self.configurations[code], criterion)
 
 
-def entry_elements(entry: dict, criterion: str) -> list[dict] | None:
+def entry_elements(entry: dict[str, Any], criterion: str) -> list[dict[str, Any]] | None:
     """The elements of a configuration's entry under a criterion, following a reference to the
     criterion with the same elements (``internal_faces: optimal``); ``None`` where there are none.
 
@@ -337,7 +342,7 @@ def table_from_data(data: dict[str, Any], name: str) -> PatternTable:
     return PatternTable(header, data["configurations"])
 
 
-def _check_entries(data, name: str, header_checked: bool = False) -> None:
+def _check_entries(data: dict[str, Any], name: str, header_checked: bool = False) -> None:
     # The one validation of entries, for every reader (check, mesh, load_patterns; YAML
     # or store), before any geometry: the schema (node ids 0..26, each once, at most 27),
     # then what it cannot say: every criterion present, references only to earlier
@@ -373,20 +378,20 @@ _ELEMENT_KEYS_MIRROR = _ELEMENT_KEYS | {"mirror"}
 
 
 @cached(maxsize=1)
-def _type_syntax() -> re.Pattern:
+def _type_syntax() -> re.Pattern[str]:
     """The schema's pattern of type ids, searched as the schema's validator searches it."""
     schema = json.loads(data_path("schemas/patterns.schema.json").read_text(encoding="utf-8"))
     return re.compile(schema["$defs"]["elements"]["items"]["properties"]["type"]["pattern"])
 
 
-def _plainly_valid(data, name: str, header_checked: bool = False) -> bool:
+def _plainly_valid(data: dict[str, Any], name: str, header_checked: bool = False) -> bool:
     """Whether ``data`` (a table, its configurations a chunk of entries) plainly meets the schema: its
     header by the schema's validator (with no entries; not again when ``header_checked``: a loaded
     table's entries are checked with the header it was loaded with), every entry by the rules above."""
     if type(data) is not dict or type(data.get("configurations")) is not dict:
         return False
     codes, types = _code_syntax(), _type_syntax()
-    known: set = set()  # type ids seen to match the pattern (a table has a few dozen)
+    known: set[str] = set()  # type ids seen to match the pattern (a table has a few dozen)
     for code, entry in data["configurations"].items():
         if type(code) is not str or not codes.fullmatch(code) or type(entry) is not dict \
                 or not entry.keys() <= _ENTRY_KEYS or type(entry.get("fvm_adequate")) is not bool:
