@@ -158,7 +158,9 @@ def files(args, record) -> None:
                         compressor = zlib.compressobj(zlevel, zlib.DEFLATED, -15)
                         packed[zlevel] += len(compressor.compress(blob)) + len(compressor.flush())
                         deflate[zlevel] += time.process_time() - start
-            assert packed[1] + headers == path.stat().st_size  # level 1 is what the writer wrote
+            # level 1 is what the writer wrote: here one stream a member, there blocks of 1 MiB deflated in threads
+            # (formats.deflated: a few bytes a block more)
+            assert abs(packed[1] + headers - path.stat().st_size) <= path.stat().st_size // 1000 + 64 * len(infos)
             row = [f"{level}", f"{len(dual.vertices):,}", f"{raw / 1e6:.1f}", f"{(packed[6] + headers) / 1e6:.2f}",
                    f"{path.stat().st_size / 1e6:.2f}", f"{path.stat().st_size / (packed[6] + headers):.2f}",
                    f"{deflate[6]:.2f}", f"{deflate[1]:.2f}", f"{write:.2f}"]
