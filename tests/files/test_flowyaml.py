@@ -67,3 +67,16 @@ def test_a_flow_value_is_json_of_the_same_value(value):
 def test_a_flow_value_is_read_back_by_a_yaml_1_1_reader(value):
     # PyYAML (YAML 1.1, not ours) reads the line as the same value: floats with a dot before the exponent
     assert yaml.safe_load(flow(value)) == value
+
+
+@pytest.mark.parametrize("text", ["1e5", " 1.0e5", '{"a": 1e5}', '{"a":\t-2E+1}', "[0.5, 1e-1]", "[1.5e3,2]",
+                                  '{"a": [0.5,\n 3e0]}'])
+def test_a_float_that_yaml_1_1_reads_otherwise_is_refused_wherever_it_stands(text):
+    with pytest.raises(FormatError, match="not a YAML 1.1 float"):
+        decode_entry(text, "e.json")
+
+
+def test_exponent_like_text_inside_strings_is_only_text():
+    # type ids are hex ("3e..."): decoded alike whichever float parser reads the numbers
+    assert decode_entry('{"type": "v4f4-3e05", "c": [0.5, 1.0e-05], "k: 1e5": 2}', "e.json") == \
+        {"type": "v4f4-3e05", "c": [0.5, 1e-05], "k: 1e5": 2}
