@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from fractions import Fraction
 
 import numpy as np
@@ -18,6 +19,7 @@ from vtk.util.numpy_support import vtk_to_numpy
 
 from cospherical.cli import main
 from cospherical.core.configuration import Box
+from cospherical.formats import vtu
 from cospherical.formats.mesh import read_leaves, table_lookup, write_vtu
 from cospherical.formats.patterns import load
 from cospherical.mesh.assembly import assemble
@@ -160,6 +162,29 @@ def test_the_same_mesh_gives_the_same_bytes_and_vtk_the_whole_volume(tmp_path_fa
     sizes.SetInputData(read_vtk(folder / "a.vtu"))
     sizes.Update()
     assert abs(vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume")).sum() - 1) < 1e-12
+
+
+@pytest.mark.oracle_vtk
+def test_blocks_deflated_on_threads_give_one_threads_bytes_and_vtk_reads_them(tmp_path, monkeypatch):
+    mesh = mixed_mesh()
+    data = {"point_data": {"label": np.arange(len(mesh.vertices)) * 7}, "cell_data": {"mark": np.arange(len(mesh)) % 5}}
+    write_vtu(mesh, tmp_path / "whole.vtu", **data)  # one block an array: compressed without threads
+    monkeypatch.setattr(vtu, "BLOCK", 256)  # up to 46 blocks an array (VTK's layout lets each be compressed alone)
+    with ThreadPoolExecutor(1) as one, ThreadPoolExecutor(4) as four:
+        write_vtu(mesh, tmp_path / "one.vtu", pool=one, **data)
+        write_vtu(mesh, tmp_path / "four.vtu", pool=four, **data)
+    write_vtu(mesh, tmp_path / "own.vtu", **data)  # the writer's own threads
+    blocks = (tmp_path / "one.vtu").read_bytes()
+    assert blocks == (tmp_path / "four.vtu").read_bytes() == (tmp_path / "own.vtu").read_bytes()
+    assert blocks != (tmp_path / "whole.vtu").read_bytes()
+    whole, cut = read_vtk(tmp_path / "whole.vtu"), read_vtk(tmp_path / "own.vtu")
+    for part in (lambda grid: grid.GetCells().GetConnectivityArray(), lambda grid: grid.GetCells().GetOffsetsArray(),
+                 lambda grid: grid.GetCellTypes(), lambda grid: grid.GetPoints().GetData(),
+                 lambda grid: grid.GetPolyhedronFaces().GetConnectivityArray(),
+                 *(lambda grid, name=name: grid.GetCellData().GetArray(name) for name in ("element", "mark", "leaf")),
+                 lambda grid: grid.GetPointData().GetArray("label")):
+        assert (vtk_to_numpy(part(cut)) == vtk_to_numpy(part(whole))).all()
+    assert (vtk_to_numpy(cut.GetPointData().GetArray("label")) == data["point_data"]["label"]).all()
 
 
 def test_a_full_disk_leaves_the_old_file(tmp_path):

@@ -45,6 +45,8 @@ from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode
 from ..mesh.report import MeshReport
 
 if TYPE_CHECKING:  # the dual's modules are imported when a dual is made, a table's reader when one is read
+    from concurrent.futures import Executor
+
     from ..adapters.devsim import MeshWithDual
     from ..formats.patterns import PatternTable
     from ..mesh.dual import Dual
@@ -342,31 +344,36 @@ class OctreeMesh:
             return
         from concurrent.futures import ThreadPoolExecutor
 
+        from ..formats.deflated import deflate_workers
         from ..formats.dual import write_dual
 
         # dual.npz is written beside the other files, in a thread of its own: its time is deflate's and the
         # checksums', which leave the interpreter free for mesh.vtu and mesh.png (the same bytes either way);
-        # its error, if any, is raised here once the others are written
-        with ThreadPoolExecutor(1, thread_name_prefix="dual.npz") as pool:
-            written = pool.submit(write_dual, self.dual, path("dual.npz"))
-            self._write_mesh_files(path, cut, others - 1, wrote, with_dual=True)
+        # its error, if any, is raised here once the others are written.  Both files deflate on one pool of
+        # threads, one a processor: two pools would ask twice as many threads of the same processors.
+        with ThreadPoolExecutor(deflate_workers(), thread_name_prefix="deflate") as deflating, \
+                ThreadPoolExecutor(1, thread_name_prefix="dual.npz") as writing:
+            written = writing.submit(write_dual, self.dual, path("dual.npz"), deflating)
+            self._write_mesh_files(path, cut, others - 1, wrote, with_dual=True, pool=deflating)
             written.result()
         wrote()
 
     def _write_mesh_files(self, path: Callable[[str], Path], cut: float | None, files: int,
-                          wrote: Callable[..., None], with_dual: bool = False) -> None:
+                          wrote: Callable[..., None], with_dual: bool = False, pool: Executor | None = None) -> None:
         """``mesh.vtu``, ``mesh.png`` and ``report.json`` (a device's own files in their place): what
-        :meth:`write_files` writes beside dual.npz and the tetrahedra, ``files`` of them."""
+        :meth:`write_files` writes beside dual.npz and the tetrahedra, ``files`` of them; ``pool``: the threads
+        that deflate mesh.vtu's blocks (default: its writer's own)."""
         from ..formats.mesh import write_report, write_vtu
         from ..outputs.mesh_picture import cut_png
 
         mesh, report, source = self.assembled, self.report, self._result.source
         point_data, cell_data = self._vtu_data(with_dual)
         if source.device is not None:
-            self._write_device(path, cut, point_data, cell_data)
+            self._write_device(path, cut, point_data, cell_data, pool)
             wrote(files)
             return
-        write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=source.leaf_order)
+        write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data=cell_data, leaves=source.leaf_order,
+                  pool=pool)
         wrote()
         at = default_cut(source.shapes, self.box) if cut is None else cut
         shapes = ", ".join(source.described.refine or ()) or source.described.file or ""
@@ -454,7 +461,7 @@ class OctreeMesh:
         return to_meshio(self.assembled, self.vertices, self._result.source.leaf_order)
 
     def _write_device(self, path: Callable[[str], Path], cut: float | None, point_data: dict[str, NDArray[Any]],
-                      cell_data: dict[str, NDArray[Any]]) -> None:
+                      cell_data: dict[str, NDArray[Any]], pool: Executor | None = None) -> None:
         """A device's files: ``mesh.vtu`` with cell data ``region`` (names and materials in field data),
         ``contacts.vtu`` (its contact and interface faces, when it has any), ``mesh.png`` coloured by region, ``report.json``."""
         from ..formats.mesh import write_faces_vtu, write_report, write_vtu
@@ -467,7 +474,7 @@ class OctreeMesh:
         device = layout.device
         region_cells, fields = self._device_data()
         write_vtu(mesh, path("mesh.vtu"), point_data=point_data, cell_data={**region_cells, **cell_data},
-                  field_data=fields, origin=device.origin)
+                  field_data=fields, origin=device.origin, pool=pool)
         if device.has_faces:
             write_faces_vtu(mesh, faces, path("contacts.vtu"), origin=device.origin)
         axis = device_cut_axis(device)

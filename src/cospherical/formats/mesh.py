@@ -39,7 +39,9 @@ from .check import EntryCheck
 from .patterns import PatternTable
 from .vtu import quoteattr
 
-if TYPE_CHECKING:  # the device's modules are imported where a device is meshed
+if TYPE_CHECKING:  # the device's modules are imported where a device is meshed, the threads' where they deflate
+    from concurrent.futures import Executor
+
     from ..mesh.regions import RegionFaces
 
 __all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "VtuGrid", "vtu_arrays", "vtu_grid",
@@ -310,19 +312,21 @@ def vtu_arrays(mesh: Mesh) -> VtuArrays:
 
 
 def write_vtu(mesh: Mesh, path: str | Path, point_data: dict[str, np.ndarray] | None = None, cell_data: dict[str, np.ndarray] | None = None,
-              leaves: np.ndarray | None = None, field_data: dict[str, np.ndarray] | None = None, origin: Sequence[Fraction] | None = None) -> None:
+              leaves: np.ndarray | None = None, field_data: dict[str, np.ndarray] | None = None, origin: Sequence[Fraction] | None = None,
+              pool: Executor | None = None) -> None:
     """Write the mesh as one compressed binary VTU grid, atomically (a complete new file or the old one).
 
     Standard VTK cells (tetra, pyramid, wedge, hexahedron, nodes in VTK order) for
     the elements that are one, ``VTK_POLYHEDRON`` with faces for the others, sorted
     by cell type; the cell data say which element each cell is.  The grid's arrays
-    and data are :func:`vtu_grid`'s (see it for each array).
+    and data are :func:`vtu_grid`'s (see it for each array).  ``pool``: the threads that deflate its
+    blocks (see :func:`~cospherical.formats.vtu.write_grid`: the same bytes with any).
     """
     from .vtu import write_grid
 
     grid = vtu_grid(mesh, point_data, cell_data, leaves, field_data, origin)
     write_grid(path, grid.points, grid.types, grid.connectivity, grid.offsets, grid.faces, grid.faceoffsets,
-               point_data=grid.point_data, cell_data=grid.cell_data, field_data=grid.field_data)
+               point_data=grid.point_data, cell_data=grid.cell_data, field_data=grid.field_data, pool=pool)
 
 
 @dataclass(frozen=True)

@@ -19,12 +19,16 @@ from __future__ import annotations
 
 import zlib
 from pathlib import Path
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 
 from ..core.tessellation import Tessellation
 from ..errors import InputError
 from ..files.yamlio import atomic_open
+
+if TYPE_CHECKING:  # the threads' modules are imported where a file has blocks to share among them
+    from concurrent.futures import Executor
 
 __all__ = ["VTK_CELL", "narrow", "quoteattr", "text_array", "write_grid", "write_vtu"]
 
@@ -58,12 +62,37 @@ def quoteattr(text: str) -> str:
     return '"{}"'.format(text.replace('"', "&quot;"))
 
 
-def _compressed(array: np.ndarray) -> bytes:
-    """An array in VTK's compressed layout: (blocks, block size, last block size, compressed sizes), blocks."""
-    raw = np.ascontiguousarray(array).view(np.uint8).reshape(-1).data  # a memoryview of the bytes
-    blocks = [zlib.compress(raw[i:i + BLOCK], LEVEL) for i in range(0, len(raw), BLOCK)]
-    header = np.array([len(blocks), BLOCK, len(raw) % BLOCK] + [len(b) for b in blocks], dtype="<u8")
-    return header.tobytes() + b"".join(blocks)
+def _compressed(arrays: Sequence[np.ndarray], pool: Executor | None) -> list[bytes]:
+    """Each array in VTK's compressed layout: (blocks, block size, last block size, compressed sizes), blocks.
+
+    Every block is compressed on its own (VTK's layout), so ``pool``'s threads take them all at once, the
+    largest first, and each block's bytes are what one thread would make of it: the same file whatever the
+    threads do.  Without a pool, more than one block goes to a pool of :func:`deflate_workers` threads made
+    for the call; a single block is compressed here.
+    """
+    raws = [np.ascontiguousarray(array).view(np.uint8).reshape(-1).data for array in arrays]  # memoryviews
+    blocks = [[raw[i:i + BLOCK] for i in range(0, len(raw), BLOCK)] for raw in raws]
+    flat = [block for parts in blocks for block in parts]
+    if pool is None and len(flat) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        from .deflated import deflate_workers
+
+        with ThreadPoolExecutor(min(deflate_workers(), len(flat)), thread_name_prefix="mesh.vtu") as own:
+            return _compressed(arrays, own)
+    if pool is None:
+        done = [zlib.compress(block, LEVEL) for block in flat]
+    else:  # zlib releases the GIL: the largest blocks first, so that no thread is left with one at the end
+        futures = {n: pool.submit(zlib.compress, flat[n], LEVEL)
+                   for n in sorted(range(len(flat)), key=lambda n: -len(flat[n]))}
+        done = [futures[n].result() for n in range(len(flat))]
+    out, at = [], 0
+    for raw, parts in zip(raws, blocks):
+        mine = done[at:at + len(parts)]
+        at += len(parts)
+        header = np.array([len(mine), BLOCK, len(raw) % BLOCK] + [len(b) for b in mine], dtype="<u8")
+        out.append(header.tobytes() + b"".join(mine))
+    return out
 
 
 def _array(name: str, data: np.ndarray) -> tuple[str, np.ndarray, int]:
@@ -91,14 +120,16 @@ def text_array(text: str) -> np.ndarray:
 def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, connectivity: np.ndarray,
                offsets: np.ndarray, faces: np.ndarray | None = None, faceoffsets: np.ndarray | None = None,
                point_data: dict[str, np.ndarray] | None = None, cell_data: dict[str, np.ndarray] | None = None,
-               field_data: dict[str, np.ndarray] | None = None) -> None:
+               field_data: dict[str, np.ndarray] | None = None, pool: Executor | None = None) -> None:
     """Write one unstructured grid as a compressed binary VTU, atomically.
 
     ``connectivity`` lists every cell's points one after the other, ``offsets`` is
     where each cell ends in it (VTK's layout); for ``VTK_POLYHEDRON`` cells ``faces``
     holds each one's face stream (number of faces, then per face its number of points
     and the points) and ``faceoffsets`` where that stream ends (-1 for other cells).
-    Data arrays have one row per point, per cell, or any length (field data).
+    Data arrays have one row per point, per cell, or any length (field data).  The arrays' blocks are
+    deflated on ``pool``'s threads (default: threads of the call's own when there is more than one block);
+    the file is the same byte for byte with any pool or none.
     """
     if (faces is None) != (faceoffsets is None):
         raise InputError("write_grid: faces and faceoffsets go together")
@@ -117,17 +148,19 @@ def write_grid(path: str | Path, points: np.ndarray, cell_types: np.ndarray, con
         for name, data, _ in items:
             if len(data) != (n_points if section == "PointData" else n_cells):
                 raise InputError(f"{section} {name}: {len(data)} rows for {n_points} points and {n_cells} cells")
-    xml, blobs, offset = [], [], 0
+    # every block of every array deflated at once (the XML's offsets need the compressed sizes first)
+    blobs = _compressed([data for _, items in arrays for _, data, _ in items], pool)
+    sizes = iter(len(blob) for blob in blobs)  # in the order data_array is called: the arrays' order
+    xml, offset = [], 0
 
     def data_array(name: str, data: np.ndarray, components: int, tuples: bool) -> str:
         nonlocal offset
-        blob = _compressed(data)
-        blobs.append(blob)
+        size = next(sizes)
         text = (f'<DataArray type="{_VTK_TYPE[data.dtype.newbyteorder("=")]}" Name={quoteattr(name)} '
                 + (f'NumberOfTuples="{len(data)}" ' if tuples else "")
                 + (f'NumberOfComponents="{components}" ' if components != 1 or tuples else "")
                 + f'format="appended" offset="{offset}"/>')
-        offset += len(blob)
+        offset += size
         return text
 
     for section, items in arrays:

@@ -5,7 +5,8 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Executor, ThreadPoolExecutor
+from contextlib import ExitStack
 from pathlib import Path
 
 import numpy as np
@@ -52,8 +53,9 @@ def _exact(array: np.ndarray) -> np.ndarray:
     return text.astype(f"U{max(width, _TEXT_WIDTH)}")
 
 
-def write_dual(dual: Dual, path: str | Path) -> None:
-    """Write ``dual`` as ``dual.npz`` (see the module), atomically and deterministically."""
+def write_dual(dual: Dual, path: str | Path, pool: Executor | None = None) -> None:
+    """Write ``dual`` as ``dual.npz`` (see the module), atomically and deterministically; ``pool``: the threads
+    that hash and deflate (default: threads of the call's own), the same bytes with any."""
     arrays = {name: getattr(dual, name) for name in _MEMBERS}
     arrays["coefficient_exact"] = _exact(arrays["coefficient_exact"])
     arrays["volume_exact"] = _exact(arrays["volume_exact"])
@@ -90,7 +92,9 @@ def write_dual(dual: Dual, path: str | Path) -> None:
                       "interface_part_denominator": str(interfaces.denominator)})
     members = {name: _npy(array) for name, array in arrays.items()}
     version = 3 if parts is None else 4 if interfaces is None else DUAL_FORMAT_VERSION
-    with ThreadPoolExecutor(deflate_workers(), thread_name_prefix="dual.npz") as pool:
+    with ExitStack() as stack:
+        if pool is None:
+            pool = stack.enter_context(ThreadPoolExecutor(deflate_workers(), thread_name_prefix="dual.npz"))
         # the checksums first (the manifest, the first member, holds them), on every core, then every member
         # deflated in blocks on every core and written in order as it comes (formats.deflated)
         digests = {name: pool.submit(_sha256, *member) for name, member in members.items()}
