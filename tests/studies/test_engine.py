@@ -70,3 +70,18 @@ def _float_margin(shape, points) -> float:
         n = np.array([float(x) for x in normal])
         margins.append((float(offset) - n @ center) / np.linalg.norm(n))
     return min(margins)
+
+
+def test_a_study_takes_another_policys_tessellations_only_where_the_points_agree(shape_studies):
+    # the prism's none-policy study, alone and taking the octree study's tessellations: the same study
+    from cospherical.studies.engine import bisection_codes, run_study
+
+    octree = shape_studies["prism"]
+    box, codes = standard_shape("prism").box, bisection_codes("prism")
+    alone = run_study("bisection", box, codes, "none", element="prism")
+    taking = run_study("bisection", box, codes, "none", element="prism", known=octree)
+    assert taking.tessellations == alone.tessellations and taking.choices == alone.choices
+    taken = [rep for rep, tess in taking.tessellations.items() if tess.elements is octree.tessellations[rep].elements]
+    with_face_points = [rep for rep, tess in octree.tessellations.items() if tess.configuration.point_faces]
+    assert taken and with_face_points and not set(taken) & set(with_face_points)
+    assert len(taken) + len(with_face_points) == octree.orbits

@@ -196,13 +196,18 @@ def run_study(
     progress: Progress | None = None,
     criteria: Sequence[str] = CRITERIA,
     element: str = "cuboid",
+    known: Study | None = None,
 ) -> Study:
     """Tessellate every configuration code of a base element, one per orbit of its symmetries.
 
     ``progress(n)`` is called as orbits are done, with the number of
     configurations they account for.  Each criterion (``optimal``,
     ``internal_faces``, ``internal_edges_and_faces``) gets its kept types and
-    split tessellations.
+    split tessellations.  ``known``: another study, whose representative's
+    tessellation is taken (for this study's configuration) wherever it has
+    exactly the same points in the same shape: the Delaunay tessellation is
+    the points' (two thirds of a bisection study under the ``none`` policy are
+    its ``octree`` study's configurations without a face point).
 
     Examples
     --------
@@ -218,7 +223,14 @@ def run_study(
     sizes = Counter(reps)
     tessellations = {}
     for rep in sorted(sizes):
-        tessellations[rep] = family.tessellate(family.configuration(rep))
+        configuration = family.configuration(rep)
+        same = known.tessellations.get(rep) if known is not None else None
+        points = configuration.point_set_code  # None where no code names the point set
+        if same is not None and points is not None and same.configuration.point_set_code == points \
+                and same.configuration.shape == configuration.shape:
+            tessellations[rep] = replace(same, configuration=configuration)
+        else:
+            tessellations[rep] = family.tessellate(configuration)
         if progress:
             progress(sizes[rep])
     choices = {criterion: choose(tessellations, sizes, criterion) for criterion in criteria}
