@@ -79,7 +79,7 @@ def test_a_study_takes_another_policys_tessellations_only_where_the_points_agree
     octree = shape_studies["prism"]
     box, codes = standard_shape("prism").box, bisection_codes("prism")
     alone = run_study("bisection", box, codes, "none", element="prism")
-    taking = run_study("bisection", box, codes, "none", element="prism", known=octree)
+    taking = run_study("bisection", box, codes, "none", element="prism", known=[octree])
     assert taking.tessellations == alone.tessellations and taking.choices == alone.choices
     taken = [rep for rep, tess in taking.tessellations.items() if tess.elements is octree.tessellations[rep].elements]
     with_face_points = [rep for rep, tess in octree.tessellations.items() if tess.configuration.point_faces]

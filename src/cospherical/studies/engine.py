@@ -196,18 +196,19 @@ def run_study(
     progress: Progress | None = None,
     criteria: Sequence[str] = CRITERIA,
     element: str = "cuboid",
-    known: Study | None = None,
+    known: Sequence[Study] = (),
 ) -> Study:
     """Tessellate every configuration code of a base element, one per orbit of its symmetries.
 
     ``progress(n)`` is called as orbits are done, with the number of
     configurations they account for.  Each criterion (``optimal``,
     ``internal_faces``, ``internal_edges_and_faces``) gets its kept types and
-    split tessellations.  ``known``: another study, whose representative's
-    tessellation is taken (for this study's configuration) wherever it has
+    split tessellations.  ``known``: other studies, whose representatives'
+    tessellations are taken (for this study's configuration) wherever one has
     exactly the same points in the same shape: the Delaunay tessellation is
     the points' (two thirds of a bisection study under the ``none`` policy are
-    its ``octree`` study's configurations without a face point).
+    its ``octree`` study's configurations without a face point, and most leaf
+    configurations are one of the two).
 
     Examples
     --------
@@ -221,13 +222,13 @@ def run_study(
     reps, sym_index = family.orbit_representatives(codes)
     representative = {code: (rep, symmetries[i]) for code, rep, i in zip(codes, reps, sym_index)}
     sizes = Counter(reps)
+    by_points = {tess.configuration.point_set_code: tess for study in known for tess in study.tessellations.values()}
+    by_points.pop(None, None)  # no code names those point sets
     tessellations = {}
     for rep in sorted(sizes):
         configuration = family.configuration(rep)
-        same = known.tessellations.get(rep) if known is not None else None
-        points = configuration.point_set_code  # None where no code names the point set
-        if same is not None and points is not None and same.configuration.point_set_code == points \
-                and same.configuration.shape == configuration.shape:
+        same = by_points.get(configuration.point_set_code)
+        if same is not None and same.configuration.shape == configuration.shape:
             tessellations[rep] = replace(same, configuration=configuration)
         else:
             tessellations[rep] = family.tessellate(configuration)

@@ -50,7 +50,8 @@ def leaf_codes() -> list[str]:
     return codes
 
 
-def run_leaves(box: Box, progress: Progress | None = None, criteria: Sequence[str] = CRITERIA) -> Study:
+def run_leaves(box: Box, progress: Progress | None = None, criteria: Sequence[str] = CRITERIA,
+               known: Sequence[Study] = ()) -> Study:
     """The leaf study of a box: every configuration of :func:`leaf_codes`, one per symmetry orbit.
 
     Parameters
@@ -61,6 +62,9 @@ def run_leaves(box: Box, progress: Progress | None = None, criteria: Sequence[st
         Called with the number of configurations each finished orbit accounts for.
     criteria : sequence of str
         The criteria to apply (all three by default; ``("optimal",)`` skips the split search).
+    known : sequence of Study
+        Studies of the same box whose tessellations are taken where a leaf configuration has the
+        same points (:func:`~cospherical.studies.engine.run_study`'s ``known``).
 
     Returns
     -------
@@ -73,4 +77,4 @@ def run_leaves(box: Box, progress: Progress | None = None, criteria: Sequence[st
     >>> study.configurations, study.orbits, study.face_points, study.fvm_adequate, study.fvm_adequate_open
     (6210, 227, 'explicit', 6210, 6210)
     """
-    return run_study("leaves", box, leaf_codes(), "explicit", progress=progress, criteria=criteria)
+    return run_study("leaves", box, leaf_codes(), "explicit", progress=progress, criteria=criteria, known=known)

@@ -48,8 +48,10 @@ def run_paper_studies(progress: Callable[[int], None] | None = None) -> PaperStu
     for box in PAPER_BOXES:
         for policy in POINT_POLICIES:  # the first policy's tessellations are the others' where the points agree
             bisection.append(run_study("bisection", Box.parse(box), codes, policy, progress=progress,
-                                       known=bisection[-1] if policy != POINT_POLICIES[0] else None))
-    leaves = [run_leaves(Box.parse(box), progress=progress) for box in LEAF_BOXES]
+                                       known=[s for s in bisection if s.box == Box.parse(box)]))
+    # most leaf configurations are a bisection configuration of one policy or the other
+    leaves = [run_leaves(Box.parse(box), progress=progress, known=[s for s in bisection if s.box == Box.parse(box)])
+              for box in LEAF_BOXES]
     shapes = [run_study("bisection", Box.parse(SHAPE_BOX), bisection_codes(element), progress=progress,
                         element=element) for element in SHAPE_ELEMENTS]
     return PaperStudies(bisection, leaves, shapes)
