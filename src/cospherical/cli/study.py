@@ -134,8 +134,8 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError("cospherical study: error: the leaf study gives its face points in its codes and sets "
                              "the octree-policy bisection study beside it: no --face-points, no --compare-paper")
         with progress_bar(len(leaf_codes()) + len(codes), "leaves") as advance:
-            study = run_leaves(box, progress=advance)
             bisection = run_study("bisection", box, codes, "octree", progress=advance)
+            study = run_leaves(box, progress=advance, known=[bisection])  # its tessellations where the points agree
         summary = compared_with(study_summary(study), study_summary(bisection))
     else:
         with progress_bar(len(codes), "bisection") as advance:
