@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from commands import in_process
+from commands import in_process, one_clean_line
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from sampling import examples, sampled_table
@@ -233,7 +233,9 @@ def _mutated_entries(draw):
         element = draw(st.sampled_from(elements))
         field = draw(st.sampled_from(["type", "nodes", "circumcenter", "mirror", "other"]))
         if field == "nodes" and draw(st.booleans()):
-            element["nodes"] = draw(st.lists(ELEMENT_VALUES, max_size=28))
+            # a list among the ids too: it cannot go into a set (the plain rules check types first)
+            element["nodes"] = draw(st.lists(st.one_of(ELEMENT_VALUES, st.lists(st.integers(0, 26), max_size=1)),
+                                             max_size=28))
         else:
             element[field] = draw(st.one_of(ELEMENT_VALUES, st.lists(ELEMENT_VALUES, max_size=4)))
     return entry
@@ -255,3 +257,15 @@ def test_the_plain_entry_rules_accept_only_what_the_schema_accepts(entry, code):
     data = {**_CUBE_TABLE.header, "configurations": {code: entry}}
     if _plainly_valid(data, "t.yaml"):
         validate(data, "patterns", "t.yaml")
+
+
+def test_a_list_among_the_node_ids_is_refused_in_one_line(tmp_path, capsys, small_table_path):
+    # was a TypeError (unhashable list) from the plain entry rules: now the schema's refusal, as for any bad id
+    lines = small_table_path.read_text().split("\n")
+    at = next(i for i, line in enumerate(lines) if line.startswith("  '800000000000'"))
+    lines[at] = lines[at].replace('"nodes": [', '"nodes": [[0], ', 1)
+    path = tmp_path / "nested.yaml"
+    path.write_text("\n".join(lines))
+    with pytest.raises(FormatError, match=r"800000000000\.optimal\.0\.nodes\.0: value must be integer"):
+        load(path).elements("800000000000")
+    one_clean_line(in_process(capsys, "check", path), "nested.yaml")

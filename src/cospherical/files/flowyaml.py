@@ -164,9 +164,10 @@ def _refuse_constant(text: str) -> NoReturn:
 def _yaml_float(text: str) -> float:
     """A JSON float that YAML 1.1 reads as a float too: with an exponent, only after a dot and signed
     (PyYAML reads 1e5 and 1.0e5 as strings; JSON takes all three)."""
-    exponent = max(text.find("e"), text.find("E"))
-    if exponent >= 0 and ("." not in text or text[exponent + 1] not in "+-"):
-        raise ValueError(f"{text[:exponent + 1]}...: not a YAML 1.1 float (write a dot and a signed exponent)")
+    if "e" in text or "E" in text:  # (most floats have no exponent: a million a table, one test each)
+        exponent = max(text.find("e"), text.find("E"))
+        if "." not in text or text[exponent + 1] not in "+-":
+            raise ValueError(f"{text[:exponent + 1]}...: not a YAML 1.1 float (write a dot and a signed exponent)")
     return float(text)
 
 

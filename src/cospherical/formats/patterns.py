@@ -375,6 +375,9 @@ _CRITERION_REFERENCES = {"internal_faces": ("optimal",), "internal_edges_and_fac
 _ENTRY_KEYS = frozenset(("fvm_adequate", "optimal", "internal_faces", "internal_edges_and_faces"))
 _ELEMENT_KEYS = frozenset(("type", "nodes", "circumcenter"))
 _ELEMENT_KEYS_MIRROR = _ELEMENT_KEYS | {"mirror"}
+_INTEGER = {int}  # exactly: a boolean is not a node id
+_NUMBER = frozenset((int, float))
+_NODE_IDS = frozenset(range(27))
 
 
 @cached(maxsize=1)
@@ -412,10 +415,13 @@ def _plainly_valid(data: dict[str, Any], name: str, header_checked: bool = False
                 if not (keys == _ELEMENT_KEYS or (keys == _ELEMENT_KEYS_MIRROR and type(element["mirror"]) is bool)):
                     return False
                 nodes, center, type_id = element["nodes"], element["circumcenter"], element["type"]
-                if type(nodes) is not list or not 4 <= len(nodes) <= 27 or len(set(nodes)) != len(nodes) \
-                        or not all(type(n) is int and 0 <= n <= 26 for n in nodes):
+                # the types first (a list among the node ids cannot go into a set), each test a C loop
+                if type(nodes) is not list or not 4 <= len(nodes) <= 27 or set(map(type, nodes)) != _INTEGER:
                     return False
-                if type(center) is not list or len(center) != 3 or not all(type(x) in (int, float) for x in center):
+                ids = set(nodes)
+                if len(ids) != len(nodes) or not ids <= _NODE_IDS:
+                    return False
+                if type(center) is not list or len(center) != 3 or not set(map(type, center)) <= _NUMBER:
                     return False
                 if type(type_id) is not str:
                     return False
