@@ -260,17 +260,11 @@ def _region_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], n_ver
         if not isinstance(manifest.get(key), str) or not _POSITIVE.fullmatch(manifest[key]):
             raise FormatError(f"{path}: manifest: {key} is not a positive integer of at most {_MAX_TEXT_DIGITS} digits")
         denominators.append(int(manifest[key]))
-    for name, bound in (("element_region", len(names)), ("volume_part_vertex", n_vertices),
-                        ("volume_part_region", len(names)), ("coupling_part_edge", n_edges),
-                        ("coupling_part_region", len(names)), ("contact_face_contact", len(contacts)),
-                        ("contact_part_vertex", n_vertices), ("contact_part_contact", len(contacts))):
-        values = arrays[name]
-        if len(values) and (values.min() < 0 or values.max() >= bound):
-            raise FormatError(f"{path}: member {name}: an index outside 0..{bound - 1}")
-    faces = arrays["contact_face_nodes"]
-    if np.any((faces < -1) | (faces >= n_vertices)) or np.any((faces[:, :3] < 0)):
-        raise FormatError(f"{path}: member contact_face_nodes: a face that names no vertex")
-    _distinct_faces(faces, n_face_bound, path)
+    _indices_within(arrays, (("element_region", len(names)), ("volume_part_vertex", n_vertices),
+                             ("volume_part_region", len(names)), ("coupling_part_edge", n_edges),
+                             ("coupling_part_region", len(names)), ("contact_face_contact", len(contacts)),
+                             ("contact_part_vertex", n_vertices), ("contact_part_contact", len(contacts))), path)
+    faces = _face_nodes(arrays, "contact_face_nodes", n_vertices, n_face_bound, path)
     if len(arrays["element_region"]) != n_elements:
         raise FormatError(f"{path}: member element_region: not one region per element")
     origin: Any = manifest.get("origin")
@@ -323,18 +317,9 @@ def _interface_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], na
     if not isinstance(denominator, str) or not _POSITIVE.fullmatch(denominator):
         raise FormatError(f"{path}: manifest: interface_part_denominator is not a positive integer of at most {_MAX_TEXT_DIGITS} "
                           "digits")
-    for name, bound in (("interface_face_interface", len(pairs)), ("interface_part_vertex", n_vertices),
-                        ("interface_part_interface", len(pairs))):
-        values = arrays[name]
-        if len(values) and (values.min() < 0 or values.max() >= bound):
-            raise FormatError(f"{path}: member {name}: an index outside 0..{bound - 1}")
-    faces = arrays["interface_face_nodes"]
-    if np.any((faces < -1) | (faces >= n_vertices)) or np.any((faces[:, :3] < 0)):
-        raise FormatError(f"{path}: member interface_face_nodes: a face that names no vertex")
-    if len(faces) > n_face_bound:
-        raise FormatError(f"{path}: member interface_face_nodes: {len(faces):,} faces, more than its elements have "
-                          f"({n_face_bound:,})")
-    _distinct_rows(faces, faces >= 0, path, "interface_face_nodes", "face")
+    _indices_within(arrays, (("interface_face_interface", len(pairs)), ("interface_part_vertex", n_vertices),
+                             ("interface_part_interface", len(pairs))), path)
+    faces = _face_nodes(arrays, "interface_face_nodes", n_vertices, n_face_bound, path)
     regions = np.array(pairs, dtype=np.int32).reshape(-1, 2)
     return InterfaceParts(regions, tuple(f"{names[a]}|{names[b]}" for a, b in regions.tolist()), faces.astype(np.int32),
                           arrays["interface_face_interface"].astype(np.int32),
@@ -343,14 +328,27 @@ def _interface_parts(arrays: dict[str, np.ndarray], manifest: dict[str, Any], na
                           _integers(arrays["interface_part_exact"], "interface_part_exact", path), int(denominator))
 
 
-def _distinct_faces(faces: np.ndarray, most: int, path: Path) -> None:
-    """Contact faces: each of distinct vertices, no two of the same vertices, and no more than the elements
-    have faces (``most``), refused in bulk before check walks them one by one (a face repeated three million
-    times deflates to 115 kB and took 48 CPU-s)."""
+def _indices_within(arrays: dict[str, np.ndarray], bounds: tuple[tuple[str, int], ...], path: Path) -> None:
+    """Refuse a member of index arrays (``bounds``: its name, the count it indexes) with an index outside
+    ``0..count - 1``."""
+    for name, bound in bounds:
+        values = arrays[name]
+        if len(values) and (values.min() < 0 or values.max() >= bound):
+            raise FormatError(f"{path}: member {name}: an index outside 0..{bound - 1}")
+
+
+def _face_nodes(arrays: dict[str, np.ndarray], member: str, n_vertices: int, most: int, path: Path) -> np.ndarray:
+    """A member of faces (contact or interface faces, rows of vertex ids padded with -1), checked: every face
+    names at least three vertices, each of distinct vertices, no two of the same vertices, and no more faces
+    than the elements have (``most``); refused in bulk before check walks them one by one (a face repeated
+    three million times deflates to 115 kB and took 48 CPU-s)."""
+    faces = arrays[member]
+    if np.any((faces < -1) | (faces >= n_vertices)) or np.any((faces[:, :3] < 0)):
+        raise FormatError(f"{path}: member {member}: a face that names no vertex")
     if len(faces) > most:
-        raise FormatError(f"{path}: member contact_face_nodes: {len(faces):,} faces, more than its elements have "
-                          f"({most:,})")
-    _distinct_rows(faces, faces >= 0, path, "contact_face_nodes", "face")
+        raise FormatError(f"{path}: member {member}: {len(faces):,} faces, more than its elements have ({most:,})")
+    _distinct_rows(faces, faces >= 0, path, member, "face")
+    return faces
 
 
 def _distinct_rows(nodes: np.ndarray, used: np.ndarray, path: Path, member: str, row: str) -> None:
