@@ -23,56 +23,50 @@ def test_contracts_are_kept():
     assert "0 broken" in result.stdout
 
 
+# One wrong import per contract: the module (under src/cospherical), the line appended to it, and what
+# import-linter says of it.
+WRONG_IMPORTS = [
+    # The core reaching up into the catalogue is exactly the circle the layers forbid.
+    ("core/geometry.py", "from ..catalogue import type_name", "cospherical.core.geometry -> cospherical.catalogue"),
+    # One command importing another breaks "one module per subcommand".
+    ("cli/check.py", "from . import diff", "cospherical.cli.check -> cospherical.cli.diff"),
+    # Inside the core: a configuration needs no Delaunay cells; reaching up to them inverts the data flow.
+    ("core/configuration.py", "from .delaunay import delaunay_cells",
+     "cospherical.core.configuration -> cospherical.core.delaunay"),
+    # A writer reaching into the studies: formats only reads and writes what is computed below it.
+    ("formats/diff.py", "from ..studies.engine import run_study", "cospherical.formats.diff -> cospherical.studies.engine"),
+    # The intersection study's statistics importing its run: the circle its layers broke.
+    ("studies/intersection/statistics.py", "from .run import run_intersection",
+     "cospherical.studies.intersection.statistics is not allowed to import"),
+    # One element's pieces know nothing of the mesh's sums built on them.
+    ("mesh/dual/pieces.py", "from .sums import mesh_dual", "cospherical.mesh.dual.pieces -> cospherical.mesh.dual.sums"),
+    # The tree's arrays know nothing of the refinement that fills them.
+    ("mesh/tree.py", "from .octree import build_octree", "cospherical.mesh.tree -> cospherical.mesh.octree"),
+    # A cluster's cells know nothing of the step that asks for them (they were split out of it).
+    ("mesh/merged_cells.py", "from .delaunay import retessellate",
+     "cospherical.mesh.merged_cells -> cospherical.mesh.delaunay"),
+    # The zip writer knows no file format of ours: the dual's writer builds on it, not the other way.
+    ("formats/deflated.py", "from .dual import write_dual", "cospherical.formats.deflated -> cospherical.formats.dual"),
+    # One check reaching into another: the mesh's checks stand side by side.
+    ("mesh/checks/volume.py", "from .conformity import pair_faces",
+     "cospherical.mesh.checks.volume -> cospherical.mesh.checks.conformity"),
+    # dual.npz's member table knows nothing of the writer that writes it.
+    ("formats/dual/members.py", "from .writer import write_dual",
+     "cospherical.formats.dual.members -> cospherical.formats.dual.writer"),
+]
+
+
 def test_wrong_imports_break_the_contracts(tmp_path):
-    # The core reaching up into the catalogue is exactly the circle the layers forbid;
-    # one command importing another breaks "one module per subcommand".
     shutil.copytree(ROOT / "src" / "cospherical", tmp_path / "cospherical",
                     ignore=shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc"))
-    geometry = tmp_path / "cospherical" / "core" / "geometry.py"
-    geometry.write_text(geometry.read_text() + "\nfrom ..catalogue import type_name  # wrong on purpose\n")
-    check = tmp_path / "cospherical" / "cli" / "check.py"
-    check.write_text(check.read_text() + "\nfrom . import diff  # wrong on purpose\n")
-    # Inside the core: a configuration needs no Delaunay cells; reaching up to them inverts the data flow.
-    configuration = tmp_path / "cospherical" / "core" / "configuration.py"
-    configuration.write_text(configuration.read_text() + "\nfrom .delaunay import delaunay_cells  # wrong on purpose\n")
-    # A writer reaching into the studies: formats only reads and writes what is computed below it.
-    diff = tmp_path / "cospherical" / "formats" / "diff.py"
-    diff.write_text(diff.read_text() + "\nfrom ..studies.engine import run_study  # wrong on purpose\n")
-    # The intersection study's statistics importing its run: the circle its layers broke.
-    statistics = tmp_path / "cospherical" / "studies" / "intersection" / "statistics.py"
-    statistics.write_text(statistics.read_text() + "\nfrom .run import run_intersection  # wrong on purpose\n")
-    # One element's pieces know nothing of the mesh's sums built on them.
-    pieces = tmp_path / "cospherical" / "mesh" / "dual" / "pieces.py"
-    pieces.write_text(pieces.read_text() + "\nfrom .sums import mesh_dual  # wrong on purpose\n")
-    # The tree's arrays know nothing of the refinement that fills them.
-    tree = tmp_path / "cospherical" / "mesh" / "tree.py"
-    tree.write_text(tree.read_text() + "\nfrom .octree import build_octree  # wrong on purpose\n")
-    # A cluster's cells know nothing of the step that asks for them (they were split out of it).
-    merged_cells = tmp_path / "cospherical" / "mesh" / "merged_cells.py"
-    merged_cells.write_text(merged_cells.read_text() + "\nfrom .delaunay import retessellate  # wrong on purpose\n")
-    # The zip writer knows no file format of ours: the dual's writer builds on it, not the other way.
-    deflated = tmp_path / "cospherical" / "formats" / "deflated.py"
-    deflated.write_text(deflated.read_text() + "\nfrom .dual import write_dual  # wrong on purpose\n")
-    # One check reaching into another: the mesh's checks stand side by side.
-    volume = tmp_path / "cospherical" / "mesh" / "checks" / "volume.py"
-    volume.write_text(volume.read_text() + "\nfrom .conformity import pair_faces  # wrong on purpose\n")
-    # dual.npz's member table knows nothing of the writer that writes it.
-    members = tmp_path / "cospherical" / "formats" / "dual" / "members.py"
-    members.write_text(members.read_text() + "\nfrom .writer import write_dual  # wrong on purpose\n")
+    for module, wrong, _ in WRONG_IMPORTS:
+        target = tmp_path / "cospherical" / module
+        target.write_text(target.read_text() + f"\n{wrong}  # wrong on purpose\n")
     result = lint(tmp_path, tmp_path)
     assert result.returncode != 0
     assert "Contracts: 0 kept, 11 broken." in result.stdout
-    assert "cospherical.formats.dual.members -> cospherical.formats.dual.writer" in result.stdout
-    assert "cospherical.mesh.checks.volume -> cospherical.mesh.checks.conformity" in result.stdout
-    assert "cospherical.formats.deflated -> cospherical.formats.dual" in result.stdout
-    assert "cospherical.mesh.merged_cells -> cospherical.mesh.delaunay" in result.stdout
-    assert "cospherical.mesh.tree -> cospherical.mesh.octree" in result.stdout
-    assert "cospherical.mesh.dual.pieces -> cospherical.mesh.dual.sums" in result.stdout
-    assert "cospherical.studies.intersection.statistics is not allowed to import" in result.stdout
-    assert "cospherical.formats.diff -> cospherical.studies.engine" in result.stdout
-    assert "cospherical.core.configuration -> cospherical.core.delaunay" in result.stdout
-    assert "cospherical.core.geometry -> cospherical.catalogue" in result.stdout
-    assert "cospherical.cli.check -> cospherical.cli.diff" in result.stdout
+    for _, _, reported in WRONG_IMPORTS:
+        assert reported in result.stdout, reported
 
 
 def test_ruff_finds_nothing():
