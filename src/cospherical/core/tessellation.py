@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Mapping, Sequence
 
 from ..choices import DelaunayBackend
@@ -54,7 +55,7 @@ class Tessellation:
     nodes: dict[int, Point]
     elements: tuple[Element, ...]
 
-    @property
+    @cached_property  # read per configuration by the studies' rows, counts and tables: exact comparisons, made once
     def fvm_adequate(self) -> bool:
         """Every element's circumcenter lies in the closed box, or the closed base element of another
         shape (the paper's FVM test)."""

@@ -144,13 +144,10 @@ class Study:
         is FVM-adequate, its orbit representative's tessellation per criterion, and the map of
         those onto the configuration itself (the same element objects for equal images)."""
         images = ElementImages()
-        adequate: dict[str, bool] = {}  # per orbit: a symmetry keeps circumcenters in the box
         for code in sorted(self.codes):
             rep, _ = self.representative[code]
-            if rep not in adequate:
-                adequate[rep] = self.tessellations[rep].fvm_adequate
             yield (code,
-                   adequate[rep],
+                   self.tessellations[rep].fvm_adequate,  # a symmetry keeps circumcenters in the box
                    {criterion: self.choices[criterion].tessellations[rep] for criterion in self.criteria},
                    partial(self.member_tessellation, code, images=images))
 
