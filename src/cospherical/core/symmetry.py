@@ -33,7 +33,7 @@ from .polyhedron import Polyhedron
 from .box import CORNERS, EDGES, FACES, Point
 from .shapes import Shape, standard_shape
 
-__all__ = ["Symmetry", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
+__all__ = ["Symmetry", "axis_maps", "box_symmetries", "code_digits", "key_code", "map_polyhedron", "orbit_keys",
            "orbit_point_keys", "orbit_representatives", "shape_symmetries"]
 
 
@@ -449,22 +449,33 @@ def box_symmetries(box: Box) -> tuple[Symmetry, ...]:
     return shape_symmetries(standard_shape("cuboid", box))
 
 
+def axis_maps(squared: Sequence[Rational]) -> tuple[tuple[tuple[int, ...], tuple[bool, ...]], ...]:
+    """A box's symmetries as maps of its axes, from its squared edge lengths: ``(perm, flips)``, the image
+    point's coordinate ``i`` being the point's coordinate ``perm[i]``, reflected where ``flips[i]``; the
+    permutations of axes of equal length, each with every reflection, identity first (the order that the
+    study tables' symmetry indices refer to).
+
+    Examples
+    --------
+    >>> len(axis_maps((1, 1, 1))), len(axis_maps((1, 2, 2))), axis_maps((1, 2, 4))[1]
+    (48, 16, ((0, 1, 2), (False, False, True)))
+    """
+    return tuple((perm, flips) for perm in permutations(range(3))
+                 if all(squared[i] == squared[perm[i]] for i in range(3))
+                 for flips in product((False, True), repeat=3))
+
+
 def _box_isometries(shape: Shape) -> tuple[Symmetry, ...]:
-    # The cuboid's isometries built directly as the box's: q[i] = p[perm[i]], reflected
-    # (1 - x) where flips[i], permutations (of axes of equal length) first, then the
-    # reflections; the order that the study tables' symmetry indices refer to.
-    squared = shape.box.squared
+    # The cuboid's isometries built directly as the box's (axis_maps): q[i] = p[perm[i]], reflected
+    # (1 - x) where flips[i].
     corner_index: dict[tuple[Rational, ...], int] = {corner: i for i, corner in enumerate(CORNERS)}
     result = []
-    for perm in permutations(range(3)):
-        if any(squared[i] != squared[perm[i]] for i in range(3)):
-            continue
-        for flips in product((False, True), repeat=3):
-            def point(p: Sequence[Rational]) -> tuple[Rational, ...]:
-                return tuple(1 - p[a] if f else p[a] for a, f in zip(perm, flips))
-            corner_map = tuple(corner_index[point(c)] for c in CORNERS)
-            linear = tuple(tuple(Fraction(-1 if f else 1) if col == a else Fraction(0) for col in range(3))
-                           for a, f in zip(perm, flips))
-            shift = tuple(Fraction(int(f)) for f in flips)
-            result.append(Symmetry(shape, corner_map, linear, shift))
+    for perm, flips in axis_maps(shape.box.squared):
+        def point(p: Sequence[Rational]) -> tuple[Rational, ...]:
+            return tuple(1 - p[a] if f else p[a] for a, f in zip(perm, flips))
+        corner_map = tuple(corner_index[point(c)] for c in CORNERS)
+        linear = tuple(tuple(Fraction(-1 if f else 1) if col == a else Fraction(0) for col in range(3))
+                       for a, f in zip(perm, flips))
+        shift = tuple(Fraction(int(f)) for f in flips)
+        result.append(Symmetry(shape, corner_map, linear, shift))
     return tuple(result)

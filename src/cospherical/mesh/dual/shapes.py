@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from ...core.configuration import Box
 from ...core.geometry import Frame, Rational
 from ...core.polyhedron import measure
+from ...core.symmetry import axis_maps
 from ...errors import InputError
 from .pieces import ElementPieces, Point, element_pieces
 
@@ -188,35 +189,19 @@ _MAX_SHAPES = 1 << 16  # element shapes remembered at most (a table's configurat
 _CLASSES: dict[Hashable, tuple[ElementPieces, tuple[int, ...]]] = {}
 
 
-def _signed_permutations() -> NDArray[np.int64]:
-    """The cube's 48 symmetries as signed permutation matrices, the identity first: row ``i`` of each takes
-    coordinate ``perm[i]`` of a point, times ``±1``."""
-    matrices = []
-    for perm in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
-        for signs in range(8):
-            matrix = np.zeros((3, 3), dtype=np.int64)
-            for i in range(3):
-                matrix[i, perm[i]] = -1 if signs >> i & 1 else 1
-            matrices.append(matrix)
-    return np.array(matrices)
+_ISOMETRIES: dict[tuple[bool, bool, bool], tuple[NDArray[np.int64], NDArray[np.int64]]] = {}
 
 
-_SIGNED_PERMUTATIONS = _signed_permutations()
-
-
-_ISOMETRIES: dict[tuple[bool, bool, bool], tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]] = {}
-
-
-def _isometries(squared: Squared) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
-    """The box's symmetries (of the 48): the reflections, and the permutations of axes of equal length; as
-    matrices, and as each one's axis taken per coordinate with its sign."""
+def _isometries(squared: Squared) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The box's symmetries (:func:`~cospherical.core.symmetry.axis_maps`: the reflections, and the
+    permutations of axes of equal length) as arrays, symmetries x coordinates: the axis each coordinate is
+    taken from, and its sign (a reflection as ``-x``: the shapes' classes are up to translation)."""
     equal = (squared[0] == squared[1], squared[1] == squared[2], squared[0] == squared[2])
     found = _ISOMETRIES.get(equal)
-    if found is None:
-        keep = [all(squared[i] == squared[int(np.flatnonzero(m[i])[0])] for i in range(3))
-                for m in _SIGNED_PERMUTATIONS]
-        matrices = _SIGNED_PERMUTATIONS[np.array(keep)]
-        found = _ISOMETRIES[equal] = (matrices, np.abs(matrices).argmax(axis=2), matrices.sum(axis=2))
+    if found is None:  # the symmetries depend on which lengths are equal only
+        maps = axis_maps(squared)
+        found = _ISOMETRIES[equal] = (np.array([perm for perm, _ in maps], dtype=np.int64),
+                                      np.array([[-1 if f else 1 for f in flips] for _, flips in maps], dtype=np.int64))
     return found
 
 
@@ -230,7 +215,7 @@ def _shape_class(points: tuple[tuple[int, int, int], ...], scale: int, faces: tu
     point in the orders returned, with the same faces and centre, so that their pieces are the same up to
     that map (exact, as rationals: lengths, areas and volumes are kept, and so the signs).
     """
-    matrices, axes, signs = _isometries(squared)
+    axes, signs = _isometries(squared)
     coordinates = np.array(points, dtype=np.int64)
     images = coordinates[:, axes] * signs  # points x symmetries x 3
     low = images.min(axis=0)
@@ -245,8 +230,8 @@ def _shape_class(points: tuple[tuple[int, int, int], ...], scale: int, faces: tu
     # the centre n / (d * scale) as integers over common * scale, moved like the points (Python integers: on a
     # tiny or huge domain they pass int64)
     offset = [n * (common // d) for n, d in center]
-    moved = tuple(sum(int(m) * x for m, x in zip(row, offset)) - common * int(corner)
-                  for row, corner in zip(matrices[g].tolist(), low[g].tolist()))
+    moved = tuple(sign * offset[axis] - common * corner
+                  for axis, sign, corner in zip(axes[g].tolist(), signs[g].tolist(), low[g].tolist()))
     shape_faces = tuple(sorted(tuple(sorted(position[n] for n in face)) for face in faces))
     key = (scale, base, tuple(ordered[g]), common, moved, shape_faces, squared)
     return key, order
