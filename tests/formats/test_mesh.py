@@ -335,6 +335,45 @@ def test_the_good_tables_entries_are_used(tmp_path, capsys):
     assert report["configurations_from_table"] == 2 and report["volume_ok"] and report["nonconforming_faces"] == 0
 
 
+def test_the_checked_tables_are_the_committed_tables_against_the_shipped_catalogue():
+    """CHECKED_TABLES names each committed table by the SHA-256 of its bytes: a table regenerated or edited
+    fails here until `cospherical check` passes it and its digest is written there."""
+    import hashlib
+    from pathlib import Path
+
+    from cospherical.catalogue import shipped_catalogue
+    from cospherical.formats.mesh import CHECKED_TABLES
+
+    committed = {hashlib.sha256(path.read_bytes()).hexdigest(): path.name
+                 for path in (Path(__file__).parents[2] / "patterns").glob("*.yaml")}
+    assert {digest: name for digest, (name, _) in CHECKED_TABLES.items()} == committed
+    assert {version for _, version in CHECKED_TABLES.values()} == {shipped_catalogue().version}
+
+
+def test_a_committed_tables_entries_are_proven_and_a_changed_copys_checked(tmp_path, capsys):
+    """The committed leaf table's bytes: its entries are not checked again and the report says why; a copy
+    with a comment line first (the same entries) is checked, and --check all checks the committed one."""
+    from pathlib import Path
+
+    committed = Path(__file__).parents[2] / "patterns" / "leaves-1x1x1.yaml"
+    changed = tmp_path / "leaves-1x1x1.yaml"
+    changed.write_bytes(b"# a copy\n" + committed.read_bytes())
+    runs = {}
+    for name, path, more in (("committed", committed, []), ("changed", changed, []),
+                             ("all", committed, ["--check", "all"])):
+        assert main(["mesh", *SMALL_TREE, "--patterns", str(path), "--format", "json", *more]) == 0
+        runs[name] = json.loads(capsys.readouterr().out)
+    proven = runs["committed"]["checks"]
+    assert "table_entries" not in proven["run"] and "leaves-1x1x1.yaml (SHA-256 3fc551314021aaea" in \
+        proven["not_run"]["table_entries"]
+    for name in ("changed", "all"):
+        assert runs[name]["checks"]["run"][0] == "table_entries" and "table_entries" not in \
+            runs[name]["checks"]["not_run"], name
+    # the same mesh either way
+    figures = {name: {k: v for k, v in run.items() if k != "checks"} for name, run in runs.items()}
+    assert figures["committed"] == figures["changed"] == figures["all"]
+
+
 def test_a_store_whose_count_is_not_its_entries_is_refused_by_the_mesher(tmp_path, capsys):
     import sqlite3
 

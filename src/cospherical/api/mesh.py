@@ -150,16 +150,32 @@ def pattern_lookup(patterns: PatternSource | None, criterion: str, box: Box,
     Each entry used is checked under ``criterion``, or under every criterion of the table with
     ``every_criterion`` (see :func:`~cospherical.formats.mesh.table_lookup`).
     """
+    lookup, name, _ = _pattern_lookup(patterns, criterion, box, every_criterion)
+    return lookup, name
+
+
+def _pattern_lookup(patterns: PatternSource | None, criterion: str, box: Box,
+                    every_criterion: bool = False) -> tuple[Lookup | None, str | None, str | None]:
+    """:func:`pattern_lookup`, and why the table's entries were not checked (``None``: they are checked).
+
+    A table file whose bytes are a committed table's (:func:`~cospherical.formats.mesh.checked_table`)
+    has its entries proven; with ``every_criterion`` (``--check all``) they are checked all the same.
+    """
     if patterns is None:
-        return None, None
-    from ..formats.mesh import table_lookup
-    from ..formats.patterns import PatternTable, load
+        return None, None, None
+    from ..catalogue import shipped_catalogue
+    from ..formats.mesh import checked_table, load_table, table_lookup
+    from ..formats.patterns import PatternTable
 
     if isinstance(patterns, PatternTable):  # read by the caller: named by its study, it has no file name here
         return (table_lookup(patterns, criterion, box, every_criterion=every_criterion),
-                f"{patterns.header.get('study', 'pattern')} table")
+                f"{patterns.header.get('study', 'pattern')} table", None)
     path = Path(patterns)
-    return table_lookup(load(path), criterion, box, str(path), every_criterion=every_criterion), path.name
+    table, digest = load_table(path)
+    catalogue = shipped_catalogue()
+    proven = None if every_criterion else checked_table(digest, catalogue)
+    return (table_lookup(table, criterion, box, str(path), catalogue, every_criterion=every_criterion,
+                         check_entries=proven is None), path.name, proven)
 
 
 class ExactVertices(NamedTuple):
@@ -596,13 +612,13 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         origin = (0.0, 0.0, 0.0)
     timings = {"tree": time.perf_counter() - clock}
     clock = time.perf_counter()
-    lookup, name = pattern_lookup(patterns, criterion, source.tree.box, every_criterion=checks == "all")
+    lookup, name, proven = _pattern_lookup(patterns, criterion, source.tree.box, every_criterion=checks == "all")
     if patterns is not None:
         timings["table"] = time.perf_counter() - clock
     return OctreeMesh(run_pipeline(source, lookup, patterns=name, criterion=criterion, delaunay=delaunay,
                                    check_delaunay=check_delaunay, uniform=uniform, dual=dual,
                                    tetrahedral_counts=tetrahedral_counts, progress=progress, timings=timings,
-                                   checks=checks), origin)
+                                   checks=checks, entries_proven=proven), origin)
 
 
 def _domain_box(domain: Sequence[Any] | Box | None, tree: Octree | None) -> Box:

@@ -19,7 +19,7 @@ from ..errors import FormatError
 from .data import data_path
 from .outputs import atomic_open, atomic_path, atomic_write
 
-__all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_text", "dump_yaml", "load_document", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
+__all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_bytes", "read_text", "dump_yaml", "load_document", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
 
 _Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 
@@ -106,6 +106,16 @@ def load_yaml(path: str | Path) -> Any:
 def read_text(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> str:
     """The UTF-8 text of an input file: only a regular file (never a device or a FIFO), at most
     ``max_bytes`` of it; anything else raises FormatError with one line."""
+    data = read_bytes(path, max_bytes)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise FormatError(f"{path}: cannot read: {error}") from None
+
+
+def read_bytes(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> bytes:
+    """The bytes of an input file, as :func:`read_text` reads them (a regular file, at most ``max_bytes``):
+    for a reader that also needs a digest of exactly what it parses."""
     path = Path(path)
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)  # a FIFO must not block the open
@@ -122,8 +132,8 @@ def read_text(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> str:
             os.close(fd)
         if len(data) > max_bytes:
             raise FormatError(f"{path}: cannot read: too large (more than {max_bytes} bytes)")
-        return data.decode("utf-8")
-    except (OSError, UnicodeDecodeError) as error:
+        return data
+    except OSError as error:
         raise FormatError(f"{path}: cannot read: {getattr(error, 'strerror', None) or error}") from None
 
 

@@ -17,6 +17,7 @@ it is written.
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import json
 import os
@@ -32,19 +33,20 @@ from ..catalogue import Catalogue
 from ..choices import POINT_POLICIES
 from ..core.configuration import Box, Configuration
 from ..errors import FormatError, InputError
-from ..files.yamlio import atomic_write, parse_json, read_text, validate
+from ..files.yamlio import atomic_write, parse_json, read_bytes, read_text, validate
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
-from .check import EntryCheck
-from .patterns import PatternTable
+from .patterns import PatternTable, load, table_from_text
+from .sqlite_store import is_store
 from .vtu import quoteattr
 
 if TYPE_CHECKING:  # the device's modules are imported where a device is meshed, the threads' where they deflate
     from concurrent.futures import Executor
 
     from ..mesh.regions import RegionFaces
+    from .check import EntryCheck
 
-__all__ = ["MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "VtuGrid", "vtu_arrays", "vtu_grid",
+__all__ = ["CHECKED_TABLES", "MAX_LEAF_DIGITS", "REPORT_SCHEMA_VERSION", "checked_table", "load_table", "orbit_lookup", "read_leaves", "report_json", "table_lookup", "VtuGrid", "vtu_arrays", "vtu_grid",
            "write_faces_vtu",
            "write_piece", "write_pvtu", "write_report", "write_vtu"]
 
@@ -124,8 +126,59 @@ def read_leaves(path: str | Path, max_leaves: int | None = None) -> tuple[np.nda
     return array[:, 0], array[:, 1:]
 
 
+# The committed pattern tables (patterns/*.yaml) by the SHA-256 of their bytes, each with the version of the
+# catalogue it was checked against: every entry of each, under every criterion, passes ``cospherical check``
+# (run on all of them when a table is added or regenerated; tests/formats/test_mesh.py holds this list to the
+# files, the tests check every type and a sample of entries of each, ``--full`` every entry).  Such a table's
+# entries are proven: the mesher need not hold them to ``check``'s rules again (``--check all`` still does).
+CHECKED_TABLES: dict[str, tuple[str, str]] = {
+    "3dca5c535acbd5341cda50ff917d087f478a171449a1079181094a71e1229189": ("bisection-1x1.4142x1.4142.yaml",
+                                                                         "0c8dbfebf3fd"),
+    "1700ace6e1ff991052ea554630497ddb00de6a1e665844d0d968914c0f812956": ("bisection-1x1x1.yaml", "0c8dbfebf3fd"),
+    "a93dc3d00f34f6efd7efd887b34738f496d3b466ca21e6e72373b915b6a7c559": ("bisection-1x2x4.yaml", "0c8dbfebf3fd"),
+    "7292147952d09c2a89826d3bc8c33abde7fa802b9bcd6c40255984ed7c67dff0": ("bisection-1xsqrt2xsqrt2.yaml",
+                                                                         "0c8dbfebf3fd"),
+    "ec496b27310d0dc17575d9473879800828e4cb1505e8d9ada3ed40e43a2e9c93": ("bisection-prism-1x1x1.yaml",
+                                                                         "0c8dbfebf3fd"),
+    "4ce1e5fbad84617c22bebd1e947c2b29de238a923bf1012784d7a5e666d88b22": ("bisection-pyramid-1x1x1.yaml",
+                                                                         "0c8dbfebf3fd"),
+    "55dbe744f8f656ea555dfb19344b262b15fce263ce22da461befc32246f0ecf2": ("bisection-tetrahedron-1x1x1.yaml",
+                                                                         "0c8dbfebf3fd"),
+    "3fc551314021aaeaa641f0c133fb26c04defa582b40c85f7ae3a9b3f404ffe23": ("leaves-1x1x1.yaml", "0c8dbfebf3fd"),
+    "cd33fe2c1f9ef63c4eda3f699695b10245248f2ba91a91889b6182cab64b66a1": ("leaves-1x2x4.yaml", "0c8dbfebf3fd"),
+}
+
+
+def load_table(path: str | Path) -> tuple[PatternTable, str | None]:
+    """:func:`cospherical.formats.patterns.load`, and the SHA-256 of the bytes it parsed (``None`` for an
+    indexed store, which is read a configuration at a time): see :func:`checked_table`."""
+    if is_store(path):
+        return load(path), None
+    data = read_bytes(path)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise FormatError(f"{path}: cannot read: {error}") from None
+    return table_from_text(text, str(path)), hashlib.sha256(data).hexdigest()
+
+
+def checked_table(digest: str | None, catalogue: Catalogue) -> str | None:
+    """Why the entries of the table whose bytes have SHA-256 ``digest`` need no check against ``catalogue``
+    (one of :data:`CHECKED_TABLES`, checked against this catalogue's version), else ``None``.
+
+    The digest is of the very bytes the table was parsed from (:func:`load_table`): a copy of a
+    committed table anywhere is proven, a table changed by one byte is not.
+    """
+    known = CHECKED_TABLES.get(digest) if digest is not None else None
+    if digest is None or known is None or known[1] != catalogue.version:
+        return None
+    return (f"the bytes of the committed {known[0]} (SHA-256 {digest[:16]}...), every entry of which passes "
+            "cospherical check (--check all checks them)")
+
+
 def table_lookup(table: PatternTable, criterion: str, box: Box, name: str = "pattern table",
-                 catalogue: Catalogue | None = None, every_criterion: bool = False) -> Lookup:
+                 catalogue: Catalogue | None = None, every_criterion: bool = False,
+                 check_entries: bool = True) -> Lookup:
     """A lookup for :func:`cospherical.mesh.assembly.assemble` reading a pattern table.
 
     The table is asked for the leaf's whole-point-set code (``800000000000+f``), and
@@ -141,7 +194,8 @@ def table_lookup(table: PatternTable, criterion: str, box: Box, name: str = "pat
     instead of giving inverted or overlapping cells.  Its elements under ``criterion`` are
     the ones checked (the others never reach the mesh: half the leaf table's entries have
     split elements of their own, a third of the elements); ``every_criterion``: all of them,
-    as ``check`` does (``mesh --check all``).
+    as ``check`` does (``mesh --check all``).  ``check_entries=False``: none, for a table whose
+    entries are proven (:func:`checked_table`).
     """
     if catalogue is None:
         from ..catalogue import shipped_catalogue
@@ -161,13 +215,17 @@ def table_lookup(table: PatternTable, criterion: str, box: Box, name: str = "pat
             raise InputError(f"{name}: its box {' x '.join(header['box'])} is not shaped like the domain "
                              f"{' x '.join(box.texts)}: its tessellations are not the leaves'")
     policy = header.get("face_points", "octree")
-    check = EntryCheck(header, catalogue, name, only=None if every_criterion else criterion)
+    check: EntryCheck | None = None
+    if check_entries:  # check's module (and what it reads) imported only when an entry is to be checked
+        from .check import EntryCheck
+
+        check = EntryCheck(header, catalogue, name, only=None if every_criterion else criterion)
     checked: set[str] = set()
 
     def elements(code: str) -> list[dict[str, Any]] | None:
         """The table's elements of ``code``, its entry checked as ``check`` does the first time (KeyError: none)."""
         found = table.elements(code, criterion)
-        if code not in checked:
+        if check is not None and code not in checked:
             check(code, table.configurations[code])
             checked.add(code)
         return found

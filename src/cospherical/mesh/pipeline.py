@@ -46,7 +46,7 @@ from .delaunay import delaunay_mesh
 from .device import Device, DeviceLayout, device_layout, device_octree
 from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape
 from .report import MeshReport, checked_mesh_report
-from .report_sections import TreeSummary
+from .report_sections import TreeSummary, read_only
 
 if TYPE_CHECKING:  # the dual's and a device's regions' modules are imported when they are asked for
     from .dual import Dual
@@ -220,7 +220,7 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
                  criterion: str = "optimal", delaunay: str | None = None, check_delaunay: bool = True,
                  uniform: bool = True, dual: bool = False, tetrahedral_counts: bool = False,
                  progress: Progress | None = None, timings: dict[str, float] | None = None,
-                 checks: str = "default") -> PipelineResult:
+                 checks: str = "default", entries_proven: str | None = None) -> PipelineResult:
     """Mesh ``source``'s tree, check it exactly, report it and, with ``dual``, compute its finite-volume dual.
 
     Parameters
@@ -257,6 +257,10 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
         none bounded by the tree's structure (the cross-check of that bound: see
         :mod:`cospherical.mesh.checks.empty_sphere`), and the uniform study is computed even where its
         figures ship precomputed; ``default``: bounded where the tree allows.
+    entries_proven
+        Why ``lookup``'s table entries were not held to ``check``'s rules (a committed table's bytes:
+        :func:`cospherical.formats.mesh.checked_table`); the report's ``checks`` then lists
+        ``table_entries`` as not run, with this reason.
     """
     mode = delaunay_mode(criterion, delaunay)
     if checks not in ("default", "all"):
@@ -286,6 +290,11 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
                                          conformity_progress=told("conformity", None),
                                          uniform_computed=checks == "all")
     report = checked_report.report
+    if entries_proven is not None and report.checks is not None and "table_entries" in report.checks.run:
+        checks_run = report.checks
+        report = replace(report, checks=replace(
+            checks_run, run=tuple(name for name in checks_run.run if name != "table_entries"),
+            not_run=read_only({"table_entries": entries_proven, **(checks_run.not_run or {})})))
     found = faces = None
     if source.device is not None:
         from .regions import device_report, region_faces
