@@ -32,11 +32,11 @@ def test_element_list_path_equals_the_configuration_path():
 
 
 def test_pieces_remembered_per_shape_are_each_elements_own():
-    """A configuration's pieces, its elements measured once per class of shapes up to translation and the box's
-    symmetries and mapped and moved back, are the pieces of each element measured where it lies, exactly:
-    boundary planes, node ids and all (a cube, whose configurations repeat shapes at other corners and in
-    mirror images, a 1 x sqrt 2 x sqrt 2 box, whose last two axes may be swapped, and a 1 x 2 x 4 box, only
-    mirrored)."""
+    """A configuration's pieces, carried over from another configuration of its class (equal up to the box's
+    symmetries), or its elements measured once per class of shapes up to translation and the box's symmetries
+    and mapped and moved back, are the pieces of each element measured where it lies, exactly: boundary planes,
+    node ids and all (a cube, whose configurations repeat at other corners and in mirror images, a
+    1 x sqrt 2 x sqrt 2 box, whose last two axes may be swapped, and a 1 x 2 x 4 box, only mirrored)."""
     from cospherical.mesh.dual import shapes
     from cospherical.mesh.dual.pieces import element_pieces
 
@@ -45,21 +45,30 @@ def test_pieces_remembered_per_shape_are_each_elements_own():
         box = Box.parse(texts)
         mesh = assemble(build_octree(box, 3, [parse_shape(shape)]), cache=CACHES.setdefault(box.texts, {}))
         squared = tuple(Fraction(x) for x in box.squared)
-        shapes._REMEMBERED.clear()
-        shapes._SHAPES.clear()
-        shapes._CLASSES.clear()
-        elements = 0
-        for _, tessellation, _ in mesh.groups():
-            points = tessellation.configuration.nodes()
-            direct = shapes.ShapePieces([element_pieces({n: points[n] for n in e.nodes}, e.faces, e.center, squared)
-                                         for e in tessellation.elements])
-            remembered = shapes._tessellation_pieces(tessellation, squared)
-            assert np.array_equal(direct.edges, remembered.edges) and direct.edge_q == remembered.edge_q
-            assert np.array_equal(direct.volume_nodes, remembered.volume_nodes)
-            assert direct.volume_q == remembered.volume_q and direct.boundary == remembered.boundary
-            elements += len(tessellation.elements)
-        assert len(shapes._SHAPES) < elements or texts[1] != "1"  # the cube's shapes were met again
-        assert len(shapes._CLASSES) < len(shapes._SHAPES)  # and mapped: measured once per class
+        for per_configuration in (False, True):  # element shapes mapped (each configuration its own class), or both
+            shapes._REMEMBERED.clear()
+            shapes._SHAPES.clear()
+            shapes._CLASSES.clear()
+            shapes._CONFIGURATIONS.clear()
+            elements = configurations = 0
+            for _, tessellation, _ in mesh.groups():
+                points = tessellation.configuration.nodes()
+                direct = shapes.ShapePieces.summed([
+                    element_pieces({n: points[n] for n in e.nodes}, e.faces, e.center, squared)
+                    for e in tessellation.elements])
+                if not per_configuration:
+                    shapes._CONFIGURATIONS.clear()
+                remembered = shapes._tessellation_pieces(tessellation, squared)
+                assert np.array_equal(direct.edges, remembered.edges) and direct.edge_q == remembered.edge_q
+                assert np.array_equal(direct.volume_nodes, remembered.volume_nodes)
+                assert direct.volume_q == remembered.volume_q and direct.boundary == remembered.boundary
+                elements += len(tessellation.elements)
+                configurations += 1
+            if per_configuration:  # measured once per class of configurations, carried over to the others
+                assert len(shapes._CONFIGURATIONS) < configurations
+            else:
+                assert len(shapes._SHAPES) < elements or texts[1] != "1"  # the cube's shapes were met again
+                assert len(shapes._CLASSES) < len(shapes._SHAPES)  # and mapped: measured once per class
 
 
 def test_element_shapes_are_classed_exactly_even_when_their_hashes_collide(monkeypatch):
@@ -79,3 +88,26 @@ def test_element_shapes_are_classed_exactly_even_when_their_hashes_collide(monke
     again = mesh_dual(mesh, mesh.connectivity())
     for name in ("edges", "coefficient_exact", "volume_exact", "boundary_area_exact", "element_circumcenter"):
         assert np.array_equal(getattr(hashed, name), getattr(again, name))
+
+
+def test_a_configuration_tessellated_otherwise_is_not_carried_over():
+    """The cube cut into two prisms along x = y, and along x + y = 1: one point set, tessellations that are mirror
+    images but not the same, so that each is measured on its own (never one carried over to the other)."""
+    from cospherical.core.configuration import Configuration
+    from cospherical.mesh.assembly import local_tessellation
+    from cospherical.mesh.dual import shapes
+    from cospherical.mesh.dual.pieces import element_pieces
+
+    cube = Configuration.from_code("000000000000", faces=[])
+    points = cube.nodes()
+    squared = (Fraction(1), Fraction(1), Fraction(1))
+    shapes._CONFIGURATIONS.clear()
+    for cut in (lambda p: p[0] - p[1], lambda p: p[0] + p[1] - 1):
+        halves = [[n for n, p in points.items() if side * cut(p) >= 0] for side in (1, -1)]
+        tessellation = local_tessellation(cube, [("prism", half) for half in halves])
+        direct = shapes.ShapePieces.summed([element_pieces({n: points[n] for n in e.nodes}, e.faces, e.center,
+                                                           squared) for e in tessellation.elements])
+        pieces = shapes._tessellation_pieces(tessellation, squared)
+        assert np.array_equal(direct.edges, pieces.edges) and direct.edge_q == pieces.edge_q
+        assert direct.volume_q == pieces.volume_q and direct.boundary == pieces.boundary
+    assert len(shapes._CONFIGURATIONS) == 2

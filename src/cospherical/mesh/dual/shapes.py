@@ -2,7 +2,8 @@
 
 The pieces of a leaf's configuration scale with the leaf's size (coefficients as
 ``h``, areas as ``h^2``, volumes as ``h^3``), so they are computed once per
-configuration (and remembered across meshes), once per shape of the cells that
+configuration (and remembered across meshes; measured once per class of configurations
+equal up to the box's symmetries, carried over to the others), once per shape of the cells that
 replace leaves, or, for an element list given as such, once per distinct element
 shape up to translation and powers of two.  Each :class:`Group` holds its pieces
 (:class:`ShapePieces`, keyed by local node ids) and the rows of global vertex ids of
@@ -26,7 +27,7 @@ from ...errors import InputError
 from .pieces import ElementPieces, Point, element_pieces
 
 if TYPE_CHECKING:
-    from ..assembly import LocalTessellation, Mesh
+    from ..assembly import LocalElement, LocalTessellation, Mesh
 
 __all__ = ["Group", "ShapePieces", "cell_groups", "element_groups", "leaf_groups", "row_hashes"]
 
@@ -44,7 +45,17 @@ class ShapePieces:
 
     __slots__ = ("edges", "edge_q", "volume_nodes", "volume_q", "boundary")
 
-    def __init__(self, pieces_list: Sequence[ElementPieces]) -> None:
+    def __init__(self, edges: NDArray[np.int64], edge_q: list[Fraction], volume_nodes: NDArray[np.int64],
+                 volume_q: list[Fraction], boundary: list[tuple[tuple[int, Fraction, int], Fraction]]) -> None:
+        self.edges = edges
+        self.edge_q = edge_q
+        self.volume_nodes = volume_nodes
+        self.volume_q = volume_q
+        self.boundary = boundary
+
+    @classmethod
+    def summed(cls, pieces_list: Sequence[ElementPieces]) -> ShapePieces:
+        """The pieces of elements that share their nodes' numbering (a configuration's), summed."""
         edges = _summed([item for pieces in pieces_list for item in pieces.edges.items()])
         volumes = _summed([item for pieces in pieces_list for item in pieces.volumes.items()])
         # a node lies in one plane normal to each axis: (axis, node) keys the plane's shares, its value beside
@@ -53,18 +64,40 @@ class ShapePieces:
         boundary = _summed([((axis, node), q) for pieces in pieces_list for (axis, _), shares in pieces.boundary.items()
                             for node, q in shares.items()])
         keys = sorted(edges)
-        self.edges: NDArray[np.int64] = np.array(keys, dtype=np.int64).reshape(-1, 2)
-        self.edge_q: list[Fraction] = [edges[k] for k in keys]
         nodes = sorted(volumes)
-        self.volume_nodes: NDArray[np.int64] = np.array(nodes, dtype=np.int64)
-        self.volume_q: list[Fraction] = [volumes[n] for n in nodes]
-        entries = [((axis, planes[axis, node], node), q) for (axis, node), q in boundary.items()]
-        # sorted by (axis, plane, node), the planes compared as integers over their common denominator (the same
-        # order as the fractions', at a fraction of the cost)
-        common = math.lcm(1, *(value.denominator for (_, value, _), _ in entries))
-        self.boundary: list[tuple[tuple[int, Fraction, int], Fraction]] = sorted(
-            entries, key=lambda entry: (entry[0][0], entry[0][1].numerator * (common // entry[0][1].denominator),
-                                        entry[0][2]))
+        return cls(np.array(keys, dtype=np.int64).reshape(-1, 2), [edges[k] for k in keys],
+                   np.array(nodes, dtype=np.int64), [volumes[n] for n in nodes],
+                   _plane_sorted([((axis, planes[axis, node], node), q) for (axis, node), q in boundary.items()]))
+
+    def moved(self, node: Sequence[int], axis: Sequence[int], points: Mapping[int, tuple[int, int, int]],
+              scale: int) -> ShapePieces:
+        """These pieces carried over by an isometry of the box: node ``u`` becomes ``node[u]``, a plane normal to
+        axis ``a`` one normal to ``axis[a]``, its value read from the moved nodes' points (``points[n] / scale``).
+        The shares are the same numbers (lengths, areas, volumes and their signs are kept), in the new order."""
+        edges = sorted(((node[u], node[v]) if node[u] < node[v] else (node[v], node[u]), q)
+                       for (u, v), q in zip(self.edges.tolist(), self.edge_q))
+        volumes = sorted(zip((node[u] for u in self.volume_nodes.tolist()), self.volume_q))
+        planes: dict[tuple[int, int], Fraction] = {}  # one Fraction per plane
+        boundary = []
+        for (a, _, u), q in self.boundary:
+            b, n = axis[a], node[u]
+            value = points[n][b]
+            plane = planes.get((b, value))
+            if plane is None:
+                plane = planes[b, value] = Fraction(value, scale)
+            boundary.append(((b, plane, n), q))
+        return ShapePieces(np.array([e for e, _ in edges], dtype=np.int64).reshape(-1, 2), [q for _, q in edges],
+                           np.array([n for n, _ in volumes], dtype=np.int64), [q for _, q in volumes],
+                           _plane_sorted(boundary))
+
+
+def _plane_sorted(entries: list[tuple[tuple[int, Fraction, int], Fraction]]
+                  ) -> list[tuple[tuple[int, Fraction, int], Fraction]]:
+    """Boundary shares sorted by (axis, plane, node), the planes compared as integers over their common denominator
+    (the same order as the fractions', at a fraction of the cost)."""
+    common = math.lcm(1, *(value.denominator for (_, value, _), _ in entries))
+    return sorted(entries, key=lambda entry: (entry[0][0], entry[0][1].numerator * (common // entry[0][1].denominator),
+                                              entry[0][2]))
 
 
 Key = TypeVar("Key", bound=Hashable)
@@ -131,7 +164,7 @@ def cell_groups(mesh: Mesh, squared: Squared, centers: NDArray[np.float64]) -> l
         rows = np.flatnonzero(cells.shape == s)
         points: dict[int, Point] = {n: (Fraction(o[0]), Fraction(o[1]), Fraction(o[2]))
                                     for n, o in enumerate(shape.offsets)}
-        pieces = ShapePieces([element_pieces(points, shape.faces, shape.center, squared)])
+        pieces = ShapePieces.summed([element_pieces(points, shape.faces, shape.center, squared)])
         groups.append(Group(pieces, cells.nodes, rows, np.ones(len(rows), dtype=np.int64)))
         centers[mesh.leaf_elements + rows] = _real_centers(cells.anchor[rows], shape.center, np.ones(1, np.int64),
                                                            lengths, mesh.grid)
@@ -139,20 +172,60 @@ def cell_groups(mesh: Mesh, squared: Squared, centers: NDArray[np.float64]) -> l
 
 
 _REMEMBERED: dict[tuple[str, Squared, tuple[tuple[int, ...], ...]], ShapePieces] = {}
+# per class of configurations (equal tessellations up to the box's symmetries, see _configuration_class): the
+# pieces of the first one met, its nodes in the class's order and the axis each of its axes goes to in the class
+_CONFIGURATIONS: dict[Hashable, tuple[ShapePieces, tuple[int, ...], tuple[int, ...]]] = {}
 
 
 def _tessellation_pieces(tessellation: LocalTessellation, squared: Squared) -> ShapePieces:
-    """A configuration's pieces, remembered by its code, box and element node lists (meshes share them)."""
+    """A configuration's pieces, remembered by its code, box and element node lists (meshes share them).
+
+    Measured once per class of configurations up to the box's symmetries (the level-6 sphere tree's 95
+    configurations are 8 classes: a hanging node on one edge of a leaf is one class whichever edge it is on),
+    and carried over from the class's first configuration for the others."""
     key = (tessellation.code, squared, tuple(e.nodes for e in tessellation.elements))
     shape = _REMEMBERED.get(key)
     if shape is None:
         points = tessellation.configuration.nodes()
         scale = math.lcm(*(x.denominator for p in points.values() for x in p))
-        grid = {n: (int(p[0] * scale), int(p[1] * scale), int(p[2] * scale)) for n, p in points.items()}
-        shape = _REMEMBERED[key] = ShapePieces([
-            _placed_pieces(grid, scale, e.nodes, e.faces, e.center, squared)
-            for e in tessellation.elements if e.center is not None])
+        grid = {n: (p[0].numerator * (scale // p[0].denominator), p[1].numerator * (scale // p[1].denominator),
+                    p[2].numerator * (scale // p[2].denominator)) for n, p in points.items()}
+        elements = [e for e in tessellation.elements if e.center is not None]
+        configuration_class, order, axes = _configuration_class(grid, scale, elements, squared)
+        known = _CONFIGURATIONS.get(configuration_class)
+        if known is None:
+            shape = ShapePieces.summed([_placed_pieces(grid, scale, e.nodes, e.faces, e.center, squared)
+                                        for e in elements if e.center is not None])
+            _CONFIGURATIONS[configuration_class] = (shape, order, axes)
+        else:
+            pieces, first, first_axes = known
+            node = [0] * (max(first) + 1)
+            for u, v in zip(first, order):
+                node[u] = v
+            # axis a of the first configuration is the class's axis k with first_axes[k] == a, this one's axes[k]
+            axis = [0, 0, 0]
+            for k in range(3):
+                axis[first_axes[k]] = axes[k]
+            shape = pieces.moved(node, axis, grid, scale)
+        _REMEMBERED[key] = shape
     return shape
+
+
+def _configuration_class(grid: Mapping[int, tuple[int, int, int]], scale: int, elements: Sequence[LocalElement],
+                         squared: Squared) -> tuple[Hashable, tuple[int, ...], tuple[int, ...]]:
+    """A configuration's class up to the box's symmetries, with its tessellation: the class's key, the node ids in
+    the class's order, and the axis of the configuration that each of the class's axes is taken from.
+
+    Two configurations of one class are one moved by an isometry of the box, point for point in the orders
+    returned, with the same elements (node sets) and the same faces (node sets): so the same pieces up to that
+    map.  An element's centre need not be compared: it is the centre of the sphere through its points."""
+    ids = list(grid)
+    g, order_index, codes, base, _ = _canonical(np.array([grid[n] for n in ids], dtype=np.int64), squared)
+    order = tuple(ids[i] for i in order_index)
+    position = {n: i for i, n in enumerate(order)}
+    structure = frozenset((frozenset([position[n] for n in e.nodes]),
+                           frozenset([frozenset([position[n] for n in face]) for face in e.faces])) for e in elements)
+    return (scale, base, codes, structure, squared), order, tuple(_isometries(squared)[0][g].tolist())
 
 
 def _placed_pieces(grid: Mapping[int, tuple[int, int, int]], scale: int, nodes: Sequence[int],
@@ -205,18 +278,15 @@ def _isometries(squared: Squared) -> tuple[NDArray[np.int64], NDArray[np.int64]]
     return found
 
 
-def _shape_class(points: tuple[tuple[int, int, int], ...], scale: int, faces: tuple[tuple[int, ...], ...],
-                 center: Offset, squared: Squared) -> tuple[Hashable, tuple[int, ...]]:
-    """An element shape's class up to the box's symmetries and translation, and its nodes in the class's order.
+def _canonical(coordinates: NDArray[np.int64], squared: Squared
+               ) -> tuple[int, list[int], tuple[int, ...], int, list[int]]:
+    """Points (non-negative integers, one a row) in the form shared by their images under the box's symmetries.
 
     Every symmetry's image of the points, moved to its low corner, is coded one integer a point and sorted; the
-    least such list (compared as lists) is the class's, with the image's centre and its faces as sets of
-    positions in that list: two shapes of one class are one shape moved by an isometry of the box, point for
-    point in the orders returned, with the same faces and centre, so that their pieces are the same up to
-    that map (exact, as rationals: lengths, areas and volumes are kept, and so the signs).
-    """
+    least such list (compared as lists) is the canonical one.  Returns that symmetry's index (into
+    :func:`_isometries`), the points' order in the list, the list, the base of the codes and the image's low
+    corner (what the symmetry's image was moved by)."""
     axes, signs = _isometries(squared)
-    coordinates = np.array(points, dtype=np.int64)
     images = coordinates[:, axes] * signs  # points x symmetries x 3
     low = images.min(axis=0)
     images -= low
@@ -224,16 +294,30 @@ def _shape_class(points: tuple[tuple[int, int, int], ...], scale: int, faces: tu
     codes = images @ np.array([base * base, base, 1], dtype=np.int64)  # points x symmetries
     ordered = np.sort(codes, axis=0).T.tolist()
     g = min(range(len(ordered)), key=ordered.__getitem__)
-    order = tuple(np.argsort(codes[:, g]).tolist())
+    return g, np.argsort(codes[:, g]).tolist(), tuple(ordered[g]), base, low[g].tolist()
+
+
+def _shape_class(points: tuple[tuple[int, int, int], ...], scale: int, faces: tuple[tuple[int, ...], ...],
+                 center: Offset, squared: Squared) -> tuple[Hashable, tuple[int, ...]]:
+    """An element shape's class up to the box's symmetries and translation, and its nodes in the class's order.
+
+    The class is the points' canonical form (:func:`_canonical`) with the image's centre and its faces as sets
+    of positions in that form's list: two shapes of one class are one shape moved by an isometry of the box,
+    point for point in the orders returned, with the same faces and centre, so that their pieces are the same
+    up to that map (exact, as rationals: lengths, areas and volumes are kept, and so the signs).
+    """
+    axes, signs = _isometries(squared)
+    g, order_index, codes, base, low = _canonical(np.array(points, dtype=np.int64), squared)
+    order = tuple(order_index)
     position = {n: i for i, n in enumerate(order)}
     common = math.lcm(*(d for _, d in center))
     # the centre n / (d * scale) as integers over common * scale, moved like the points (Python integers: on a
     # tiny or huge domain they pass int64)
     offset = [n * (common // d) for n, d in center]
     moved = tuple(sign * offset[axis] - common * corner
-                  for axis, sign, corner in zip(axes[g].tolist(), signs[g].tolist(), low[g].tolist()))
+                  for axis, sign, corner in zip(axes[g].tolist(), signs[g].tolist(), low))
     shape_faces = tuple(sorted(tuple(sorted(position[n] for n in face)) for face in faces))
-    key = (scale, base, tuple(ordered[g]), common, moved, shape_faces, squared)
+    key = (scale, base, codes, common, moved, shape_faces, squared)
     return key, order
 
 
@@ -292,7 +376,7 @@ def _measured_pieces(key: NDArray[np.int64], squared: Squared, element: int) -> 
         raise InputError(f"element {element} is flat: it has no dual")
     if measured.sphere is None or measured.center is None:
         raise InputError(f"element {element} is not co-spherical: it has no dual")
-    return ShapePieces([element_pieces(points, measured.cycles, measured.center, squared)]), measured.center
+    return ShapePieces.summed([element_pieces(points, measured.cycles, measured.center, squared)]), measured.center
 
 
 
