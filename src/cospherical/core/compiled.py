@@ -180,8 +180,10 @@ def walk(coords: _Ints, lifted: _Ints, weights: _Ints, cell_mask: _Ints, cell_sp
     or the points do not span 3D (the caller then takes the Python walk).
     """
     n = coords.shape[0]
+    # The indices and counts handed to the helpers start as np.int64, never as a literal 0: numba would
+    # compile each helper a second time for the literal's own type (a second of compiling in a fresh clone).
     # First cell: an empty sphere through the lexicographically smallest point.
-    anchor = 0
+    anchor = np.int64(0)
     for p in range(1, n):
         for axis in range(3):
             if coords[p, axis] != coords[anchor, axis]:
@@ -200,8 +202,16 @@ def walk(coords: _Ints, lifted: _Ints, weights: _Ints, cell_mask: _Ints, cell_sp
             keys[t] = dist * 64 + p
             others[t] = p
             t += 1
-    others = others[np.argsort(keys)]
-    ncells = 0
+    # Nearest first (keys are distinct: the index is in the low bits).  Insertion sort on at most 61
+    # keys: np.argsort would compile numba's quicksort into the walk, about a second of compiling.
+    for t in range(1, n - 1):
+        key, other = keys[t], others[t]
+        pos = t
+        while pos > 0 and keys[pos - 1] > key:
+            keys[pos], others[pos] = keys[pos - 1], others[pos - 1]
+            pos -= 1
+        keys[pos], others[pos] = key, other
+    ncells = np.int64(0)
     members = np.empty(n, dtype=np.int64)
     found = False
     for q in range(n - 1):
@@ -233,13 +243,13 @@ def walk(coords: _Ints, lifted: _Ints, weights: _Ints, cell_mask: _Ints, cell_sp
     if not found:
         return -1, -1
     crossed = np.empty(face_nodes.shape[0], dtype=np.int64)
-    ncrossed = 0
+    ncrossed = np.int64(0)
     beyond = np.empty(n, dtype=np.int64)
-    nfaces = 0
+    nfaces = np.int64(0)
     done = 0
     while done < ncells:
         mask = cell_mask[done]
-        count = 0
+        count = np.int64(0)
         for p in range(n):
             if mask >> p & 1:
                 members[count] = p
