@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -107,14 +108,16 @@ def test_a_refine_shape_outside_the_domain_is_one_warning_line(capsys):
 
 
 def test_mesh_out_imports_only_what_it_uses(tmp_path):
-    # A default `mesh --out` of a cube (its uniform study shipped) in a fresh process: what only other
-    # options use is not imported; each of these cost a `mesh` run 5-30 ms of its fixed ~0.5 s.
+    # A default `mesh --out` of a cube (its uniform study shipped) with the committed leaf table in a fresh
+    # process: what only other options use is not imported; each of these cost a `mesh` run 3-30 ms of its
+    # fixed ~0.4 s.
     import subprocess
     import sys
 
+    table = str(Path(__file__).parents[2] / "patterns" / "leaves-1x1x1.yaml")
     script = ("import sys\nfrom cospherical.cli import main\n"
               f"assert main(['mesh', '--domain', '1', '1', '1', '--levels', '2', '--refine', 'point:0.1,0.1,0.1', "
-              f"'--out', {str(tmp_path / 'out')!r}]) == 0\n"
+              f"'--patterns', {table!r}, '--out', {str(tmp_path / 'out')!r}]) == 0\n"
               "print(' '.join(sorted(sys.modules)))")
     loaded = set(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                                 check=True).stdout.split("\n")[-2].split())
@@ -123,6 +126,9 @@ def test_mesh_out_imports_only_what_it_uses(tmp_path):
               "cospherical.mesh.dual", "cospherical.formats.dual", "cospherical.mesh.regions",  # --dual, --device
               "cospherical.mesh.tetrahedra",  # --gmsh, --tets
               "cospherical.studies.engine",  # the uniform study of a shipped shape is read, not run
+              "cospherical.mesh.device",  # --device
+              "cospherical.formats.check",  # a committed table's entries are proven by its digest
+              "PIL.JpegImagePlugin",  # mesh.png saved as PNG by its name, not after Pillow's five plugins
               "numpy.ma",  # numpy 2.4's unique() without counts or indices imports it to test for a mask
               "scipy"}
     assert not unused & loaded, unused & loaded

@@ -133,3 +133,29 @@ def test_a_compiled_validator_is_kept_and_gives_fastjsonschemas_verdicts(tmp_pat
     assert len(list(tmp_path.glob("demo.*"))) == 1
     (tmp_path / "file").write_text("")  # a folder it cannot make (root writes anywhere else): compiled, no error
     assert _compiled_validator("demo", text, tmp_path / "file" / "cache")({"n": 2}) == {"n": 2}
+
+
+def test_validated_data_is_kept_and_read_back_only_for_the_same_text(tmp_path, monkeypatch):
+    """The shipped catalogue's parsed, validated data kept: read back for the same text, never for another."""
+    import sys
+
+    from cospherical.catalogue.names import _catalogue_data, catalogue_path
+    from cospherical.files.yamlio import read_text, validated_data
+
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)
+    parsed = []
+
+    def parse(text, name):
+        parsed.append(name)
+        return _catalogue_data(text, name)
+
+    text = read_text(catalogue_path())
+    first = validated_data(text, "catalogue", "c.yaml", parse, tmp_path)
+    assert first == validated_data(text, "catalogue", "c.yaml", parse, tmp_path) and parsed == ["c.yaml"]
+    assert len(list(tmp_path.glob("catalogue-data.*.marshal"))) == 1
+    broken = text.replace("schema_version: 1", "schema_version: one", 1)  # another text: parsed and validated
+    with pytest.raises(FormatError, match="catalogue format"):
+        validated_data(broken, "catalogue", "c.yaml", parse, tmp_path)
+    assert len(parsed) == 2
+    next(tmp_path.glob("catalogue-data.*.marshal")).write_bytes(b"\x00damaged")  # parsed again
+    assert validated_data(text, "catalogue", "c.yaml", parse, tmp_path) == first and len(parsed) == 3

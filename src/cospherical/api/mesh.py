@@ -38,18 +38,19 @@ from ..errors import InputError, shown
 from ..files.outputs import OutputFolder
 from ..formats.gmsh import GMSH_VERSIONS
 from ..mesh.assembly import Lookup, Mesh
-from ..mesh.device import Device
 from ..mesh.octree import Octree, Shape
 from ..mesh.pipeline import (PipelineResult, Progress, TreeSource, delaunay_mode, full_dual, run_pipeline,
                              tree_from_device, tree_from_leaves, tree_from_octree, tree_from_refine)
 from ..mesh.report import MeshReport
 
-if TYPE_CHECKING:  # the dual's modules are imported when a dual is made, a table's reader when one is read
+if TYPE_CHECKING:  # the dual's modules are imported when a dual is made, a table's reader when one is read,
+    # a device's when a device is meshed
     from concurrent.futures import Executor
 
     from ..adapters.devsim import MeshWithDual
     from ..formats.patterns import PatternTable
     from ..mesh.dual import Dual
+    from ..mesh.device import Device
 
     # a pattern table: a path to its file, or a table cospherical.load_patterns read
     PatternSource = PatternTable | str | os.PathLike[str]
@@ -597,6 +598,8 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         raise InputError("tetrahedral_counts=True counts beside the dual's figures: give dual=True too")
     clock = time.perf_counter()
     if device is not None:
+        from ..mesh.device import Device
+
         if not isinstance(device, Device):
             from ..formats.device_file import read_device
 
@@ -643,7 +646,13 @@ def _check_keywords(**given: Any) -> None:
     keyword (a value of the right type is checked where it is used)."""
     from ..choices import CRITERIA
     from ..formats.patterns import PatternTable
-    from ..mesh.device import Device
+
+    def device(value: Any) -> bool:  # a device's module imported only to tell a Device given
+        if path_like(value):
+            return True
+        from ..mesh.device import Device
+
+        return isinstance(value, Device)
 
     def path_like(value: Any) -> bool:
         return isinstance(value, (str, Path)) and str(value).strip() != ""
@@ -662,7 +671,7 @@ def _check_keywords(**given: Any) -> None:
                      "a pattern table's path, or a table cospherical.load_patterns read"),
         "criterion": (lambda v: isinstance(v, str) and v in CRITERIA, f"one of {', '.join(CRITERIA)}"),
         "delaunay": (lambda v: isinstance(v, str), "global or leaf"),
-        "device": (lambda v: isinstance(v, Device) or path_like(v), "a device file's path, or a Device"),
+        "device": (device, "a device file's path, or a Device"),
         "max_leaves": (lambda v: isinstance(v, (int, np.integer)) and not isinstance(v, bool) and bool(v >= 1),
                        "a positive integer"),
         "progress": (callable, "a callable progress(stage, total, advance)"),

@@ -13,13 +13,13 @@ what comparisons with the paper use.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Iterable
+from typing import Any, Iterable
 
 from ..caches import cached
 from ..core.element_types import ElementType, systematic_name
 from ..files.data import data_path
 from ..files.flowyaml import decode_entry, split_section
-from ..files.yamlio import parse_yaml, read_text, validate
+from ..files.yamlio import parse_yaml, read_text, validate, validated_data
 from ..paper import paper_class
 from .model import Catalogue
 
@@ -49,7 +49,8 @@ def shipped_catalogue() -> Catalogue:
     path = catalogue_path()
     if not path.exists():
         return Catalogue.empty(SCHEMA_VERSION)
-    return load_catalogue(path)
+    # the same text every run: its validated data kept as the validators are (load_catalogue's verdicts)
+    return Catalogue.from_dict(validated_data(read_text(path), "catalogue", str(path), _catalogue_data))
 
 
 def known_name(code: str, catalogue: Catalogue | None = None) -> str | None:
@@ -129,6 +130,13 @@ def catalogue_from_text(text: str, name: str) -> Catalogue:
     has its types decoded as JSON and only its header parsed as YAML; any other
     YAML spelling is read by the YAML parser.
     """
+    data = _catalogue_data(text, name)
+    validate(data, "catalogue", name)
+    return Catalogue.from_dict(data)
+
+
+def _catalogue_data(text: str, name: str) -> Any:
+    """A catalogue's text parsed (not yet validated): see :func:`catalogue_from_text`."""
     split = split_section(text, "types")
     data = None
     if split is not None and isinstance(split[1], list):
@@ -139,5 +147,4 @@ def catalogue_from_text(text: str, name: str) -> Catalogue:
             data = None
     if data is None:
         data = parse_yaml(text, name)
-    validate(data, "catalogue", name)
-    return Catalogue.from_dict(data)
+    return data

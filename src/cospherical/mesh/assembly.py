@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
-from typing import Any, Callable, Iterable, Iterator, NamedTuple
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Iterator, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,8 +36,10 @@ from ..core.geometry import Frame, Sphere, in_closed_box
 from ..core.tessellation import tessellate
 from ..errors import InputError
 from ..paper import paper_class
-from .device import Regions
 from .tree import Octree, distinct
+
+if TYPE_CHECKING:  # a device's module is imported where a device is meshed
+    from .device import Regions
 
 __all__ = ["CellShape", "Cells", "ElementBlock", "LocalElement", "LocalTessellation", "Lookup", "MeasureCache", "Mesh",
            "MeshType", "NODE_OFFSETS",

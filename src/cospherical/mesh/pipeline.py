@@ -43,12 +43,12 @@ from ..errors import InputError
 from .assembly import Lookup, Mesh, assemble
 from ..choices import MODES, DelaunayMode
 from .delaunay import delaunay_mesh
-from .device import Device, DeviceLayout, device_layout, device_octree
 from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape
 from .report import MeshReport, checked_mesh_report
 from .report_sections import TreeSummary, read_only
 
-if TYPE_CHECKING:  # the dual's and a device's regions' modules are imported when they are asked for
+if TYPE_CHECKING:  # the dual's and a device's modules are imported when they are asked for
+    from .device import Device, DeviceLayout
     from .dual import Dual
     from .regions import RegionFaces
 
@@ -102,6 +102,8 @@ def tree_from_leaves(box: Box, levels: Sequence[int] | np.ndarray, positions: Se
 def tree_from_device(device: Device, max_leaves: int | None = None) -> TreeSource:
     """The tree of a device (:mod:`cospherical.mesh.device`): checked, refined until its region boundaries and
     contact edges lie on leaf faces, balanced, the leaves outside every region dropped."""
+    from .device import device_layout, device_octree
+
     try:
         layout = device_layout(device)
         device = layout.device  # checked: exact coordinates, shapes parsed

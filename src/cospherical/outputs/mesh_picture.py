@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -158,8 +159,13 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
             y = ly + 8 + 20 * i
             draw.rectangle((lx + 12, y + 2, lx + 40, y + 12), fill=colour[t], outline=BLACK)
             draw.text((lx + 48, y + 7), row, font=font, fill=BLACK, anchor="lm")
+    # Encoded under a name that says PNG: Image.save(format=...) first loads five format plugins (BMP, GIF,
+    # JPEG, PPM and PNG, ~5 ms) where a ".png" name loads PNG's alone; the same encoder, the same bytes.
+    encoded = io.BytesIO()
+    encoded.name = "mesh.png"
+    image.save(encoded, optimize=False)
     with atomic_open(path, binary=True) as handle:
-        image.save(handle, format="png", optimize=False)
+        handle.write(encoded.getbuffer())
 
 
 def frame(a: float, b: float) -> tuple[int, int, int, int, float]:

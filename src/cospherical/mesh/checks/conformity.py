@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Callable, Iterable, Mapping, NamedTuple, Sequence, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping, NamedTuple, Sequence, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,9 +20,11 @@ from ...core.geometry import Frame, Rational
 from ...core.polyhedron import measure
 from ...errors import InputError
 from ..assembly import NODE_OFFSETS, LocalTessellation, Mesh
-from ..device import DeviceLayout
 from ..tree import distinct
 from .domain import on_domain_boundary
+
+if TYPE_CHECKING:  # a device's module is imported where a device is meshed
+    from ..device import DeviceLayout
 
 __all__ = ["ConformityCheck", "Faces", "OpenFaces", "check_conformity", "element_faces", "match_seams", "pair_faces"]
 

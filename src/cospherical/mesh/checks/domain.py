@@ -3,10 +3,14 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...core.geometry import in_closed_box
-from ..device import DeviceLayout, domain_boundary
+
+if TYPE_CHECKING:  # a device's module is imported where a device's boundary is asked for
+    from ..device import DeviceLayout
 
 __all__ = ["in_closed_domain", "on_domain_boundary"]
 
@@ -21,6 +25,8 @@ def on_domain_boundary(points: np.ndarray, grid: int, layout: DeviceLayout | Non
     :func:`~cospherical.mesh.device.domain_boundary`).
     """
     if layout is not None:
+        from ..device import domain_boundary
+
         return domain_boundary(layout, points, grid)
     on_boundary = np.zeros(len(points), dtype=bool)
     for axis in range(3):
