@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import shutil
 import subprocess
@@ -20,15 +21,22 @@ def qhull_regions(points: dict[int, tuple[float, float, float]]) -> set[frozense
     assert QDELAUNAY, "qdelaunay not found: install Debian's qhull-bin (scripts/setup.sh does)"
     ids = sorted(points)
     text = f"3\n{len(ids)}\n" + "\n".join(" ".join(repr(x) for x in points[i]) for i in ids) + "\n"
+    return {frozenset(ids[i] for i in region) for region in _qdelaunay(text)}
+
+
+@functools.lru_cache(maxsize=4096)
+def _qdelaunay(text: str) -> tuple[tuple[int, ...], ...]:
+    # Qhull's regions of one input, as point indices; the same input text is run once per test process
+    # (a bisection configuration without face points is the same point set under both face-point policies)
     result = subprocess.run([QDELAUNAY, "Qz", "Fv"], input=text, capture_output=True, text=True, check=True)
     lines = result.stdout.split("\n")
     count = int(lines[0])
-    regions = set()
+    regions = []
     for line in lines[1 : 1 + count]:
         numbers = [int(x) for x in line.split()]
         assert numbers[0] == len(numbers) - 1
-        regions.add(frozenset(ids[i] for i in numbers[1:]))
-    return regions
+        regions.append(tuple(numbers[1:]))
+    return tuple(regions)
 
 
 def incidence_graph(faces, kinds) -> nx.Graph:

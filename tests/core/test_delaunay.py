@@ -49,25 +49,29 @@ def test_every_bisection_configuration_matches_qhull(box, policy, full):
     # Every configuration's tessellation in the study (its orbit's, carried by the study's
     # symmetry maps) is compared with Qhull's regions of its own point set; Qhull runs once
     # per orbit, its answer carried to the other members by an isometry checked exactly
-    # (oracle.qhull_regions_by_orbit).  Every orbit's representative and a seeded 1 in 16 of
-    # the other configurations (--full: all 4096, three times the CPU) are also tessellated
-    # directly, which must give the study's tessellation: the carried members' cells are
-    # already held to Qhull above, this adds their types and details (1 in 4 cost 8 cases
-    # x ~1 CPU-s more).
+    # (oracle.qhull_regions_by_orbit).  Every member's configuration in the study is the one
+    # built here from its code; a representative's tessellation in the study is tessellate()
+    # of that configuration (run_study without known=), so tessellating it again here would
+    # repeat the same computation.  A seeded 1 in 16 of the other configurations (--full: all
+    # 4096, representatives too, three times the CPU) are tessellated directly, which must
+    # give the study's mapped tessellation: their cells are already held to Qhull above, this
+    # adds their types and details (1 in 4 cost 8 cases x ~1 CPU-s more).
     lengths = Box.parse(BOXES[box])
-    configurations = [Configuration.from_code(code, lengths, policy) for code in bisection_codes()]
-    study = run_study("bisection", lengths, [cfg.code for cfg in configurations], policy, criteria=("optimal",))
+    configurations = {(cfg := Configuration.from_code(code, lengths, policy)).code: cfg for code in bisection_codes()}
+    study = run_study("bisection", lengths, list(configurations), policy, criteria=("optimal",))
     # each member's tessellation as a pattern table gets it (the rows' images: equal elements mapped once;
     # studies/test_engine.py holds them equal to Study.tessellation's), a quarter of the mapping's CPU
     members = {code: (tessellations["optimal"], image) for code, _, tessellations, image in study.rows()}
     samples: dict[str, list] = defaultdict(list)
     direct = random.Random(4096)
-    for cfg, regions in zip(configurations, qhull_regions_by_orbit(configurations, box_symmetries(lengths))):
-        representative, image = members[cfg.code]
+    regions_by_code = qhull_regions_by_orbit(configurations.values(), box_symmetries(lengths))
+    for (code, cfg), regions in zip(configurations.items(), regions_by_code):
+        representative, image = members[code]
         tess = image(representative)
-        assert {frozenset(e.nodes) for e in tess.elements} == regions, f"{box} {policy} {cfg.code}"
-        if full or cfg.code in study.tessellations or direct.random() < 1 / 16:
-            assert tessellate(cfg) == tess, f"{box} {policy} {cfg.code}"
+        assert {frozenset(e.nodes) for e in tess.elements} == regions, f"{box} {policy} {code}"
+        assert tess.configuration == cfg, f"{box} {policy} {code}"
+        if full or (code not in study.tessellations and direct.random() < 1 / 16):
+            assert tessellate(cfg) == tess, f"{box} {policy} {code}"
         for e in tess.elements:
             poly = e.polyhedron
             if len(samples[e.type.code]) < 3:
