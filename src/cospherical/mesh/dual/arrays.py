@@ -267,7 +267,8 @@ def as_floats(exact: ExactArray, den: int, factor: float) -> NDArray[np.float64]
     """``exact / den * factor`` as floats.  Python integers (extreme boxes: 1e-12 x 1 x 3e9 gives numerators
     and denominators past float's range) are divided exactly first, Python's int / int rounding once."""
     if exact.dtype != object:
-        floats: NDArray[np.float64] = exact.astype(np.float64) * (factor / float(den))
+        floats: NDArray[np.float64] = exact.astype(np.float64)
+        floats *= factor / float(den)  # in place: one array of the result's size, not two
     else:
         floats = np.array([x / den for x in exact.tolist()], dtype=np.float64) * factor
     return floats
