@@ -269,9 +269,9 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
     naming the table's types).  Mapped elements carry ``mapped_from`` (the
     representative's code).
     """
-    from ..core.symmetry import box_symmetries, orbit_representatives
+    from ..core.symmetry import Symmetry, box_symmetries, orbit_representatives
 
-    symmetries = box_symmetries(box)
+    symmetries: list[Symmetry] = []  # made at the first configuration the table lacks (a leaf table lacks none)
     vtk = {entry.id: entry.vtk for entry in catalogue}
 
     def mapped(configuration: Configuration) -> list[dict[str, Any]] | None:
@@ -281,6 +281,8 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
         code = configuration.point_set_code
         if code is None:  # a table holds configurations by their point-set codes
             return None
+        if not symmetries:
+            symmetries.extend(box_symmetries(box))
         (representative,), (index,) = orbit_representatives([code], symmetries)
         if representative == code:
             return None

@@ -22,15 +22,17 @@ from __future__ import annotations
 
 import json
 import os
-import sqlite3
 import stat
 import zlib
 from collections.abc import Iterable, Iterator, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from pathlib import Path
 
 from ..errors import FormatError
 from ..files.yamlio import atomic_path, parse_json
+
+if TYPE_CHECKING:  # SQLite's module is imported where a store is written or opened, not to tell one
+    import sqlite3
 
 __all__ = ["MAGIC", "StoreEntries", "dictionary_of", "is_store", "open_store", "pack", "write_store"]
 
@@ -96,6 +98,8 @@ def pack(text: str, dictionary: bytes) -> bytes:
 def write_store(path: str | Path, header: dict[str, Any], dictionary: bytes, rows: Iterable[tuple[str, bytes]]) -> None:
     """Write a store of ``header`` and ``rows`` ((code, entry packed with ``dictionary``) pairs, in
     code order, which makes the file the same bytes for the same table), atomically."""
+    import sqlite3
+
     with atomic_path(path) as tmp:  # an empty file: SQLite makes it a new database
         connection = sqlite3.connect(tmp)
         try:
@@ -139,6 +143,8 @@ def _complete(path: Path) -> bool:
 
 def open_store(path: str | Path) -> tuple[dict[str, Any], "StoreEntries"]:
     """The header and the entries of a store; a bad or truncated store raises :class:`FormatError`."""
+    import sqlite3
+
     path = Path(path)
     if not _complete(path):
         raise FormatError(f"{path}: not a complete pattern-table store (truncated, in WAL mode, or not an SQLite database)")
@@ -190,6 +196,8 @@ class StoreEntries(Mapping[str, str]):
         self._name = name
 
     def _rows(self, sql: str, arguments: tuple[object, ...] = ()) -> Iterator[tuple[Any, ...]]:
+        import sqlite3
+
         # SQLite reads pages as rows are stepped through: a damaged page shows while
         # iterating, not only when the query starts
         try:

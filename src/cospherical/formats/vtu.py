@@ -68,12 +68,13 @@ def _compressed(arrays: Sequence[np.ndarray], pool: Executor | None) -> list[byt
     Every block is compressed on its own (VTK's layout), so ``pool``'s threads take them all at once, the
     largest first, and each block's bytes are what one thread would make of it: the same file whatever the
     threads do.  Without a pool, more than one block goes to a pool of :func:`deflate_workers` threads made
-    for the call; a single block is compressed here.
+    for the call; a single block, or blocks of at most one block's bytes in all (a few milliseconds of
+    zlib: less than the threads and their module cost), are compressed here.
     """
     raws = [np.ascontiguousarray(array).view(np.uint8).reshape(-1).data for array in arrays]  # memoryviews
     blocks = [[raw[i:i + BLOCK] for i in range(0, len(raw), BLOCK)] for raw in raws]
     flat = [block for parts in blocks for block in parts]
-    if pool is None and len(flat) > 1:
+    if pool is None and len(flat) > 1 and sum(len(raw) for raw in raws) > BLOCK:
         from concurrent.futures import ThreadPoolExecutor
 
         from .deflated import deflate_workers
