@@ -72,3 +72,20 @@ def test_exact_values_wider_than_the_text_column_are_written_whole(tmp_path, cap
     assert dual.coefficient_exact.dtype == object and max(len(str(v)) for v in dual.coefficient_exact) > 200
     capsys.readouterr()
     assert main(["check", str(out / "dual.npz")]) == 0, capsys.readouterr().err
+
+
+def test_writing_loads_neither_the_reader_nor_the_verification():
+    """The package gives the writer at once and the reader and the verification when first asked for: a run that
+    writes dual.npz imports neither (nor the zip reader they need), and every name still imports."""
+    import subprocess
+    import sys
+
+    script = ("import sys\nimport cospherical.formats.dual as d\n"
+              "before = {m for m in ('cospherical.formats.dual.reader', 'cospherical.formats.dual.verify', 'zipfile') "
+              "if m in sys.modules}\n"
+              "from cospherical.formats.dual import read_dual, verify_dual, domain_sums, dual_layout, write_dual\n"
+              "assert read_dual.__module__.endswith('.reader') and verify_dual.__module__.endswith('.verify')\n"
+              "assert d.dual_layout is dual_layout and 'read_dual' in dir(d)\n"
+              "try:\n    d.no_such_name\nexcept AttributeError:\n    print(sorted(before))\n")
+    assert subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          check=True).stdout.split() == ["[]"]
