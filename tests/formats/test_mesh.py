@@ -350,6 +350,28 @@ def test_the_checked_tables_are_the_committed_tables_against_the_shipped_catalog
     assert {version for _, version in CHECKED_TABLES.values()} == {shipped_catalogue().version}
 
 
+def test_a_committed_table_read_by_its_sorted_lines_is_the_table_cut_into_entries():
+    """Each committed table (the bytes load_table reads by bisection) has the header, the codes in their
+    order and the entry texts that cutting its whole section gives, and lacks what that lacks."""
+    from pathlib import Path
+
+    from cospherical.formats.mesh import SortedLines, load_table
+    from cospherical.formats.patterns import table_from_text
+
+    for path in sorted((Path(__file__).parents[2] / "patterns").glob("*.yaml")):
+        fast, _ = load_table(path)
+        whole = table_from_text(path.read_text(encoding="utf-8"), str(path))
+        assert isinstance(fast.configurations._texts, SortedLines) and fast.header == whole.header
+        codes = list(whole.configurations)
+        assert list(fast.configurations) == codes and len(fast.configurations) == len(codes)
+        fresh, _ = load_table(path)  # looked up before anything iterates it
+        for code in codes if path.name == "leaves-1x1x1.yaml" else codes[::7] + codes[-3:]:
+            assert fresh.configurations.text(code) == whole.configurations.text(code), (path.name, code)
+        assert fresh.elements(codes[-1]) == whole.elements(codes[-1])
+        for absent in ("", "0", codes[0] + "0", codes[-1] + "0", codes[len(codes) // 2][:-1], "~", None):
+            assert absent not in fresh.configurations and absent not in whole.configurations
+
+
 def test_a_committed_tables_entries_are_proven_and_a_changed_copys_checked(tmp_path, capsys):
     """The committed leaf table's bytes: its entries are not checked again and the report says why; a copy
     with a comment line first (the same entries) is checked, and --check all checks the committed one."""
