@@ -12,8 +12,6 @@ from collections.abc import Callable, Hashable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
-import yaml
-
 from ..caches import cached
 from ..errors import FormatError
 from .data import data_path
@@ -21,41 +19,45 @@ from .outputs import atomic_open, atomic_path, atomic_write
 
 __all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_bytes", "read_text", "validated_data", "dump_yaml", "load_document", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
 
-_Dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+if TYPE_CHECKING:
+    import yaml
 
 
-if TYPE_CHECKING:  # the C loader where libyaml is there: the same API
-    _SafeLoader = yaml.SafeLoader
-else:
-    _SafeLoader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+@cached(maxsize=1)
+def _loader() -> type:
+    """The loader of :func:`parse_yaml`, made on first use: PyYAML's import (~10 ms, a regex compiled at
+    import) is paid by the commands that parse YAML, not by a mesh whose inputs need none."""
+    import yaml
 
+    class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]  # the C loader where libyaml is there: the same API
+        """Safe loading that refuses a mapping with a repeated key (YAML would keep the last).
 
-class _Loader(_SafeLoader):
-    """Safe loading that refuses a mapping with a repeated key (YAML would keep the last).
+        Timestamps are not resolved: a date stays a string (an impossible date such as
+        2001-13-14 would otherwise raise from deep inside the loader), and the schemas
+        say which strings are allowed.
+        """
 
-    Timestamps are not resolved: a date stays a string (an impossible date such as
-    2001-13-14 would otherwise raise from deep inside the loader), and the schemas
-    say which strings are allowed.
-    """
+        yaml_implicit_resolvers = {
+            first: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:timestamp"]
+            for first, resolvers in getattr(yaml, "CSafeLoader", yaml.SafeLoader).yaml_implicit_resolvers.items()
+        }
 
-    yaml_implicit_resolvers = {
-        first: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:timestamp"]
-        for first, resolvers in getattr(yaml, "CSafeLoader", yaml.SafeLoader).yaml_implicit_resolvers.items()
-    }
+        def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Hashable, Any]:
+            seen = set()
+            for key_node, _ in node.value:
+                key = self.construct_object(key_node, deep=deep)
+                try:
+                    repeated = key in seen
+                    seen.add(key)
+                except TypeError:
+                    raise yaml.constructor.ConstructorError(None, None, "a mapping key that is not a plain value",
+                                                            key_node.start_mark) from None
+                if repeated:
+                    raise yaml.constructor.ConstructorError(None, None, f"repeated key {key!r}", key_node.start_mark)
+            mapping: dict[Hashable, Any] = super().construct_mapping(node, deep)
+            return mapping
 
-    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Hashable, Any]:
-        seen = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=deep)
-            try:
-                repeated = key in seen
-                seen.add(key)
-            except TypeError:
-                raise yaml.constructor.ConstructorError(None, None, "a mapping key that is not a plain value",
-                                                        key_node.start_mark) from None
-            if repeated:
-                raise yaml.constructor.ConstructorError(None, None, f"repeated key {key!r}", key_node.start_mark)
-        return super().construct_mapping(node, deep)
+    return _Loader
 
 
 # Reading: our files are at most a few MB (a pattern table at R = 4 is 69 MB); a
@@ -82,7 +84,10 @@ def machine_memory() -> int:
 
 
 def yaml_text(data: object) -> str:
-    return yaml.dump(data, Dumper=_Dumper, sort_keys=False, default_flow_style=None, width=100, allow_unicode=True)
+    import yaml
+
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+    return yaml.dump(data, Dumper=dumper, sort_keys=False, default_flow_style=None, width=100, allow_unicode=True)
 
 
 def dump_yaml(data: object, path: str | Path) -> None:
@@ -225,6 +230,8 @@ def load_document(text: str, name: str, loader: type) -> Any:
     The one place a YAML parser's errors become a user's message: the reader of the
     project's own files and the device file's exact reader (its own loader) share it.
     """
+    import yaml
+
     try:
         return yaml.load(text, Loader=loader)
     except yaml.YAMLError as error:
@@ -251,7 +258,7 @@ def parse_yaml(text: str, name: str) -> Any:
             pass  # a YAML flow mapping, or broken: the YAML reader says where
     if len(text) > MAX_YAML_PARSE:
         _refuse_size(text, name)
-    data = load_document(text, name, _Loader)
+    data = load_document(text, name, _loader())
     _refuse_aliases(data, name)
     return data
 

@@ -34,7 +34,7 @@ from ..catalogue import Catalogue
 from ..choices import POINT_POLICIES
 from ..core.configuration import Box, Configuration
 from ..errors import FormatError, InputError
-from ..files.yamlio import atomic_write, parse_json, read_bytes, read_text, validate
+from ..files.yamlio import atomic_write, parse_json, parse_yaml, read_bytes, read_text, validate, validated_data
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
 from .patterns import Entries, PatternTable, load, table_from_text
@@ -155,8 +155,9 @@ def load_table(path: str | Path) -> tuple[PatternTable, str | None]:
     indexed store, which is read a configuration at a time): see :func:`checked_table`.
 
     A committed table's bytes (:data:`CHECKED_TABLES`) are read as :class:`SortedLines`: its header as
-    :func:`~cospherical.formats.patterns.table_from_text` reads it, each entry found when asked for,
-    instead of the whole section cut into entries (~20 ms of a 9 MB table's reading); the same entries.
+    :func:`~cospherical.formats.patterns.table_from_text` reads and validates it (the data kept once
+    validated), each entry found when asked for, instead of the whole section cut into entries (~20 ms
+    of a 9 MB table's reading); the same entries.
     """
     if is_store(path):
         return load(path), None
@@ -168,10 +169,18 @@ def load_table(path: str | Path) -> tuple[PatternTable, str | None]:
     digest = hashlib.sha256(data).hexdigest()
     if digest in CHECKED_TABLES:
         lines = SortedLines(text)
-        # the header, validated as table_from_text validates it, read with the first entry alone
-        first = table_from_text(text[:text.index("\n", lines.start) + 1], str(path))
-        return PatternTable(first.header, Entries(lines, first.header, str(path))), digest
+        # the header as table_from_text reads it (the text before "configurations:"), validated with no entries
+        # by the schema; its data kept as the schema validators are (files.yamlio.validated_data): no YAML parser
+        data = validated_data(text[:lines.start - len("configurations:\n")], "patterns", str(path), _header_data)
+        header = {key: value for key, value in data.items() if key != "configurations"}
+        return PatternTable(header, Entries(lines, header, str(path))), digest
     return table_from_text(text, str(path)), digest
+
+
+def _header_data(text: str, name: str) -> Any:
+    """A pattern table's header text parsed, with no configurations, as its schema validates it."""
+    header = parse_yaml(text, name)
+    return {**header, "configurations": {}} if isinstance(header, dict) else header
 
 
 class SortedLines(Mapping[str, str]):
