@@ -108,23 +108,32 @@ def _linear_forms(code: str, ray: Ray, u: Fraction) -> tuple[list[tuple[int, int
                 for i in range(4):
                     e, e2 = sub(pts[(i + 1) % 4], pts[i]), sub(pts[(i + 2) % 4], pts[(i + 1) % 4])
                     forms.append((f0.real_dot(e, e2), f1.real_dot(e, e2)))
+    p, q = u.numerator, u.denominator
     for a, b in forms:
-        if b and Fraction(-a, b) == u:
+        if b and -a * q == p * b:  # the root -a/b is u (integers: no Fraction per form)
             raise _Critical
     state = (tess.fvm_adequate, frozenset(e.type.id for e in tess.elements))
     return forms, state
 
 
 def _interval(forms: Iterable[tuple[int, int]], u: Fraction) -> tuple[Fraction | None, Fraction | None]:
-    lo = hi = None
-    for a, b in forms:
+    """The nearest roots -a/b of the forms below and above u (None: no root on that side).
+
+    Roots are compared as integer cross-products, each root ``n / d`` with ``d > 0``: a study's
+    configuration has thousands of forms, and a Fraction per form cost most of a ray's profile.
+    """
+    p, q = u.numerator, u.denominator
+    lo: tuple[int, int] | None = None
+    hi: tuple[int, int] | None = None
+    for a, b in set(forms):
         if b:
-            root = Fraction(-a, b)
-            if root < u and (lo is None or root > lo):
-                lo = root
-            elif root > u and (hi is None or root < hi):
-                hi = root
-    return lo, hi
+            n, d = (-a, b) if b > 0 else (a, -b)
+            if n * q < p * d:
+                if lo is None or n * lo[1] > lo[0] * d:
+                    lo = (n, d)
+            elif n * q > p * d and (hi is None or n * hi[1] < hi[0] * d):
+                hi = (n, d)
+    return (None if lo is None else Fraction(*lo)), (None if hi is None else Fraction(*hi))
 
 
 def _state_at(code: str, ray: Ray, u: Fraction) -> State:
