@@ -162,18 +162,19 @@ def load_table(path: str | Path) -> tuple[PatternTable, str | None]:
     if is_store(path):
         return load(path), None
     data = read_bytes(path)
+    digest = hashlib.sha256(data).hexdigest()
+    if digest in CHECKED_TABLES:  # UTF-8 throughout (its digest says so): each part decoded as it is read
+        lines = SortedLines(data)
+        # the header as table_from_text reads it (the text before "configurations:"), validated with no entries
+        # by the schema; its data kept as the schema validators are (files.yamlio.validated_data): no YAML parser
+        header_text = data[:lines.start - len(b"configurations:\n")].decode("utf-8")
+        header = {key: value for key, value in validated_data(header_text, "patterns", str(path), _header_data).items()
+                  if key != "configurations"}
+        return PatternTable(header, Entries(lines, header, str(path))), digest
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as error:
         raise FormatError(f"{path}: cannot read: {error}") from None
-    digest = hashlib.sha256(data).hexdigest()
-    if digest in CHECKED_TABLES:
-        lines = SortedLines(text)
-        # the header as table_from_text reads it (the text before "configurations:"), validated with no entries
-        # by the schema; its data kept as the schema validators are (files.yamlio.validated_data): no YAML parser
-        data = validated_data(text[:lines.start - len("configurations:\n")], "patterns", str(path), _header_data)
-        header = {key: value for key, value in data.items() if key != "configurations"}
-        return PatternTable(header, Entries(lines, header, str(path))), digest
     return table_from_text(text, str(path)), digest
 
 
@@ -187,35 +188,36 @@ class SortedLines(Mapping[str, str]):
     """A committed table's entries as written, code -> JSON text, each found by bisection over its lines.
 
     The layout every committed table has (tests/formats/test_mesh.py holds each to it, and its bytes
-    are known by their digest): the header, then ``configurations:`` and to the end of the text one
+    are known by their digest): the header, then ``configurations:`` and to the end of the file one
     line an entry, ``  'CODE': {...}``, in the order of the codes.  A mesher asks for ~100 entries
-    of thousands: about 15 lines read each, not all of them cut up front.
+    of thousands: about 15 lines read each, and only the lines found decoded (``data``: the file's
+    UTF-8 bytes), not the whole section cut up front.
     """
 
-    def __init__(self, text: str) -> None:
-        self._text = text
-        self.start = text.index("\nconfigurations:\n") + len("\nconfigurations:\n")  # the first entry's line
+    def __init__(self, data: bytes) -> None:
+        self._data = data
+        self.start = data.index(b"\nconfigurations:\n") + len(b"\nconfigurations:\n")  # the first entry's line
         self._all: dict[str, str] | None = None
 
-    def _line(self, start: int) -> tuple[str, str, int]:
-        """The code and JSON text of the line starting at ``start``, and where the next line starts."""
-        text = self._text
-        end = text.index("\n", start)
-        quote = text.index("'", start + 3)
-        return text[start + 3:quote], text[quote + 3:end], end + 1
+    def _line(self, start: int) -> tuple[bytes, int, int]:
+        """The code of the line starting at ``start`` (bytes), where its JSON text starts, and the line's end."""
+        data = self._data
+        quote = data.index(b"'", start + 3)
+        return data[start + 3:quote], quote + 3, data.index(b"\n", start)
 
     def __getitem__(self, code: str) -> str:
         if not isinstance(code, str):
             raise KeyError(code)
-        text = self._text
-        low, high = self.start, len(text)  # line starts: the entry, if there, starts in [low, high)
+        key = code.encode("utf-8")  # byte order is code point order in UTF-8: the codes' order
+        data = self._data
+        low, high = self.start, len(data)  # line starts: the entry, if there, starts in [low, high)
         while low < high:
-            middle = max(text.rfind("\n", low, (low + high) // 2) + 1, low)  # a line start in [low, middle]
-            found, entry, after = self._line(middle)
-            if found == code:
-                return entry
-            if found < code:
-                low = after
+            middle = max(data.rfind(b"\n", low, (low + high) // 2) + 1, low)  # a line start in [low, middle]
+            found, entry, end = self._line(middle)
+            if found == key:
+                return data[entry:end].decode("utf-8")
+            if found < key:
+                low = end + 1
             else:
                 high = middle
         raise KeyError(code)
@@ -224,9 +226,10 @@ class SortedLines(Mapping[str, str]):
         if self._all is None:
             self._all = {}
             at = self.start
-            while at < len(self._text):
-                code, entry, at = self._line(at)
-                self._all[code] = entry
+            while at < len(self._data):
+                code, entry, end = self._line(at)
+                self._all[code.decode("utf-8")] = self._data[entry:end].decode("utf-8")
+                at = end + 1
         return self._all
 
     def __iter__(self) -> Iterator[str]:
