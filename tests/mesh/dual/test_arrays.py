@@ -62,3 +62,18 @@ def test_exact_sums_are_pythons_sums(values, wide):
 
     array = np.array(values, dtype=object if wide else np.int64)
     assert _exact_sum(array) == sum(values)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(1, 1, 1), (8, 2, 4), (2, 3, 6)]), st.integers(1, 2**40))
+def test_boundary_areas_are_numpys_row_sums_bit_for_bit(seed, squares, denominator):
+    """The boundary areas, summed one axis at a time, are bit for bit numpy's sum over each row of the three
+    products, divided by the denominator (the members boundary_area keep their bits)."""
+    from fractions import Fraction
+
+    from cospherical.mesh.dual import boundary_areas
+
+    exact = np.random.default_rng(seed).integers(-2**50, 2**50, size=(60, 3))
+    factors = [Fraction(f) for f in squares]
+    expected = (exact.astype(np.float64) * np.sqrt(np.array(squares, dtype=np.float64))).sum(axis=1) / denominator
+    assert np.array_equal(boundary_areas(exact, denominator, factors).view(np.int64), expected.view(np.int64))

@@ -259,7 +259,12 @@ def boundary_areas(exact: ExactArray, denominator: int, factors_squared: Sequenc
         areas: NDArray[np.float64] = (as_floats(exact.reshape(-1), denominator, 1.0).reshape(exact.shape) * factors
                                       ).sum(axis=1)
         return areas
-    areas = (exact.astype(np.float64) * factors).sum(axis=1) / denominator
+    # (x0 f0 + x1 f1) + x2 f2, the order and so the bits of numpy's sum over each row of three products, one
+    # column at a time (no array of every product)
+    areas = exact[:, 0] * factors[0]
+    for k in (1, 2):
+        areas += exact[:, k] * factors[k]
+    areas /= denominator
     return areas
 
 

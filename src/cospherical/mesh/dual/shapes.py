@@ -146,8 +146,12 @@ def leaf_groups(mesh: Mesh, squared: Squared) -> tuple[list[Group], NDArray[np.f
         # every element of every leaf at once (leaves x elements x 3), by the sums and products of _real_centers
         offsets = np.array([[float(x) for x in element.center] for element in tessellation.elements if
                             element.center is not None]).reshape(1, -1, 3)
-        centers[first[:, None] + np.arange(offsets.shape[1])] = (low[:, None, :] + offsets * size[:, :, None]) * (
-            lengths / mesh.grid)
+        # in place, one array of the group's size (low + offset * size == offset * size + low: sums commute, bit
+        # for bit), its rows put in with a flat index (numpy's fast path)
+        placed: NDArray[np.float64] = offsets * size[:, :, None]
+        placed += low[:, None, :]
+        placed *= lengths / mesh.grid
+        centers[(first[:, None] + np.arange(offsets.shape[1])).reshape(-1)] = placed.reshape(-1, 3)
         groups.append(Group(_tessellation_pieces(tessellation, squared), mesh.slots, leaves, sizes[leaves]))
     return groups, centers
 

@@ -114,9 +114,10 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
         q = _integers(shape.volume_q, vden).astype(dtype)
         touching_parts = []  # the members with a vertex on the domain's boundary: only they have boundary areas
         for part in _chunks(len(rows), len(shape.volume_nodes)):
-            ids = source[rows[part, None], shape.volume_nodes]
-            # integer sums, unbuffered: exact in any order
-            np.add.at(volume_exact, ids, sizes[part, None].astype(dtype) ** 3 * q)
+            ids = source[rows[part]][:, shape.volume_nodes]  # whole rows, then columns: twice a 2-D index's speed
+            # integer sums, unbuffered: exact in any order (flat indices: numpy's fast path for ufunc.at, five
+            # times a 2-D index's speed)
+            np.add.at(volume_exact, ids.reshape(-1), (sizes[part, None].astype(dtype) ** 3 * q).reshape(-1))
             if shape.boundary:
                 touching_parts.append(part.start + np.flatnonzero(boundary[ids].any(axis=1)))
         if not touching_parts:
@@ -128,12 +129,12 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
         shares = np.array([_over(share, bden) for _, share in shape.boundary], dtype=object).astype(dtype)
         for part in _chunks(len(touching), len(nodes)):
             members = touching[part]
-            ids = source[rows[members, None], nodes].astype(np.int64)
+            ids = source[rows[members]][:, nodes].astype(np.int64)
             coordinate = verts[ids, axes]
             # the face lies in the vertex's plane: on the boundary where that plane is a side of the domain
             on = (coordinate == 0) | (coordinate == grid)
             values = sizes[members, None].astype(dtype) ** 2 * shares
-            np.add.at(boundary_exact, (ids[on], np.broadcast_to(axes, ids.shape)[on]), values[on])
+            np.add.at(boundary_exact.reshape(-1), ids[on] * 3 + np.broadcast_to(axes, ids.shape)[on], values[on])
     lengths = np.array(box.to_float())
     real = verts * (lengths / grid)
     factor = math.sqrt(factor_squared)
@@ -215,9 +216,9 @@ def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DType
         shifts = np.log2(sizes).astype(np.int64)  # sizes are powers of two: exact
         pieces = (offset + np.arange(count, dtype=np.int64)) << shift_bits
         for part in _chunks(len(rows), count):
-            ids = rows[part, None]
-            a = source[ids, shape.edges[:, 0]]
-            b = source[ids, shape.edges[:, 1]]
+            members = source[rows[part]]  # whole rows, then columns: twice a 2-D index's speed
+            a = members[:, shape.edges[:, 0]]
+            b = members[:, shape.edges[:, 1]]
             end = at + a.size
             key = keys[at:end].reshape(a.shape)  # written in place: (min << vertex_bits | max), then the payload
             np.left_shift(np.minimum(a, b), vertex_bits, out=key, dtype=np.int64)
