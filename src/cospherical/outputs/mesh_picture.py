@@ -46,50 +46,66 @@ def cut_polygons(mesh: Mesh, at: float = 0.5, axis: int = 2) -> tuple[list[np.nd
 
 
 def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[str], list[int]]:
-    """:func:`cut_polygons`, and each polygon's element."""
+    """:func:`cut_polygons`, and each polygon's element.
+
+    Blocks of elements with the same face list (a configuration's element on all its leaves, a cell
+    shape: their edges are the same columns) are cut together, and the polygons put back in the
+    blocks' order (then by which edges cross the plane, then element order within a block).
+    """
     grid = mesh.grid
     across = (*_PLANES[axis], axis)
     z0 = round(at * grid) + 1 / 3
     scale = np.array(mesh.box.to_float())[list(across)] / grid
-    polygons: list[np.ndarray] = []
-    types: list[str] = []
-    elements: list[int] = []
     # a leaf's elements lie in its box: only the leaves the plane crosses can hold a section (a cell of
     # the global Delaunay subdivision may reach beyond its first leaf: cells are always looked at)
     low = mesh.tree.positions[:, axis].astype(np.int64) * mesh.leaf_size()
     near = (low < z0) & (low + mesh.leaf_size() > z0)
     vertices = mesh.vertices[:, list(across)]  # the picture's two axes, then the cut's
-    edge_ends: dict[Any, np.ndarray] = {}  # an element's edges (pairs of positions in its node list) per face list
+    # per face list: the blocks' crossing elements, (block, element, vertex ids) stacked
+    alike: dict[Any, tuple[list[int], list[np.ndarray], list[np.ndarray]]] = {}
+    types: list[str] = []  # per block
     for element_rows, nodes, faces, type_id in mesh.blocks(near):
         if type_id is None:  # a mesh's blocks all have types: only an element list's have none
             raise ValueError("mesh_picture: an element without a type")
         z = vertices[nodes, 2]  # (elements, nodes)
         crossing = np.flatnonzero((z.min(axis=1) < z0) & (z.max(axis=1) > z0))
-        if not len(crossing):
-            continue
-        ends = edge_ends.get(faces)
-        if ends is None:  # blocks of one configuration's element, or of one cell shape, share their faces
-            edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in faces for i in range(len(c))})
-            ends = edge_ends[faces] = np.array(edges, dtype=np.intp).reshape(-1, 2)
-        a = nodes[np.ix_(crossing, ends[:, 0])]  # (crossing elements, edges): vertex ids
-        b = nodes[np.ix_(crossing, ends[:, 1])]
-        pa, pb = vertices[a].astype(float), vertices[b].astype(float)  # (elements, edges, 3)
-        za, zb = pa[..., 2] - z0, pb[..., 2] - z0
+        types.append(type_id)
+        if len(crossing):
+            blocks, rows, ids = alike.setdefault(faces, ([], [], []))
+            blocks.append(len(types) - 1)
+            rows.append(element_rows[crossing])
+            ids.append(nodes[crossing])
+    polygons: list[np.ndarray] = []
+    keys: list[tuple[int, int, int]] = []  # per polygon: its block, its edges' mask, its place in the block
+    elements: list[int] = []
+    block_of: list[int] = []
+    for faces, (blocks, rows, ids) in alike.items():
+        # an element's edges (pairs of positions in its node list)
+        edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in faces for i in range(len(c))})
+        ends = np.array(edges, dtype=np.intp).reshape(-1, 2)
+        nodes = np.concatenate(ids)
+        block = np.repeat(blocks, [len(r) for r in rows])
+        place = np.concatenate([np.arange(len(r)) for r in rows])
+        element = np.concatenate(rows)
+        pa, pb = vertices[nodes[:, ends[:, 0]]].astype(float), vertices[nodes[:, ends[:, 1]]].astype(float)
+        za, zb = pa[..., 2] - z0, pb[..., 2] - z0  # (elements, edges)
         cut = za * zb < 0
         masks = (cut.astype(np.int64) << np.arange(len(ends))).sum(axis=1)
         for mask in sorted(set(masks.tolist())):
-            rows = np.flatnonzero(masks == mask)
-            which = np.flatnonzero(cut[rows[0]])
-            ra, rb = pa[rows][:, which], pb[rows][:, which]  # (rows, corners, 3)
-            t = (za[rows][:, which] / (za[rows][:, which] - zb[rows][:, which]))[..., None]
+            chosen = np.flatnonzero(masks == mask)
+            which = np.flatnonzero(cut[chosen[0]])
+            ra, rb = pa[chosen][:, which], pb[chosen][:, which]  # (rows, corners, 3)
+            t = (za[chosen][:, which] / (za[chosen][:, which] - zb[chosen][:, which]))[..., None]
             xy = (ra + t * (rb - ra))[..., :2]
             center = xy.mean(axis=1, keepdims=True)
             angle = np.arctan2(xy[..., 1] - center[..., 1], xy[..., 0] - center[..., 0])
             xy = np.take_along_axis(xy, np.argsort(angle, axis=1)[..., None], axis=1) * scale[:2]
             polygons.extend(xy)
-            types.extend([type_id] * len(rows))
-            elements.extend(element_rows[crossing[rows]].tolist())
-    return polygons, types, elements
+            keys.extend(zip(block[chosen].tolist(), [mask] * len(chosen), place[chosen].tolist()))
+            elements.extend(element[chosen].tolist())
+            block_of.extend(block[chosen].tolist())
+    order = sorted(range(len(polygons)), key=keys.__getitem__)
+    return [polygons[i] for i in order], [types[block_of[i]] for i in order], [elements[i] for i in order]
 
 
 def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: int = 10, axis: int = 2,
