@@ -570,7 +570,9 @@ def build_mesh(domain: Sequence[Any] | Box | None = None, levels: int | None = N
         ``"all"``: the Delaunay check searches the vertices near every element's sphere,
         none bounded by the tree's structure (a cross-check; the report's ``checks`` says
         which ran and how), each table entry used is checked under every criterion of the
-        table (by default only ``criterion``'s elements, the ones that reach the mesh), and the
+        table (by default only ``criterion``'s elements, the ones that reach the mesh, and none
+        of a committed table's, proven by its bytes' digest: see
+        :func:`~cospherical.formats.mesh.checked_table`), and the
         uniform study is run even for a box whose figures ship with the package
         (:func:`~cospherical.mesh.statistics.uniform_study`); ``"default"``: bounded where the
         tree allows.

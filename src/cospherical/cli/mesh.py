@@ -117,7 +117,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--check", choices=("default", "all"), default="default",
                         help="all: the Delaunay check searches the vertices near every element's sphere with a k-d "
                         "tree, none bounded by the tree's structure (a cross-check of that bound), each table entry used "
-                        "is checked under every criterion of the table (not only --criterion's elements), and the "
+                        "is checked under every criterion of the table (not only --criterion's elements; also a "
+                        "committed table's, whose entries its bytes' digest proves by default), and the "
                         "uniform study is run even where its figures ship with the package; the report's checks says "
                         "which checks ran and how")
     parser.add_argument("--no-uniform", action="store_true",
