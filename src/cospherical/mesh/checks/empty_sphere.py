@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 
 from ...core.morton import morton_codes
 from ...errors import InputError
-from ..assembly import LocalTessellation, Mesh
+from ..assembly import LocalElement, LocalTessellation, Mesh
 from ..report_sections import LeafMeshSummary
 from ..tree import distinct
 
@@ -187,63 +187,75 @@ _QUARTERS = np.array(list(itertools.product(range(-3, 8), repeat=3)), dtype=np.i
 _HALF_A_LEAF_OUT = _QUARTERS[np.maximum(np.maximum(-_QUARTERS, _QUARTERS - 4), 0).max(axis=1) == 2]
 
 
-def _leaf_suspects(tessellation: LocalTessellation, squared: tuple[Fraction, Fraction, Fraction]
-                   ) -> list[_Suspects | None]:
-    """Per element of a configuration, its :class:`_Suspects`, or ``None`` when its closed sphere reaches 3/4 of
+def _leaf_suspects(tessellations: Sequence[LocalTessellation], squared: tuple[Fraction, Fraction, Fraction]
+                   ) -> list[list[_Suspects | None]]:
+    """Per configuration, per element, its :class:`_Suspects`, or ``None`` when its closed sphere reaches 3/4 of
     a leaf beyond the leaf on some axis (or it has none): decided exactly in the leaf's unit frame, where the
     squared distance is the sum over the axes of ``squared[k]`` (the box's squared lengths) times the squared
-    difference.
+    difference.  Every configuration's elements at once, in integer coordinates of one common scale (the
+    verdicts are comparisons of squared distances: the same at any scale).
     """
-    nodes = tessellation.configuration.nodes()
     scale_w = math.lcm(*(w.denominator for w in squared))
     weights = [int(w * scale_w) for w in squared]
+    nodes = [tessellation.configuration.nodes() for tessellation in tessellations]
+    measured: list[tuple[int, int, LocalElement]] = []  # (configuration, element, the element) with a centre
+    exact: list[tuple[Fraction, Fraction, Fraction]] = []  # their centres
+    for t, tessellation in enumerate(tessellations):
+        for j, element in enumerate(tessellation.elements):
+            if element.center is not None:
+                measured.append((t, j, element))
+                exact.append(element.center)
+    found: list[list[_Suspects | None]] = [[None] * len(tessellation.elements) for tessellation in tessellations]
+    if not measured:
+        return found
     # integer coordinates: unit coordinates times m (a multiple of 4, so the lattice's quarters are whole)
-    m = math.lcm(4, *(c.denominator for e in tessellation.elements if e.center is not None for c in e.center),
-                 *(x.denominator for point in nodes.values() for x in point))
+    m = math.lcm(4, *(c.denominator for center in exact for c in center),
+                 *(x.denominator for points in nodes for point in points.values() for x in point))
 
     def scaled(point: Sequence[int | Fraction]) -> list[int]:
         return [x.numerator * (m // x.denominator) for x in point]
 
-    whole = {s: scaled(point) for s, point in nodes.items()}
-    measured = [e for e in tessellation.elements if e.center is not None]
-    if not measured:
-        return [None] * len(tessellation.elements)
-    centers = [scaled(e.center) for e in measured if e.center is not None]
+    centers = [scaled(center) for center in exact]
     # int64 when every term is below 2**61 (the lattice reaches 7/4 of the leaf), else Python integers
     reach = max(abs(x) for center in centers for x in center)
     kind = np.int64 if max(weights) * (2 * m + reach) ** 2 < 2**61 else object
     center_array = np.array(centers, dtype=kind)  # elements x 3
     weight_array = np.array(weights, dtype=kind)
+    # each configuration's 27 slots (node ids 0..26), those it has
+    slots = np.zeros((len(tessellations), 27, 3), dtype=kind)
+    present = np.zeros((len(tessellations), 27), dtype=bool)
+    for t, points in enumerate(nodes):
+        for n, point in points.items():
+            slots[t, n] = scaled(point)
+            present[t, n] = True
+    owner = np.array([t for t, _, _ in measured], dtype=np.intp)
 
     def squared_distances(points: np.ndarray) -> np.ndarray:
-        """elements x points: the squared distances of ``points`` (n x 3, scaled) from each element's centre."""
-        offsets = points[None, :, :] - center_array[:, None, :]
+        """elements x points: the squared distances of ``points`` (elements x n x 3: each element's own,
+        scaled) from each element's centre."""
+        offsets = points - center_array[:, None, :]
         distances: np.ndarray = (offsets * offsets * weight_array).sum(axis=2)
         return distances
 
-    slot_ids = list(whole)
-    to_slots = squared_distances(np.array([whole[n] for n in slot_ids], dtype=kind))
-    to_lattice = squared_distances(_HALF_A_LEAF_OUT.astype(kind) * (m // 4))
-    place = {n: i for i, n in enumerate(slot_ids)}
-    found: list[_Suspects | None] = []
-    row = 0
-    for element in tessellation.elements:
-        if element.center is None:
-            found.append(None)
-            continue
-        center = centers[row]
-        radius2 = int(to_slots[row, place[element.nodes[0]]])
-        # the sphere's extent on each axis, from its centre: strictly inside -3/4 .. 7/4 of the leaf
-        inside = all(low > 0 and high > 0 and radius2 < w * low * low and radius2 < w * high * high
-                     for w, c in zip(weights, center) for low, high in [(c + 3 * m // 4, 7 * m // 4 - c)])
-        if inside:
+    to_slots = squared_distances(slots[owner])
+    # the lattice's points have 11 coordinates an axis: per axis, each element's terms for those 11, then
+    # each point's three terms added (the same integers as a point-by-point sum, in a fraction of the time)
+    quarters = np.arange(-3, 8).astype(kind) * (m // 4)
+    terms = [weight_array[k] * (quarters[None, :] - center_array[:, k:k + 1]) ** 2 for k in range(3)]
+    at = _HALF_A_LEAF_OUT + 3  # the points' coordinates as indices into the 11
+    to_lattice = terms[0][:, at[:, 0]] + terms[1][:, at[:, 1]] + terms[2][:, at[:, 2]]
+    radius2 = to_slots[np.arange(len(measured)), [e.nodes[0] for _, _, e in measured]][:, None]
+    # the sphere's extent on each axis, from its centre: strictly inside -3/4 .. 7/4 of the leaf
+    low, high = center_array + 3 * m // 4, 7 * m // 4 - center_array
+    inside = ((low > 0) & (high > 0) & (radius2 < weight_array * low * low)
+              & (radius2 < weight_array * high * high)).all(axis=1).tolist()
+    near = ((to_slots <= radius2) & present[owner]).tolist()
+    in_lattice = to_lattice <= radius2
+    for row, (t, j, element) in enumerate(measured):
+        if inside[row]:
             own = set(element.nodes)
-            near = to_slots[row] <= radius2
-            found.append(_Suspects(tuple(n for n, i in place.items() if near[i] and n not in own),
-                                   _HALF_A_LEAF_OUT[np.flatnonzero(to_lattice[row] <= radius2)]))
-        else:
-            found.append(None)
-        row += 1
+            found[t][j] = _Suspects(tuple(n for n, hit in enumerate(near[row]) if hit and n not in own),
+                                    _HALF_A_LEAF_OUT[in_lattice[row]])
     return found
 
 
@@ -268,8 +280,10 @@ def _spheres(mesh: Mesh) -> tuple[_Spheres, list[tuple[int, np.ndarray, _Suspect
     without_sphere = [np.zeros(0, dtype=np.int64)]
     cells = mesh.cells
     structured = mesh.tree.vertex_balanced
-    for p, tessellation, leaves in (mesh.groups() if cells is None else ()):
-        suspects = _leaf_suspects(tessellation, mesh.box.squared) if structured else [None] * len(tessellation.elements)
+    groups = list(mesh.groups()) if cells is None else []
+    every = _leaf_suspects([tessellation for _, tessellation, _ in groups], mesh.box.squared) if structured else None
+    for g, (p, tessellation, leaves) in enumerate(groups):
+        suspects = every[g] if every is not None else [None] * len(tessellation.elements)
         for j, element in enumerate(tessellation.elements):
             if element.sphere is None or element.center is None:  # check_circumcenters: not co-spherical
                 without_sphere.append(mesh.element_offsets[leaves].astype(np.int64) + j)
