@@ -53,6 +53,12 @@ def small_table(tmp_path_factory):
     return load_yaml(path)
 
 
+@pytest.fixture(scope="module")
+def catalogue_data():
+    """The shipped catalogue as data, read once: each case edits a copy."""
+    return load_yaml(ROOT / "catalogue" / "catalogue.yaml")
+
+
 def write(tmp_path, name, data) -> str:
     path = tmp_path / name
     dump_yaml(data, path)
@@ -108,8 +114,8 @@ def test_repeated_configuration_codes_are_refused(tmp_path, capsys, small_table)
         (lambda d: d["types"][0].pop("code"), "code"),
     ],
 )
-def test_bad_catalogues_are_refused(tmp_path, capsys, edit, needle):
-    data = load_yaml(ROOT / "catalogue" / "catalogue.yaml")
+def test_bad_catalogues_are_refused(tmp_path, capsys, catalogue_data, edit, needle):
+    data = copy.deepcopy(catalogue_data)
     edit(data)
     one_clean_line(in_process(capsys, "check", write(tmp_path, "bad-catalogue.yaml", data)), needle)
 
