@@ -77,18 +77,17 @@ class ShapePieces:
         edges = sorted(((node[u], node[v]) if node[u] < node[v] else (node[v], node[u]), q)
                        for (u, v), q in zip(self.edges.tolist(), self.edge_q))
         volumes = sorted(zip((node[u] for u in self.volume_nodes.tolist()), self.volume_q))
+        # sorted by (axis, plane, node) as _plane_sorted sorts, every plane here being an integer over ``scale``
+        moved = sorted((axis[a], points[node[u]][axis[a]], node[u], q) for (a, _, u), q in self.boundary)
         planes: dict[tuple[int, int], Fraction] = {}  # one Fraction per plane
         boundary = []
-        for (a, _, u), q in self.boundary:
-            b, n = axis[a], node[u]
-            value = points[n][b]
+        for b, value, n, q in moved:
             plane = planes.get((b, value))
             if plane is None:
                 plane = planes[b, value] = Fraction(value, scale)
             boundary.append(((b, plane, n), q))
         return ShapePieces(np.array([e for e, _ in edges], dtype=np.int64).reshape(-1, 2), [q for _, q in edges],
-                           np.array([n for n, _ in volumes], dtype=np.int64), [q for _, q in volumes],
-                           _plane_sorted(boundary))
+                           np.array([n for n, _ in volumes], dtype=np.int64), [q for _, q in volumes], boundary)
 
 
 def _plane_sorted(entries: list[tuple[tuple[int, Fraction, int], Fraction]]
