@@ -31,6 +31,13 @@ def test_element_list_path_equals_the_configuration_path():
 
 
 
+def _same(a, b):
+    """Two ShapePieces are the same: node ids, edges, planes, numerators and denominators (each the least common
+    one of fractions in lowest terms, so equal fractions are equal numbers)."""
+    return all(np.array_equal(getattr(a, name), getattr(b, name)) if name in ("edges", "volume_nodes")
+               else getattr(a, name) == getattr(b, name) for name in a.__slots__)
+
+
 def test_pieces_remembered_per_shape_are_each_elements_own():
     """A configuration's pieces, carried over from another configuration of its class (equal up to the box's
     symmetries), or its elements measured once per class of shapes up to translation and the box's symmetries
@@ -59,9 +66,7 @@ def test_pieces_remembered_per_shape_are_each_elements_own():
                 if not per_configuration:
                     shapes._CONFIGURATIONS.clear()
                 remembered = shapes._tessellation_pieces(tessellation, squared)
-                assert np.array_equal(direct.edges, remembered.edges) and direct.edge_q == remembered.edge_q
-                assert np.array_equal(direct.volume_nodes, remembered.volume_nodes)
-                assert direct.volume_q == remembered.volume_q and direct.boundary == remembered.boundary
+                assert _same(direct, remembered)
                 elements += len(tessellation.elements)
                 configurations += 1
             if per_configuration:  # measured once per class of configurations, carried over to the others
@@ -108,6 +113,5 @@ def test_a_configuration_tessellated_otherwise_is_not_carried_over():
         direct = shapes.ShapePieces.summed([element_pieces({n: points[n] for n in e.nodes}, e.faces, e.center,
                                                            squared) for e in tessellation.elements])
         pieces = shapes._tessellation_pieces(tessellation, squared)
-        assert np.array_equal(direct.edges, pieces.edges) and direct.edge_q == pieces.edge_q
-        assert direct.volume_q == pieces.volume_q and direct.boundary == pieces.boundary
+        assert _same(direct, pieces)
     assert len(shapes._CONFIGURATIONS) == 2

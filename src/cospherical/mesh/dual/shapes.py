@@ -37,79 +37,88 @@ Squared = tuple[Fraction, Fraction, Fraction]
 class ShapePieces:
     """The pieces of one element shape (or one configuration: its elements' pieces summed), keyed by local node ids.
 
-    ``edges`` (k x 2, ``u < v``, sorted) with ``edge_q`` their shares of ``area / length``
-    over ``a*b*c``; ``volume_nodes`` with ``volume_q`` their control-volume shares over
-    ``a*b*c``; ``boundary``: sorted ``((axis, plane value, node), share)`` of the faces
+    ``edges`` (k x 2, ``u < v``, sorted) with ``edge_numerators`` over ``edge_denominator`` their
+    shares of ``area / length`` over ``a*b*c``; ``volume_nodes`` with ``volume_numerators`` over
+    ``volume_denominator`` their control-volume shares over ``a*b*c``; ``boundary``: sorted
+    ``((axis, plane value, node), numerator)`` over ``boundary_denominator``, the shares of the faces
     that lie in a coordinate plane (see :class:`~cospherical.mesh.dual.pieces.ElementPieces`).
+    Each denominator is the least common one of its shares in lowest terms, so that the mesh's
+    common denominators (:func:`~cospherical.mesh.dual.sums.mesh_dual`) are those of the fractions.
     """
 
-    __slots__ = ("edges", "edge_q", "volume_nodes", "volume_q", "boundary")
+    __slots__ = ("edges", "edge_numerators", "edge_denominator", "volume_nodes", "volume_numerators",
+                 "volume_denominator", "boundary", "boundary_denominator")
 
-    def __init__(self, edges: NDArray[np.int64], edge_q: list[Fraction], volume_nodes: NDArray[np.int64],
-                 volume_q: list[Fraction], boundary: list[tuple[tuple[int, Fraction, int], Fraction]]) -> None:
+    def __init__(self, edges: NDArray[np.int64], edge_numerators: list[int], edge_denominator: int,
+                 volume_nodes: NDArray[np.int64], volume_numerators: list[int], volume_denominator: int,
+                 boundary: list[tuple[tuple[int, Fraction, int], int]], boundary_denominator: int) -> None:
         self.edges = edges
-        self.edge_q = edge_q
+        self.edge_numerators = edge_numerators
+        self.edge_denominator = edge_denominator
         self.volume_nodes = volume_nodes
-        self.volume_q = volume_q
+        self.volume_numerators = volume_numerators
+        self.volume_denominator = volume_denominator
         self.boundary = boundary
+        self.boundary_denominator = boundary_denominator
 
     @classmethod
     def summed(cls, pieces_list: Sequence[ElementPieces]) -> ShapePieces:
         """The pieces of elements that share their nodes' numbering (a configuration's), summed."""
-        edges = _summed([item for pieces in pieces_list for item in pieces.edges.items()])
-        volumes = _summed([item for pieces in pieces_list for item in pieces.volumes.items()])
+        edges, edge_denominator = _summed([item for pieces in pieces_list for item in pieces.edges.items()])
+        volumes, volume_denominator = _summed([item for pieces in pieces_list for item in pieces.volumes.items()])
         # a node lies in one plane normal to each axis: (axis, node) keys the plane's shares, its value beside
         planes = {(axis, node): value for pieces in pieces_list for (axis, value), shares in pieces.boundary.items()
                   for node in shares}
-        boundary = _summed([((axis, node), q) for pieces in pieces_list for (axis, _), shares in pieces.boundary.items()
-                            for node, q in shares.items()])
+        boundary, boundary_denominator = _summed([((axis, node), q) for pieces in pieces_list
+                                                  for (axis, _), shares in pieces.boundary.items()
+                                                  for node, q in shares.items()])
         keys = sorted(edges)
         nodes = sorted(volumes)
-        return cls(np.array(keys, dtype=np.int64).reshape(-1, 2), [edges[k] for k in keys],
-                   np.array(nodes, dtype=np.int64), [volumes[n] for n in nodes],
-                   _plane_sorted([((axis, planes[axis, node], node), q) for (axis, node), q in boundary.items()]))
+        # sorted by (axis, plane, node), the planes compared as integers over their common denominator (the same
+        # order as the fractions', at a fraction of the cost)
+        entries = [((axis, planes[axis, node], node), n) for (axis, node), n in boundary.items()]
+        common = math.lcm(1, *(value.denominator for (_, value, _), _ in entries))
+        entries.sort(key=lambda entry: (entry[0][0], entry[0][1].numerator * (common // entry[0][1].denominator),
+                                        entry[0][2]))
+        return cls(np.array(keys, dtype=np.int64).reshape(-1, 2), [edges[k] for k in keys], edge_denominator,
+                   np.array(nodes, dtype=np.int64), [volumes[n] for n in nodes], volume_denominator,
+                   entries, boundary_denominator)
 
     def moved(self, node: Sequence[int], axis: Sequence[int], points: Mapping[int, tuple[int, int, int]],
               scale: int) -> ShapePieces:
         """These pieces carried over by an isometry of the box: node ``u`` becomes ``node[u]``, a plane normal to
         axis ``a`` one normal to ``axis[a]``, its value read from the moved nodes' points (``points[n] / scale``).
         The shares are the same numbers (lengths, areas, volumes and their signs are kept), in the new order."""
-        edges = sorted(((node[u], node[v]) if node[u] < node[v] else (node[v], node[u]), q)
-                       for (u, v), q in zip(self.edges.tolist(), self.edge_q))
-        volumes = sorted(zip((node[u] for u in self.volume_nodes.tolist()), self.volume_q))
-        # sorted by (axis, plane, node) as _plane_sorted sorts, every plane here being an integer over ``scale``
-        moved = sorted((axis[a], points[node[u]][axis[a]], node[u], q) for (a, _, u), q in self.boundary)
+        edges = sorted(((node[u], node[v]) if node[u] < node[v] else (node[v], node[u]), n)
+                       for (u, v), n in zip(self.edges.tolist(), self.edge_numerators))
+        volumes = sorted(zip((node[u] for u in self.volume_nodes.tolist()), self.volume_numerators))
+        # sorted by (axis, plane, node) as summed sorts them, every plane here being an integer over ``scale``
+        moved = sorted((axis[a], points[node[u]][axis[a]], node[u], n) for (a, _, u), n in self.boundary)
         planes: dict[tuple[int, int], Fraction] = {}  # one Fraction per plane
         boundary = []
-        for b, value, n, q in moved:
+        for b, value, u, n in moved:
             plane = planes.get((b, value))
             if plane is None:
                 plane = planes[b, value] = Fraction(value, scale)
-            boundary.append(((b, plane, n), q))
-        return ShapePieces(np.array([e for e, _ in edges], dtype=np.int64).reshape(-1, 2), [q for _, q in edges],
-                           np.array([n for n, _ in volumes], dtype=np.int64), [q for _, q in volumes], boundary)
-
-
-def _plane_sorted(entries: list[tuple[tuple[int, Fraction, int], Fraction]]
-                  ) -> list[tuple[tuple[int, Fraction, int], Fraction]]:
-    """Boundary shares sorted by (axis, plane, node), the planes compared as integers over their common denominator
-    (the same order as the fractions', at a fraction of the cost)."""
-    common = math.lcm(1, *(value.denominator for (_, value, _), _ in entries))
-    return sorted(entries, key=lambda entry: (entry[0][0], entry[0][1].numerator * (common // entry[0][1].denominator),
-                                              entry[0][2]))
+            boundary.append(((b, plane, u), n))
+        return ShapePieces(np.array([e for e, _ in edges], dtype=np.int64).reshape(-1, 2), [n for _, n in edges],
+                           self.edge_denominator, np.array([u for u, _ in volumes], dtype=np.int64),
+                           [n for _, n in volumes], self.volume_denominator, boundary, self.boundary_denominator)
 
 
 Key = TypeVar("Key", bound=Hashable)
 
 
-def _summed(items: Sequence[tuple[Key, Fraction]]) -> dict[Key, Fraction]:
-    """The fractions of each key summed: as integers over their common denominator, one fraction a key made at the
-    end (a sum of fractions one by one reduces every partial sum)."""
+def _summed(items: Sequence[tuple[Key, Fraction]]) -> tuple[dict[Key, int], int]:
+    """The fractions of each key summed, as integer numerators over their least common denominator in lowest
+    terms: over the fractions' common denominator first (a sum of fractions one by one reduces every partial sum),
+    then divided by what that denominator shares with every sum (the lcm of the sums' own denominators)."""
     common = math.lcm(1, *(q.denominator for _, q in items))
     totals: dict[Key, int] = {}
     for key, q in items:
         totals[key] = totals.get(key, 0) + q.numerator * (common // q.denominator)
-    return {key: Fraction(total, common) for key, total in totals.items()}
+    shared = math.gcd(common, *totals.values())
+    return {key: total // shared for key, total in totals.items()}, common // shared
 
 
 class Group(NamedTuple):

@@ -51,17 +51,15 @@ def _chunks(count: int, width: int) -> Iterator[slice]:
         yield slice(start, min(start + step, count))
 
 
-def _lcm_denominator(values: Sequence[Fraction]) -> int:
-    return math.lcm(1, *(v.denominator for v in values))
+def _over(numerators: list[int], denominator: int, common: int) -> list[int]:
+    """Numerators over ``denominator`` put over its multiple ``common``."""
+    factor = common // denominator
+    return numerators if factor == 1 else [n * factor for n in numerators]
 
 
-def _over(q: Fraction, denominator: int) -> int:
-    """``q * denominator`` for a multiple ``denominator`` of ``q``'s: an integer, without a Fraction made."""
-    return q.numerator * (denominator // q.denominator)
-
-
-def _integers(values: Sequence[Fraction], denominator: int) -> NDArray[np.object_]:
-    return np.array([_over(v, denominator) for v in values], dtype=object)
+def _largest(numerators: list[int], denominator: int, common: int) -> int:
+    """The largest numerator, in absolute value, over ``common`` (a multiple of ``denominator``)."""
+    return max(map(abs, numerators), default=0) * (common // denominator)
 
 
 def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], NDArray[np.integer]] | None = None
@@ -93,16 +91,17 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
         elements = mesh.connectivity()
     else:
         groups, centers = element_groups(box, grid, verts, squared, *elements)
-    cden = math.lcm(1, *(_lcm_denominator(group.pieces.edge_q) for group in groups))
-    vden = math.lcm(1, *(_lcm_denominator(group.pieces.volume_q) for group in groups))
-    bden = math.lcm(1, *(_lcm_denominator([q for _, q in group.pieces.boundary]) for group in groups))
+    cden = math.lcm(1, *(group.pieces.edge_denominator for group in groups))
+    vden = math.lcm(1, *(group.pieces.volume_denominator for group in groups))
+    bden = math.lcm(1, *(group.pieces.boundary_denominator for group in groups))
     max_size = max((int(group.sizes.max()) for group in groups if len(group.sizes)), default=1)
     # int64 sums while every product and sum is bounded below 2**62: the largest numerator (not just the
     # denominator: on tiny or huge domains the pieces over a*b*c are far from 1) times the size scaling,
     # times a bound on the pieces met by one edge or vertex
-    largest_coefficient = max((abs(_over(q, cden)) for group in groups for q in group.pieces.edge_q), default=0)
-    largest_volume = max((abs(_over(q, vden)) for group in groups for q in group.pieces.volume_q), default=0)
-    largest_boundary = max((abs(_over(q, bden)) for group in groups for _, q in group.pieces.boundary), default=0)
+    largest_coefficient = max((_largest(p.edge_numerators, p.edge_denominator, cden) for p, *_ in groups), default=0)
+    largest_volume = max((_largest(p.volume_numerators, p.volume_denominator, vden) for p, *_ in groups), default=0)
+    largest_boundary = max((_largest([n for _, n in p.boundary], p.boundary_denominator, bden) for p, *_ in groups),
+                           default=0)
     wide = largest_volume * max_size ** 3 * 4096 >= 2**62 or largest_coefficient * max_size * 4096 >= 2**62 or \
         largest_boundary * max_size ** 2 * 4096 >= 2**62
     dtype: DTypeLike = object if wide else np.int64
@@ -111,7 +110,7 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
     volume_exact: ExactArray = np.zeros(n_vertices, dtype=dtype)
     boundary_exact: ExactArray = np.zeros((n_vertices, 3), dtype=dtype)  # per axis: the area in the sides normal to it
     for shape, source, rows, sizes in groups:
-        q = _integers(shape.volume_q, vden).astype(dtype)
+        q = np.array(_over(shape.volume_numerators, shape.volume_denominator, vden), dtype=dtype)
         touching_parts = []  # the members with a vertex on the domain's boundary: only they have boundary areas
         for part in _chunks(len(rows), len(shape.volume_nodes)):
             ids = source[rows[part]][:, shape.volume_nodes]  # whole rows, then columns: twice a 2-D index's speed
@@ -126,7 +125,7 @@ def mesh_dual(mesh: Mesh | GridVertices, elements: tuple[NDArray[np.integer], ND
         # every boundary share of every touching member at once: (member, share) tables of vertex ids and axes
         axes = np.array([axis for (axis, _, _), _ in shape.boundary], dtype=np.int64)
         nodes = np.array([node for (_, _, node), _ in shape.boundary], dtype=np.int64)
-        shares = np.array([_over(share, bden) for _, share in shape.boundary], dtype=object).astype(dtype)
+        shares = np.array(_over([n for _, n in shape.boundary], shape.boundary_denominator, bden), dtype=dtype)
         for part in _chunks(len(touching), len(nodes)):
             members = touching[part]
             ids = source[rows[members]][:, nodes].astype(np.int64)
@@ -198,7 +197,7 @@ def _edge_sums(groups: Sequence[Group], n_vertices: int, cden: int, dtype: DType
     total, max_shift = 0, 0
     for shape, _, rows, sizes in groups:
         offsets.append(len(table))
-        table.extend(_over(q, cden) for q in shape.edge_q)
+        table.extend(_over(shape.edge_numerators, shape.edge_denominator, cden))
         total += len(rows) * len(shape.edges)
         if len(sizes):
             max_shift = max(max_shift, int(sizes.max()).bit_length() - 1)
