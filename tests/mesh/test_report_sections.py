@@ -81,6 +81,15 @@ def test_what_a_section_holds_cannot_be_changed_through_it_or_its_dict():
     assert plain((NegativeCoefficients(1, 2), {"a": (1, 2)})) == [{"interior": 1, "boundary": 2}, {"a": [1, 2]}]
 
 
+def test_a_check_not_run_moves_from_run_to_not_run_with_its_reason_first():
+    checks = ChecksSummary.from_dict(EXAMPLES["ChecksSummary"])
+    moved = checks.not_running("conformity", "proven")
+    assert moved.run == ("volume",) and list(moved.not_run.items())[0] == ("conformity", "proven")
+    assert dict(moved.not_run) == {"conformity": "proven", **checks.not_run}
+    assert checks.not_running("delaunay", "not run anyway") is checks  # not in run: unchanged
+    assert ChecksSummary.from_dict(moved.to_dict()) == moved
+
+
 def test_leaf_mesh_figures_of_pieces_add_up():
     total = LeafMeshSummary(3, 1, 0, 2) + LeafMeshSummary(4, 0, 1, 0)
     assert total == LeafMeshSummary(7, 1, 1, 2)

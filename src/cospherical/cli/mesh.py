@@ -362,11 +362,16 @@ def _in_pieces(args: argparse.Namespace, source: TreeSource, out: OutputFolder |
     tree, described, listed = source.tree, source.described, source.leaf_order
     mode = delaunay_mode(args.criterion, args.delaunay)
     table = None
+    proven = None
     if args.patterns is not None:
-        from ..formats.patterns import load
+        from ..catalogue import shipped_catalogue
+        from ..formats.mesh import checked_table, load_table
 
-        # table_lookup's arguments (the shipped catalogue; every criterion checked with --check all)
-        table = (load(args.patterns), args.criterion, tree.box, str(args.patterns), None, args.check == "all")
+        # table_lookup's arguments (the shipped catalogue; every criterion checked with --check all; none of a
+        # committed table's entries otherwise, as in one process)
+        loaded, digest = load_table(args.patterns)
+        proven = None if args.check == "all" else checked_table(digest, shipped_catalogue())
+        table = (loaded, args.criterion, tree.box, str(args.patterns), None, args.check == "all", proven is None)
 
     write = write_piece if listed is None else partial(_write_listed_piece, listed)
 
@@ -384,6 +389,8 @@ def _in_pieces(args: argparse.Namespace, source: TreeSource, out: OutputFolder |
                                 write=write if out is not None else None,
                                 path=paths.__getitem__ if paths is not None else None, jobs=args.jobs,
                                 scheduler=args.scheduler, dask_workers=args.dask_workers, progress=progress)
+    if proven is not None and report.checks is not None:
+        report = replace(report, checks=report.checks.not_running("table_entries", proven))
     if out is not None and paths is not None:
         write_pvtu(out.path("mesh.pvtu"), [Path(p) for p in paths])
         write_report(report.to_dict(), out.path("report.json"))

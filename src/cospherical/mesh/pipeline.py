@@ -45,7 +45,7 @@ from ..choices import MODES, DelaunayMode
 from .delaunay import delaunay_mesh
 from .octree import Octree, Shape, build_octree, leaf_list_order, leaves_octree, parse_shape
 from .report import MeshReport, checked_mesh_report
-from .report_sections import TreeSummary, read_only
+from .report_sections import TreeSummary
 
 if TYPE_CHECKING:  # the dual's and a device's modules are imported when they are asked for
     from .device import Device, DeviceLayout
@@ -292,11 +292,8 @@ def run_pipeline(source: TreeSource, lookup: Lookup | None = None, *, patterns: 
                                          conformity_progress=told("conformity", None),
                                          uniform_computed=checks == "all")
     report = checked_report.report
-    if entries_proven is not None and report.checks is not None and "table_entries" in report.checks.run:
-        checks_run = report.checks
-        report = replace(report, checks=replace(
-            checks_run, run=tuple(name for name in checks_run.run if name != "table_entries"),
-            not_run=read_only({"table_entries": entries_proven, **(checks_run.not_run or {})})))
+    if entries_proven is not None and report.checks is not None:
+        report = replace(report, checks=report.checks.not_running("table_entries", entries_proven))
     found = faces = None
     if source.device is not None:
         from .regions import device_report, region_faces

@@ -14,7 +14,7 @@ report only gathers them.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING, Any, ClassVar, Iterator, Mapping, TypeVar, cast
 
 if TYPE_CHECKING:
@@ -597,6 +597,13 @@ class ChecksSummary(_Section):
     run: tuple[str, ...]
     delaunay_spheres: DelaunaySpheres | None = None
     not_run: Mapping[str, str] | None = None
+
+    def not_running(self, name: str, why: str) -> ChecksSummary:
+        """The same summary with check ``name`` (if it is in :attr:`run`) not run, for the reason ``why``."""
+        if name not in self.run:
+            return self
+        return replace(self, run=tuple(check for check in self.run if check != name),
+                       not_run=read_only({name: why, **(self.not_run or {})}))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ChecksSummary:
