@@ -346,7 +346,9 @@ def test_the_checked_tables_are_the_committed_tables_against_the_shipped_catalog
 
     committed = {hashlib.sha256(path.read_bytes()).hexdigest(): path.name
                  for path in (Path(__file__).parents[2] / "patterns").glob("*.yaml")}
-    assert {digest: name for digest, (name, _) in CHECKED_TABLES.items()} == committed
+    assert {digest: name for digest, (name, _) in CHECKED_TABLES.items()} == committed, (
+        "a committed table changed: run `cospherical check` on it, then write its bytes' SHA-256 (sha256sum) in "
+        "cospherical.formats.mesh.CHECKED_TABLES")
     assert {version for _, version in CHECKED_TABLES.values()} == {shipped_catalogue().version}
 
 
