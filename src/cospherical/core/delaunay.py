@@ -48,6 +48,10 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
     from outside and starting at its smallest index.
     """
     coords = frame.coords
+    if len(members) == 4:  # most cells: one side test per face instead of a scan of the four points
+        faces = _tetrahedron_faces(coords, members)
+        if faces is not None:
+            return faces
     points = [(m, *coords[m]) for m in members]
     # Triples of a face with more than three points: the face is found at its first
     # triple, the others are skipped (a set lookup, not a scan of the faces found).
@@ -85,6 +89,21 @@ def hull_faces(frame: Frame, members: list[int]) -> list[tuple[tuple[int, ...], 
     return faces
 
 
+def _tetrahedron_faces(coords: Sequence[Sequence[int]],
+                       members: list[int]) -> list[tuple[tuple[int, ...], tuple[int, int, int]]] | None:
+    # hull_faces of four points, the same faces in the same order: each triple of combinations() with the
+    # fourth point on one side; None when the four are coplanar (hull_faces' own path says what follows).
+    faces: list[tuple[tuple[int, ...], tuple[int, int, int]]] = []
+    for (i, j, k), m in zip(combinations(members, 3), (members[3], members[2], members[1], members[0])):
+        nx, ny, nz = plane_normal(coords[i], coords[j], coords[k])
+        (x0, y0, z0), (x, y, z) = coords[i], coords[m]
+        side = nx * (x - x0) + ny * (y - y0) + nz * (z - z0)
+        if side == 0:
+            return None
+        faces.append(((i, k, j), (-nx, -ny, -nz)) if side > 0 else ((i, j, k), (nx, ny, nz)))
+    return faces
+
+
 def _triangle(points: list[int], above: bool) -> tuple[int, ...]:
     # points are i < j < k, and the plane normal (j - i) x (k - i) points along the outward
     # normal exactly when the other points are below it: keep the order then, else swap j and k.
@@ -109,11 +128,13 @@ def _first_cell(frame: Frame) -> tuple[list[int], Sphere]:
     # try spheres through it and its nearest points first.
     coords, lifted = frame.coords, frame.lifted
     anchor = min(range(len(coords)), key=lambda i: coords[i])
+    (ax, ay, az), (wx, wy, wz) = coords[anchor], frame.weights
+    # nearest first: the real squared distance (frame.real_dot of the difference with itself), written out
     others = sorted(
-        (i for i in range(len(coords)) if i != anchor),
-        key=lambda i: (frame.real_dot(sub(coords[i], coords[anchor]), sub(coords[i], coords[anchor])), i),
+        (wx * (x - ax) ** 2 + wy * (y - ay) ** 2 + wz * (z - az) ** 2, i)
+        for i, (x, y, z) in enumerate(coords) if i != anchor
     )
-    for j, k, m in combinations(others, 3):
+    for j, k, m in combinations([i for _, i in others], 3):
         sphere = frame.sphere(anchor, j, k, m)
         if sphere is None:
             continue
@@ -142,6 +163,11 @@ def delaunay_cells(frame: Frame, backend: DelaunayBackend = "python") -> list[Ce
         if cells is not None:
             return cells
     coords, lifted = frame.coords, frame.lifted
+    # The points' extent along each axis: a face in the plane of an extreme coordinate, its normal along
+    # that axis and outward, has no point beyond it (the hull's faces of a box), with no scan of the points.
+    lowest = [min(p[axis] for p in coords) for axis in range(3)]
+    highest = [max(p[axis] for p in coords) for axis in range(3)]
+    node_id = frame.ids.__getitem__
     members, sphere = _first_cell(frame)
     seen = {frozenset(members)}
     queue = deque([(members, sphere)])
@@ -152,8 +178,8 @@ def delaunay_cells(frame: Frame, backend: DelaunayBackend = "python") -> list[Ce
         faces = hull_faces(frame, members)
         cells.append(
             Cell(
-                nodes=tuple(frame.ids[i] for i in members),
-                faces=tuple(sorted(tuple(frame.ids[i] for i in cycle) for cycle, _ in faces)),
+                nodes=tuple(map(node_id, members)),
+                faces=tuple(sorted(tuple(map(node_id, cycle)) for cycle, _ in faces)),
                 center=frame.center(sphere),
             )
         )
@@ -163,7 +189,12 @@ def delaunay_cells(frame: Frame, backend: DelaunayBackend = "python") -> list[Ce
                 continue
             crossed.add(key)
             nx, ny, nz = normal
-            offset = dot(normal, coords[cycle[0]])
+            on = coords[cycle[0]]
+            if ((ny == nz == 0 and on[0] == (highest[0] if nx > 0 else lowest[0]))
+                    or (nx == nz == 0 and on[1] == (highest[1] if ny > 0 else lowest[1]))
+                    or (nx == ny == 0 and on[2] == (highest[2] if nz > 0 else lowest[2]))):
+                continue
+            offset = dot(normal, on)
             beyond = [m for m, (x, y, z) in enumerate(coords) if nx * x + ny * y + nz * z > offset]
             if not beyond:
                 continue
