@@ -198,6 +198,7 @@ class SortedLines(Mapping[str, str]):
         self._data = data
         self.start = data.index(b"\nconfigurations:\n") + len(b"\nconfigurations:\n")  # the first entry's line
         self._all: dict[str, str] | None = None
+        self._found: dict[str, str] = {}  # what a lookup found: a table is asked "in it?", then for the entry
 
     def _line(self, start: int) -> tuple[bytes, int, int]:
         """The code of the line starting at ``start`` (bytes), where its JSON text starts, and the line's end."""
@@ -208,15 +209,19 @@ class SortedLines(Mapping[str, str]):
     def __getitem__(self, code: str) -> str:
         if not isinstance(code, str):
             raise KeyError(code)
+        found = self._found.get(code)
+        if found is not None:
+            return found
         key = code.encode("utf-8")  # byte order is code point order in UTF-8: the codes' order
         data = self._data
         low, high = self.start, len(data)  # line starts: the entry, if there, starts in [low, high)
         while low < high:
             middle = max(data.rfind(b"\n", low, (low + high) // 2) + 1, low)  # a line start in [low, middle]
-            found, entry, end = self._line(middle)
-            if found == key:
-                return data[entry:end].decode("utf-8")
-            if found < key:
+            line, entry, end = self._line(middle)
+            if line == key:
+                text = self._found[code] = data[entry:end].decode("utf-8")
+                return text
+            if line < key:
                 low = end + 1
             else:
                 high = middle
