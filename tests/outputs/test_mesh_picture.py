@@ -64,3 +64,30 @@ def test_the_picture_cuts_what_vtk_cuts(tmp_path):
             assert tuple(pixels[int(center[1]), int(center[0])]) == TAB20[commonest.index(t) % 20]
             checked += 1
     assert checked > len(polygons) / 2
+
+
+@pytest.mark.oracle_vtk
+def test_png_bytes_are_the_pixels_for_pillow_and_libpng(tmp_path):
+    """png_bytes' file decodes to the very pixels in Pillow's decoder and in VTK's (libpng), CRCs checked."""
+    from PIL import Image
+
+    from cospherical.outputs.mesh_picture import _ROWS, png_bytes
+
+    rng = np.random.default_rng(5)
+    pixels = np.repeat(rng.integers(0, 256, (7, 11, 3), dtype=np.uint8), 20, axis=0)  # rows equal to the one above,
+    assert len(pixels) > 2 * _ROWS  # in bands of rows filtered and deflated in turn
+    pixels[::4] = rng.integers(0, 256, pixels[::4].shape, dtype=np.uint8)  # and rows that differ, wrapping mod 256
+    path = tmp_path / "picture.png"
+    path.write_bytes(png_bytes(pixels))
+    assert png_bytes(pixels) == path.read_bytes()  # deterministic
+    with Image.open(path) as image:
+        image.verify()
+    with Image.open(path) as image:
+        assert image.mode == "RGB" and np.array_equal(np.asarray(image), pixels)
+    reader = vtk.vtkPNGReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    decoded = vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars())
+    assert np.array_equal(decoded.reshape(pixels.shape)[::-1], pixels)  # VTK's rows run bottom-up
+    with pytest.raises(ValueError, match="RGB picture of uint8"):
+        png_bytes(pixels[:, :, :2])

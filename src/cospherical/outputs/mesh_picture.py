@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-import io
 import math
+import struct
+import zlib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -15,7 +16,7 @@ from ..mesh.assembly import Mesh
 if TYPE_CHECKING:
     from PIL import ImageFont
 
-__all__ = ["TAB20", "cut_png", "cut_polygons", "frame"]
+__all__ = ["TAB20", "cut_png", "cut_polygons", "frame", "png_bytes"]
 
 # matplotlib's tab20 palette (its colours for the commonest types first, as the pictures always had)
 TAB20 = ((31, 119, 180), (174, 199, 232), (255, 127, 14), (255, 187, 120), (44, 160, 44), (152, 223, 138),
@@ -23,6 +24,7 @@ TAB20 = ((31, 119, 180), (174, 199, 232), (255, 127, 14), (255, 187, 120), (44, 
          (227, 119, 194), (247, 182, 210), (127, 127, 127), (199, 199, 199), (188, 189, 34), (219, 219, 141),
          (23, 190, 207), (158, 218, 229))
 WHITE, BLACK, GREY = (255, 255, 255), (0, 0, 0), (204, 204, 204)
+_ROWS = 64  # rows of a picture filtered and deflated at a time (png_bytes)
 _OVER = 3  # over-sampling of the polygons: their outlines a third of a pixel wide, as thin as matplotlib's
 
 
@@ -181,13 +183,40 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
             y = ly + 8 + 20 * i
             draw.rectangle((lx + 12, y + 2, lx + 40, y + 12), fill=colour[t], outline=BLACK)
             draw.text((lx + 48, y + 7), row, font=font, fill=BLACK, anchor="lm")
-    # Encoded under a name that says PNG: Image.save(format=...) first loads five format plugins (BMP, GIF,
-    # JPEG, PPM and PNG, ~5 ms) where a ".png" name loads PNG's alone; the same encoder, the same bytes.
-    encoded = io.BytesIO()
-    encoded.name = "mesh.png"
-    image.save(encoded, optimize=False)
     with atomic_open(path, binary=True) as handle:
-        handle.write(encoded.getbuffer())
+        handle.write(png_bytes(np.asarray(image)))
+
+
+def png_bytes(pixels: np.ndarray) -> bytes:
+    """The PNG file of an RGB picture (``pixels``: height x width x 3, ``uint8``), as a preview is: fast, lossless.
+
+    Every row filtered by PNG's "Up" filter (its bytes minus the row above's, modulo 256:
+    a picture of flat colours becomes mostly zeros) and deflated at zlib level 1, as
+    ``mesh.vtu``'s data is.  Pillow's encoder (each row's filter chosen among five, zlib
+    level 6) made files 8-25 % smaller in four to five times the time (0.028 s against
+    0.006 s for a 1300 x 845 picture) and imported its PNG plugin to do it.  The same
+    pixels give the same bytes.
+    """
+    height, width, channels = pixels.shape
+    if channels != 3 or pixels.dtype != np.uint8:
+        raise ValueError(f"png_bytes: an RGB picture of uint8, not {channels} channels of {pixels.dtype}")
+    flat = pixels.reshape(height, 3 * width)
+    deflate, data = zlib.compressobj(1), []
+    for start in range(0, height, _ROWS):  # a band of rows at a time: the filtered copy is a band, not the picture
+        band = flat[start:start + _ROWS]
+        rows = np.empty((len(band), 1 + 3 * width), dtype=np.uint8)
+        rows[:, 0] = 2  # "Up"; above the first row are zeros, so its bytes are its own
+        np.subtract(band[0], flat[start - 1] if start else 0, out=rows[0, 1:])
+        np.subtract(band[1:], band[:-1], out=rows[1:, 1:])  # uint8: wraps modulo 256, as the filter is defined
+        data.append(deflate.compress(rows.data))
+    data.append(deflate.flush())
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)  # 8 bits per sample, RGB, deflate, no interlace
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", b"".join(data))
+            + chunk(b"IEND", b""))
 
 
 def frame(a: float, b: float) -> tuple[int, int, int, int, float]:
