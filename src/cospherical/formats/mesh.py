@@ -41,9 +41,10 @@ from .patterns import Entries, PatternTable, load, table_from_text
 from .sqlite_store import is_store
 from .vtu import quoteattr
 
-if TYPE_CHECKING:  # the device's modules are imported where a device is meshed, the threads' where they deflate
+if TYPE_CHECKING:  # imported where used: a device's modules, the threads (deflate), the symmetries (a table lacks one)
     from concurrent.futures import Executor
 
+    from ..core.symmetry import Symmetry
     from ..mesh.regions import RegionFaces
     from .check import EntryCheck
 
@@ -351,8 +352,6 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
     naming the table's types).  Mapped elements carry ``mapped_from`` (the
     representative's code).
     """
-    from ..core.symmetry import Symmetry, box_symmetries, orbit_representatives
-
     symmetries: list[Symmetry] = []  # made at the first configuration the table lacks (a leaf table lacks none)
     vtk = {entry.id: entry.vtk for entry in catalogue}
 
@@ -363,6 +362,8 @@ def orbit_lookup(lookup: Lookup, box: Box, catalogue: Catalogue) -> Lookup:
         code = configuration.point_set_code
         if code is None:  # a table holds configurations by their point-set codes
             return None
+        from ..core.symmetry import box_symmetries, orbit_representatives  # imported, too, where first needed
+
         if not symmetries:
             symmetries.extend(box_symmetries(box))
         (representative,), (index,) = orbit_representatives([code], symmetries)

@@ -76,9 +76,16 @@ class LocalElement:
     sphere: Sphere | None
     center: tuple[Fraction, Fraction, Fraction] | None
 
-    @cached_property  # read per element by several checks and writers: Fraction comparisons, made once
+    @cached_property  # read per element by several checks and writers: made once
     def center_in_leaf(self) -> bool:
-        return self.center is not None and all(0 <= x <= 1 for x in self.center)
+        # 0 <= n/d <= 1 as 0 <= n <= d (a Fraction's denominator is positive): integers, not Fraction comparisons
+        return self.center is not None and all(0 <= x.numerator <= x.denominator for x in self.center)
+
+    @cached_property  # every walk over the mesh's blocks reads them: made once per element of a configuration
+    def face_columns(self) -> tuple[tuple[int, ...], ...]:
+        """:attr:`faces` as cycles of indices into :attr:`nodes` (the columns of a block's vertex ids)."""
+        column = {n: i for i, n in enumerate(self.nodes)}
+        return tuple(tuple(column[n] for n in cycle) for cycle in self.faces)
 
 
 @dataclass(frozen=True)
@@ -325,9 +332,8 @@ class Mesh:
             first = self.element_offsets[leaves]
             slots = self.slots[leaves]  # the configuration's slots once, each element's columns from it
             for j, element in enumerate(tessellation.elements):
-                column = {n: i for i, n in enumerate(element.nodes)}
-                yield ElementBlock(first + j, slots[:, np.asarray(element.nodes, dtype=np.intp)],
-                                   tuple(tuple(column[n] for n in cycle) for cycle in element.faces), element.type_id)
+                yield ElementBlock(first + j, slots[:, np.asarray(element.nodes, dtype=np.intp)], element.face_columns,
+                                   element.type_id)
         if self.cells is not None:
             order = np.argsort(self.cells.shape, kind="stable")
             counts = np.bincount(self.cells.shape, minlength=len(self.cells.shapes))
