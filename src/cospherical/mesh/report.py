@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass, field, fields, replace
 from fractions import Fraction
-from typing import Any, Callable, Iterable, Mapping, NamedTuple, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping, NamedTuple, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,12 +22,15 @@ from ..version import __version__
 from .assembly import Mesh, MeshType
 from .checks import (DelaunayCheck, OpenFaces, check_circumcenters, check_conformity, check_delaunay, check_volume,
                      match_seams)
-from .report_sections import (ChecksSummary, ConfigurationFrequency, ContactSummary, DelaunaySpheres, DeviceSummary,
-                              DualSummary, InterfaceSummary, LeafMeshSummary, MixedCounts, NegativeCoefficients,
-                              OutsideType, RegionSummary, TetrahedralCounts, TreeSummary, TypeFrequency, UniformSummary,
-                              plain, read_only)
+from . import report_sections
+from .report_sections import (ChecksSummary, ConfigurationFrequency, DelaunaySpheres, LeafMeshSummary, OutsideType,
+                              TreeSummary, TypeFrequency, UniformSummary, plain, read_only)
 from .statistics import ConfigurationOccurrence, level_counts, occurrences, statistics, uniform_study
 from .tree import Octree
+
+if TYPE_CHECKING:  # made where first asked for (report_sections' __getattr__); this module's names as well
+    from ._dual_device_sections import (ContactSummary, DeviceSummary, DualSummary, InterfaceSummary, MixedCounts,
+                                        NegativeCoefficients, RegionSummary, TetrahedralCounts)
 
 __all__ = ["CheckedReport", "ChecksSummary", "ConfigurationFrequency", "ContactSummary", "DelaunaySpheres",
            "DeviceSummary", "DualSummary", "InterfaceSummary", "LeafMeshSummary", "MeshFigures", "MeshReport",
@@ -35,6 +38,14 @@ __all__ = ["CheckedReport", "ChecksSummary", "ConfigurationFrequency", "ContactS
            "MixedCounts", "NegativeCoefficients", "OutsideType", "RegionSummary", "TetrahedralCounts", "TreeSummary",
            "TypeFrequency", "UniformSummary", "checked_mesh_report", "merged_report", "mesh_figures", "mesh_report",
            "outside_catalogue"]
+
+
+def __getattr__(name: str) -> Any:
+    # The dual's and a device's sections, exported here too, made where first asked for (see report_sections)
+    if name in report_sections._DUAL_AND_DEVICE:
+        return getattr(report_sections, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 # A nonconforming face: its vertices, each three fractions of the domain's sides (floats)
 Example = tuple[tuple[float, ...], ...]
@@ -475,10 +486,12 @@ class MeshReport:
         return replace(self, timings=read_only(timings))
 
 
-# The report's sections that are objects, and those that are lists of rows: how each is read from JSON
+# The report's sections that are objects, and those that are lists of rows: how each is read from JSON (the
+# dual's and a device's sections looked up when read: report_sections makes them when first asked for)
 _SECTIONS: dict[str, Callable[[Mapping[str, Any]], Any]] = {
     "leaf_mesh": LeafMeshSummary.from_dict, "uniform": UniformSummary.from_dict,
-    "negative_coefficients": NegativeCoefficients.from_dict, "dual": DualSummary.from_dict,
-    "device": DeviceSummary.from_dict, "checks": ChecksSummary.from_dict}
+    "negative_coefficients": lambda data: report_sections.NegativeCoefficients.from_dict(data),
+    "dual": lambda data: report_sections.DualSummary.from_dict(data),
+    "device": lambda data: report_sections.DeviceSummary.from_dict(data), "checks": ChecksSummary.from_dict}
 _ROWS: dict[str, Callable[[Mapping[str, Any]], Any]] = {
     "type_frequencies": TypeFrequency.from_dict, "configuration_frequencies": ConfigurationFrequency.from_dict}
