@@ -129,6 +129,7 @@ def test_mesh_out_imports_only_what_it_uses(tmp_path):
               "cospherical.mesh.device",  # --device
               "cospherical.formats.check",  # a committed table's entries are proven by its digest
               "PIL.JpegImagePlugin", "PIL.PngImagePlugin",  # mesh.png encoded by png_bytes, not Pillow's plugins
+              "PIL.ImageFile",  # nor their base module (and logging with it): the pixels read by the raw encoder
               "numpy.ma",  # numpy 2.4's unique() without counts or indices imports it to test for a mask
               "scipy"}
     assert not unused & loaded, unused & loaded

@@ -91,3 +91,16 @@ def test_png_bytes_are_the_pixels_for_pillow_and_libpng(tmp_path):
     assert np.array_equal(decoded.reshape(pixels.shape)[::-1], pixels)  # VTK's rows run bottom-up
     with pytest.raises(ValueError, match="RGB picture of uint8"):
         png_bytes(pixels[:, :, :2])
+
+
+def test_the_pixels_read_are_pillows_tobytes():
+    """_pixels (Pillow's raw encoder run as tobytes runs it, in several buffers here) gives tobytes' very pixels."""
+    from PIL import Image, ImageDraw
+
+    from cospherical.outputs.mesh_picture import _pixels
+
+    image = Image.new("RGB", (301, 250), (255, 255, 255))  # 225,750 bytes: four buffers of 64 KiB
+    ImageDraw.Draw(image).polygon([(3, 5), (290, 40), (120, 240)], fill=(31, 119, 180), outline=(0, 0, 0))
+    pixels = _pixels(image)
+    assert pixels.shape == (250, 301, 3) and pixels.dtype == np.uint8
+    assert pixels.tobytes() == image.tobytes() and np.array_equal(pixels, np.asarray(image))

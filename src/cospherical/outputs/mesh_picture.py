@@ -14,7 +14,7 @@ from ..files.yamlio import atomic_open
 from ..mesh.assembly import Mesh
 
 if TYPE_CHECKING:
-    from PIL import ImageFont
+    from PIL import Image, ImageFont
 
 __all__ = ["TAB20", "cut_png", "cut_polygons", "frame", "png_bytes"]
 
@@ -184,7 +184,28 @@ def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: in
             draw.rectangle((lx + 12, y + 2, lx + 40, y + 12), fill=colour[t], outline=BLACK)
             draw.text((lx + 48, y + 7), row, font=font, fill=BLACK, anchor="lm")
     with atomic_open(path, binary=True) as handle:
-        handle.write(png_bytes(np.asarray(image)))
+        handle.write(png_bytes(_pixels(image)))
+
+
+def _pixels(image: Image.Image) -> np.ndarray:
+    """An RGB picture's pixels (height x width x 3, ``uint8``): its bytes from Pillow's raw encoder, as ``tobytes()``.
+
+    ``Image.tobytes()`` (and ``numpy.asarray(image)``, through it) runs the same encoder the same way, but
+    first imports Pillow's file-format base module (and ``logging`` with it, ~6 ms of a run) for the size
+    of a buffer; nothing else in a mesh run needs that module.
+    """
+    from PIL import Image
+
+    width, height = image.size
+    encoder = Image.core.raw_encoder("RGB", "RGB")
+    encoder.setimage(image.im, (0, 0, width, height))
+    chunks, status = [], 0
+    while not status:
+        _, status, chunk = encoder.encode(max(1 << 16, 4 * width))
+        chunks.append(chunk)
+    if status < 0:
+        raise OSError(f"mesh.png: Pillow's raw encoder failed ({status})")
+    return np.frombuffer(b"".join(chunks), dtype=np.uint8).reshape(height, width, 3)
 
 
 def png_bytes(pixels: np.ndarray) -> bytes:
