@@ -68,6 +68,7 @@ class _Pool(ProcessPoolExecutor):
         interrupted or terminated must end now.
         """
         workers = list((getattr(self, "_processes", None) or {}).values())
+        manager = getattr(self, "_executor_manager_thread", None)
         for worker in workers:  # computation only, nothing to clean up: SIGKILL, not a request to stop
             try:
                 worker.kill()
@@ -76,6 +77,11 @@ class _Pool(ProcessPoolExecutor):
         self.shutdown(wait=False, cancel_futures=True)
         for worker in workers:
             worker.join(timeout=5)
+        # The pool's management thread sees its workers die and closes its wake-up pipe. Python 3.11's exit
+        # wakes every such thread through that pipe without a lock: a thread still closing it then is an
+        # "Exception ignored ... Bad file descriptor" printed after the command's last line. It ends at once.
+        if manager is not None:
+            manager.join(timeout=5)
 
 
 def process_pool(jobs: int) -> ProcessPoolExecutor:
