@@ -6,7 +6,6 @@ import sys
 
 import numpy as np
 import pytest
-import pyvista
 
 import cospherical
 from cospherical.adapters.pyvista import legacy_cells
@@ -16,12 +15,22 @@ pytestmark = pytest.mark.oracle_vtk
 
 
 @pytest.fixture(scope="module")
+def pyvista():
+    """pyvista, imported by the tests that use it: held at module level, it is asked by pytest's collection
+    for attributes it lacks, and its module ``__getattr__`` then imports pyvista.plotting (~0.5 CPU-s) in
+    every worker."""
+    import pyvista
+
+    return pyvista
+
+
+@pytest.fixture(scope="module")
 def graded():
     """A 1 x 2 x 4 octree whose global Delaunay cells include general polyhedra (VTK_POLYHEDRON)."""
     return cospherical.build_mesh(domain=(1, 2, 4), levels=4, refine=["sphere:0.5,1,2,0.3"], uniform=False)
 
 
-def test_cell_volumes_sum_to_the_domain(graded):
+def test_cell_volumes_sum_to_the_domain(graded, pyvista):
     grid = graded.to_pyvista()
     assert grid.n_cells == len(graded.elements) and grid.n_points == len(graded.vertices)
     assert pyvista.CellType.POLYHEDRON in set(grid.celltypes.tolist())
@@ -30,7 +39,7 @@ def test_cell_volumes_sum_to_the_domain(graded):
     assert volume.sum() == pytest.approx(8.0, rel=1e-12)
 
 
-def test_the_grid_is_the_written_file_as_vtk_reads_it(graded, tmp_path):
+def test_the_grid_is_the_written_file_as_vtk_reads_it(graded, tmp_path, pyvista):
     graded.write(tmp_path)
     read = pyvista.read(tmp_path / "mesh.vtu")
     grid = graded.to_pyvista()
@@ -43,7 +52,7 @@ def test_the_grid_is_the_written_file_as_vtk_reads_it(graded, tmp_path):
     assert list(grid.field_data["type_ids"]) == list(graded.elements.type_ids)
 
 
-def test_a_devices_grid_is_its_written_file_regions_included(tmp_path):
+def test_a_devices_grid_is_its_written_file_regions_included(tmp_path, pyvista):
     # the regions a solver's materials hang on: in memory as in mesh.vtu (they were only in the file)
     mos = cospherical.build_mesh(device="examples/devices/mos-capacitor.yaml", uniform=False)
     mos.write(tmp_path)
