@@ -199,13 +199,15 @@ def _pixels(image: Image.Image) -> np.ndarray:
     width, height = image.size
     encoder = Image.core.raw_encoder("RGB", "RGB")
     encoder.setimage(image.im, (0, 0, width, height))
-    chunks, status = [], 0
+    pixels = np.empty(3 * width * height, dtype=np.uint8)  # filled buffer by buffer: one copy of the picture
+    at, status = 0, 0
     while not status:
         _, status, chunk = encoder.encode(max(1 << 16, 4 * width))
-        chunks.append(chunk)
-    if status < 0:
-        raise OSError(f"mesh.png: Pillow's raw encoder failed ({status})")
-    return np.frombuffer(b"".join(chunks), dtype=np.uint8).reshape(height, width, 3)
+        pixels[at:at + len(chunk)] = np.frombuffer(chunk, dtype=np.uint8)
+        at += len(chunk)
+    if status < 0 or at != len(pixels):
+        raise OSError(f"mesh.png: Pillow's raw encoder failed ({status}, {at} of {len(pixels)} bytes)")
+    return pixels.reshape(height, width, 3)
 
 
 def png_bytes(pixels: np.ndarray) -> bytes:
