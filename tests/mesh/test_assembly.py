@@ -175,3 +175,19 @@ def test_configurations_sharing_an_element_measure_it_once():
         assert shared == tessellation == local_tessellation(tessellation.configuration, listed, on_the_fly=True)
         elements += len(listed)
     assert len(mesh.tessellations) == 21 and len(measured) < elements  # some shared, each measured once
+
+
+def test_connectivity_is_the_blocks_vertex_ids():
+    """connectivity() (one gather per configuration) gives every element the vertex ids its block gives it, padded
+    with -1, with leaves and cells that replace leaves (a brick's sphere tree has both)."""
+    import cospherical
+
+    mesh = cospherical.build_mesh(domain=(1, 2, 4), levels=4, refine=["sphere:0.5,1,2,0.3"]).assembled  # 168 cells
+    assert mesh.cells is not None and mesh.leaf_elements > 0
+    conn, sizes = mesh.connectivity()
+    seen = np.zeros(len(mesh), dtype=bool)
+    for rows, nodes, _, _ in mesh.blocks():
+        assert np.array_equal(conn[rows, :nodes.shape[1]], nodes) and (conn[rows, nodes.shape[1]:] == -1).all()
+        assert (sizes[rows] == nodes.shape[1]).all() and not seen[rows].any()
+        seen[rows] = True
+    assert seen.all() and conn.dtype == np.int32 and sizes.dtype == np.int8
