@@ -89,9 +89,14 @@ class ShapePieces:
         """These pieces carried over by an isometry of the box: node ``u`` becomes ``node[u]``, a plane normal to
         axis ``a`` one normal to ``axis[a]``, its value read from the moved nodes' points (``points[n] / scale``).
         The shares are the same numbers (lengths, areas, volumes and their signs are kept), in the new order."""
-        edges = sorted(((node[u], node[v]) if node[u] < node[v] else (node[v], node[u]), n)
-                       for (u, v), n in zip(self.edges.tolist(), self.edge_numerators))
-        volumes = sorted(zip((node[u] for u in self.volume_nodes.tolist()), self.volume_numerators))
+        # node ids mapped and sorted as arrays (the map is one to one: no two edges or nodes become equal, so the
+        # order is that of the sorted pairs; the numerators follow it)
+        ids = np.array(node, dtype=np.int64)
+        ends = ids[self.edges]
+        ends.sort(axis=1)
+        edge_order = np.lexsort((ends[:, 1], ends[:, 0])).tolist()
+        nodes = ids[self.volume_nodes]
+        volume_order = np.argsort(nodes, kind="stable")
         # sorted by (axis, plane, node) as summed sorts them, every plane here being an integer over ``scale``
         moved = sorted((axis[a], points[node[u]][axis[a]], node[u], n) for (a, _, u), n in self.boundary)
         planes: dict[tuple[int, int], Fraction] = {}  # one Fraction per plane
@@ -101,9 +106,9 @@ class ShapePieces:
             if plane is None:
                 plane = planes[b, value] = Fraction(value, scale)
             boundary.append(((b, plane, u), n))
-        return ShapePieces(np.array([e for e, _ in edges], dtype=np.int64).reshape(-1, 2), [n for _, n in edges],
-                           self.edge_denominator, np.array([u for u, _ in volumes], dtype=np.int64),
-                           [n for _, n in volumes], self.volume_denominator, boundary, self.boundary_denominator)
+        return ShapePieces(ends[edge_order], [self.edge_numerators[k] for k in edge_order], self.edge_denominator,
+                           nodes[volume_order], [self.volume_numerators[k] for k in volume_order.tolist()],
+                           self.volume_denominator, boundary, self.boundary_denominator)
 
 
 Key = TypeVar("Key", bound=Hashable)
@@ -152,8 +157,9 @@ def leaf_groups(mesh: Mesh, squared: Squared) -> tuple[list[Group], NDArray[np.f
             if element.center is None:
                 raise InputError(f"configuration {tessellation.code}: element {j} is not co-spherical: it has no dual")
         # every element of every leaf at once (leaves x elements x 3), by the sums and products of _real_centers
-        offsets = np.array([[float(x) for x in element.center] for element in tessellation.elements if
-                            element.center is not None]).reshape(1, -1, 3)
+        # each coordinate n / d as float(Fraction) divides it (int / int, rounded once), without its four calls
+        offsets = np.array([[n / d for n, d in (x.as_integer_ratio() for x in element.center)] for element in tessellation.elements
+                            if element.center is not None]).reshape(1, -1, 3)
         # in place, one array of the group's size (low + offset * size == offset * size + low: sums commute, bit
         # for bit), its rows put in with a flat index (numpy's fast path)
         placed: NDArray[np.float64] = offsets * size[:, :, None]
@@ -198,10 +204,13 @@ def _tessellation_pieces(tessellation: LocalTessellation, squared: Squared) -> S
     key = (tessellation.code, squared, tuple(e.nodes for e in tessellation.elements))
     shape = _REMEMBERED.get(key)
     if shape is None:
-        points = tessellation.configuration.nodes()
-        scale = math.lcm(*(x.denominator for p in points.values() for x in p))
-        grid = {n: (p[0].numerator * (scale // p[0].denominator), p[1].numerator * (scale // p[1].denominator),
-                    p[2].numerator * (scale // p[2].denominator)) for n, p in points.items()}
+        # (numerator, denominator) of each coordinate in one call (a Fraction's numerator and denominator are
+        # properties: two calls), then every point over the common denominator
+        ratios = {n: (x.as_integer_ratio(), y.as_integer_ratio(), z.as_integer_ratio())
+                  for n, (x, y, z) in tessellation.configuration.nodes().items()}
+        scale = math.lcm(*(d for p in ratios.values() for _, d in p))
+        grid = {n: (x * (scale // dx), y * (scale // dy), z * (scale // dz))
+                for n, ((x, dx), (y, dy), (z, dz)) in ratios.items()}
         elements = [e for e in tessellation.elements if e.center is not None]
         configuration_class, order, axes = _configuration_class(grid, scale, elements, squared)
         known = _CONFIGURATIONS.get(configuration_class)
