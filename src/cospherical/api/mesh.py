@@ -359,10 +359,16 @@ class OctreeMesh:
         if report.dual is None:
             self._write_mesh_files(path, cut, others, wrote)
             return
+        from ..formats.dual.writer import threaded, write_dual
+
+        if not threaded(self.dual):  # a small dual: threads would cost more than they save (formats.deflated)
+            self._write_mesh_files(path, cut, others - 1, wrote, with_dual=True)
+            write_dual(self.dual, path("dual.npz"))
+            wrote()
+            return
         from concurrent.futures import ThreadPoolExecutor
 
         from ..formats.deflated import deflate_workers
-        from ..formats.dual import write_dual
 
         # dual.npz is written beside the other files, in a thread of its own: its time is deflate's and the
         # checksums', which leave the interpreter free for mesh.vtu and mesh.png (the same bytes either way);

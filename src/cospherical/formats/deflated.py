@@ -25,10 +25,12 @@ import os
 import struct
 import zlib
 from collections import deque
-from concurrent.futures import Executor, Future
-from typing import BinaryIO, Iterator, Sequence, Union
+from typing import TYPE_CHECKING, Any, BinaryIO, Callable, Generic, Iterator, Sequence, TypeVar, Union
 
-__all__ = ["BLOCK", "ZIP64_LIMIT", "deflate_workers", "write_zip"]
+if TYPE_CHECKING:
+    from concurrent.futures import Executor, Future
+
+__all__ = ["BLOCK", "SERIAL_BYTES", "ZIP64_LIMIT", "InlinePool", "deflate_workers", "in_threads", "write_zip"]
 
 BLOCK = 1 << 20
 ZIP64_LIMIT = (1 << 31) - 1  # zipfile's: sizes and offsets past it are written as zip64 fields
@@ -40,7 +42,40 @@ _DATE, _TIME = (1980 - 1980) << 9 | 1 << 5 | 1, 0  # 1980-01-01 00:00:00, the ea
 _DEFLATED = 8
 _MAX_WORKERS = 8  # deflate's threads at most: past that the writing of the file itself dominates
 
+# Payloads up to this many bytes are deflated in the caller's thread: below it, starting threads, handing them the
+# blocks and importing concurrent.futures (5 ms: logging comes with it) cost more CPU than the threads save wall
+# time.  The README's sphere trees, `mesh --dual` serial against threaded (11 pairs): level 4 (0.7 MB of members)
+# and level 5 (2.6 MB) -5 % CPU-s at the same wall time; level 6 (11 MB) keeps its threads (serial: the same
+# CPU-s, +8 % wall)
+SERIAL_BYTES = 4 << 20
+
 Buffer = Union[bytes, memoryview]
+T = TypeVar("T")
+
+
+class _Done(Generic[T]):
+    """A call's result, computed already: what :meth:`InlinePool.submit` gives for a future."""
+
+    __slots__ = ("value",)
+
+    def __init__(self, value: T) -> None:
+        self.value = value
+
+    def result(self) -> T:
+        return self.value
+
+
+class InlinePool:
+    """The part of an executor :func:`write_zip` uses, run in the caller's thread: each call at once, when
+    submitted (the same bytes as any pool: only the order of the work differs)."""
+
+    def submit(self, fn: Callable[..., T], /, *args: Any) -> _Done[T]:
+        return _Done(fn(*args))
+
+
+def in_threads(nbytes: int) -> bool:
+    """Whether a payload of ``nbytes`` is worth deflating in threads (see ``SERIAL_BYTES``)."""
+    return nbytes > SERIAL_BYTES
 
 
 def deflate_workers() -> int:
@@ -89,8 +124,8 @@ def _crc32(parts: Sequence[Buffer]) -> int:
     return crc
 
 
-def write_zip(handle: BinaryIO, members: Sequence[tuple[str, Sequence[Buffer]]], level: int, pool: Executor,
-              zip64_limit: int = ZIP64_LIMIT) -> None:
+def write_zip(handle: BinaryIO, members: Sequence[tuple[str, Sequence[Buffer]]], level: int,
+              pool: Executor | InlinePool, zip64_limit: int = ZIP64_LIMIT) -> None:
     """Write a zip of ``members`` (name, then its bytes as parts to be joined) to ``handle``, in that order,
     each deflated at ``level`` in blocks on ``pool``'s threads (see the module).
 
@@ -100,7 +135,7 @@ def write_zip(handle: BinaryIO, members: Sequence[tuple[str, Sequence[Buffer]]],
     names = [name.encode("ascii") for name, _ in members]  # no flag for UTF-8 names: ASCII only
     crcs = [pool.submit(_crc32, parts) for _, parts in members]
     blocks = ((m, pieces, last) for m, (_, parts) in enumerate(members) for pieces, last in _blocks(parts))
-    pending: deque[tuple[int, Future[bytes]]] = deque()
+    pending: deque[tuple[int, Future[bytes] | _Done[bytes]]] = deque()
     window = 4 * deflate_workers()  # blocks in flight: every thread busy, a few blocks of output held
 
     def top_up() -> None:

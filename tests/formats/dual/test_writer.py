@@ -89,3 +89,28 @@ def test_writing_loads_neither_the_reader_nor_the_verification():
               "try:\n    d.no_such_name\nexcept AttributeError:\n    print(sorted(before))\n")
     assert subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                           check=True).stdout.split() == ["[]"]
+
+
+def test_a_small_dual_is_written_without_threads_and_a_large_one_with_them_the_same_bytes(tmp_path, monkeypatch):
+    """Below formats.deflated.SERIAL_BYTES the mesher writes dual.npz after the other files in its own thread (no
+    pool, no concurrent.futures); above it beside them, deflated in threads: every file the same bytes."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from cospherical.api.mesh import build_mesh
+    from cospherical.cli import main
+    from cospherical.formats import deflated
+    from cospherical.formats.dual.writer import threaded, write_dual
+
+    argv = ["mesh", "--domain", "1", "1", "1", "--refine", "point:0.3,0.3,0.3", "--levels", "2", "--dual",
+            "--format", "json"]
+    dual = build_mesh(domain=(1, 1, 1), levels=2, refine=["point:0.3,0.3,0.3"], dual=True).dual
+    assert not threaded(dual)
+    assert main([*argv, "--out", str(tmp_path / "inline")]) == 0
+    monkeypatch.setattr(deflated, "SERIAL_BYTES", 0)
+    assert threaded(dual)
+    assert main([*argv, "--out", str(tmp_path / "threads")]) == 0
+    with ThreadPoolExecutor(3) as pool:
+        write_dual(dual, tmp_path / "pool.npz", pool)
+    for name in ("dual.npz", "mesh.vtu", "report.json"):
+        assert (tmp_path / "inline" / name).read_bytes() == (tmp_path / "threads" / name).read_bytes()
+    assert (tmp_path / "pool.npz").read_bytes() == (tmp_path / "inline" / "dual.npz").read_bytes()

@@ -2,7 +2,7 @@
 
 A zip of ``.npy`` arrays (``numpy.load`` opens it; no pickles), each deflated at
 zlib's fastest level (a fifth of the default level's time for about a quarter more
-bytes) in blocks on every core (:mod:`~cospherical.formats.deflated`), written deterministically (fixed member order and time stamps: the same mesh
+bytes) in blocks on every core when the dual is large (:mod:`~cospherical.formats.deflated`), written deterministically (fixed member order and time stamps: the same mesh
 gives the same bytes) and atomically.  Members, ``n`` vertices, ``m`` edges, ``e`` elements:
 
 ===========================  ==========  ==================================================

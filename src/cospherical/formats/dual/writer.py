@@ -1,23 +1,27 @@
-"""Writing ``dual.npz``: the members as ``.npy`` files, their checksums in the manifest, deflated in threads."""
+"""Writing ``dual.npz``: the members as ``.npy`` files, their checksums in the manifest, deflated (in threads
+when the dual is large)."""
 
 from __future__ import annotations
 
 import hashlib
 import io
 import json
-from concurrent.futures import Executor, ThreadPoolExecutor
 from contextlib import ExitStack
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import InputError
 from ...files.yamlio import atomic_open
 from ...mesh.dual import Dual
-from ..deflated import deflate_workers, write_zip
+from ..deflated import InlinePool, deflate_workers, in_threads, write_zip
 from .members import DUAL_FORMAT_VERSION, _MAX_TEXT_DIGITS, _MEMBERS
 
-__all__ = ["write_dual"]
+if TYPE_CHECKING:
+    from concurrent.futures import Executor
+
+__all__ = ["threaded", "write_dual"]
 
 # Every member is deflated at zlib's fastest level: on the README's level-8 tree (172 MB of arrays) level 6 took
 # 3.0 CPU-s for a file of 18.2 MB, level 1 0.6 CPU-s for 22.8 MB (1.26 times larger); a whole `mesh --out` run
@@ -53,9 +57,16 @@ def _exact(array: np.ndarray) -> np.ndarray:
     return text.astype(f"U{max(width, _TEXT_WIDTH)}")
 
 
-def write_dual(dual: Dual, path: str | Path, pool: Executor | None = None) -> None:
+def threaded(dual: Dual) -> bool:
+    """Whether ``dual.npz`` is worth writing in threads (:func:`~cospherical.formats.deflated.in_threads` of the
+    dual's arrays' bytes): else :func:`write_dual` hashes and deflates in the caller's thread."""
+    return in_threads(sum(getattr(dual, name).nbytes for name in _MEMBERS))
+
+
+def write_dual(dual: Dual, path: str | Path, pool: Executor | InlinePool | None = None) -> None:
     """Write ``dual`` as ``dual.npz`` (see the module), atomically and deterministically; ``pool``: the threads
-    that hash and deflate (default: threads of the call's own), the same bytes with any."""
+    that hash and deflate (default: threads of the call's own when :func:`threaded`, else none), the same bytes
+    with any."""
     arrays = {name: getattr(dual, name) for name in _MEMBERS}
     arrays["coefficient_exact"] = _exact(arrays["coefficient_exact"])
     arrays["volume_exact"] = _exact(arrays["volume_exact"])
@@ -93,8 +104,12 @@ def write_dual(dual: Dual, path: str | Path, pool: Executor | None = None) -> No
     members = {name: _npy(array) for name, array in arrays.items()}
     version = 3 if parts is None else 4 if interfaces is None else DUAL_FORMAT_VERSION
     with ExitStack() as stack:
-        if pool is None:
+        if pool is None and threaded(dual):
+            from concurrent.futures import ThreadPoolExecutor
+
             pool = stack.enter_context(ThreadPoolExecutor(deflate_workers(), thread_name_prefix="dual.npz"))
+        elif pool is None:
+            pool = InlinePool()
         # the checksums first (the manifest, the first member, holds them), on every core, then every member
         # deflated in blocks on every core and written in order as it comes (formats.deflated)
         digests = {name: pool.submit(_sha256, *member) for name, member in members.items()}
