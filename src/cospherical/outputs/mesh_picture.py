@@ -80,7 +80,6 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
     polygons: list[np.ndarray] = []
     keys: list[tuple[int, int, int]] = []  # per polygon: its block, its edges' mask, its place in the block
     elements: list[int] = []
-    block_of: list[int] = []
     for faces, (blocks, rows, ids) in alike.items():
         # an element's edges (pairs of positions in its node list)
         edges = sorted({tuple(sorted((c[i], c[(i + 1) % len(c)]))) for c in faces for i in range(len(c))})
@@ -105,9 +104,8 @@ def _sections(mesh: Mesh, at: float, axis: int) -> tuple[list[np.ndarray], list[
             polygons.extend(xy)
             keys.extend(zip(block[chosen].tolist(), [mask] * len(chosen), place[chosen].tolist()))
             elements.extend(element[chosen].tolist())
-            block_of.extend(block[chosen].tolist())
     order = sorted(range(len(polygons)), key=keys.__getitem__)
-    return [polygons[i] for i in order], [types[block_of[i]] for i in order], [elements[i] for i in order]
+    return [polygons[i] for i in order], [types[keys[i][0]] for i in order], [elements[i] for i in order]
 
 
 def cut_png(mesh: Mesh, path: Path, title: str = "", at: float = 0.5, legend: int = 10, axis: int = 2,
