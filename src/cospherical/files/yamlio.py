@@ -17,7 +17,7 @@ from ..errors import FormatError
 from .data import data_path
 from .outputs import atomic_open, atomic_path, atomic_write
 
-__all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_bytes", "read_text", "validated_data", "dump_yaml", "load_document", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
+__all__ = ["MAX_INTEGER_DIGITS", "FormatError", "atomic_open", "atomic_path", "atomic_write", "check_nesting", "read_bytes", "read_text", "utf8_text", "validated_data", "dump_yaml", "load_document", "load_yaml", "parse_json", "parse_yaml", "validate", "yaml_float"]
 
 if TYPE_CHECKING:
     import yaml
@@ -111,7 +111,11 @@ def load_yaml(path: str | Path) -> Any:
 def read_text(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> str:
     """The UTF-8 text of an input file: only a regular file (never a device or a FIFO), at most
     ``max_bytes`` of it; anything else raises FormatError with one line."""
-    data = read_bytes(path, max_bytes)
+    return utf8_text(read_bytes(path, max_bytes), path)
+
+
+def utf8_text(data: bytes, path: str | Path) -> str:
+    """An input file's bytes (:func:`read_bytes`) as UTF-8 text; anything else raises FormatError with one line."""
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:

@@ -34,7 +34,8 @@ from ..catalogue import Catalogue
 from ..choices import POINT_POLICIES
 from ..core.configuration import Box, Configuration
 from ..errors import FormatError, InputError
-from ..files.yamlio import atomic_write, parse_json, parse_yaml, read_bytes, read_text, validate, validated_data
+from ..files.yamlio import (atomic_write, parse_json, parse_yaml, read_bytes, read_text, utf8_text, validate,
+                              validated_data)
 from ..mesh.assembly import Lookup, Mesh
 from ..mesh.octree import check_leaf_count, leaf_bound
 from .patterns import Entries, PatternTable, load, table_from_text
@@ -172,11 +173,7 @@ def load_table(path: str | Path) -> tuple[PatternTable, str | None]:
         header = {key: value for key, value in validated_data(header_text, "patterns", str(path), _header_data).items()
                   if key != "configurations"}
         return PatternTable(header, Entries(lines, header, str(path))), digest
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        raise FormatError(f"{path}: cannot read: {error}") from None
-    return table_from_text(text, str(path)), digest
+    return table_from_text(utf8_text(data, path), str(path)), digest
 
 
 def _header_data(text: str, name: str) -> Any:
