@@ -35,10 +35,10 @@ Examples
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
 
 from .errors import CosphericalError, FormatError, InputError, UsageError
+from .lazy import on_first_use
 from .version import __version__
 
 # name -> module that defines it
@@ -104,14 +104,7 @@ if TYPE_CHECKING:  # a type checker sees the names _API loads on first use (X as
 __all__ = ["CosphericalError", "FormatError", "InputError", "UsageError", "__version__", *_API]
 
 
-def __getattr__(name: str) -> object:
-    if name not in _API:
-        raise AttributeError(f"module 'cospherical' has no attribute {name!r}")
-    where = _API[name]
-    module, attribute = where if isinstance(where, tuple) else (where, name)
-    value = getattr(importlib.import_module(module), attribute)
-    globals()[name] = value  # once loaded, an ordinary attribute
-    return value
+__getattr__ = on_first_use(globals(), _API)
 
 
 def __dir__() -> list[str]:

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from ..catalogue import Catalogue
 from ..choices import DelaunayMode
+from ..lazy import on_first_use
 from ..version import __version__
 from .assembly import Mesh, MeshType
 from .checks import (DelaunayCheck, OpenFaces, check_circumcenters, check_conformity, check_delaunay, check_volume,
@@ -40,11 +41,8 @@ __all__ = ["CheckedReport", "ChecksSummary", "ConfigurationFrequency", "ContactS
            "outside_catalogue"]
 
 
-def __getattr__(name: str) -> Any:
-    # The dual's and a device's sections, exported here too, made where first asked for (see report_sections)
-    if name in report_sections._DUAL_AND_DEVICE:
-        return getattr(report_sections, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+# The dual's and a device's sections, exported here too, made where first asked for (see report_sections)
+__getattr__ = on_first_use(globals(), dict.fromkeys(report_sections._DUAL_AND_DEVICE, report_sections.__name__))
 
 
 # A nonconforming face: its vertices, each three fractions of the domain's sides (floats)

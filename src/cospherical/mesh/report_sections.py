@@ -17,6 +17,8 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING, Any, ClassVar, Iterator, Mapping, TypeVar, cast
 
+from ..lazy import on_first_use
+
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
 
@@ -33,16 +35,9 @@ _DUAL_AND_DEVICE = frozenset({"ContactSummary", "DeviceSummary", "DualSummary", 
                               "NegativeCoefficients", "RegionSummary", "TetrahedralCounts"})
 
 
-def __getattr__(name: str) -> Any:
-    # A mesh without a dual or a device never makes these eight dataclasses (~4 ms at start-up); their
-    # names stay this module's: `from cospherical.mesh.report_sections import DualSummary` loads them.
-    if name in _DUAL_AND_DEVICE:
-        from . import _dual_device_sections
-
-        value = getattr(_dual_device_sections, name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+# A mesh without a dual or a device never makes these eight dataclasses (~4 ms at start-up); their names stay
+# this module's: `from cospherical.mesh.report_sections import DualSummary` loads them.
+__getattr__ = on_first_use(globals(), dict.fromkeys(_DUAL_AND_DEVICE, f"{__package__}._dual_device_sections"))
 
 
 K = TypeVar("K")

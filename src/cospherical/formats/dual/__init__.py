@@ -110,9 +110,9 @@ The circumcentres
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
 
+from ...lazy import on_first_use
 from .members import DUAL_FORMAT_VERSION
 from .writer import write_dual
 
@@ -124,16 +124,8 @@ __all__ = ["DUAL_FORMAT_VERSION", "domain_sums", "dual_layout", "read_dual", "ve
 
 # the reader and the verification, by the module that defines them: writing a dual (`mesh --dual`) needs neither,
 # nor the zip reader and the device model they import (6 ms of every such run)
-_ON_FIRST_USE = {"read_dual": "reader", "domain_sums": "verify", "dual_layout": "verify", "verify_dual": "verify"}
-
-
-def __getattr__(name: str) -> object:
-    module = _ON_FIRST_USE.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
-    globals()[name] = value  # once loaded, an ordinary attribute
-    return value
+__getattr__ = on_first_use(globals(), {"read_dual": f"{__name__}.reader", "domain_sums": f"{__name__}.verify",
+                                       "dual_layout": f"{__name__}.verify", "verify_dual": f"{__name__}.verify"})
 
 
 def __dir__() -> list[str]:
