@@ -25,12 +25,13 @@ import os
 import struct
 import zlib
 from collections import deque
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any, BinaryIO, Callable, Generic, Iterator, Sequence, TypeVar, Union
 
 if TYPE_CHECKING:
     from concurrent.futures import Executor, Future
 
-__all__ = ["BLOCK", "SERIAL_BYTES", "ZIP64_LIMIT", "InlinePool", "deflate_workers", "in_threads", "write_zip"]
+__all__ = ["BLOCK", "SERIAL_BYTES", "ZIP64_LIMIT", "InlinePool", "deflate_workers", "deflating", "in_threads", "write_zip"]
 
 BLOCK = 1 << 20
 ZIP64_LIMIT = (1 << 31) - 1  # zipfile's: sizes and offsets past it are written as zip64 fields
@@ -85,6 +86,24 @@ def deflate_workers() -> int:
     except AttributeError:  # not on every system
         count = os.cpu_count() or 1
     return max(1, min(count, _MAX_WORKERS))
+
+
+@contextmanager
+def deflating(nbytes: int, pool: Executor | InlinePool | None = None, name: str = "deflate",
+              most: int | None = None) -> Iterator[Executor | InlinePool]:
+    """What deflates a payload of ``nbytes``: ``pool`` when the caller gives one; else, for a payload worth them
+    (:func:`in_threads`), :func:`deflate_workers` threads (at most ``most``) named ``name``, shut down on leaving;
+    else the caller's thread (:class:`InlinePool`).  The same bytes with any."""
+    if pool is not None:
+        yield pool
+    elif not in_threads(nbytes):
+        yield InlinePool()
+    else:
+        from concurrent.futures import ThreadPoolExecutor  # with logging: ~5 ms, paid only where threads run
+
+        workers = deflate_workers() if most is None else min(deflate_workers(), most)
+        with ThreadPoolExecutor(workers, thread_name_prefix=name) as threads:
+            yield threads
 
 
 def _blocks(parts: Sequence[Buffer]) -> Iterator[tuple[list[memoryview], bool]]:

@@ -26,6 +26,7 @@ import numpy as np
 from ..core.tessellation import Tessellation
 from ..errors import InputError
 from ..files.yamlio import atomic_open
+from .deflated import deflating
 
 if TYPE_CHECKING:  # the threads' modules are imported where a file has blocks to share among them
     from concurrent.futures import Executor
@@ -67,24 +68,15 @@ def _compressed(arrays: Sequence[np.ndarray], pool: Executor | None) -> list[byt
 
     Every block is compressed on its own (VTK's layout), so ``pool``'s threads take them all at once, the
     largest first, and each block's bytes are what one thread would make of it: the same file whatever the
-    threads do.  Without a pool, more than one block goes to a pool of :func:`deflate_workers` threads made
-    for the call; a single block, or blocks of at most one block's bytes in all (a few milliseconds of
-    zlib: less than the threads and their module cost), are compressed here.
+    threads do.  Without a pool, the arrays go to threads of the call's own where their bytes are worth them
+    (:func:`~cospherical.formats.deflated.deflating`), else are compressed in this thread.
     """
     raws = [np.ascontiguousarray(array).view(np.uint8).reshape(-1).data for array in arrays]  # memoryviews
     blocks = [[raw[i:i + BLOCK] for i in range(0, len(raw), BLOCK)] for raw in raws]
     flat = [block for parts in blocks for block in parts]
-    if pool is None and len(flat) > 1 and sum(len(raw) for raw in raws) > BLOCK:
-        from concurrent.futures import ThreadPoolExecutor
-
-        from .deflated import deflate_workers
-
-        with ThreadPoolExecutor(min(deflate_workers(), len(flat)), thread_name_prefix="mesh.vtu") as own:
-            return _compressed(arrays, own)
-    if pool is None:
-        done = [zlib.compress(block, LEVEL) for block in flat]
-    else:  # zlib releases the GIL: the largest blocks first, so that no thread is left with one at the end
-        futures = {n: pool.submit(zlib.compress, flat[n], LEVEL)
+    with deflating(sum(len(raw) for raw in raws), pool, "mesh.vtu", most=len(flat)) as threads:
+        # zlib releases the GIL: the largest blocks first, so that no thread is left with one at the end
+        futures = {n: threads.submit(zlib.compress, flat[n], LEVEL)
                    for n in sorted(range(len(flat)), key=lambda n: -len(flat[n]))}
         done = [futures[n].result() for n in range(len(flat))]
     out, at = [], 0

@@ -6,7 +6,6 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -15,7 +14,7 @@ import numpy as np
 from ...errors import InputError
 from ...files.yamlio import atomic_open
 from ...mesh.dual import Dual
-from ..deflated import InlinePool, deflate_workers, in_threads, write_zip
+from ..deflated import InlinePool, deflating, in_threads, write_zip
 from .members import DUAL_FORMAT_VERSION, _MAX_TEXT_DIGITS, _MEMBERS
 
 if TYPE_CHECKING:
@@ -57,10 +56,16 @@ def _exact(array: np.ndarray) -> np.ndarray:
     return text.astype(f"U{max(width, _TEXT_WIDTH)}")
 
 
+def _dual_bytes(dual: Dual) -> int:
+    """The bytes of ``dual``'s arrays, which decide whether ``dual.npz`` is hashed and deflated in threads
+    (:func:`~cospherical.formats.deflated.deflating`)."""
+    return sum(getattr(dual, name).nbytes for name in _MEMBERS)
+
+
 def threaded(dual: Dual) -> bool:
-    """Whether ``dual.npz`` is worth writing in threads (:func:`~cospherical.formats.deflated.in_threads` of the
-    dual's arrays' bytes): else :func:`write_dual` hashes and deflates in the caller's thread."""
-    return in_threads(sum(getattr(dual, name).nbytes for name in _MEMBERS))
+    """Whether ``dual.npz`` is worth writing in threads (:func:`~cospherical.formats.deflated.in_threads` of
+    :func:`_dual_bytes`): else :func:`write_dual` hashes and deflates in the caller's thread."""
+    return in_threads(_dual_bytes(dual))
 
 
 def write_dual(dual: Dual, path: str | Path, pool: Executor | InlinePool | None = None) -> None:
@@ -103,16 +108,10 @@ def write_dual(dual: Dual, path: str | Path, pool: Executor | InlinePool | None 
                       "interface_part_denominator": str(interfaces.denominator)})
     members = {name: _npy(array) for name, array in arrays.items()}
     version = 3 if parts is None else 4 if interfaces is None else DUAL_FORMAT_VERSION
-    with ExitStack() as stack:
-        if pool is None and threaded(dual):
-            from concurrent.futures import ThreadPoolExecutor
-
-            pool = stack.enter_context(ThreadPoolExecutor(deflate_workers(), thread_name_prefix="dual.npz"))
-        elif pool is None:
-            pool = InlinePool()
+    with deflating(_dual_bytes(dual), pool, "dual.npz") as workers:
         # the checksums first (the manifest, the first member, holds them), on every core, then every member
         # deflated in blocks on every core and written in order as it comes (formats.deflated)
-        digests = {name: pool.submit(_sha256, *member) for name, member in members.items()}
+        digests = {name: workers.submit(_sha256, *member) for name, member in members.items()}
         manifest = {
             "format": "cospherical-dual", "version": version, **extra,
             "domain": list(dual.box.texts),
@@ -127,7 +126,7 @@ def write_dual(dual: Dual, path: str | Path, pool: Executor | InlinePool | None 
                    **members}
         # straight into the file (no copy of the zip in memory), in place only once whole
         with atomic_open(path, binary=True) as handle:
-            write_zip(handle, [(f"{name}.npy", member) for name, member in members.items()], _DEFLATE_LEVEL, pool)
+            write_zip(handle, [(f"{name}.npy", member) for name, member in members.items()], _DEFLATE_LEVEL, workers)
 
 
 def _sha256(header: bytes, data: memoryview) -> str:
